@@ -1,0 +1,77 @@
+// The time loop: velocity Verlet over the net force of peridynamics, body force and loading.
+#pragma once
+
+#include <array>
+#include <memory>
+#include <vector>
+
+#include "granulate/loading.hpp"
+#include "granulate/model.hpp"
+#include "granulate/state.hpp"
+
+namespace granulate {
+
+/// Wall-clock seconds spent in each phase of the step loop.
+struct PhaseTimes {
+  double peridynamics = 0;
+  double integration = 0;
+  double loading = 0;
+};
+
+class Simulation {
+public:
+  /// Finalizes the model if needed; the state starts at rest in the reference configuration.
+  explicit Simulation(std::shared_ptr<Model> model);
+
+  const Model& model() const { return *model_; }
+  State& state() { return state_; }
+  const State& state() const { return state_; }
+
+  /// Time step [s]; by default safety 0.8 times the stable estimate.
+  real time_step() const { return time_step_; }
+  void set_time_step(real dt);
+  real stable_time_step() const { return stable_time_step_; }
+
+  /// Uniform body acceleration g (gravity) [m/s^2]: adds rho g to every node's force density.
+  void set_body_acceleration(const std::array<real, 3>& g);
+  void add_prescribed_motion(PrescribedMotion motion);
+  void add_nodal_force(NodalForce force);
+
+  /// Advances n steps of velocity Verlet:
+  ///   v += dt/2 f/rho; x += dt v; prescribed motion; f = F(x); v += dt/2 f/rho; prescribed v.
+  /// Throws InstabilityError if positions become non-finite or a node moves more than its
+  /// mesh size in one step.
+  void run(std::uint64_t steps);
+
+  /// Recomputes forces (and breaks bonds) at the current positions.
+  void compute_forces();
+
+  // Diagnostics (computed on demand; sums in a fixed order, so identical for any thread count).
+  real kinetic_energy() const;  ///< sum 1/2 rho V |v|^2 [J; J/m in 2D]
+  real strain_energy() const;   ///< sum W_i V_i [J; J/m in 2D]
+  /// phi_i = 1 - (intact weighted volume)/(initial weighted volume); z_i = max_j |s_ij| / s0.
+  void damage(real* phi, real* z) const;
+  std::uint64_t broken_bonds() const;  ///< broken bonds, each counted once
+  /// Bit k set: component k of the node is prescribed.
+  std::vector<std::uint8_t> fixity() const;
+  const PhaseTimes& phase_times() const { return phase_times_; }
+
+private:
+  void apply_prescribed_motion(bool positions_too);
+  void check_stability() const;
+  real bond_extension(index_t i, index_t bond, const std::vector<real>& x) const;
+
+  std::shared_ptr<Model> model_;
+  State state_;
+  real time_step_ = 0;
+  real stable_time_step_ = 0;
+  std::array<real, 3> body_acceleration_{0, 0, 0};
+  std::vector<PrescribedMotion> motions_;
+  std::vector<NodalForce> nodal_forces_;
+  std::vector<real> pressure_;   // A_i theta_i of LPS nodes
+  std::vector<real> mesh_size_;  // per node, for the stability check
+  bool forces_current_ = false;
+  PhaseTimes phase_times_;
+};
+
+}  // namespace granulate

@@ -1,0 +1,240 @@
+// nanobind module granulate._core: the C++ core seen from Python.
+// Arrays returned by Model and Simulation are zero-copy NumPy views whose owner is the bound
+// object: they stay valid while any view or the object itself is alive.
+#include <nanobind/nanobind.h>
+#include <nanobind/ndarray.h>
+#include <nanobind/stl/array.h>
+#include <nanobind/stl/shared_ptr.h>
+#include <nanobind/stl/string.h>
+#include <nanobind/stl/vector.h>
+#include <omp.h>
+
+#include "granulate/simulation.hpp"
+
+namespace nb = nanobind;
+using namespace nb::literals;
+using namespace granulate;
+
+namespace {
+
+using Points = nb::ndarray<const double, nb::shape<-1, 3>, nb::c_contig, nb::device::cpu>;
+using Scalars = nb::ndarray<const double, nb::ndim<1>, nb::c_contig, nb::device::cpu>;
+using Indices = nb::ndarray<const std::uint32_t, nb::ndim<1>, nb::c_contig, nb::device::cpu>;
+
+template <class T>
+nb::ndarray<nb::numpy, T> view(T* data, std::size_t rows, std::size_t columns, nb::handle owner) {
+  if (columns == 0) return nb::ndarray<nb::numpy, T>(data, {rows}, owner);
+  return nb::ndarray<nb::numpy, T>(data, {rows, columns}, owner);
+}
+
+template <class T>
+nb::ndarray<nb::numpy, T> copy_out(const std::vector<T>& values) {
+  auto* data = new std::vector<T>(values);
+  nb::capsule owner(data, [](void* p) noexcept { delete static_cast<std::vector<T>*>(p); });
+  return nb::ndarray<nb::numpy, T>(data->data(), {data->size()}, owner);
+}
+
+std::vector<index_t> to_vector(const Indices& nodes) {
+  return std::vector<index_t>(nodes.data(), nodes.data() + nodes.shape(0));
+}
+
+TimeFunction make_function(TimeFunction::Kind kind, real a, real b) {
+  TimeFunction f;
+  f.kind = kind;
+  f.a = a;
+  f.b = b;
+  return f;
+}
+
+}  // namespace
+
+NB_MODULE(_core, m) {
+  m.doc() = "granulate C++ core: peridynamic particles, bonds, time integration";
+  nb::exception<InputError>(m, "InputError", PyExc_ValueError);
+  nb::exception<InstabilityError>(m, "InstabilityError", PyExc_RuntimeError);
+
+  m.def("set_num_threads", [](int n) {
+    if (n < 1) throw InputError("number of threads must be at least 1");
+    omp_set_num_threads(n);
+  });
+  m.def("get_max_threads", [] { return omp_get_max_threads(); });
+
+  nb::enum_<PlaneMode>(m, "PlaneMode").value("strain", PlaneMode::strain).value("stress", PlaneMode::stress);
+  nb::enum_<ForceModel>(m, "ForceModel").value("lps", ForceModel::lps).value("pmb", ForceModel::pmb);
+  nb::enum_<InfluenceKind>(m, "InfluenceKind")
+      .value("constant", InfluenceKind::constant)
+      .value("linear", InfluenceKind::linear)
+      .value("gaussian", InfluenceKind::gaussian)
+      .value("inverse", InfluenceKind::inverse);
+  nb::enum_<TimeFunction::Kind>(m, "TimeFunctionKind")
+      .value("constant", TimeFunction::Kind::constant)
+      .value("linear", TimeFunction::Kind::linear)
+      .value("quadratic", TimeFunction::Kind::quadratic)
+      .value("sine", TimeFunction::Kind::sine)
+      .value("smooth_ramp", TimeFunction::Kind::smooth_ramp)
+      .value("velocity_ramp", TimeFunction::Kind::velocity_ramp);
+
+  m.def("time_function_value",
+        [](TimeFunction::Kind kind, real a, real b, real t) { return make_function(kind, a, b).value(t); });
+  m.def("time_function_rate",
+        [](TimeFunction::Kind kind, real a, real b, real t) { return make_function(kind, a, b).rate(t); });
+  m.def("influence", &influence, "kind"_a, "xi"_a);
+  m.def(
+      "fracture_coefficients",
+      [](ForceModel model, InfluenceKind kind, int dimension) {
+        const FractureCoefficients c = fracture_coefficients(model, kind, dimension);
+        return nb::make_tuple(c.pair, c.dilatation);
+      },
+      "model"_a, "influence"_a, "dimension"_a);
+
+  nb::class_<MaterialParams>(m, "MaterialParams")
+      .def(nb::init<>())
+      .def_rw("model", &MaterialParams::model)
+      .def_rw("density", &MaterialParams::density)
+      .def_rw("bulk_modulus", &MaterialParams::bulk_modulus)
+      .def_rw("shear_modulus", &MaterialParams::shear_modulus)
+      .def_rw("horizon", &MaterialParams::horizon)
+      .def_rw("fracture_energy", &MaterialParams::fracture_energy)
+      .def_rw("influence", &MaterialParams::influence)
+      .def_rw("fracture", &MaterialParams::fracture)
+      .def_rw("break_in_compression", &MaterialParams::break_in_compression);
+
+  nb::class_<Material>(m, "Material")
+      .def_static("make", &Material::make, "params"_a, "dimension"_a, "plane"_a)
+      .def_ro("params", &Material::params)
+      .def_ro("dilatation_modulus", &Material::dilatation_modulus)
+      .def_ro("deviatoric_factor", &Material::deviatoric_factor)
+      .def_ro("micromodulus", &Material::micromodulus)
+      .def_ro("critical_stretch", &Material::critical_stretch);
+
+  nb::class_<Model>(m, "Model")
+      .def(nb::init<int, PlaneMode>(), "dimension"_a, "plane"_a = PlaneMode::strain)
+      .def("add_material", &Model::add_material, "params"_a)
+      .def(
+          "add_particle",
+          [](Model& self, Points positions, Scalars volumes, index_t material, real mesh_size) {
+            return self.add_particle({positions.data(), positions.shape(0) * 3},
+                                     {volumes.data(), volumes.shape(0)}, material, mesh_size);
+          },
+          "positions"_a, "volumes"_a, "material"_a, "mesh_size"_a)
+      .def("finalize", &Model::finalize, nb::call_guard<nb::gil_scoped_release>())
+      .def_prop_ro("finalized", &Model::finalized)
+      .def_prop_ro("dimension", &Model::dimension)
+      .def_prop_ro("node_count", &Model::node_count)
+      .def_prop_ro("bond_count", [](const Model& self) { return self.bonds().size(); })
+      .def_prop_ro("particle_count", [](const Model& self) { return self.particles().size(); })
+      .def_prop_ro("materials", &Model::materials)
+      .def("stable_time_step", &Model::stable_time_step)
+      .def_prop_ro("reference_positions",
+                   [](Model& self) {
+                     return view(const_cast<real*>(self.reference_positions().data()), self.node_count(), 3,
+                                 nb::find(self));
+                   })
+      .def_prop_ro("volumes",
+                   [](Model& self) {
+                     return view(const_cast<real*>(self.volumes().data()), self.node_count(), 0, nb::find(self));
+                   })
+      .def_prop_ro("node_particle",
+                   [](Model& self) {
+                     return view(const_cast<index_t*>(self.node_particle().data()), self.node_count(), 0,
+                                 nb::find(self));
+                   })
+      .def_prop_ro("bond_offsets",
+                   [](Model& self) {
+                     return view(const_cast<index_t*>(self.bonds().offsets.data()), self.bonds().offsets.size(), 0,
+                                 nb::find(self));
+                   })
+      .def_prop_ro("bond_neighbors",
+                   [](Model& self) {
+                     return view(const_cast<index_t*>(self.bonds().neighbors.data()), self.bonds().size(), 0,
+                                 nb::find(self));
+                   })
+      .def_prop_ro("weighted_volume", [](Model& self) {
+        return view(const_cast<real*>(self.weighted_volume().data()), self.node_count(), 0, nb::find(self));
+      });
+
+  nb::class_<PhaseTimes>(m, "PhaseTimes")
+      .def_ro("peridynamics", &PhaseTimes::peridynamics)
+      .def_ro("integration", &PhaseTimes::integration)
+      .def_ro("loading", &PhaseTimes::loading);
+
+  nb::class_<Simulation>(m, "Simulation")
+      .def(nb::init<std::shared_ptr<Model>>(), "model"_a, nb::call_guard<nb::gil_scoped_release>())
+      .def_prop_rw("time_step", &Simulation::time_step, &Simulation::set_time_step)
+      .def_prop_ro("stable_time_step", &Simulation::stable_time_step)
+      .def_prop_rw(
+          "time", [](const Simulation& self) { return self.state().time; },
+          [](Simulation& self, real t) { self.state().time = t; })
+      .def_prop_rw(
+          "step", [](const Simulation& self) { return self.state().step; },
+          [](Simulation& self, std::uint64_t s) { self.state().step = s; })
+      .def("set_body_acceleration", &Simulation::set_body_acceleration, "acceleration"_a)
+      .def(
+          "add_displacement",
+          [](Simulation& self, Indices nodes, unsigned components, std::array<real, 3> direction,
+             TimeFunction::Kind kind, real a, real b) {
+            PrescribedMotion motion;
+            motion.nodes = to_vector(nodes);
+            motion.components = static_cast<std::uint8_t>(components & 0b111u);
+            motion.direction = direction;
+            motion.function = make_function(kind, a, b);
+            self.add_prescribed_motion(std::move(motion));
+          },
+          "nodes"_a, "components"_a, "direction"_a, "kind"_a, "a"_a, "b"_a)
+      .def(
+          "add_rotation",
+          [](Simulation& self, Indices nodes, std::array<real, 3> center, std::array<real, 3> axis,
+             TimeFunction::Kind kind, real a, real b) {
+            PrescribedMotion motion;
+            motion.kind = PrescribedMotion::Kind::rotation;
+            motion.nodes = to_vector(nodes);
+            motion.center = center;
+            motion.axis = axis;
+            motion.function = make_function(kind, a, b);
+            self.add_prescribed_motion(std::move(motion));
+          },
+          "nodes"_a, "center"_a, "axis"_a, "kind"_a, "a"_a, "b"_a)
+      .def(
+          "add_nodal_force",
+          [](Simulation& self, Indices nodes, std::array<real, 3> vector, TimeFunction::Kind kind, real a,
+             real b) {
+            NodalForce force;
+            force.nodes = to_vector(nodes);
+            force.vector = vector;
+            force.function = make_function(kind, a, b);
+            self.add_nodal_force(std::move(force));
+          },
+          "nodes"_a, "vector"_a, "kind"_a, "a"_a, "b"_a)
+      .def("run", &Simulation::run, "steps"_a, nb::call_guard<nb::gil_scoped_release>())
+      .def("compute_forces", &Simulation::compute_forces, nb::call_guard<nb::gil_scoped_release>())
+      .def("kinetic_energy", &Simulation::kinetic_energy)
+      .def("strain_energy", &Simulation::strain_energy)
+      .def("broken_bonds", &Simulation::broken_bonds)
+      .def("damage",
+           [](const Simulation& self) {
+             std::vector<real> phi(self.model().node_count()), z(self.model().node_count());
+             self.damage(phi.data(), z.data());
+             return nb::make_tuple(copy_out(phi), copy_out(z));
+           })
+      .def("fixity", [](const Simulation& self) { return copy_out(self.fixity()); })
+      .def_prop_ro("phase_times", &Simulation::phase_times)
+      .def_prop_ro("positions",
+                   [](Simulation& self) {
+                     return view(self.state().positions.data(), self.model().node_count(), 3, nb::find(self));
+                   })
+      .def_prop_ro("velocities",
+                   [](Simulation& self) {
+                     return view(self.state().velocities.data(), self.model().node_count(), 3, nb::find(self));
+                   })
+      .def_prop_ro("forces",
+                   [](Simulation& self) {
+                     return view(self.state().forces.data(), self.model().node_count(), 3, nb::find(self));
+                   })
+      .def_prop_ro("dilatation",
+                   [](Simulation& self) {
+                     return view(self.state().dilatation.data(), self.model().node_count(), 0, nb::find(self));
+                   })
+      .def_prop_ro("bond_intact", [](Simulation& self) {
+        return view(self.state().bond_intact.data(), self.state().bond_intact.size(), 0, nb::find(self));
+      });
+}

@@ -1,0 +1,175 @@
+#include "granulate/material.hpp"
+
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <sstream>
+
+namespace granulate {
+namespace {
+
+constexpr int quadrature_points = 160;
+
+std::string format(real value) {
+  std::ostringstream out;
+  out << value;
+  return out.str();
+}
+
+void require_positive(real value, const char* name, const char* fix) {
+  if (!(value > 0) || !std::isfinite(value)) {
+    throw InputError(std::string("material ") + name + " must be a positive finite number, got " +
+                     format(value) + "; " + fix);
+  }
+}
+
+/// Dilatation of a node at depth zeta (in horizons) below the separation plane when the two
+/// half-spaces are pulled apart by u = s0 * delta * v, divided by s0 * v (see fracture_coefficients).
+real separation_dilatation_slope(InfluenceKind influence_kind, int dimension, real zeta, real v) {
+  const int n = quadrature_points;
+  const real step = (1.0 - zeta) / n;
+  real sum = 0;
+  for (int k = 0; k < n; ++k) {
+    const real rho = zeta + (k + 0.5) * step;
+    const real cos_low = zeta / rho;                        // the bond reaches the other side
+    const real cos_high = v > rho ? rho / v : 1.0;          // the bond is still intact
+    if (cos_high <= cos_low) continue;
+    const real weight = influence(influence_kind, rho);
+    if (dimension == 3) {
+      sum += weight * rho * rho * rho * (cos_high * cos_high - cos_low * cos_low);
+    } else {
+      sum += weight * rho * rho *
+             (std::sqrt(1.0 - cos_low * cos_low) - std::sqrt(1.0 - cos_high * cos_high));
+    }
+  }
+  sum *= step;
+  if (dimension == 3) return 3.0 / (4.0 * influence_moment(influence_kind, 4)) * sum;
+  return 2.0 / (std::numbers::pi * influence_moment(influence_kind, 3)) * sum;
+}
+
+}  // namespace
+
+real influence_moment(InfluenceKind influence_kind, int power) {
+  const int n = 4000;
+  real sum = 0;
+  for (int k = 0; k < n; ++k) {
+    const real xi = (k + 0.5) / n;
+    sum += influence(influence_kind, xi) * std::pow(xi, power);
+  }
+  return sum / n;
+}
+
+FractureCoefficients fracture_coefficients(ForceModel model, InfluenceKind influence_kind,
+                                           int dimension) {
+  FractureCoefficients result;
+  if (model == ForceModel::pmb) {
+    // Pair energy w = c J s^2 r / 2 integrated over the bonds crossing a unit area:
+    // 3D: pi int w r^3 dr, 2D: 2 int w r^2 dr.
+    result.pair = dimension == 3 ? std::numbers::pi / 2.0 * influence_moment(influence_kind, 4)
+                                 : influence_moment(influence_kind, 3);
+    return result;
+  }
+  // LPS energy W = (kappa_d - a G/d^2) theta^2 / 2 + (a G / 2m) sum J e^2 V: the second term is
+  // a pair energy (a G / m) J e^2 per pair, released bond by bond whatever the path.
+  if (dimension == 3) {
+    result.pair = 15.0 / 4.0 * influence_moment(influence_kind, 5) / influence_moment(influence_kind, 4);
+  } else {
+    result.pair = 8.0 / std::numbers::pi * influence_moment(influence_kind, 4) /
+                  influence_moment(influence_kind, 3);
+  }
+  // The dilatation term depends on the path. Along rigid separation (opening u, a bond at angle
+  // phi to the normal has e = u cos(phi) and breaks at u = s0 r / cos(phi)) the work per unit area
+  // is 2 int_0^delta dz int_0^inf (kappa_d - a G/d^2) u g(z,u)^2 du with theta = u g. In units of
+  // s0^2 delta this is 2 int_0^1 dzeta int_0^inf v G(zeta, v)^2 dv.
+  const int n = quadrature_points;
+  real total = 0;
+  for (int iz = 0; iz < n; ++iz) {
+    const real zeta = (iz + 0.5) / n;
+    real inner = 0;
+    for (int iv = 0; iv < n; ++iv) {
+      const real v = (iv + 0.5) / n;  // v in (0, 1)
+      const real g = separation_dilatation_slope(influence_kind, dimension, zeta, v);
+      inner += v * g * g / n;
+      const real t = (iv + 0.5) / n;  // v = 1/t in (1, inf): v dv = dt / t^3
+      const real g_far = separation_dilatation_slope(influence_kind, dimension, zeta, 1.0 / t);
+      inner += g_far * g_far / (t * t * t) / n;
+    }
+    total += inner / n;
+  }
+  result.dilatation = 2.0 * total;
+  return result;
+}
+
+Material Material::make(const MaterialParams& params, int dimension, PlaneMode plane) {
+  if (dimension != 2 && dimension != 3) {
+    throw InputError("dimension must be 2 or 3, got " + std::to_string(dimension));
+  }
+  require_positive(params.density, "density", "give the mass density in kg/m^3");
+  require_positive(params.bulk_modulus, "bulk_modulus", "give K in Pa (or E and nu)");
+  require_positive(params.horizon, "horizon", "give the horizon in m (typically 3 mesh sizes)");
+  require_positive(params.shear_modulus, "shear_modulus", "give G in Pa (or E and nu)");
+  {
+    const real nu = (3 * params.bulk_modulus - 2 * params.shear_modulus) /
+                    (2 * (3 * params.bulk_modulus + params.shear_modulus));
+    if (!(nu > -1.0 && nu < 0.5)) {
+      throw InputError("material Poisson ratio " + format(nu) + " from K = " +
+                       format(params.bulk_modulus) + " and G = " + format(params.shear_modulus) +
+                       " is outside (-1, 0.5); check the elastic constants");
+    }
+  }
+  if (params.fracture) {
+    require_positive(params.fracture_energy, "fracture_energy (Gc)",
+                     "give the critical energy release rate in J/m^2, or turn fracture off");
+  }
+
+  Material m;
+  m.params = params;
+  m.dimension = dimension;
+  m.plane = plane;
+  const real K = params.bulk_modulus;
+  const real G = params.shear_modulus;
+  if (dimension == 3) {
+    m.dilatation_modulus = K;
+    m.deviatoric_factor = 15.0;
+  } else {
+    m.dilatation_modulus = plane == PlaneMode::strain ? K + G / 3.0 : 9.0 * K * G / (3.0 * K + 4.0 * G);
+    m.deviatoric_factor = 8.0;
+  }
+  const real delta = params.horizon;
+  // PMB matches the classical energy of an isotropic expansion, d^2 kappa_d eps^2 / 2, with the
+  // same kappa_d as LPS; being bond-based it cannot match G as well (its Poisson ratio is 1/4 in
+  // 3D and plane strain, 1/3 in plane stress).
+  if (params.model == ForceModel::pmb) {
+    if (dimension == 3) {
+      m.micromodulus = 18.0 * K / (4.0 * std::numbers::pi * std::pow(delta, 4) *
+                                   influence_moment(params.influence, 3));
+    } else {
+      m.micromodulus = 8.0 * m.dilatation_modulus /
+                       (2.0 * std::numbers::pi * std::pow(delta, 3) *
+                        influence_moment(params.influence, 2));
+    }
+  }
+
+  m.critical_stretch = std::numeric_limits<real>::infinity();
+  if (params.fracture) {
+    const FractureCoefficients coefficients =
+        fracture_coefficients(params.model, params.influence, dimension);
+    real energy_per_stretch2;  // Gc / s0^2
+    if (params.model == ForceModel::lps) {
+      const real d = dimension;
+      energy_per_stretch2 =
+          delta * (coefficients.pair * G +
+                   coefficients.dilatation * (m.dilatation_modulus - m.deviatoric_factor * G / (d * d)));
+    } else {
+      energy_per_stretch2 = coefficients.pair * m.micromodulus * std::pow(delta, dimension + 2);
+    }
+    if (!(energy_per_stretch2 > 0)) {
+      throw InputError("material constants give a non-positive fracture energy per stretch; "
+                       "check K and G (Poisson ratio near -1?)");
+    }
+    m.critical_stretch = std::sqrt(params.fracture_energy / energy_per_stretch2);
+  }
+  return m;
+}
+
+}  // namespace granulate

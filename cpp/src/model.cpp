@@ -1,0 +1,299 @@
+#include "granulate/model.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+namespace granulate {
+namespace {
+
+/// Uniform grid of cells of one particle, nodes sorted by cell (counting sort).
+struct CellGrid {
+  std::array<real, 3> origin{};
+  real cell_size = 1;
+  std::array<std::int64_t, 3> dims{1, 1, 1};
+  std::vector<index_t> cell_start;  // size cells + 1
+  std::vector<index_t> cell_nodes;  // global node ids
+
+  std::array<std::int64_t, 3> cell_of(const real* x) const {
+    std::array<std::int64_t, 3> c{};
+    for (int k = 0; k < 3; ++k) {
+      c[k] = std::clamp<std::int64_t>(static_cast<std::int64_t>((x[k] - origin[k]) / cell_size), 0,
+                                      dims[k] - 1);
+    }
+    return c;
+  }
+  std::int64_t linear(const std::array<std::int64_t, 3>& c) const {
+    return (c[2] * dims[1] + c[1]) * dims[0] + c[0];
+  }
+};
+
+CellGrid build_grid(const std::vector<real>& x, const Particle& p, real cell_size) {
+  CellGrid grid;
+  grid.cell_size = cell_size;
+  std::array<real, 3> lo{}, hi{};
+  lo.fill(std::numeric_limits<real>::max());
+  hi.fill(std::numeric_limits<real>::lowest());
+  for (index_t i = p.first_node; i < p.first_node + p.node_count; ++i) {
+    for (int k = 0; k < 3; ++k) {
+      lo[k] = std::min(lo[k], x[3 * i + k]);
+      hi[k] = std::max(hi[k], x[3 * i + k]);
+    }
+  }
+  std::int64_t cells = 1;
+  for (int k = 0; k < 3; ++k) {
+    grid.origin[k] = lo[k];
+    grid.dims[k] = std::max<std::int64_t>(1, static_cast<std::int64_t>((hi[k] - lo[k]) / cell_size) + 1);
+    cells *= grid.dims[k];
+  }
+  if (cells > 64 * static_cast<std::int64_t>(p.node_count) + 1024) {
+    // Very sparse particle relative to its horizon; cap the grid by enlarging the cells.
+    const real factor = std::cbrt(static_cast<real>(cells) / (64.0 * p.node_count + 1024));
+    return build_grid(x, p, cell_size * factor * 1.01);
+  }
+  grid.cell_start.assign(static_cast<std::size_t>(cells) + 1, 0);
+  std::vector<std::int64_t> node_cell(p.node_count);
+  for (index_t a = 0; a < p.node_count; ++a) {
+    node_cell[a] = grid.linear(grid.cell_of(&x[3 * (p.first_node + a)]));
+    ++grid.cell_start[node_cell[a] + 1];
+  }
+  for (std::size_t c = 0; c + 1 < grid.cell_start.size(); ++c) grid.cell_start[c + 1] += grid.cell_start[c];
+  grid.cell_nodes.resize(p.node_count);
+  std::vector<index_t> fill(grid.cell_start.begin(), grid.cell_start.end() - 1);
+  for (index_t a = 0; a < p.node_count; ++a) grid.cell_nodes[fill[node_cell[a]]++] = p.first_node + a;
+  return grid;
+}
+
+/// Calls visit(j, r^2) for every node j != i of the grid with |X_j - X_i| <= radius.
+template <class Visit>
+void for_each_within(const CellGrid& grid, const std::vector<real>& x, index_t i, real radius,
+                     int dimension, Visit&& visit) {
+  const real* xi = &x[3 * i];
+  const auto c = grid.cell_of(xi);
+  const real limit = radius * radius * (1.0 + 1e-10);
+  const std::int64_t z_reach = dimension == 3 ? 1 : 0;
+  for (std::int64_t dz = -z_reach; dz <= z_reach; ++dz) {
+    for (std::int64_t dy = -1; dy <= 1; ++dy) {
+      for (std::int64_t dx = -1; dx <= 1; ++dx) {
+        const std::array<std::int64_t, 3> n{c[0] + dx, c[1] + dy, c[2] + dz};
+        if (n[0] < 0 || n[1] < 0 || n[2] < 0 || n[0] >= grid.dims[0] || n[1] >= grid.dims[1] ||
+            n[2] >= grid.dims[2]) {
+          continue;
+        }
+        const std::int64_t cell = grid.linear(n);
+        for (index_t k = grid.cell_start[cell]; k < grid.cell_start[cell + 1]; ++k) {
+          const index_t j = grid.cell_nodes[k];
+          if (j == i) continue;
+          const real* xj = &x[3 * j];
+          const real r2 = (xj[0] - xi[0]) * (xj[0] - xi[0]) + (xj[1] - xi[1]) * (xj[1] - xi[1]) +
+                          (xj[2] - xi[2]) * (xj[2] - xi[2]);
+          if (r2 <= limit) visit(j, r2);
+        }
+      }
+    }
+  }
+}
+
+std::string str(real v) {
+  std::ostringstream o;
+  o << v;
+  return o.str();
+}
+
+}  // namespace
+
+Model::Model(int dimension, PlaneMode plane) : dimension_(dimension), plane_(plane) {
+  if (dimension != 2 && dimension != 3) {
+    throw InputError("dimension must be 2 or 3, got " + std::to_string(dimension));
+  }
+}
+
+void Model::require_not_finalized(const char* what) const {
+  if (finalized_) {
+    throw InputError(std::string("cannot ") + what + " after the model is finalized; "
+                     "build the whole model before the first run");
+  }
+}
+
+index_t Model::add_material(const MaterialParams& params) {
+  require_not_finalized("add a material");
+  materials_.push_back(Material::make(params, dimension_, plane_));
+  return static_cast<index_t>(materials_.size() - 1);
+}
+
+index_t Model::add_particle(std::span<const real> positions, std::span<const real> volumes,
+                            index_t material, real mesh_size) {
+  require_not_finalized("add a particle");
+  const std::size_t n = volumes.size();
+  const index_t id = static_cast<index_t>(particles_.size());
+  if (n == 0) throw InputError("particle " + std::to_string(id) + " has no nodes");
+  if (positions.size() != 3 * n) {
+    throw InputError("particle positions must be an n x 3 array matching n volumes");
+  }
+  if (material >= materials_.size()) {
+    throw InputError("particle " + std::to_string(id) + " refers to material " +
+                     std::to_string(material) + ", but only " + std::to_string(materials_.size()) +
+                     " materials exist");
+  }
+  if (!(mesh_size > 0) || !std::isfinite(mesh_size)) {
+    throw InputError("particle " + std::to_string(id) + ": mesh size must be positive, got " + str(mesh_size));
+  }
+  const real horizon = materials_[material].params.horizon;
+  if (horizon < mesh_size * (1.0 - 1e-9)) {
+    throw InputError("particle " + std::to_string(id) + ": horizon " + str(horizon) +
+                     " is smaller than the mesh size " + str(mesh_size) +
+                     "; use a horizon of about 3 mesh sizes");
+  }
+  for (std::size_t a = 0; a < n; ++a) {
+    if (!(volumes[a] > 0) || !std::isfinite(volumes[a])) {
+      throw InputError("particle " + std::to_string(id) + ": node " + std::to_string(a) +
+                       " has volume " + str(volumes[a]) +
+                       "; every node needs a positive volume (check the mesh for degenerate elements)");
+    }
+    for (int k = 0; k < 3; ++k) {
+      if (!std::isfinite(positions[3 * a + k])) {
+        throw InputError("particle " + std::to_string(id) + ": node " + std::to_string(a) +
+                         " has a non-finite coordinate");
+      }
+    }
+    if (dimension_ == 2 && positions[3 * a + 2] != 0.0) {
+      throw InputError("particle " + std::to_string(id) + ": node " + std::to_string(a) +
+                       " has z != 0 in a 2D model");
+    }
+  }
+  if (node_count() + n > std::numeric_limits<index_t>::max() / 2) {
+    throw InputError("too many nodes for 32-bit indices");
+  }
+  Particle p;
+  p.first_node = node_count();
+  p.node_count = static_cast<index_t>(n);
+  p.material = material;
+  p.mesh_size = mesh_size;
+  particles_.push_back(p);
+  reference_positions_.insert(reference_positions_.end(), positions.begin(), positions.end());
+  volumes_.insert(volumes_.end(), volumes.begin(), volumes.end());
+  node_particle_.insert(node_particle_.end(), n, id);
+  node_material_.insert(node_material_.end(), n, material);
+  node_density_.insert(node_density_.end(), n, materials_[material].params.density);
+  return id;
+}
+
+void Model::finalize() {
+  if (finalized_) return;
+  if (particles_.empty()) throw InputError("the model has no particles; add at least one body");
+  build_bonds();
+  finalized_ = true;
+}
+
+void Model::build_bonds() {
+  const index_t nodes = node_count();
+  const auto& x = reference_positions_;
+  std::vector<CellGrid> grids;
+  grids.reserve(particles_.size());
+  for (const Particle& p : particles_) grids.push_back(build_grid(x, p, materials_[p.material].params.horizon));
+
+  bonds_.offsets.assign(nodes + 1, 0);
+#pragma omp parallel for schedule(static)
+  for (std::int64_t ii = 0; ii < static_cast<std::int64_t>(nodes); ++ii) {
+    const index_t i = static_cast<index_t>(ii);
+    const index_t p = node_particle_[i];
+    index_t count = 0;
+    for_each_within(grids[p], x, i, materials_[particles_[p].material].params.horizon, dimension_,
+                    [&](index_t, real) { ++count; });
+    bonds_.offsets[i + 1] = count;
+  }
+  for (index_t i = 0; i < nodes; ++i) bonds_.offsets[i + 1] += bonds_.offsets[i];
+  const std::size_t bond_count = bonds_.offsets[nodes];
+  bonds_.neighbors.resize(bond_count);
+  bonds_.weights.resize(bond_count);
+  bonds_.lengths.resize(bond_count);
+  weighted_volume_.assign(nodes, 0);
+  lps_coefficients_.assign(nodes, {});
+
+  std::vector<index_t> isolated;
+  std::vector<std::pair<index_t, index_t>> coincident;
+#pragma omp parallel for schedule(static)
+  for (std::int64_t ii = 0; ii < static_cast<std::int64_t>(nodes); ++ii) {
+    const index_t i = static_cast<index_t>(ii);
+    const Particle& particle = particles_[node_particle_[i]];
+    const Material& material = materials_[particle.material];
+    const real horizon = material.params.horizon;
+    const real h = particle.mesh_size;
+    index_t* family = bonds_.neighbors.data() + bonds_.offsets[i];
+    index_t filled = 0;
+    for_each_within(grids[node_particle_[i]], x, i, horizon, dimension_,
+                    [&](index_t j, real) { family[filled++] = j; });
+    std::sort(family, family + filled);
+    real m = 0;
+    for (index_t b = bonds_.offsets[i]; b < bonds_.offsets[i + 1]; ++b) {
+      const index_t j = bonds_.neighbors[b];
+      const real r = std::sqrt((x[3 * j] - x[3 * i]) * (x[3 * j] - x[3 * i]) +
+                               (x[3 * j + 1] - x[3 * i + 1]) * (x[3 * j + 1] - x[3 * i + 1]) +
+                               (x[3 * j + 2] - x[3 * i + 2]) * (x[3 * j + 2] - x[3 * i + 2]));
+      if (r == 0) {
+#pragma omp critical(granulate_coincident)
+        coincident.emplace_back(i, j);
+      }
+      const real partial = r > horizon - 0.5 * h ? std::min(1.0, (horizon + 0.5 * h - r) / h) : 1.0;
+      const real weight = influence(material.params.influence, std::min(r / horizon, 1.0)) * volumes_[j] * partial;
+      bonds_.lengths[b] = r;
+      bonds_.weights[b] = weight;
+      m += weight * r * r;
+    }
+    if (filled == 0) {
+#pragma omp critical(granulate_isolated)
+      isolated.push_back(i);
+    }
+    weighted_volume_[i] = m;
+    if (m > 0) {
+      const real d = dimension_;
+      const real a = material.deviatoric_factor;
+      const real G = material.params.shear_modulus;
+      lps_coefficients_[i].dilatation_scale = d / m;
+      lps_coefficients_[i].dilatation_coupling = (d * material.dilatation_modulus - a * G / d) / m;
+      lps_coefficients_[i].deviatoric_stiffness = a * G / m;
+    }
+  }
+  if (!coincident.empty()) {
+    std::sort(coincident.begin(), coincident.end());
+    throw InputError("nodes " + std::to_string(coincident[0].first) + " and " +
+                     std::to_string(coincident[0].second) +
+                     " are at the same position; remove duplicate nodes from the mesh");
+  }
+  if (!isolated.empty()) {
+    std::sort(isolated.begin(), isolated.end());
+    const index_t i = isolated[0];
+    throw InputError("node " + std::to_string(i) + " of particle " + std::to_string(node_particle_[i]) +
+                     " has no neighbour within the horizon (" + std::to_string(isolated.size()) +
+                     " such nodes); increase the horizon or refine the mesh");
+  }
+}
+
+real Model::stable_time_step() const {
+  const auto& b = bonds_;
+  real dt = std::numeric_limits<real>::infinity();
+  for (index_t i = 0; i < node_count(); ++i) {
+    const Material& material = materials_[node_material_[i]];
+    real stiffness = 0;
+    if (material.params.model == ForceModel::lps) {
+      const auto& ci = lps_coefficients_[i];
+      real moment = 0;
+      for (index_t k = b.offsets[i]; k < b.offsets[i + 1]; ++k) {
+        const index_t j = b.neighbors[k];
+        stiffness += b.weights[k] * (ci.deviatoric_stiffness + lps_coefficients_[j].deviatoric_stiffness);
+        moment += b.weights[k] * b.lengths[k];
+      }
+      stiffness += 2.0 * std::abs(ci.dilatation_coupling) * ci.dilatation_scale * moment * moment;
+    } else {
+      for (index_t k = b.offsets[i]; k < b.offsets[i + 1]; ++k) {
+        stiffness += material.micromodulus * b.weights[k] / b.lengths[k];
+      }
+    }
+    if (stiffness > 0) dt = std::min(dt, std::sqrt(2.0 * node_density_[i] / stiffness));
+  }
+  return dt;
+}
+
+}  // namespace granulate

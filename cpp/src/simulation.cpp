@@ -1,0 +1,354 @@
+#include "granulate/simulation.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <sstream>
+
+#include "granulate/peridynamics/critical_stretch.hpp"
+#include "granulate/peridynamics/lps.hpp"
+#include "granulate/peridynamics/pmb.hpp"
+
+namespace granulate {
+namespace {
+
+using clock_type = std::chrono::steady_clock;
+
+double seconds_since(clock_type::time_point start) {
+  return std::chrono::duration<double>(clock_type::now() - start).count();
+}
+
+constexpr std::uint64_t stability_check_interval = 64;
+
+}  // namespace
+
+Simulation::Simulation(std::shared_ptr<Model> model) : model_(std::move(model)) {
+  if (!model_) throw InputError("simulation needs a model");
+  model_->finalize();
+  const Model& m = *model_;
+  const index_t n = m.node_count();
+  state_.positions = m.reference_positions();
+  state_.velocities.assign(3 * static_cast<std::size_t>(n), 0);
+  state_.forces.assign(3 * static_cast<std::size_t>(n), 0);
+  state_.bond_intact.assign(m.bonds().size(), 1);
+  state_.dilatation.assign(n, 0);
+  pressure_.assign(n, 0);
+  mesh_size_.resize(n);
+  for (const Particle& p : m.particles()) {
+    std::fill_n(mesh_size_.begin() + p.first_node, p.node_count, p.mesh_size);
+  }
+  stable_time_step_ = m.stable_time_step();
+  time_step_ = 0.8 * stable_time_step_;
+}
+
+void Simulation::set_time_step(real dt) {
+  if (!(dt > 0) || !std::isfinite(dt)) {
+    std::ostringstream msg;
+    msg << "time step must be positive and finite, got " << dt;
+    throw InputError(msg.str());
+  }
+  time_step_ = dt;
+}
+
+void Simulation::set_body_acceleration(const std::array<real, 3>& g) {
+  for (real c : g) {
+    if (!std::isfinite(c)) throw InputError("body acceleration must be finite");
+  }
+  if (model_->dimension() == 2 && g[2] != 0) {
+    throw InputError("body acceleration has a z component in a 2D model");
+  }
+  body_acceleration_ = g;
+  forces_current_ = false;
+}
+
+void Simulation::add_prescribed_motion(PrescribedMotion motion) {
+  motion.function.validate();
+  for (index_t i : motion.nodes) {
+    if (i >= model_->node_count()) {
+      throw InputError("prescribed motion names node " + std::to_string(i) + ", but the model has " +
+                       std::to_string(model_->node_count()) + " nodes");
+    }
+  }
+  if (motion.kind == PrescribedMotion::Kind::rotation) {
+    const real norm = std::sqrt(motion.axis[0] * motion.axis[0] + motion.axis[1] * motion.axis[1] +
+                                motion.axis[2] * motion.axis[2]);
+    if (!(norm > 0)) throw InputError("rotation axis must be a non-zero vector");
+    for (real& c : motion.axis) c /= norm;
+    motion.components = 0b111;
+  }
+  motions_.push_back(std::move(motion));
+  forces_current_ = false;
+}
+
+void Simulation::add_nodal_force(NodalForce force) {
+  force.function.validate();
+  for (index_t i : force.nodes) {
+    if (i >= model_->node_count()) {
+      throw InputError("force set names node " + std::to_string(i) + ", but the model has " +
+                       std::to_string(model_->node_count()) + " nodes");
+    }
+  }
+  nodal_forces_.push_back(std::move(force));
+  forces_current_ = false;
+}
+
+void Simulation::apply_prescribed_motion(bool positions_too) {
+  const auto& X = model_->reference_positions();
+  auto& x = state_.positions;
+  auto& v = state_.velocities;
+  const real t = state_.time;
+  for (const PrescribedMotion& motion : motions_) {
+    const real value = motion.function.value(t);
+    const real rate = motion.function.rate(t);
+    if (motion.kind == PrescribedMotion::Kind::displacement) {
+      for (index_t i : motion.nodes) {
+        for (int c = 0; c < 3; ++c) {
+          if (!(motion.components & (1u << c))) continue;
+          if (positions_too) x[3 * i + c] = X[3 * i + c] + value * motion.direction[c];
+          v[3 * i + c] = rate * motion.direction[c];
+        }
+      }
+    } else {
+      // Rodrigues: R p = p cos a + (k x p) sin a + k (k . p)(1 - cos a)
+      const auto& k = motion.axis;
+      const real cs = std::cos(value), sn = std::sin(value);
+      for (index_t i : motion.nodes) {
+        if (positions_too) {
+          const real p[3] = {X[3 * i] - motion.center[0], X[3 * i + 1] - motion.center[1],
+                             X[3 * i + 2] - motion.center[2]};
+          const real kp = k[0] * p[0] + k[1] * p[1] + k[2] * p[2];
+          const real kxp[3] = {k[1] * p[2] - k[2] * p[1], k[2] * p[0] - k[0] * p[2], k[0] * p[1] - k[1] * p[0]};
+          for (int c = 0; c < 3; ++c) {
+            x[3 * i + c] = motion.center[c] + p[c] * cs + kxp[c] * sn + k[c] * kp * (1.0 - cs);
+          }
+        }
+        const real q[3] = {x[3 * i] - motion.center[0], x[3 * i + 1] - motion.center[1],
+                           x[3 * i + 2] - motion.center[2]};
+        v[3 * i] = rate * (k[1] * q[2] - k[2] * q[1]);
+        v[3 * i + 1] = rate * (k[2] * q[0] - k[0] * q[2]);
+        v[3 * i + 2] = rate * (k[0] * q[1] - k[1] * q[0]);
+      }
+    }
+  }
+}
+
+real Simulation::bond_extension(index_t i, index_t bond, const std::vector<real>& x) const {
+  const index_t j = model_->bonds().neighbors[bond];
+  const real dx = x[3 * j] - x[3 * i], dy = x[3 * j + 1] - x[3 * i + 1], dz = x[3 * j + 2] - x[3 * i + 2];
+  return std::sqrt(dx * dx + dy * dy + dz * dz) - model_->bonds().lengths[bond];
+}
+
+void Simulation::compute_forces() {
+  const Model& m = *model_;
+  const BondFamilies& bonds = m.bonds();
+  const auto& materials = m.materials();
+  const auto& node_material = m.node_material();
+  const auto& lps_coefficients = m.lps_coefficients();
+  const auto& density = m.node_density();
+  const auto& x = state_.positions;
+  auto& f = state_.forces;
+  auto& intact = state_.bond_intact;
+  auto& theta = state_.dilatation;
+  const std::int64_t n = m.node_count();
+  const auto g = body_acceleration_;
+
+  // Pass 1: stretch, irreversible breaking, dilatation. Each node updates only its own bond
+  // copies; both copies of a bond see bitwise the same stretch, so they break together.
+#pragma omp parallel for schedule(static)
+  for (std::int64_t ii = 0; ii < n; ++ii) {
+    const index_t i = static_cast<index_t>(ii);
+    const Material& material = materials[node_material[i]];
+    const CriticalStretch criterion{material.critical_stretch, material.params.break_in_compression};
+    const bool can_break = material.params.fracture;
+    real sum = 0;
+    for (index_t k = bonds.offsets[i]; k < bonds.offsets[i + 1]; ++k) {
+      if (!intact[k]) continue;
+      const real r = bonds.lengths[k];
+      const real e = bond_extension(i, k, x);
+      if (can_break && criterion.breaks(e / r)) {
+        intact[k] = 0;
+        continue;
+      }
+      sum += lps::dilatation_term(bonds.weights[k], r, e);
+    }
+    if (material.params.model == ForceModel::lps) {
+      theta[i] = lps_coefficients[i].dilatation_scale * sum;
+      pressure_[i] = lps_coefficients[i].dilatation_coupling * theta[i];
+    }
+  }
+
+  // Pass 2: each node gathers its own force density (no scatter, no atomics).
+#pragma omp parallel for schedule(static)
+  for (std::int64_t ii = 0; ii < n; ++ii) {
+    const index_t i = static_cast<index_t>(ii);
+    const Material& material = materials[node_material[i]];
+    const bool is_lps = material.params.model == ForceModel::lps;
+    const real c = material.micromodulus;
+    const real pressure_i = pressure_[i];
+    const real deviatoric_i = lps_coefficients[i].deviatoric_stiffness;
+    real fx = 0, fy = 0, fz = 0;
+    for (index_t k = bonds.offsets[i]; k < bonds.offsets[i + 1]; ++k) {
+      if (!intact[k]) continue;
+      const index_t j = bonds.neighbors[k];
+      const real dx = x[3 * j] - x[3 * i], dy = x[3 * j + 1] - x[3 * i + 1], dz = x[3 * j + 2] - x[3 * i + 2];
+      const real length = std::sqrt(dx * dx + dy * dy + dz * dz);
+      if (!(length > 0)) continue;
+      const real r = bonds.lengths[k];
+      const real e = length - r;
+      const real scalar = is_lps ? lps::pair_force(bonds.weights[k], r, e, pressure_i, pressure_[j], deviatoric_i,
+                                                   lps_coefficients[j].deviatoric_stiffness)
+                                 : pmb::pair_force(c, bonds.weights[k], e / r);
+      const real over = scalar / length;
+      fx += over * dx;
+      fy += over * dy;
+      fz += over * dz;
+    }
+    f[3 * i] = fx + density[i] * g[0];
+    f[3 * i + 1] = fy + density[i] * g[1];
+    f[3 * i + 2] = fz + density[i] * g[2];
+  }
+
+  const real t = state_.time;
+  for (const NodalForce& load : nodal_forces_) {
+    const real scale = load.function.value(t);
+    for (index_t i : load.nodes) {
+      for (int c = 0; c < 3; ++c) f[3 * i + c] += scale * load.vector[c];
+    }
+  }
+  forces_current_ = true;
+}
+
+void Simulation::run(std::uint64_t steps) {
+  const Model& m = *model_;
+  const auto& density = m.node_density();
+  const std::int64_t n3 = 3 * static_cast<std::int64_t>(m.node_count());
+  auto& x = state_.positions;
+  auto& v = state_.velocities;
+  auto& f = state_.forces;
+  const real dt = time_step_;
+  if (!forces_current_) {
+    apply_prescribed_motion(true);
+    compute_forces();
+  }
+  for (std::uint64_t s = 0; s < steps; ++s) {
+    auto start = clock_type::now();
+#pragma omp parallel for schedule(static)
+    for (std::int64_t k = 0; k < n3; ++k) {
+      v[k] += 0.5 * dt * f[k] / density[k / 3];
+      x[k] += dt * v[k];
+    }
+    state_.time += dt;
+    phase_times_.integration += seconds_since(start);
+
+    start = clock_type::now();
+    apply_prescribed_motion(true);
+    phase_times_.loading += seconds_since(start);
+
+    start = clock_type::now();
+    compute_forces();
+    phase_times_.peridynamics += seconds_since(start);
+
+    start = clock_type::now();
+#pragma omp parallel for schedule(static)
+    for (std::int64_t k = 0; k < n3; ++k) v[k] += 0.5 * dt * f[k] / density[k / 3];
+    apply_prescribed_motion(false);
+    ++state_.step;
+    if (state_.step % stability_check_interval == 0) check_stability();
+    phase_times_.integration += seconds_since(start);
+  }
+}
+
+void Simulation::check_stability() const {
+  const auto& v = state_.velocities;
+  const auto& x = state_.positions;
+  const index_t n = model_->node_count();
+  for (index_t i = 0; i < n; ++i) {
+    const real speed2 = v[3 * i] * v[3 * i] + v[3 * i + 1] * v[3 * i + 1] + v[3 * i + 2] * v[3 * i + 2];
+    const bool finite = std::isfinite(speed2) && std::isfinite(x[3 * i]) && std::isfinite(x[3 * i + 1]) &&
+                        std::isfinite(x[3 * i + 2]);
+    if (!finite || std::sqrt(speed2) * time_step_ > mesh_size_[i]) {
+      std::ostringstream msg;
+      msg << "the simulation became unstable at step " << state_.step << " (t = " << state_.time << " s): node "
+          << i << (finite ? " moved more than its mesh size in one step" : " has a non-finite position or velocity")
+          << ". The time step is " << time_step_ << " s and the stable estimate is " << stable_time_step_
+          << " s; use a smaller time step (or a slower loading)";
+      throw InstabilityError(msg.str());
+    }
+  }
+}
+
+real Simulation::kinetic_energy() const {
+  const auto& v = state_.velocities;
+  const auto& volume = model_->volumes();
+  const auto& density = model_->node_density();
+  real sum = 0;
+  for (index_t i = 0; i < model_->node_count(); ++i) {
+    sum += 0.5 * density[i] * volume[i] *
+           (v[3 * i] * v[3 * i] + v[3 * i + 1] * v[3 * i + 1] + v[3 * i + 2] * v[3 * i + 2]);
+  }
+  return sum;
+}
+
+real Simulation::strain_energy() const {
+  const Model& m = *model_;
+  const BondFamilies& bonds = m.bonds();
+  const index_t n = m.node_count();
+  std::vector<real> energy(n, 0);
+  const real inverse_dimension = 1.0 / m.dimension();
+#pragma omp parallel for schedule(static)
+  for (std::int64_t ii = 0; ii < static_cast<std::int64_t>(n); ++ii) {
+    const index_t i = static_cast<index_t>(ii);
+    const Material& material = m.materials()[m.node_material()[i]];
+    const bool is_lps = material.params.model == ForceModel::lps;
+    const real theta = state_.dilatation[i];
+    real sum = 0;
+    for (index_t k = bonds.offsets[i]; k < bonds.offsets[i + 1]; ++k) {
+      if (!state_.bond_intact[k]) continue;
+      const real r = bonds.lengths[k];
+      const real e = bond_extension(i, k, state_.positions);
+      sum += is_lps ? lps::deviatoric_energy_term(bonds.weights[k], r, e, theta, inverse_dimension)
+                    : pmb::energy_term(material.micromodulus, bonds.weights[k], e / r, r);
+    }
+    const real density = is_lps ? 0.5 * material.dilatation_modulus * theta * theta +
+                                      0.5 * m.lps_coefficients()[i].deviatoric_stiffness * sum
+                                : sum;
+    energy[i] = density * m.volumes()[i];
+  }
+  real total = 0;
+  for (real e : energy) total += e;
+  return total;
+}
+
+void Simulation::damage(real* phi, real* z) const {
+  const Model& m = *model_;
+  const BondFamilies& bonds = m.bonds();
+#pragma omp parallel for schedule(static)
+  for (std::int64_t ii = 0; ii < static_cast<std::int64_t>(m.node_count()); ++ii) {
+    const index_t i = static_cast<index_t>(ii);
+    const real s0 = m.materials()[m.node_material()[i]].critical_stretch;
+    real all = 0, intact = 0, max_stretch = 0;
+    for (index_t k = bonds.offsets[i]; k < bonds.offsets[i + 1]; ++k) {
+      all += bonds.weights[k];
+      if (state_.bond_intact[k]) intact += bonds.weights[k];
+      max_stretch = std::max(max_stretch, std::abs(bond_extension(i, k, state_.positions) / bonds.lengths[k]));
+    }
+    if (phi) phi[i] = all > 0 ? 1.0 - intact / all : 0.0;
+    if (z) z[i] = std::isfinite(s0) ? max_stretch / s0 : 0.0;
+  }
+}
+
+std::uint64_t Simulation::broken_bonds() const {
+  std::uint64_t broken = 0;
+  for (std::uint8_t b : state_.bond_intact) broken += b ? 0 : 1;
+  return broken / 2;
+}
+
+std::vector<std::uint8_t> Simulation::fixity() const {
+  std::vector<std::uint8_t> mask(model_->node_count(), 0);
+  for (const PrescribedMotion& motion : motions_) {
+    for (index_t i : motion.nodes) mask[i] |= motion.components;
+  }
+  return mask;
+}
+
+}  // namespace granulate

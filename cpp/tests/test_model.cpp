@@ -1,0 +1,165 @@
+// Bond families, forces against -dE/dx by finite differences, Newton's third law, input errors.
+#include <memory>
+#include <random>
+
+#include "check.hpp"
+#include "granulate/simulation.hpp"
+
+using namespace granulate;
+
+namespace {
+
+/// A block of n^d lattice nodes of spacing h with a material of horizon 3h.
+std::shared_ptr<Model> lattice_block(int dimension, int n, ForceModel force_model, InfluenceKind influence,
+                                     bool fracture = false) {
+  const double h = 1e-3;
+  auto model = std::make_shared<Model>(dimension, PlaneMode::strain);
+  MaterialParams p;
+  p.model = force_model;
+  p.density = 1200;
+  p.bulk_modulus = 2e9;
+  p.shear_modulus = 1e9;
+  p.horizon = 3 * h;
+  p.fracture_energy = 50;
+  p.fracture = fracture;
+  p.influence = influence;
+  const index_t material = model->add_material(p);
+  std::vector<double> x, v;
+  const int nz = dimension == 3 ? n : 1;
+  for (int k = 0; k < nz; ++k)
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i) {
+        x.insert(x.end(), {i * h, j * h, dimension == 3 ? k * h : 0.0});
+        v.push_back(dimension == 3 ? h * h * h : h * h);
+      }
+  model->add_particle(x, v, material, h);
+  return model;
+}
+
+}  // namespace
+
+TEST_CASE("bond families: interior counts, symmetry, partial volumes") {
+  auto model2 = lattice_block(2, 11, ForceModel::lps, InfluenceKind::constant);
+  model2->finalize();
+  const auto& b = model2->bonds();
+  const index_t centre = 5 * 11 + 5;
+  CHECK(b.offsets[centre + 1] - b.offsets[centre] == 28);  // lattice points with |(i,j)| <= 3
+  auto model3 = lattice_block(3, 9, ForceModel::lps, InfluenceKind::constant);
+  model3->finalize();
+  const index_t centre3 = (4 * 9 + 4) * 9 + 4;
+  CHECK(model3->bonds().offsets[centre3 + 1] - model3->bonds().offsets[centre3] == 122);
+  // every bond i->j has j->i with the same length
+  for (index_t i = 0; i < model2->node_count(); ++i) {
+    for (index_t k = b.offsets[i]; k < b.offsets[i + 1]; ++k) {
+      const index_t j = b.neighbors[k];
+      bool found = false;
+      for (index_t q = b.offsets[j]; q < b.offsets[j + 1]; ++q) {
+        if (b.neighbors[q] == i) found = (b.lengths[q] == b.lengths[k]);
+      }
+      CHECK(found);
+    }
+  }
+  // a bond of length exactly delta keeps half its volume; one of length 2h all of it
+  for (index_t k = b.offsets[centre]; k < b.offsets[centre + 1]; ++k) {
+    const double r = b.lengths[k] / 1e-3;
+    if (std::abs(r - 3.0) < 1e-9) CHECK_CLOSE(b.weights[k], 0.5e-6, 1e-9);
+    if (std::abs(r - 2.0) < 1e-9) CHECK_CLOSE(b.weights[k], 1e-6, 1e-12);
+  }
+}
+
+TEST_CASE("forces equal -dE/dx (finite differences), Newton's third law holds") {
+  for (int d : {2, 3}) {
+    for (ForceModel force_model : {ForceModel::lps, ForceModel::pmb}) {
+      auto model = lattice_block(d, d == 2 ? 8 : 5, force_model, InfluenceKind::linear);
+      Simulation sim(model);
+      std::mt19937 rng(42);
+      std::uniform_real_distribution<double> jitter(-2e-5, 2e-5);
+      auto& x = sim.state().positions;
+      for (std::size_t k = 0; k < x.size(); ++k) {
+        if (d == 3 || k % 3 != 2) x[k] += jitter(rng);
+      }
+      sim.compute_forces();
+      const std::vector<double> f = sim.state().forces;
+      const auto& V = model->volumes();
+      double sum[3] = {0, 0, 0};
+      double scale = 0;
+      for (index_t i = 0; i < model->node_count(); ++i) {
+        for (int c = 0; c < 3; ++c) {
+          sum[c] += f[3 * i + c] * V[i];
+          scale = std::max(scale, std::abs(f[3 * i + c] * V[i]));
+        }
+      }
+      for (double s : sum) CHECK(std::abs(s) < 1e-10 * scale * model->node_count());
+      for (index_t i : {index_t(0), index_t(7), index_t(model->node_count() / 2)}) {
+        for (int c = 0; c < d; ++c) {
+          const double step = 1e-8;
+          const double saved = x[3 * i + c];
+          x[3 * i + c] = saved + step;
+          sim.compute_forces();
+          const double plus = sim.strain_energy();
+          x[3 * i + c] = saved - step;
+          sim.compute_forces();
+          const double minus = sim.strain_energy();
+          x[3 * i + c] = saved;
+          const double numeric = -(plus - minus) / (2 * step);
+          CHECK(granulate_test::close(numeric, f[3 * i + c] * V[i], 1e-5, 1e-6 * scale));
+        }
+      }
+    }
+  }
+}
+
+TEST_CASE("lps dilatation of an interior node equals the trace of a homogeneous strain") {
+  for (int d : {2, 3}) {
+    auto model = lattice_block(d, d == 2 ? 13 : 9, ForceModel::lps, InfluenceKind::linear);
+    Simulation sim(model);
+    const double strain[3] = {1e-4, -3e-4, d == 3 ? 4e-4 : 0.0};
+    auto& x = sim.state().positions;
+    for (std::size_t k = 0; k < x.size(); ++k) x[k] *= 1.0 + strain[k % 3];
+    sim.compute_forces();
+    const int n = d == 2 ? 13 : 9;
+    const index_t centre = d == 2 ? index_t(6 * 13 + 6) : index_t((4 * 9 + 4) * 9 + 4);
+    (void)n;
+    CHECK_CLOSE(sim.state().dilatation[centre], strain[0] + strain[1] + strain[2], 1e-3);
+  }
+}
+
+TEST_CASE("bonds break irreversibly at the critical stretch") {
+  auto model = lattice_block(2, 8, ForceModel::lps, InfluenceKind::linear, true);
+  Simulation sim(model);
+  const double s0 = model->materials()[0].critical_stretch;
+  auto& x = sim.state().positions;
+  for (std::size_t k = 0; k < x.size(); k += 3) x[k] *= 1.0 + 1.5 * s0;  // all x-bonds beyond s0
+  sim.compute_forces();
+  const auto broken = sim.broken_bonds();
+  CHECK(broken > 0);
+  for (std::size_t k = 0; k < x.size(); k += 3) x[k] /= 1.0 + 1.5 * s0;  // back to the reference
+  sim.compute_forces();
+  CHECK(sim.broken_bonds() == broken);
+}
+
+TEST_CASE("bad particles are refused with InputError") {
+  auto model = std::make_shared<Model>(2, PlaneMode::strain);
+  MaterialParams p;
+  p.density = 1000;
+  p.bulk_modulus = 1e9;
+  p.shear_modulus = 1e9;
+  p.horizon = 3e-3;
+  p.fracture_energy = 10;
+  const index_t material = model->add_material(p);
+  const std::vector<double> x = {0, 0, 0, 1e-3, 0, 0};
+  CHECK_THROWS(model->add_particle(x, std::vector<double>{1e-6, 0.0}, material, 1e-3), InputError);
+  CHECK_THROWS(model->add_particle(x, std::vector<double>{1e-6, 1e-6}, 5, 1e-3), InputError);
+  CHECK_THROWS(model->add_particle(x, std::vector<double>{1e-6, 1e-6}, material, 4e-3), InputError);
+  CHECK_THROWS(model->add_particle(std::vector<double>{0, 0, 1, 1, 0, 0}, std::vector<double>{1e-6, 1e-6}, material, 1e-3),
+               InputError);
+  // coincident nodes
+  model->add_particle(std::vector<double>{0, 0, 0, 0, 0, 0}, std::vector<double>{1e-6, 1e-6}, material, 1e-3);
+  CHECK_THROWS(model->finalize(), InputError);
+  // an isolated node
+  auto lonely = std::make_shared<Model>(2, PlaneMode::strain);
+  lonely->add_material(p);
+  lonely->add_particle(std::vector<double>{0, 0, 0, 1e-3, 0, 0, 1, 1, 0}, std::vector<double>{1e-6, 1e-6, 1e-6}, 0, 1e-3);
+  CHECK_THROWS(lonely->finalize(), InputError);
+  CHECK_THROWS(Model(4, PlaneMode::strain), InputError);
+}
