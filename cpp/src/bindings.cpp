@@ -210,6 +210,12 @@ NB_MODULE(_core, m) {
       .def("kinetic_energy", &Simulation::kinetic_energy)
       .def("strain_energy", &Simulation::strain_energy)
       .def("broken_bonds", &Simulation::broken_bonds)
+      .def("strain_energy_density",
+           [](const Simulation& self) {
+             std::vector<real> density(self.model().node_count());
+             self.strain_energy_density(density.data());
+             return copy_out(density);
+           })
       .def("damage",
            [](const Simulation& self) {
              std::vector<real> phi(self.model().node_count()), z(self.model().node_count());

@@ -192,7 +192,11 @@ void Model::build_bonds() {
   const auto& x = reference_positions_;
   std::vector<CellGrid> grids;
   grids.reserve(particles_.size());
-  for (const Particle& p : particles_) grids.push_back(build_grid(x, p, materials_[p.material].params.horizon));
+  // Cells slightly larger than the horizon: two nodes exactly one horizon apart (common on
+  // lattices) are then never two cells apart after rounding.
+  for (const Particle& p : particles_) {
+    grids.push_back(build_grid(x, p, materials_[p.material].params.horizon * (1.0 + 1e-6)));
+  }
 
   bonds_.offsets.assign(nodes + 1, 0);
 #pragma omp parallel for schedule(static)

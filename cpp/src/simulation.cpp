@@ -289,14 +289,12 @@ real Simulation::kinetic_energy() const {
   return sum;
 }
 
-real Simulation::strain_energy() const {
+void Simulation::strain_energy_density(real* out) const {
   const Model& m = *model_;
   const BondFamilies& bonds = m.bonds();
-  const index_t n = m.node_count();
-  std::vector<real> energy(n, 0);
   const real inverse_dimension = 1.0 / m.dimension();
 #pragma omp parallel for schedule(static)
-  for (std::int64_t ii = 0; ii < static_cast<std::int64_t>(n); ++ii) {
+  for (std::int64_t ii = 0; ii < static_cast<std::int64_t>(m.node_count()); ++ii) {
     const index_t i = static_cast<index_t>(ii);
     const Material& material = m.materials()[m.node_material()[i]];
     const bool is_lps = material.params.model == ForceModel::lps;
@@ -309,13 +307,17 @@ real Simulation::strain_energy() const {
       sum += is_lps ? lps::deviatoric_energy_term(bonds.weights[k], r, e, theta, inverse_dimension)
                     : pmb::energy_term(material.micromodulus, bonds.weights[k], e / r, r);
     }
-    const real density = is_lps ? 0.5 * material.dilatation_modulus * theta * theta +
-                                      0.5 * m.lps_coefficients()[i].deviatoric_stiffness * sum
-                                : sum;
-    energy[i] = density * m.volumes()[i];
+    out[i] = is_lps ? 0.5 * material.dilatation_modulus * theta * theta +
+                          0.5 * m.lps_coefficients()[i].deviatoric_stiffness * sum
+                    : sum;
   }
+}
+
+real Simulation::strain_energy() const {
+  std::vector<real> density(model_->node_count());
+  strain_energy_density(density.data());
   real total = 0;
-  for (real e : energy) total += e;
+  for (index_t i = 0; i < model_->node_count(); ++i) total += density[i] * model_->volumes()[i];
   return total;
 }
 

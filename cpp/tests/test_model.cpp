@@ -11,7 +11,7 @@ namespace {
 
 /// A block of n^d lattice nodes of spacing h with a material of horizon 3h.
 std::shared_ptr<Model> lattice_block(int dimension, int n, ForceModel force_model, InfluenceKind influence,
-                                     bool fracture = false) {
+                                     bool fracture = false, double offset = 0.0) {
   const double h = 1e-3;
   auto model = std::make_shared<Model>(dimension, PlaneMode::strain);
   MaterialParams p;
@@ -29,7 +29,7 @@ std::shared_ptr<Model> lattice_block(int dimension, int n, ForceModel force_mode
   for (int k = 0; k < nz; ++k)
     for (int j = 0; j < n; ++j)
       for (int i = 0; i < n; ++i) {
-        x.insert(x.end(), {i * h, j * h, dimension == 3 ? k * h : 0.0});
+        x.insert(x.end(), {offset + (i + 0.5) * h, offset + (j + 0.5) * h, dimension == 3 ? (k + 0.5) * h : 0.0});
         v.push_back(dimension == 3 ? h * h * h : h * h);
       }
   model->add_particle(x, v, material, h);
@@ -48,6 +48,16 @@ TEST_CASE("bond families: interior counts, symmetry, partial volumes") {
   model3->finalize();
   const index_t centre3 = (4 * 9 + 4) * 9 + 4;
   CHECK(model3->bonds().offsets[centre3 + 1] - model3->bonds().offsets[centre3] == 122);
+  // every node at least one horizon inside has the full family, wherever the lattice sits
+  for (double offset : {0.0, -0.0123, 0.37}) {
+    auto shifted = lattice_block(2, 24, ForceModel::lps, InfluenceKind::constant, false, offset);
+    shifted->finalize();
+    for (int j = 3; j < 21; ++j)
+      for (int i = 3; i < 21; ++i) {
+        const index_t node = j * 24 + i;
+        CHECK(shifted->bonds().offsets[node + 1] - shifted->bonds().offsets[node] == 28);
+      }
+  }
   // every bond i->j has j->i with the same length
   for (index_t i = 0; i < model2->node_count(); ++i) {
     for (index_t k = b.offsets[i]; k < b.offsets[i + 1]; ++k) {

@@ -1,0 +1,66 @@
+"""granulate: granular media of deformable, breakable particles.
+
+Peridynamics inside each particle (LPS or PMB, with fracture), velocity-Verlet time stepping in
+a C++ core (OpenMP), set-up and output from Python.
+
+    >>> import granulate as gr
+    >>> rock = gr.Material(density=2600, youngs_modulus=50e9, poisson_ratio=0.25,
+    ...                    fracture_energy=40.0)
+    >>> sim = gr.Simulation(dimension=2)
+    >>> body = sim.add_body(gr.Rectangle((0, 0), (0.05, 0.01)), rock, mesh_size=1e-3)
+"""
+
+from granulate import _core
+from granulate.errors import GranulateWarning, InputError, InstabilityError
+from granulate.functions import (
+    Constant,
+    Linear,
+    Quadratic,
+    Sine,
+    SmoothRamp,
+    TimeFunction,
+    VelocityRamp,
+)
+from granulate.materials import Material
+from granulate.shapes import Box, Disc, Polygon, Rectangle, Shape, Sphere, lattice
+from granulate.simulation import FIELDS, Body, Simulation
+
+__version__ = "0.1.0"
+
+
+def set_num_threads(threads: int) -> None:
+    """Number of OpenMP threads used by the core (results are identical for any number)."""
+    _core.set_num_threads(int(threads))
+
+
+def get_num_threads() -> int:
+    """Number of OpenMP threads the core will use."""
+    return _core.get_max_threads()
+
+
+__all__ = [
+    "FIELDS",
+    "Body",
+    "Box",
+    "Constant",
+    "Disc",
+    "GranulateWarning",
+    "InputError",
+    "InstabilityError",
+    "Linear",
+    "Material",
+    "Polygon",
+    "Quadratic",
+    "Rectangle",
+    "Shape",
+    "Simulation",
+    "Sine",
+    "SmoothRamp",
+    "Sphere",
+    "TimeFunction",
+    "VelocityRamp",
+    "__version__",
+    "get_num_threads",
+    "lattice",
+    "set_num_threads",
+]

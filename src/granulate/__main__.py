@@ -1,0 +1,3 @@
+from granulate.cli import main
+
+raise SystemExit(main())

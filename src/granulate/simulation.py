@@ -1,0 +1,621 @@
+"""The Python front of a granulate simulation.
+
+Build the model (bodies, materials, loading, outputs), then ``run``. The model is handed to the
+C++ core on the first run (or the first access to the state); after that, bodies can no longer
+be added. State arrays (``positions``, ``velocities``, ...) are zero-copy NumPy views into the
+core: they stay valid as long as the simulation exists, and writing to ``velocities`` before a
+run sets initial conditions.
+
+Units are SI. In 2D, volumes are areas (per unit thickness), force densities are N/m^2 per unit
+thickness and energies J per metre of thickness.
+"""
+
+from __future__ import annotations
+
+import json
+import time as wallclock
+import warnings
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Literal
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from granulate import _core
+from granulate.errors import GranulateWarning, InputError
+from granulate.functions import Constant, Linear, TimeFunction, VelocityRamp
+from granulate.io import HistoryWriter, PvdSeries, atomic_write, write_vtu
+from granulate.materials import Material
+from granulate.shapes import Shape, lattice
+
+Components = str  # any of "x", "y", "z", e.g. "xy"
+
+FIELDS = (
+    "Displacement",
+    "Velocity",
+    "Force_Density",
+    "Force",
+    "Damage",
+    "Damage_Z",
+    "Dilatation",
+    "Particle_ID",
+    "Fixity",
+    "Nodal_Volume",
+)
+HISTORY_COLUMNS = (
+    "step",
+    "time",
+    "kinetic_energy",
+    "strain_energy",
+    "total_energy",
+    "broken_bonds",
+)
+
+
+@dataclass(frozen=True)
+class Body:
+    """A particle: a contiguous range of nodes with one material and mesh size."""
+
+    index: int
+    name: str
+    first_node: int
+    node_count: int
+    material: Material
+    mesh_size: float
+
+    @property
+    def nodes(self) -> NDArray[np.uint32]:
+        """Global indices of the body's nodes."""
+        return np.arange(self.first_node, self.first_node + self.node_count, dtype=np.uint32)
+
+
+@dataclass
+class _Output:
+    directory: Path
+    every: int
+    fields: tuple[str, ...]
+    pvd: PvdSeries
+    history: HistoryWriter
+    frames: int = 0
+
+
+def _component_mask(components: Components, dimension: int) -> int:
+    mask = 0
+    for c in components:
+        if c not in "xyz"[:dimension]:
+            raise InputError(
+                f"component {c!r} is not one of {', '.join('xyz'[:dimension])} in {dimension}D"
+            )
+        mask |= 1 << "xyz".index(c)
+    if mask == 0:
+        raise InputError("name at least one component (x, y or z)")
+    return mask
+
+
+class Simulation:
+    """A peridynamic simulation of one or more bodies.
+
+    Args:
+        dimension: 2 or 3.
+        plane: 2D assumption, ``"strain"`` (default) or ``"stress"``; ignored in 3D.
+        dt: time step [s]; default ``dt_safety`` times the stable estimate.
+        dt_safety: fraction of the stable estimate used when ``dt`` is not given.
+        gravity: body acceleration [m/s^2], e.g. (0, -9.81, 0).
+    """
+
+    def __init__(
+        self,
+        dimension: int = 2,
+        plane: Literal["strain", "stress"] = "strain",
+        *,
+        dt: float | None = None,
+        dt_safety: float = 0.8,
+        gravity: ArrayLike | None = None,
+    ) -> None:
+        if dimension not in (2, 3):
+            raise InputError(f"dimension must be 2 or 3, got {dimension!r}")
+        if plane not in ("strain", "stress"):
+            raise InputError(f"plane must be 'strain' or 'stress', got {plane!r}")
+        if not 0 < dt_safety <= 1:
+            raise InputError(f"dt_safety must be in (0, 1], got {dt_safety}")
+        self.dimension = dimension
+        self.plane = plane
+        self._dt = None if dt is None else self._check_dt(dt)
+        self._dt_safety = dt_safety
+        self._gravity = np.zeros(3)
+        if gravity is not None:
+            self.gravity = gravity  # type: ignore[assignment]
+        self.bodies: list[Body] = []
+        self._positions: list[NDArray[np.float64]] = []
+        self._volumes: list[NDArray[np.float64]] = []
+        self._initial_velocities: list[tuple[Body, NDArray[np.float64], float | NDArray[np.float64]]] = []
+        self._loads: list[tuple[str, tuple]] = []
+        self._output: _Output | None = None
+        self._core: _core.Simulation | None = None
+        self._model: _core.Model | None = None
+        self._reference: NDArray[np.float64] | None = None
+        self._wall_seconds = 0.0
+
+    # ------------------------------------------------------------------ building
+    @staticmethod
+    def _check_dt(dt: float) -> float:
+        if not (np.isfinite(dt) and dt > 0):
+            raise InputError(f"time step dt must be a positive number of seconds, got {dt!r}")
+        return float(dt)
+
+    def _require_building(self, what: str) -> None:
+        if self._core is not None:
+            raise InputError(f"cannot {what} after the simulation has started; build everything first")
+
+    def add_body(
+        self,
+        shape: Shape,
+        material: Material,
+        mesh_size: float,
+        *,
+        jitter: float = 0.0,
+        seed: int = 0,
+        velocity: ArrayLike | None = None,
+        angular_velocity: float | ArrayLike | None = None,
+        name: str | None = None,
+    ) -> Body:
+        """Discretize a shape on a uniform lattice of spacing ``mesh_size`` [m] and add it.
+
+        ``velocity`` [m/s] and ``angular_velocity`` [rad/s; a scalar about z in 2D, a vector in
+        3D, about the body's centroid] set the initial motion.
+        """
+        if shape.dimension != self.dimension:
+            raise InputError(
+                f"{type(shape).__name__} is a {shape.dimension}D shape but the simulation is "
+                f"{self.dimension}D"
+            )
+        positions, volumes = lattice(shape, mesh_size, jitter=jitter, seed=seed)
+        return self.add_body_from_nodes(
+            positions, volumes, material, mesh_size, velocity=velocity,
+            angular_velocity=angular_velocity, name=name,
+        )
+
+    def add_body_from_nodes(
+        self,
+        positions: ArrayLike,
+        volumes: ArrayLike,
+        material: Material,
+        mesh_size: float,
+        *,
+        velocity: ArrayLike | None = None,
+        angular_velocity: float | ArrayLike | None = None,
+        name: str | None = None,
+    ) -> Body:
+        """Add a body from its nodes: positions (n, 2 or 3) [m] and volumes (n,) [m^d]."""
+        self._require_building("add a body")
+        if not isinstance(material, Material):
+            raise InputError(f"material must be a granulate.Material, got {type(material).__name__}")
+        p = np.asarray(positions, dtype=np.float64)
+        if p.ndim != 2 or p.shape[1] not in (self.dimension, 3):
+            raise InputError(f"positions must be an (n, {self.dimension}) array, got shape {p.shape}")
+        if p.shape[1] == 2:
+            p = np.column_stack([p, np.zeros(len(p))])
+        v = np.asarray(volumes, dtype=np.float64).reshape(-1)
+        if len(v) != len(p):
+            raise InputError(f"{len(p)} positions but {len(v)} volumes")
+        if not (np.isfinite(mesh_size) and mesh_size > 0):
+            raise InputError(f"mesh size must be positive, got {mesh_size}")
+        index = len(self.bodies)
+        first = sum(b.node_count for b in self.bodies)
+        body = Body(index, name or f"body{index}", first, len(p), material, float(mesh_size))
+        self.bodies.append(body)
+        self._positions.append(np.ascontiguousarray(p))
+        self._volumes.append(np.ascontiguousarray(v))
+        if velocity is not None or angular_velocity is not None:
+            linear = np.zeros(3) if velocity is None else self._vector(velocity, "velocity")
+            spin: float | NDArray[np.float64] = 0.0
+            if angular_velocity is not None:
+                if self.dimension == 2:
+                    spin = float(np.asarray(angular_velocity).reshape(-1)[-1])
+                else:
+                    spin = self._vector(angular_velocity, "angular_velocity")
+            self._initial_velocities.append((body, linear, spin))
+        return body
+
+    def _vector(self, value: ArrayLike, name: str) -> NDArray[np.float64]:
+        array = np.asarray(value, dtype=np.float64).reshape(-1)
+        if array.shape not in ((self.dimension,), (3,)) or not np.all(np.isfinite(array)):
+            raise InputError(f"{name} must be {self.dimension} finite numbers, got {value!r}")
+        out = np.zeros(3)
+        out[: len(array)] = array
+        if self.dimension == 2 and out[2] != 0:
+            raise InputError(f"{name} has a z component in a 2D simulation")
+        return out
+
+    @property
+    def reference_positions(self) -> NDArray[np.float64]:
+        """(n, 3) reference positions X of all nodes [m]."""
+        if self._model is not None:
+            return self._model.reference_positions
+        if not self._positions:
+            return np.zeros((0, 3))
+        return np.concatenate(self._positions)
+
+    def select(
+        self,
+        region: Shape | None = None,
+        *,
+        body: Body | None = None,
+        ids: ArrayLike | None = None,
+    ) -> NDArray[np.uint32]:
+        """Node indices selected by a region (tested on reference positions), a body, or ids.
+
+        Criteria combine by intersection. Raises InputError when nothing is selected.
+        """
+        count = sum(b.node_count for b in self.bodies)
+        mask = np.ones(count, dtype=bool)
+        if region is not None:
+            mask &= region.contains(self.reference_positions)
+        if body is not None:
+            in_body = np.zeros(count, dtype=bool)
+            in_body[body.first_node : body.first_node + body.node_count] = True
+            mask &= in_body
+        if ids is not None:
+            chosen = np.asarray(ids, dtype=np.int64).reshape(-1)
+            if np.any(chosen < 0) or np.any(chosen >= count):
+                raise InputError(f"node ids must be in [0, {count}), got some outside")
+            in_ids = np.zeros(count, dtype=bool)
+            in_ids[chosen] = True
+            mask &= in_ids
+        nodes = np.flatnonzero(mask).astype(np.uint32)
+        if len(nodes) == 0:
+            raise InputError("the selection contains no node; check the region against the bodies")
+        return nodes
+
+    def _nodes(self, nodes: ArrayLike) -> NDArray[np.uint32]:
+        array = np.asarray(nodes).reshape(-1)
+        count = sum(b.node_count for b in self.bodies)
+        if len(array) == 0:
+            raise InputError("the node set is empty")
+        if array.dtype.kind not in "iu" or np.any(array < 0) or np.any(array >= count):
+            raise InputError(f"node ids must be integers in [0, {count})")
+        return np.ascontiguousarray(array, dtype=np.uint32)
+
+    def fix(self, nodes: ArrayLike, components: Components = "xyz") -> None:
+        """Hold the given components of the nodes at their reference position."""
+        components = components[: self.dimension] if components == "xyz" else components
+        self.prescribe_displacement(nodes, (0, 0, 0), Constant(0.0), components=components)
+
+    def prescribe_displacement(
+        self,
+        nodes: ArrayLike,
+        direction: ArrayLike,
+        function: TimeFunction,
+        *,
+        components: Components | None = None,
+    ) -> None:
+        """Impose x = X + f(t) * direction on the given components (default: all).
+
+        Example: ``prescribe_displacement(ids, (1, 0), Linear(0.01))`` pulls at 0.01 m/s in x.
+        """
+        self._require_building("add loading")
+        mask = _component_mask(components or "xyz"[: self.dimension], self.dimension)
+        self._loads.append(
+            ("displacement", (self._nodes(nodes), mask, self._vector(direction, "direction"), function))
+        )
+
+    def prescribe_velocity(
+        self, nodes: ArrayLike, velocity: ArrayLike, *, ramp_time: float = 0.0,
+        components: Components | None = None,
+    ) -> None:
+        """Move nodes at a constant velocity [m/s], reached smoothly over ``ramp_time`` [s]."""
+        v = self._vector(velocity, "velocity")
+        speed = float(np.linalg.norm(v))
+        if speed == 0:
+            self.fix(nodes, components or "xyz"[: self.dimension])
+            return
+        function: TimeFunction = VelocityRamp(speed, ramp_time) if ramp_time > 0 else Linear(speed)
+        self.prescribe_displacement(nodes, v / speed, function, components=components)
+
+    def prescribe_rotation(
+        self,
+        nodes: ArrayLike,
+        center: ArrayLike,
+        angle: TimeFunction,
+        *,
+        axis: ArrayLike = (0, 0, 1),
+    ) -> None:
+        """Rigid rotation x = c + R(angle(t)) (X - c) about an axis through c (z in 2D)."""
+        self._require_building("add loading")
+        axis_vector = np.asarray(axis, dtype=float).reshape(-1)
+        if self.dimension == 2 and not np.allclose(axis_vector, (0, 0, 1)):
+            raise InputError("in 2D, rotations are about the z axis")
+        self._loads.append(
+            ("rotation", (self._nodes(nodes), self._vector(center, "center"), axis_vector, angle))
+        )
+
+    def add_force_density(
+        self, nodes: ArrayLike, vector: ArrayLike, function: TimeFunction | None = None
+    ) -> None:
+        """Add f(t) * vector [N/m^3; N/m^2 in 2D] to the force density of the nodes."""
+        self._require_building("add loading")
+        self._loads.append(
+            ("force", (self._nodes(nodes), self._vector(vector, "force density"), function or Constant(1.0)))
+        )
+
+    @property
+    def gravity(self) -> NDArray[np.float64]:
+        """Body acceleration g [m/s^2] (adds rho g to every node)."""
+        return self._gravity.copy()
+
+    @gravity.setter
+    def gravity(self, value: ArrayLike) -> None:
+        self._gravity = self._vector(value, "gravity")
+        if self._core is not None:
+            self._core.set_body_acceleration(tuple(self._gravity))
+
+    def output(
+        self,
+        directory: str | Path,
+        every: int,
+        *,
+        fields: tuple[str, ...] = FIELDS,
+        overwrite: bool = False,
+    ) -> None:
+        """Write VTU frames (``frames/``), ``simulation.pvd`` and ``history.csv`` every N steps.
+
+        A directory that already holds a run is refused unless ``overwrite`` is true.
+        """
+        if not (isinstance(every, int) and every > 0):
+            raise InputError(f"output interval must be a positive number of steps, got {every!r}")
+        unknown = [f for f in fields if f not in FIELDS]
+        if unknown:
+            raise InputError(f"unknown output fields {unknown}; choose from {', '.join(FIELDS)}")
+        path = Path(directory)
+        if (path / "simulation.pvd").exists() and not overwrite:
+            raise InputError(
+                f"{path} already holds a run (simulation.pvd); choose another directory or pass "
+                "overwrite=True"
+            )
+        (path / "frames").mkdir(parents=True, exist_ok=True)
+        if overwrite:
+            for old in (path / "frames").glob("frame_*.vtu"):
+                old.unlink()
+        self._output = _Output(
+            path, every, tuple(fields), PvdSeries(path / "simulation.pvd"),
+            HistoryWriter(path / "history.csv", HISTORY_COLUMNS),
+        )
+
+    # ------------------------------------------------------------------ the core
+    def _build(self) -> _core.Simulation:
+        if self._core is not None:
+            return self._core
+        if not self.bodies:
+            raise InputError("the simulation has no body; add one with add_body")
+        model = _core.Model(self.dimension, getattr(_core.PlaneMode, self.plane))
+        material_ids: dict[tuple[int, float], int] = {}
+        for body, positions, volumes in zip(self.bodies, self._positions, self._volumes, strict=True):
+            key = (id(body.material), body.material.resolved_horizon(body.mesh_size))
+            if key not in material_ids:
+                material_ids[key] = model.add_material(body.material.core_params(body.mesh_size))
+            model.add_particle(positions, volumes, material_ids[key], body.mesh_size)
+        model.finalize()
+        core = _core.Simulation(model)
+        if self._dt is None:
+            core.time_step = self._dt_safety * core.stable_time_step
+        else:
+            if self._dt > core.stable_time_step:
+                warnings.warn(
+                    f"time step {self._dt:.4g} s exceeds the stable estimate "
+                    f"{core.stable_time_step:.4g} s; the run may become unstable",
+                    GranulateWarning,
+                    stacklevel=3,
+                )
+            core.time_step = self._dt
+        core.set_body_acceleration(tuple(self._gravity))
+        for kind, args in self._loads:
+            if kind == "displacement":
+                nodes, mask, direction, function = args
+                core.add_displacement(nodes, mask, tuple(direction), *function.core())
+            elif kind == "rotation":
+                nodes, center, axis, function = args
+                core.add_rotation(nodes, tuple(center), tuple(axis), *function.core())
+            else:
+                nodes, vector, function = args
+                core.add_nodal_force(nodes, tuple(vector), *function.core())
+        velocities = core.velocities
+        X = model.reference_positions
+        volumes = model.volumes
+        for body, linear, spin in self._initial_velocities:
+            sl = slice(body.first_node, body.first_node + body.node_count)
+            centroid = np.average(X[sl], axis=0, weights=volumes[sl])
+            arm = X[sl] - centroid
+            omega = np.array([0.0, 0.0, spin]) if np.isscalar(spin) else np.asarray(spin)
+            velocities[sl] = linear + np.cross(omega, arm)
+        self._model = model
+        self._core = core
+        self._reference = model.reference_positions
+        return core
+
+    @property
+    def core(self) -> _core.Simulation:
+        """The C++ simulation (built on first access)."""
+        return self._build()
+
+    @property
+    def dt(self) -> float:
+        """Time step [s]."""
+        return self._build().time_step
+
+    @dt.setter
+    def dt(self, value: float) -> None:
+        self._dt = self._check_dt(value)
+        if self._core is not None:
+            if self._dt > self._core.stable_time_step:
+                warnings.warn(
+                    f"time step {self._dt:.4g} s exceeds the stable estimate "
+                    f"{self._core.stable_time_step:.4g} s; the run may become unstable",
+                    GranulateWarning,
+                    stacklevel=2,
+                )
+            self._core.time_step = self._dt
+
+    @property
+    def stable_dt(self) -> float:
+        """Stable time-step estimate [s] (Silling & Askari's bound, see Model::stable_time_step)."""
+        return self._build().stable_time_step
+
+    def run(self, steps: int | None = None, *, until: float | None = None) -> None:
+        """Advance ``steps`` time steps, or until simulated time ``until`` [s].
+
+        Writes outputs at step 0 and every ``output(every=...)`` steps. Raises InstabilityError
+        if the integration blows up.
+        """
+        core = self._build()
+        if (steps is None) == (until is None):
+            raise InputError("give either steps or until")
+        if until is not None:
+            if not np.isfinite(until):
+                raise InputError(f"until must be a finite time, got {until}")
+            steps = max(0, int(np.ceil((until - core.time) / core.time_step - 1e-9)))
+        assert steps is not None
+        if steps < 0:
+            raise InputError(f"steps must be non-negative, got {steps}")
+        out = self._output
+        if out is not None and out.frames == 0:
+            self._write_output()
+        target = core.step + steps
+        start = wallclock.perf_counter()
+        try:
+            while core.step < target:
+                chunk = min(target - core.step, 1000)
+                if out is not None:
+                    chunk = min(chunk, out.every - core.step % out.every)
+                core.run(chunk)
+                if out is not None and core.step % out.every == 0:
+                    self._write_output()
+        finally:
+            self._wall_seconds += wallclock.perf_counter() - start
+
+    # ------------------------------------------------------------------ results
+    @property
+    def positions(self) -> NDArray[np.float64]:
+        """(n, 3) current positions x [m] (a live view)."""
+        return self._build().positions
+
+    @property
+    def velocities(self) -> NDArray[np.float64]:
+        """(n, 3) velocities v [m/s] (a live, writable view)."""
+        return self._build().velocities
+
+    @property
+    def forces(self) -> NDArray[np.float64]:
+        """(n, 3) net force densities f [N/m^3; N/m^2 in 2D] of the last step (a live view)."""
+        return self._build().forces
+
+    @property
+    def displacements(self) -> NDArray[np.float64]:
+        """(n, 3) displacements x - X [m] (a copy)."""
+        core = self._build()
+        return core.positions - self._reference
+
+    @property
+    def volumes(self) -> NDArray[np.float64]:
+        """(n,) nodal volumes [m^3; m^2 in 2D]."""
+        self._build()
+        assert self._model is not None
+        return self._model.volumes
+
+    @property
+    def damage(self) -> NDArray[np.float64]:
+        """(n,) damage phi = 1 - intact / initial influence-weighted volume of the bonds."""
+        return self._build().damage()[0]
+
+    @property
+    def damage_z(self) -> NDArray[np.float64]:
+        """(n,) PeriDEM's Damage_Z: max over a node's bonds of |stretch| / s0."""
+        return self._build().damage()[1]
+
+    @property
+    def time(self) -> float:
+        return self._build().time
+
+    @property
+    def step(self) -> int:
+        return self._build().step
+
+    def kinetic_energy(self) -> float:
+        """sum 1/2 rho V |v|^2 [J; J/m in 2D]."""
+        return self._build().kinetic_energy()
+
+    def strain_energy(self) -> float:
+        """sum W_i V_i over intact bonds [J; J/m in 2D]."""
+        return self._build().strain_energy()
+
+    def broken_bonds(self) -> int:
+        return self._build().broken_bonds()
+
+    @property
+    def node_count(self) -> int:
+        return sum(b.node_count for b in self.bodies)
+
+    @property
+    def bond_count(self) -> int:
+        """Bonds, each counted once per end (as LAMMPS counts them)."""
+        self._build()
+        assert self._model is not None
+        return self._model.bond_count
+
+    def summary(self) -> dict[str, float | int]:
+        """Counts, time step and timings of the run so far."""
+        core = self._build()
+        phases = core.phase_times
+        return {
+            "bodies": len(self.bodies),
+            "nodes": self.node_count,
+            "bonds": self.bond_count,
+            "dt": core.time_step,
+            "stable_dt": core.stable_time_step,
+            "steps": core.step,
+            "time": core.time,
+            "threads": _core.get_max_threads(),
+            "wall_seconds": self._wall_seconds,
+            "peridynamics_seconds": phases.peridynamics,
+            "integration_seconds": phases.integration,
+            "loading_seconds": phases.loading,
+        }
+
+    def _write_output(self) -> None:
+        out = self._output
+        assert out is not None and self._model is not None
+        core = self._build()
+        phi, z = core.damage()
+        volumes = self._model.volumes
+        available = {
+            "Displacement": lambda: core.positions - self._reference,
+            "Velocity": lambda: core.velocities,
+            "Force_Density": lambda: core.forces,
+            "Force": lambda: core.forces * volumes[:, None],
+            "Damage": lambda: phi,
+            "Damage_Z": lambda: z,
+            "Dilatation": lambda: core.dilatation,
+            "Particle_ID": lambda: self._model.node_particle,
+            "Fixity": lambda: core.fixity(),
+            "Nodal_Volume": lambda: volumes,
+        }
+        name = f"frame_{out.frames:06d}.vtu"
+        write_vtu(
+            out.directory / "frames" / name,
+            core.positions,
+            {field: available[field]() for field in out.fields},
+        )
+        out.pvd.add(core.time, Path("frames") / name)
+        kinetic, strain = core.kinetic_energy(), core.strain_energy()
+        out.history.write(
+            {
+                "step": core.step,
+                "time": core.time,
+                "kinetic_energy": kinetic,
+                "strain_energy": strain,
+                "total_energy": kinetic + strain,
+                "broken_bonds": core.broken_bonds(),
+            }
+        )
+        out.frames += 1
+        atomic_write(out.directory / "run.json", json.dumps(self.summary(), indent=2).encode())
