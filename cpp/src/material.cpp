@@ -25,7 +25,9 @@ void require_positive(real value, const char* name, const char* fix) {
 
 /// Dilatation of a node at depth zeta (in horizons) below the separation plane when the two
 /// half-spaces are pulled apart by u = s0 * delta * v, divided by s0 * v (see fracture_coefficients).
-real separation_dilatation_slope(InfluenceKind influence_kind, int dimension, real zeta, real v) {
+/// moment: int_0^1 J xi^4 dxi in 3D, int_0^1 J xi^3 dxi in 2D.
+real separation_dilatation_slope(InfluenceKind influence_kind, int dimension, real moment, real zeta,
+                                 real v) {
   const int n = quadrature_points;
   const real step = (1.0 - zeta) / n;
   real sum = 0;
@@ -43,8 +45,8 @@ real separation_dilatation_slope(InfluenceKind influence_kind, int dimension, re
     }
   }
   sum *= step;
-  if (dimension == 3) return 3.0 / (4.0 * influence_moment(influence_kind, 4)) * sum;
-  return 2.0 / (std::numbers::pi * influence_moment(influence_kind, 3)) * sum;
+  if (dimension == 3) return 3.0 / (4.0 * moment) * sum;
+  return 2.0 / (std::numbers::pi * moment) * sum;
 }
 
 }  // namespace
@@ -82,16 +84,17 @@ FractureCoefficients fracture_coefficients(ForceModel model, InfluenceKind influ
   // is 2 int_0^delta dz int_0^inf (kappa_d - a G/d^2) u g(z,u)^2 du with theta = u g. In units of
   // s0^2 delta this is 2 int_0^1 dzeta int_0^inf v G(zeta, v)^2 dv.
   const int n = quadrature_points;
+  const real moment = influence_moment(influence_kind, dimension == 3 ? 4 : 3);
   real total = 0;
   for (int iz = 0; iz < n; ++iz) {
     const real zeta = (iz + 0.5) / n;
     real inner = 0;
     for (int iv = 0; iv < n; ++iv) {
       const real v = (iv + 0.5) / n;  // v in (0, 1)
-      const real g = separation_dilatation_slope(influence_kind, dimension, zeta, v);
+      const real g = separation_dilatation_slope(influence_kind, dimension, moment, zeta, v);
       inner += v * g * g / n;
       const real t = (iv + 0.5) / n;  // v = 1/t in (1, inf): v dv = dt / t^3
-      const real g_far = separation_dilatation_slope(influence_kind, dimension, zeta, 1.0 / t);
+      const real g_far = separation_dilatation_slope(influence_kind, dimension, moment, zeta, 1.0 / t);
       inner += g_far * g_far / (t * t * t) / n;
     }
     total += inner / n;

@@ -215,6 +215,7 @@ void Model::build_bonds() {
   bonds_.lengths.resize(bond_count);
   weighted_volume_.assign(nodes, 0);
   lps_coefficients_.assign(nodes, {});
+  pmb_stiffness_.assign(nodes, 0);
 
   std::vector<index_t> isolated;
   std::vector<std::pair<index_t, index_t>> coincident;
@@ -230,7 +231,7 @@ void Model::build_bonds() {
     for_each_within(grids[node_particle_[i]], x, i, horizon, dimension_,
                     [&](index_t j, real) { family[filled++] = j; });
     std::sort(family, family + filled);
-    real m = 0;
+    real m = 0, first_moment = 0;
     for (index_t b = bonds_.offsets[i]; b < bonds_.offsets[i + 1]; ++b) {
       const index_t j = bonds_.neighbors[b];
       const real r = std::sqrt((x[3 * j] - x[3 * i]) * (x[3 * j] - x[3 * i]) +
@@ -245,12 +246,16 @@ void Model::build_bonds() {
       bonds_.lengths[b] = r;
       bonds_.weights[b] = weight;
       m += weight * r * r;
+      first_moment += weight * r;
     }
     if (filled == 0) {
 #pragma omp critical(granulate_isolated)
       isolated.push_back(i);
     }
     weighted_volume_[i] = m;
+    if (material.params.model == ForceModel::pmb && first_moment > 0) {
+      pmb_stiffness_[i] = dimension_ * dimension_ * material.dilatation_modulus / first_moment;
+    }
     if (m > 0) {
       const real d = dimension_;
       const real a = material.deviatoric_factor;
@@ -292,7 +297,7 @@ real Model::stable_time_step() const {
       stiffness += 2.0 * std::abs(ci.dilatation_coupling) * ci.dilatation_scale * moment * moment;
     } else {
       for (index_t k = b.offsets[i]; k < b.offsets[i + 1]; ++k) {
-        stiffness += material.micromodulus * b.weights[k] / b.lengths[k];
+        stiffness += (pmb_stiffness_[i] + pmb_stiffness_[b.neighbors[k]]) * b.weights[k] / b.lengths[k];
       }
     }
     if (stiffness > 0) dt = std::min(dt, std::sqrt(2.0 * node_density_[i] / stiffness));

@@ -183,7 +183,7 @@ void Simulation::compute_forces() {
     const index_t i = static_cast<index_t>(ii);
     const Material& material = materials[node_material[i]];
     const bool is_lps = material.params.model == ForceModel::lps;
-    const real c = material.micromodulus;
+    const real stiffness_i = m.pmb_stiffness()[i];
     const real pressure_i = pressure_[i];
     const real deviatoric_i = lps_coefficients[i].deviatoric_stiffness;
     real fx = 0, fy = 0, fz = 0;
@@ -197,7 +197,7 @@ void Simulation::compute_forces() {
       const real e = length - r;
       const real scalar = is_lps ? lps::pair_force(bonds.weights[k], r, e, pressure_i, pressure_[j], deviatoric_i,
                                                    lps_coefficients[j].deviatoric_stiffness)
-                                 : pmb::pair_force(c, bonds.weights[k], e / r);
+                                 : pmb::pair_force(stiffness_i + m.pmb_stiffness()[j], bonds.weights[k], e / r);
       const real over = scalar / length;
       fx += over * dx;
       fy += over * dy;
@@ -305,7 +305,8 @@ void Simulation::strain_energy_density(real* out) const {
       const real r = bonds.lengths[k];
       const real e = bond_extension(i, k, state_.positions);
       sum += is_lps ? lps::deviatoric_energy_term(bonds.weights[k], r, e, theta, inverse_dimension)
-                    : pmb::energy_term(material.micromodulus, bonds.weights[k], e / r, r);
+                    : pmb::energy_term(m.pmb_stiffness()[i] + m.pmb_stiffness()[bonds.neighbors[k]],
+                                       bonds.weights[k], e / r, r);
     }
     out[i] = is_lps ? 0.5 * material.dilatation_modulus * theta * theta +
                           0.5 * m.lps_coefficients()[i].deviatoric_stiffness * sum

@@ -22,7 +22,17 @@ from granulate.functions import (
     VelocityRamp,
 )
 from granulate.materials import Material
-from granulate.shapes import Box, Disc, Polygon, Rectangle, Shape, Sphere, lattice
+from granulate.shapes import (
+    Box,
+    Difference,
+    Disc,
+    Polygon,
+    Rectangle,
+    Shape,
+    Sphere,
+    Union,
+    lattice,
+)
 from granulate.simulation import FIELDS, Body, Simulation
 
 __version__ = "0.1.0"
@@ -43,6 +53,7 @@ __all__ = [
     "Body",
     "Box",
     "Constant",
+    "Difference",
     "Disc",
     "GranulateWarning",
     "InputError",
@@ -58,6 +69,7 @@ __all__ = [
     "SmoothRamp",
     "Sphere",
     "TimeFunction",
+    "Union",
     "VelocityRamp",
     "__version__",
     "get_num_threads",

@@ -225,3 +225,66 @@ def lattice(
         points[:, :d] += rng.uniform(-jitter * mesh_size, jitter * mesh_size, size=(len(points), d))
     volumes = np.full(len(points), mesh_size**d)
     return np.ascontiguousarray(points), volumes
+
+
+@dataclass(frozen=True)
+class Union(Shape):
+    """Points in any of the shapes (all of one dimension)."""
+
+    shapes: tuple[Shape, ...]
+
+    def __post_init__(self) -> None:
+        _same_dimension(self.shapes, "Union")
+
+    @property
+    def dimension(self) -> int:  # type: ignore[override]
+        return self.shapes[0].dimension
+
+    def contains(self, points: ArrayLike) -> NDArray[np.bool_]:
+        p = _points(points)
+        inside = np.zeros(len(p), dtype=bool)
+        for shape in self.shapes:
+            inside |= shape.contains(p)
+        return inside
+
+    def bounds(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        boxes = [s.bounds() for s in self.shapes]
+        return np.min([b[0] for b in boxes], axis=0), np.max([b[1] for b in boxes], axis=0)
+
+    @property
+    def measure(self) -> float:
+        raise TypeError("the measure of a Union is not known exactly; discretize it and sum volumes")
+
+
+@dataclass(frozen=True)
+class Difference(Shape):
+    """Points of ``base`` not in ``removed`` (notches, holes)."""
+
+    base: Shape
+    removed: Shape
+
+    def __post_init__(self) -> None:
+        _same_dimension((self.base, self.removed), "Difference")
+
+    @property
+    def dimension(self) -> int:  # type: ignore[override]
+        return self.base.dimension
+
+    def contains(self, points: ArrayLike) -> NDArray[np.bool_]:
+        p = _points(points)
+        return self.base.contains(p) & ~self.removed.contains(p)
+
+    def bounds(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        return self.base.bounds()
+
+    @property
+    def measure(self) -> float:
+        raise TypeError("the measure of a Difference is not known exactly; discretize it and sum volumes")
+
+
+def _same_dimension(shapes: tuple[Shape, ...], name: str) -> None:
+    if not shapes:
+        raise InputError(f"{name} needs at least one shape")
+    dimensions = {s.dimension for s in shapes}
+    if len(dimensions) != 1:
+        raise InputError(f"{name} mixes 2D and 3D shapes")

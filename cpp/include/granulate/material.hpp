@@ -33,7 +33,8 @@ struct Material {
   real dilatation_modulus = 0;
   /// a_d: 15 in 3D, 8 in 2D (deviatoric coefficient of the LPS force state).
   real deviatoric_factor = 0;
-  /// PMB micromodulus c: 3D c = 18K / I1, 2D c = 8 kappa_d / I1, I1 = int J(r/delta) r dV [Pa/m^(d+1)].
+  /// Continuum PMB micromodulus c: 3D 18K / I1, 2D 8 kappa_d / I1, I1 = int J(r/delta) r dV
+  /// [Pa/m^(d+1)]; used to derive s0. The force loop uses the per-node discrete form (pmb.hpp).
   real micromodulus = 0;
   /// s0, critical bond stretch; infinity when fracture is off.
   real critical_stretch = 0;

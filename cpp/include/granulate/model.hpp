@@ -61,6 +61,8 @@ public:
   const BondFamilies& bonds() const { return bonds_; }
   const std::vector<real>& weighted_volume() const { return weighted_volume_; }
   const std::vector<lps::NodeCoefficients>& lps_coefficients() const { return lps_coefficients_; }
+  /// k_i = d^2 kappa_d / sum_j w_ij r_ij of PMB nodes (0 for LPS nodes), see pmb.hpp.
+  const std::vector<real>& pmb_stiffness() const { return pmb_stiffness_; }
 
   /// Per-node stable time step sqrt(2 rho / sum_j C_ij w_ij), minimised (Silling & Askari
   /// 2005, with the LPS dilatation coupling bounded by Gershgorin) [s].
@@ -83,6 +85,7 @@ private:
   BondFamilies bonds_;
   std::vector<real> weighted_volume_;
   std::vector<lps::NodeCoefficients> lps_coefficients_;
+  std::vector<real> pmb_stiffness_;
 };
 
 }  // namespace granulate

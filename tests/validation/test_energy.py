@@ -1,0 +1,60 @@
+"""A free elastic body vibrating after an initial velocity conserves kinetic + strain energy
+at the default time step (DESIGN.md section 6: within 1 %), and velocity Verlet converges at
+second order: halving dt divides the energy error by about 4."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import granulate as gr
+
+
+def vibrating_body(dimension: int, model: str, dt_safety: float = 0.8) -> gr.Simulation:
+    material = gr.Material(
+        density=2000, youngs_modulus=5e9, poisson_ratio=0.3, fracture=False, model=model
+    )
+    sim = gr.Simulation(dimension, dt_safety=dt_safety)
+    h = 1e-3
+    shape = gr.Rectangle((0, 0), (0.04, 0.012)) if dimension == 2 else gr.Box((0, 0, 0), (0.02, 0.008, 0.006))
+    sim.add_body(shape, material, h)
+    X = sim.reference_positions
+    size = X.max(axis=0) - X.min(axis=0)
+    # A mix of bending, stretching and twisting, no rigid-body motion.
+    sim.velocities[:, 1] = 0.05 * np.sin(2 * np.pi * X[:, 0] / size[0])
+    sim.velocities[:, 0] = 0.03 * np.cos(np.pi * X[:, 0] / size[0]) * (X[:, 1] - X[:, 1].mean()) / size[1]
+    if dimension == 3:
+        sim.velocities[:, 2] = 0.02 * np.sin(np.pi * X[:, 0] / size[0]) * (X[:, 1] - X[:, 1].mean()) / size[1]
+    sim.velocities[:] -= np.average(sim.velocities, axis=0, weights=sim.volumes)
+    return sim
+
+
+def energy_drift(sim: gr.Simulation, steps: int) -> float:
+    initial = sim.kinetic_energy() + sim.strain_energy()
+    worst = 0.0
+    for _ in range(steps // 10):
+        sim.run(10)
+        total = sim.kinetic_energy() + sim.strain_energy()
+        worst = max(worst, abs(total / initial - 1))
+    return worst
+
+
+@pytest.mark.validation
+@pytest.mark.parametrize("dimension", [2, 3])
+@pytest.mark.parametrize("model", ["lps", "pmb"])
+def test_free_vibration_conserves_energy(dimension: int, model: str, full: bool) -> None:
+    sim = vibrating_body(dimension, model)
+    drift = energy_drift(sim, 4000 if full else 1500)
+    assert sim.strain_energy() > 0.05 * sim.kinetic_energy()  # it really vibrates
+    assert drift < 0.01, f"total energy drifted by {drift:.3%}"
+
+
+@pytest.mark.validation
+def test_verlet_energy_error_is_second_order() -> None:
+    errors = []
+    for safety in (0.8, 0.4):
+        sim = vibrating_body(2, "lps", dt_safety=safety)
+        steps = int(round(600 * 0.8 / safety))
+        errors.append(energy_drift(sim, steps))
+    ratio = errors[0] / errors[1]
+    assert 3.0 < ratio < 5.5, f"halving dt reduced the energy error by {ratio:.2f}, expected ~4"
