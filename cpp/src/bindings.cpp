@@ -223,6 +223,12 @@ NB_MODULE(_core, m) {
              return nb::make_tuple(copy_out(phi), copy_out(z));
            })
       .def("fixity", [](const Simulation& self) { return copy_out(self.fixity()); })
+      .def("fragments",
+           [](const Simulation& self) {
+             std::vector<index_t> labels(self.model().node_count());
+             self.fragments(labels.data());
+             return copy_out(labels);
+           })
       .def_prop_ro("phase_times", &Simulation::phase_times)
       .def_prop_ro("positions",
                    [](Simulation& self) {

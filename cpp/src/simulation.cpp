@@ -346,6 +346,35 @@ std::uint64_t Simulation::broken_bonds() const {
   return broken / 2;
 }
 
+index_t Simulation::fragments(index_t* labels) const {
+  // Union-find; the root of a set is always its smallest node, so labels are deterministic.
+  const index_t n = model_->node_count();
+  const BondFamilies& bonds = model_->bonds();
+  std::vector<index_t> parent(n);
+  for (index_t i = 0; i < n; ++i) parent[i] = i;
+  auto root = [&](index_t i) {
+    while (parent[i] != i) {
+      parent[i] = parent[parent[i]];
+      i = parent[i];
+    }
+    return i;
+  };
+  for (index_t i = 0; i < n; ++i) {
+    for (index_t k = bonds.offsets[i]; k < bonds.offsets[i + 1]; ++k) {
+      if (!state_.bond_intact[k]) continue;
+      const index_t a = root(i), b = root(bonds.neighbors[k]);
+      if (a < b) parent[b] = a;
+      if (b < a) parent[a] = b;
+    }
+  }
+  index_t count = 0;
+  for (index_t i = 0; i < n; ++i) {
+    labels[i] = root(i);
+    if (labels[i] == i) ++count;
+  }
+  return count;
+}
+
 std::vector<std::uint8_t> Simulation::fixity() const {
   std::vector<std::uint8_t> mask(model_->node_count(), 0);
   for (const PrescribedMotion& motion : motions_) {

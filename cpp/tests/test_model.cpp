@@ -148,6 +148,26 @@ TEST_CASE("bonds break irreversibly at the critical stretch") {
   CHECK(sim.broken_bonds() == broken);
 }
 
+TEST_CASE("fragments are the connected components of intact bonds") {
+  auto model = lattice_block(2, 12, ForceModel::lps, InfluenceKind::linear, true);
+  Simulation sim(model);
+  std::vector<index_t> labels(model->node_count());
+  CHECK(sim.fragments(labels.data()) == 1);
+  // Cut every bond crossing x = 6h: two fragments labelled by their smallest node.
+  const auto& b = model->bonds();
+  const auto& X = model->reference_positions();
+  for (index_t i = 0; i < model->node_count(); ++i) {
+    for (index_t k = b.offsets[i]; k < b.offsets[i + 1]; ++k) {
+      const index_t j = b.neighbors[k];
+      if ((X[3 * i] < 6e-3) != (X[3 * j] < 6e-3)) sim.state().bond_intact[k] = 0;
+    }
+  }
+  CHECK(sim.fragments(labels.data()) == 2);
+  CHECK(labels[0] == 0);
+  CHECK(labels[11] == 6);  // node (11, 0) belongs to the right part, whose smallest node is (6, 0)
+  CHECK(labels[12 * 12 - 1] == 6);
+}
+
 TEST_CASE("bad particles are refused with InputError") {
   auto model = std::make_shared<Model>(2, PlaneMode::strain);
   MaterialParams p;

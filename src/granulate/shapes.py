@@ -206,6 +206,12 @@ def lattice(
         raise InputError(f"jitter must be in [0, 0.5) mesh sizes, got {jitter}")
     lower, upper = shape.bounds()
     d = shape.dimension
+    smallest = float(np.min(upper[:d] - lower[:d]))
+    if mesh_size > smallest:
+        raise InputError(
+            f"mesh size {mesh_size} is larger than the shape (its smallest extent is {smallest:.4g}); "
+            "use a mesh size of at most a tenth of that"
+        )
     counts = np.maximum(1, np.round((upper[:d] - lower[:d]) / mesh_size).astype(np.int64))
     # Centre the lattice in the bounding box so that a box of whole cells is filled exactly.
     origin = 0.5 * (lower[:d] + upper[:d]) - 0.5 * counts * mesh_size

@@ -549,7 +549,19 @@ class Simulation:
         return self._build().strain_energy()
 
     def broken_bonds(self) -> int:
+        """Number of broken bonds, each counted once."""
         return self._build().broken_bonds()
+
+    def fragments(self, min_nodes: int = 1) -> list[NDArray[np.uint32]]:
+        """Pieces held together by intact bonds, largest first, each as its node indices.
+
+        Fragments smaller than ``min_nodes`` (dust, single detached nodes) are left out.
+        """
+        labels = self._build().fragments()
+        order = np.argsort(labels, kind="stable")
+        roots, starts, counts = np.unique(labels[order], return_index=True, return_counts=True)
+        pieces = [order[s : s + c].astype(np.uint32) for s, c in zip(starts, counts, strict=True) if c >= min_nodes]
+        return sorted(pieces, key=lambda piece: (-len(piece), int(piece[0])))
 
     @property
     def node_count(self) -> int:

@@ -54,6 +54,9 @@ public:
   /// phi_i = 1 - (intact weighted volume)/(initial weighted volume); z_i = max_j |s_ij| / s0.
   void damage(real* phi, real* z) const;
   std::uint64_t broken_bonds() const;  ///< broken bonds, each counted once
+  /// Fragments: connected components of the graph of intact bonds. Writes each node's label
+  /// (the smallest node index of its fragment) and returns the number of fragments.
+  index_t fragments(index_t* labels) const;
   /// Bit k set: component k of the node is prescribed.
   std::vector<std::uint8_t> fixity() const;
   const PhaseTimes& phase_times() const { return phase_times_; }

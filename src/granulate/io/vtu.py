@@ -52,7 +52,7 @@ def write_vtu(
         point_data: name -> (n,) or (n, k) array; dtypes float64/float32/int64/int32/uint32/uint8.
     """
     n = len(points)
-    arrays: list[tuple[str, str, int, bytes]] = []  # (section, name, components, payload)
+    arrays: list[tuple[str, str, bytes]] = []  # (section, name, payload)
     descriptors: list[str] = []
     offset = 0
 
@@ -61,14 +61,14 @@ def write_vtu(
         values = np.asarray(values)
         if values.dtype not in _VTK_TYPES:
             values = values.astype(np.float64)
-        components = 1 if values.ndim == 1 else values.shape[1]
+        components = "" if values.ndim == 1 else f' NumberOfComponents="{values.shape[1]}"'
         payload = _compressed(values)
         name_attr = f" Name={quoteattr(name)}" if name else ""
         descriptors.append(
-            f'<DataArray type="{_VTK_TYPES[values.dtype]}"{name_attr} '
-            f'NumberOfComponents="{components}" format="appended" offset="{offset}"/>'
+            f'<DataArray type="{_VTK_TYPES[values.dtype]}"{name_attr}{components} '
+            f'format="appended" offset="{offset}"/>'
         )
-        arrays.append((section, name, components, payload))
+        arrays.append((section, name, payload))
         offset += len(payload)
 
     for name, values in point_data.items():
@@ -98,7 +98,7 @@ def write_vtu(
         "</UnstructuredGrid>",
         '<AppendedData encoding="raw">',
     ]
-    body = "\n".join(xml).encode() + b"\n_" + b"".join(a[3] for a in arrays)
+    body = "\n".join(xml).encode() + b"\n_" + b"".join(a[2] for a in arrays)
     atomic_write(path, body + b"\n</AppendedData>\n</VTKFile>\n")
 
 
