@@ -31,19 +31,21 @@ def main(argv: list[str] | None = None) -> dict[str, float]:
     args = parser.parse_args(argv)
 
     # (1) Soda-lime glass: E = 70 GPa, nu = 0.22, Gc = 8 J/m^2.
-    glass = gr.Material(
-        density=2500, youngs_modulus=70e9, poisson_ratio=0.22, fracture_energy=8.0
-    )
+    glass = gr.Material(density=2500, youngs_modulus=70e9, poisson_ratio=0.22, fracture_energy=8.0)
     # (2) Geometry: plate with a notch in the middle of its top edge.
     length, height = 0.1, 0.02
     h = 1e-3 if args.smoke else 0.25e-3
-    notch = gr.Rectangle((0.5 * length - 0.5e-3 - h, height - 4e-3), (0.5 * length + 0.5e-3 + h, height + h))
+    notch = gr.Rectangle(
+        (0.5 * length - 0.5e-3 - h, height - 4e-3), (0.5 * length + 0.5e-3 + h, height + h)
+    )
     plate = gr.Difference(gr.Rectangle((0, 0), (length, height)), notch)
     sim = gr.Simulation(dimension=2, plane="stress")
     sim.add_body(plate, glass, mesh_size=h, name="plate")
     # (3) Loading: left 3 mm clamped, right 3 mm pulled at 1 m/s (ramped over 10 us).
     sim.fix(sim.select(gr.Rectangle((-1, -1), (3e-3, 1))))
-    sim.prescribe_velocity(sim.select(gr.Rectangle((length - 3e-3, -1), (1, 1))), (1.0, 0.0), ramp_time=10e-6)
+    sim.prescribe_velocity(
+        sim.select(gr.Rectangle((length - 3e-3, -1), (1, 1))), (1.0, 0.0), ramp_time=10e-6
+    )
     # (4) Run.
     end_time = 2e-6 if args.smoke else args.end_time
     steps = int(np.ceil(end_time / sim.dt))

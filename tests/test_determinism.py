@@ -13,7 +13,9 @@ import granulate as gr
 def cracking_plate_digest(dimension: int, threads: int) -> str:
     gr.set_num_threads(threads)
     try:
-        material = gr.Material(density=2500, youngs_modulus=70e9, poisson_ratio=0.22, fracture_energy=8.0)
+        material = gr.Material(
+            density=2500, youngs_modulus=70e9, poisson_ratio=0.22, fracture_energy=8.0
+        )
         sim = gr.Simulation(dimension)
         h = 1e-3
         if dimension == 2:

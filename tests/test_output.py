@@ -16,7 +16,9 @@ import granulate as gr
 
 
 def pulled_plate(out: Path, **output) -> gr.Simulation:
-    material = gr.Material(density=2500, youngs_modulus=70e9, poisson_ratio=0.22, fracture_energy=8.0)
+    material = gr.Material(
+        density=2500, youngs_modulus=70e9, poisson_ratio=0.22, fracture_energy=8.0
+    )
     sim = gr.Simulation(2)
     sim.add_body(gr.Rectangle((0, 0), (0.02, 0.005)), material, 0.5e-3)
     sim.fix(sim.select(gr.Rectangle((-1, -1), (0.0015, 1))))

@@ -49,7 +49,9 @@ def test_difference_and_union() -> None:
     hole = gr.Disc((0.5, 0.5), 0.25)
     _, volumes = gr.lattice(gr.Difference(plate, hole), 0.005)
     assert volumes.sum() == pytest.approx(1 - np.pi * 0.25**2, rel=2e-3)
-    _, volumes = gr.lattice(gr.Union((gr.Rectangle((0, 0), (1, 1)), gr.Rectangle((0.5, 0), (1.5, 1)))), 0.01)
+    _, volumes = gr.lattice(
+        gr.Union((gr.Rectangle((0, 0), (1, 1)), gr.Rectangle((0.5, 0), (1.5, 1)))), 0.01
+    )
     assert volumes.sum() == pytest.approx(1.5, rel=1e-9)
 
 

@@ -132,7 +132,8 @@ NB_MODULE(_core, m) {
                    })
       .def_prop_ro("volumes",
                    [](Model& self) {
-                     return view(const_cast<real*>(self.volumes().data()), self.node_count(), 0, nb::find(self));
+                     return view(const_cast<real*>(self.volumes().data()), self.node_count(), 0,
+                                 nb::find(self));
                    })
       .def_prop_ro("node_particle",
                    [](Model& self) {
@@ -141,8 +142,8 @@ NB_MODULE(_core, m) {
                    })
       .def_prop_ro("bond_offsets",
                    [](Model& self) {
-                     return view(const_cast<index_t*>(self.bonds().offsets.data()), self.bonds().offsets.size(), 0,
-                                 nb::find(self));
+                     return view(const_cast<index_t*>(self.bonds().offsets.data()),
+                                 self.bonds().offsets.size(), 0, nb::find(self));
                    })
       .def_prop_ro("bond_neighbors",
                    [](Model& self) {
@@ -236,7 +237,8 @@ NB_MODULE(_core, m) {
                    })
       .def_prop_ro("velocities",
                    [](Simulation& self) {
-                     return view(self.state().velocities.data(), self.model().node_count(), 3, nb::find(self));
+                     return view(self.state().velocities.data(), self.model().node_count(), 3,
+                                 nb::find(self));
                    })
       .def_prop_ro("forces",
                    [](Simulation& self) {
@@ -244,7 +246,8 @@ NB_MODULE(_core, m) {
                    })
       .def_prop_ro("dilatation",
                    [](Simulation& self) {
-                     return view(self.state().dilatation.data(), self.model().node_count(), 0, nb::find(self));
+                     return view(self.state().dilatation.data(), self.model().node_count(), 0,
+                                 nb::find(self));
                    })
       .def_prop_ro("bond_intact", [](Simulation& self) {
         return view(self.state().bond_intact.data(), self.state().bond_intact.size(), 0, nb::find(self));

@@ -6,7 +6,9 @@
 namespace granulate {
 namespace {
 
-real smoothstep(real s) { return s >= 1 ? 1.0 : (s <= 0 ? 0.0 : s * s * (3.0 - 2.0 * s)); }
+real smoothstep(real s) {
+  return s >= 1 ? 1.0 : (s <= 0 ? 0.0 : s * s * (3.0 - 2.0 * s));
+}
 
 /// int_0^s smoothstep = s^3 - s^4/2 for s < 1, then 1/2 + (s - 1).
 real smoothstep_integral(real s) {

@@ -33,15 +33,14 @@ real separation_dilatation_slope(InfluenceKind influence_kind, int dimension, re
   real sum = 0;
   for (int k = 0; k < n; ++k) {
     const real rho = zeta + (k + 0.5) * step;
-    const real cos_low = zeta / rho;                        // the bond reaches the other side
-    const real cos_high = v > rho ? rho / v : 1.0;          // the bond is still intact
+    const real cos_low = zeta / rho;                // the bond reaches the other side
+    const real cos_high = v > rho ? rho / v : 1.0;  // the bond is still intact
     if (cos_high <= cos_low) continue;
     const real weight = influence(influence_kind, rho);
     if (dimension == 3) {
       sum += weight * rho * rho * rho * (cos_high * cos_high - cos_low * cos_low);
     } else {
-      sum += weight * rho * rho *
-             (std::sqrt(1.0 - cos_low * cos_low) - std::sqrt(1.0 - cos_high * cos_high));
+      sum += weight * rho * rho * (std::sqrt(1.0 - cos_low * cos_low) - std::sqrt(1.0 - cos_high * cos_high));
     }
   }
   sum *= step;
@@ -61,8 +60,7 @@ real influence_moment(InfluenceKind influence_kind, int power) {
   return sum / n;
 }
 
-FractureCoefficients fracture_coefficients(ForceModel model, InfluenceKind influence_kind,
-                                           int dimension) {
+FractureCoefficients fracture_coefficients(ForceModel model, InfluenceKind influence_kind, int dimension) {
   FractureCoefficients result;
   if (model == ForceModel::pmb) {
     // Pair energy w = c J s^2 r / 2 integrated over the bonds crossing a unit area:
@@ -76,8 +74,8 @@ FractureCoefficients fracture_coefficients(ForceModel model, InfluenceKind influ
   if (dimension == 3) {
     result.pair = 15.0 / 4.0 * influence_moment(influence_kind, 5) / influence_moment(influence_kind, 4);
   } else {
-    result.pair = 8.0 / std::numbers::pi * influence_moment(influence_kind, 4) /
-                  influence_moment(influence_kind, 3);
+    result.pair =
+        8.0 / std::numbers::pi * influence_moment(influence_kind, 4) / influence_moment(influence_kind, 3);
   }
   // The dilatation term depends on the path. Along rigid separation (opening u, a bond at angle
   // phi to the normal has e = u cos(phi) and breaks at u = s0 r / cos(phi)) the work per unit area
@@ -115,8 +113,8 @@ Material Material::make(const MaterialParams& params, int dimension, PlaneMode p
     const real nu = (3 * params.bulk_modulus - 2 * params.shear_modulus) /
                     (2 * (3 * params.bulk_modulus + params.shear_modulus));
     if (!(nu > -1.0 && nu < 0.5)) {
-      throw InputError("material Poisson ratio " + format(nu) + " from K = " +
-                       format(params.bulk_modulus) + " and G = " + format(params.shear_modulus) +
+      throw InputError("material Poisson ratio " + format(nu) + " from K = " + format(params.bulk_modulus) +
+                       " and G = " + format(params.shear_modulus) +
                        " is outside (-1, 0.5); check the elastic constants");
     }
   }
@@ -144,12 +142,11 @@ Material Material::make(const MaterialParams& params, int dimension, PlaneMode p
   // 3D and plane strain, 1/3 in plane stress).
   if (params.model == ForceModel::pmb) {
     if (dimension == 3) {
-      m.micromodulus = 18.0 * K / (4.0 * std::numbers::pi * std::pow(delta, 4) *
-                                   influence_moment(params.influence, 3));
+      m.micromodulus =
+          18.0 * K / (4.0 * std::numbers::pi * std::pow(delta, 4) * influence_moment(params.influence, 3));
     } else {
       m.micromodulus = 8.0 * m.dilatation_modulus /
-                       (2.0 * std::numbers::pi * std::pow(delta, 3) *
-                        influence_moment(params.influence, 2));
+                       (2.0 * std::numbers::pi * std::pow(delta, 3) * influence_moment(params.influence, 2));
     }
   }
 
@@ -167,8 +164,9 @@ Material Material::make(const MaterialParams& params, int dimension, PlaneMode p
       energy_per_stretch2 = coefficients.pair * m.micromodulus * std::pow(delta, dimension + 2);
     }
     if (!(energy_per_stretch2 > 0)) {
-      throw InputError("material constants give a non-positive fracture energy per stretch; "
-                       "check K and G (Poisson ratio near -1?)");
+      throw InputError(
+          "material constants give a non-positive fracture energy per stretch; "
+          "check K and G (Poisson ratio near -1?)");
     }
     m.critical_stretch = std::sqrt(params.fracture_energy / energy_per_stretch2);
   }

@@ -20,8 +20,8 @@ struct CellGrid {
   std::array<std::int64_t, 3> cell_of(const real* x) const {
     std::array<std::int64_t, 3> c{};
     for (int k = 0; k < 3; ++k) {
-      c[k] = std::clamp<std::int64_t>(static_cast<std::int64_t>((x[k] - origin[k]) / cell_size), 0,
-                                      dims[k] - 1);
+      c[k] =
+          std::clamp<std::int64_t>(static_cast<std::int64_t>((x[k] - origin[k]) / cell_size), 0, dims[k] - 1);
     }
     return c;
   }
@@ -68,8 +68,8 @@ CellGrid build_grid(const std::vector<real>& x, const Particle& p, real cell_siz
 
 /// Calls visit(j, r^2) for every node j != i of the grid with |X_j - X_i| <= radius.
 template <class Visit>
-void for_each_within(const CellGrid& grid, const std::vector<real>& x, index_t i, real radius,
-                     int dimension, Visit&& visit) {
+void for_each_within(const CellGrid& grid, const std::vector<real>& x, index_t i, real radius, int dimension,
+                     Visit&& visit) {
   const real* xi = &x[3 * i];
   const auto c = grid.cell_of(xi);
   const real limit = radius * radius * (1.0 + 1e-10);
@@ -112,7 +112,8 @@ Model::Model(int dimension, PlaneMode plane) : dimension_(dimension), plane_(pla
 
 void Model::require_not_finalized(const char* what) const {
   if (finalized_) {
-    throw InputError(std::string("cannot ") + what + " after the model is finalized; "
+    throw InputError(std::string("cannot ") + what +
+                     " after the model is finalized; "
                      "build the whole model before the first run");
   }
 }
@@ -123,8 +124,8 @@ index_t Model::add_material(const MaterialParams& params) {
   return static_cast<index_t>(materials_.size() - 1);
 }
 
-index_t Model::add_particle(std::span<const real> positions, std::span<const real> volumes,
-                            index_t material, real mesh_size) {
+index_t Model::add_particle(std::span<const real> positions, std::span<const real> volumes, index_t material,
+                            real mesh_size) {
   require_not_finalized("add a particle");
   const std::size_t n = volumes.size();
   const index_t id = static_cast<index_t>(particles_.size());
@@ -133,12 +134,12 @@ index_t Model::add_particle(std::span<const real> positions, std::span<const rea
     throw InputError("particle positions must be an n x 3 array matching n volumes");
   }
   if (material >= materials_.size()) {
-    throw InputError("particle " + std::to_string(id) + " refers to material " +
-                     std::to_string(material) + ", but only " + std::to_string(materials_.size()) +
-                     " materials exist");
+    throw InputError("particle " + std::to_string(id) + " refers to material " + std::to_string(material) +
+                     ", but only " + std::to_string(materials_.size()) + " materials exist");
   }
   if (!(mesh_size > 0) || !std::isfinite(mesh_size)) {
-    throw InputError("particle " + std::to_string(id) + ": mesh size must be positive, got " + str(mesh_size));
+    throw InputError("particle " + std::to_string(id) + ": mesh size must be positive, got " +
+                     str(mesh_size));
   }
   const real horizon = materials_[material].params.horizon;
   if (horizon < mesh_size * (1.0 - 1e-9)) {
@@ -148,8 +149,8 @@ index_t Model::add_particle(std::span<const real> positions, std::span<const rea
   }
   for (std::size_t a = 0; a < n; ++a) {
     if (!(volumes[a] > 0) || !std::isfinite(volumes[a])) {
-      throw InputError("particle " + std::to_string(id) + ": node " + std::to_string(a) +
-                       " has volume " + str(volumes[a]) +
+      throw InputError("particle " + std::to_string(id) + ": node " + std::to_string(a) + " has volume " +
+                       str(volumes[a]) +
                        "; every node needs a positive volume (check the mesh for degenerate elements)");
     }
     for (int k = 0; k < 3; ++k) {
@@ -242,7 +243,8 @@ void Model::build_bonds() {
         coincident.emplace_back(i, j);
       }
       const real partial = r > horizon - 0.5 * h ? std::min(1.0, (horizon + 0.5 * h - r) / h) : 1.0;
-      const real weight = influence(material.params.influence, std::min(r / horizon, 1.0)) * volumes_[j] * partial;
+      const real weight =
+          influence(material.params.influence, std::min(r / horizon, 1.0)) * volumes_[j] * partial;
       bonds_.lengths[b] = r;
       bonds_.weights[b] = weight;
       m += weight * r * r;

@@ -117,7 +117,8 @@ void Simulation::apply_prescribed_motion(bool positions_too) {
           const real p[3] = {X[3 * i] - motion.center[0], X[3 * i + 1] - motion.center[1],
                              X[3 * i + 2] - motion.center[2]};
           const real kp = k[0] * p[0] + k[1] * p[1] + k[2] * p[2];
-          const real kxp[3] = {k[1] * p[2] - k[2] * p[1], k[2] * p[0] - k[0] * p[2], k[0] * p[1] - k[1] * p[0]};
+          const real kxp[3] = {k[1] * p[2] - k[2] * p[1], k[2] * p[0] - k[0] * p[2],
+                               k[0] * p[1] - k[1] * p[0]};
           for (int c = 0; c < 3; ++c) {
             x[3 * i + c] = motion.center[c] + p[c] * cs + kxp[c] * sn + k[c] * kp * (1.0 - cs);
           }
@@ -195,9 +196,10 @@ void Simulation::compute_forces() {
       if (!(length > 0)) continue;
       const real r = bonds.lengths[k];
       const real e = length - r;
-      const real scalar = is_lps ? lps::pair_force(bonds.weights[k], r, e, pressure_i, pressure_[j], deviatoric_i,
-                                                   lps_coefficients[j].deviatoric_stiffness)
-                                 : pmb::pair_force(stiffness_i + m.pmb_stiffness()[j], bonds.weights[k], e / r);
+      const real scalar = is_lps
+                              ? lps::pair_force(bonds.weights[k], r, e, pressure_i, pressure_[j],
+                                                deviatoric_i, lps_coefficients[j].deviatoric_stiffness)
+                              : pmb::pair_force(stiffness_i + m.pmb_stiffness()[j], bonds.weights[k], e / r);
       const real over = scalar / length;
       fx += over * dx;
       fy += over * dy;
@@ -268,8 +270,10 @@ void Simulation::check_stability() const {
                         std::isfinite(x[3 * i + 2]);
     if (!finite || std::sqrt(speed2) * time_step_ > mesh_size_[i]) {
       std::ostringstream msg;
-      msg << "the simulation became unstable at step " << state_.step << " (t = " << state_.time << " s): node "
-          << i << (finite ? " moved more than its mesh size in one step" : " has a non-finite position or velocity")
+      msg << "the simulation became unstable at step " << state_.step << " (t = " << state_.time
+          << " s): node " << i
+          << (finite ? " moved more than its mesh size in one step"
+                     : " has a non-finite position or velocity")
           << ". The time step is " << time_step_ << " s and the stable estimate is " << stable_time_step_
           << " s; use a smaller time step (or a slower loading)";
       throw InstabilityError(msg.str());
@@ -333,7 +337,8 @@ void Simulation::damage(real* phi, real* z) const {
     for (index_t k = bonds.offsets[i]; k < bonds.offsets[i + 1]; ++k) {
       all += bonds.weights[k];
       if (state_.bond_intact[k]) intact += bonds.weights[k];
-      max_stretch = std::max(max_stretch, std::abs(bond_extension(i, k, state_.positions) / bonds.lengths[k]));
+      max_stretch =
+          std::max(max_stretch, std::abs(bond_extension(i, k, state_.positions) / bonds.lengths[k]));
     }
     if (phi) phi[i] = all > 0 ? 1.0 - intact / all : 0.0;
     if (z) z[i] = std::isfinite(s0) ? max_stretch / s0 : 0.0;

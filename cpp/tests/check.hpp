@@ -20,7 +20,9 @@ struct Registry {
 };
 
 struct Register {
-  Register(const char* name, std::function<void()> body) { Registry::get().cases.emplace_back(name, std::move(body)); }
+  Register(const char* name, std::function<void()> body) {
+    Registry::get().cases.emplace_back(name, std::move(body));
+  }
 };
 
 inline void fail(const char* file, int line, const std::string& what) {
@@ -42,26 +44,32 @@ inline bool close(double a, double b, double rtol, double atol = 0) {
 
 #define GT_CAT2(a, b) a##b
 #define GT_CAT(a, b) GT_CAT2(a, b)
-#define TEST_CASE(name)                                                                          \
-  static void GT_CAT(test_body_, __LINE__)();                                                    \
+#define TEST_CASE(name)                                                                                 \
+  static void GT_CAT(test_body_, __LINE__)();                                                           \
   static granulate_test::Register GT_CAT(test_register_, __LINE__)(name, GT_CAT(test_body_, __LINE__)); \
   static void GT_CAT(test_body_, __LINE__)()
 
-#define CHECK(condition) \
-  do { if (!(condition)) granulate_test::fail(__FILE__, __LINE__, #condition); } while (0)
-
-#define CHECK_CLOSE(a, b, rtol)                                                                    \
-  do {                                                                                             \
-    const double check_a_ = (a), check_b_ = (b);                                                   \
-    if (!granulate_test::close(check_a_, check_b_, (rtol)))                                        \
-      granulate_test::fail(__FILE__, __LINE__,                                                     \
-                           std::string(#a " ~ " #b ": ") + granulate_test::show(check_a_) + " vs " + \
-                               granulate_test::show(check_b_));                                    \
+#define CHECK(condition)                                                    \
+  do {                                                                      \
+    if (!(condition)) granulate_test::fail(__FILE__, __LINE__, #condition); \
   } while (0)
 
-#define CHECK_THROWS(expression, type)                                                  \
-  do {                                                                                  \
-    bool thrown_ = false;                                                               \
-    try { (void)(expression); } catch (const type&) { thrown_ = true; }                 \
+#define CHECK_CLOSE(a, b, rtol)                                                                      \
+  do {                                                                                               \
+    const double check_a_ = (a), check_b_ = (b);                                                     \
+    if (!granulate_test::close(check_a_, check_b_, (rtol)))                                          \
+      granulate_test::fail(__FILE__, __LINE__,                                                       \
+                           std::string(#a " ~ " #b ": ") + granulate_test::show(check_a_) + " vs " + \
+                               granulate_test::show(check_b_));                                      \
+  } while (0)
+
+#define CHECK_THROWS(expression, type)                                                           \
+  do {                                                                                           \
+    bool thrown_ = false;                                                                        \
+    try {                                                                                        \
+      (void)(expression);                                                                        \
+    } catch (const type&) {                                                                      \
+      thrown_ = true;                                                                            \
+    }                                                                                            \
     if (!thrown_) granulate_test::fail(__FILE__, __LINE__, #expression " did not throw " #type); \
   } while (0)

@@ -44,8 +44,9 @@ TEST_CASE("critical stretch breaks in tension only unless asked") {
 
 TEST_CASE("time functions: values and rates by finite differences") {
   using K = TimeFunction::Kind;
-  const TimeFunction functions[] = {{K::constant, 2, 0},   {K::linear, 2, 0},      {K::quadratic, 2, 3},
-                                    {K::sine, 2, 5},       {K::smooth_ramp, 2, 0.4}, {K::velocity_ramp, 2, 0.4}};
+  const TimeFunction functions[] = {{K::constant, 2, 0},      {K::linear, 2, 0},
+                                    {K::quadratic, 2, 3},     {K::sine, 2, 5},
+                                    {K::smooth_ramp, 2, 0.4}, {K::velocity_ramp, 2, 0.4}};
   for (const TimeFunction& f : functions) {
     for (double t : {0.05, 0.2, 0.33, 0.7}) {
       const double h = 1e-6;

@@ -29,7 +29,8 @@ std::shared_ptr<Model> lattice_block(int dimension, int n, ForceModel force_mode
   for (int k = 0; k < nz; ++k)
     for (int j = 0; j < n; ++j)
       for (int i = 0; i < n; ++i) {
-        x.insert(x.end(), {offset + (i + 0.5) * h, offset + (j + 0.5) * h, dimension == 3 ? (k + 0.5) * h : 0.0});
+        x.insert(x.end(),
+                 {offset + (i + 0.5) * h, offset + (j + 0.5) * h, dimension == 3 ? (k + 0.5) * h : 0.0});
         v.push_back(dimension == 3 ? h * h * h : h * h);
       }
   model->add_particle(x, v, material, h);
@@ -181,7 +182,8 @@ TEST_CASE("bad particles are refused with InputError") {
   CHECK_THROWS(model->add_particle(x, std::vector<double>{1e-6, 0.0}, material, 1e-3), InputError);
   CHECK_THROWS(model->add_particle(x, std::vector<double>{1e-6, 1e-6}, 5, 1e-3), InputError);
   CHECK_THROWS(model->add_particle(x, std::vector<double>{1e-6, 1e-6}, material, 4e-3), InputError);
-  CHECK_THROWS(model->add_particle(std::vector<double>{0, 0, 1, 1, 0, 0}, std::vector<double>{1e-6, 1e-6}, material, 1e-3),
+  CHECK_THROWS(model->add_particle(std::vector<double>{0, 0, 1, 1, 0, 0}, std::vector<double>{1e-6, 1e-6},
+                                   material, 1e-3),
                InputError);
   // coincident nodes
   model->add_particle(std::vector<double>{0, 0, 0, 0, 0, 0}, std::vector<double>{1e-6, 1e-6}, material, 1e-3);
@@ -189,7 +191,8 @@ TEST_CASE("bad particles are refused with InputError") {
   // an isolated node
   auto lonely = std::make_shared<Model>(2, PlaneMode::strain);
   lonely->add_material(p);
-  lonely->add_particle(std::vector<double>{0, 0, 0, 1e-3, 0, 0, 1, 1, 0}, std::vector<double>{1e-6, 1e-6, 1e-6}, 0, 1e-3);
+  lonely->add_particle(std::vector<double>{0, 0, 0, 1e-3, 0, 0, 1, 1, 0},
+                       std::vector<double>{1e-6, 1e-6, 1e-6}, 0, 1e-3);
   CHECK_THROWS(lonely->finalize(), InputError);
   CHECK_THROWS(Model(4, PlaneMode::strain), InputError);
 }

@@ -66,7 +66,9 @@ class Material(BaseModel):
         if self.fracture and self.fracture_energy is None:
             raise ValueError("fracture_energy (Gc, J/m^2) is required; or set fracture=False")
         if self.horizon is not None and self.horizon_factor is not None:
-            raise ValueError("give horizon (absolute) or horizon_factor (times mesh size), not both")
+            raise ValueError(
+                "give horizon (absolute) or horizon_factor (times mesh size), not both"
+            )
         self.elastic_moduli()  # raises for E outside what K or G allow (nu outside (-1, 0.5))
         return self
 

@@ -59,9 +59,14 @@ class Rectangle(Shape):
     dimension: int = field(default=2, init=False)
 
     def __post_init__(self) -> None:
-        lo, hi = _vector(self.lower, 2, "Rectangle lower"), _vector(self.upper, 2, "Rectangle upper")
+        lo, hi = (
+            _vector(self.lower, 2, "Rectangle lower"),
+            _vector(self.upper, 2, "Rectangle upper"),
+        )
         if np.any(hi <= lo):
-            raise InputError(f"Rectangle upper {self.upper} must exceed lower {self.lower} in x and y")
+            raise InputError(
+                f"Rectangle upper {self.upper} must exceed lower {self.lower} in x and y"
+            )
 
     def contains(self, points: ArrayLike) -> NDArray[np.bool_]:
         p = _points(points)
@@ -209,7 +214,8 @@ def lattice(
     smallest = float(np.min(upper[:d] - lower[:d]))
     if mesh_size > smallest:
         raise InputError(
-            f"mesh size {mesh_size} is larger than the shape (its smallest extent is {smallest:.4g}); "
+            f"mesh size {mesh_size} is larger than the shape (its smallest extent is "
+            f"{smallest:.4g}); "
             "use a mesh size of at most a tenth of that"
         )
     counts = np.maximum(1, np.round((upper[:d] - lower[:d]) / mesh_size).astype(np.int64))
@@ -225,7 +231,9 @@ def lattice(
     points[:, :d] = grid
     points = points[shape.contains(points)]
     if len(points) == 0:
-        raise InputError(f"mesh size {mesh_size} is too coarse: no lattice node falls inside the shape")
+        raise InputError(
+            f"mesh size {mesh_size} is too coarse: no lattice node falls inside the shape"
+        )
     if jitter > 0:
         rng = np.random.default_rng(seed)
         points[:, :d] += rng.uniform(-jitter * mesh_size, jitter * mesh_size, size=(len(points), d))
@@ -259,7 +267,9 @@ class Union(Shape):
 
     @property
     def measure(self) -> float:
-        raise TypeError("the measure of a Union is not known exactly; discretize it and sum volumes")
+        raise TypeError(
+            "the measure of a Union is not known exactly; discretize it and sum volumes"
+        )
 
 
 @dataclass(frozen=True)
@@ -285,7 +295,9 @@ class Difference(Shape):
 
     @property
     def measure(self) -> float:
-        raise TypeError("the measure of a Difference is not known exactly; discretize it and sum volumes")
+        raise TypeError(
+            "the measure of a Difference is not known exactly; discretize it and sum volumes"
+        )
 
 
 def _same_dimension(shapes: tuple[Shape, ...], name: str) -> None:

@@ -129,7 +129,9 @@ class Simulation:
         self.bodies: list[Body] = []
         self._positions: list[NDArray[np.float64]] = []
         self._volumes: list[NDArray[np.float64]] = []
-        self._initial_velocities: list[tuple[Body, NDArray[np.float64], float | NDArray[np.float64]]] = []
+        self._initial_velocities: list[
+            tuple[Body, NDArray[np.float64], float | NDArray[np.float64]]
+        ] = []
         self._loads: list[tuple[str, tuple]] = []
         self._output: _Output | None = None
         self._core: _core.Simulation | None = None
@@ -146,7 +148,9 @@ class Simulation:
 
     def _require_building(self, what: str) -> None:
         if self._core is not None:
-            raise InputError(f"cannot {what} after the simulation has started; build everything first")
+            raise InputError(
+                f"cannot {what} after the simulation has started; build everything first"
+            )
 
     def add_body(
         self,
@@ -172,8 +176,13 @@ class Simulation:
             )
         positions, volumes = lattice(shape, mesh_size, jitter=jitter, seed=seed)
         return self.add_body_from_nodes(
-            positions, volumes, material, mesh_size, velocity=velocity,
-            angular_velocity=angular_velocity, name=name,
+            positions,
+            volumes,
+            material,
+            mesh_size,
+            velocity=velocity,
+            angular_velocity=angular_velocity,
+            name=name,
         )
 
     def add_body_from_nodes(
@@ -190,10 +199,14 @@ class Simulation:
         """Add a body from its nodes: positions (n, 2 or 3) [m] and volumes (n,) [m^d]."""
         self._require_building("add a body")
         if not isinstance(material, Material):
-            raise InputError(f"material must be a granulate.Material, got {type(material).__name__}")
+            raise InputError(
+                f"material must be a granulate.Material, got {type(material).__name__}"
+            )
         p = np.asarray(positions, dtype=np.float64)
         if p.ndim != 2 or p.shape[1] not in (self.dimension, 3):
-            raise InputError(f"positions must be an (n, {self.dimension}) array, got shape {p.shape}")
+            raise InputError(
+                f"positions must be an (n, {self.dimension}) array, got shape {p.shape}"
+            )
         if p.shape[1] == 2:
             p = np.column_stack([p, np.zeros(len(p))])
         v = np.asarray(volumes, dtype=np.float64).reshape(-1)
@@ -297,11 +310,18 @@ class Simulation:
         self._require_building("add loading")
         mask = _component_mask(components or "xyz"[: self.dimension], self.dimension)
         self._loads.append(
-            ("displacement", (self._nodes(nodes), mask, self._vector(direction, "direction"), function))
+            (
+                "displacement",
+                (self._nodes(nodes), mask, self._vector(direction, "direction"), function),
+            )
         )
 
     def prescribe_velocity(
-        self, nodes: ArrayLike, velocity: ArrayLike, *, ramp_time: float = 0.0,
+        self,
+        nodes: ArrayLike,
+        velocity: ArrayLike,
+        *,
+        ramp_time: float = 0.0,
         components: Components | None = None,
     ) -> None:
         """Move nodes at a constant velocity [m/s], reached smoothly over ``ramp_time`` [s]."""
@@ -336,7 +356,14 @@ class Simulation:
         """Add f(t) * vector [N/m^3; N/m^2 in 2D] to the force density of the nodes."""
         self._require_building("add loading")
         self._loads.append(
-            ("force", (self._nodes(nodes), self._vector(vector, "force density"), function or Constant(1.0)))
+            (
+                "force",
+                (
+                    self._nodes(nodes),
+                    self._vector(vector, "force density"),
+                    function or Constant(1.0),
+                ),
+            )
         )
 
     @property
@@ -378,7 +405,10 @@ class Simulation:
             for old in (path / "frames").glob("frame_*.vtu"):
                 old.unlink()
         self._output = _Output(
-            path, every, tuple(fields), PvdSeries(path / "simulation.pvd"),
+            path,
+            every,
+            tuple(fields),
+            PvdSeries(path / "simulation.pvd"),
             HistoryWriter(path / "history.csv", HISTORY_COLUMNS),
         )
 
@@ -390,7 +420,9 @@ class Simulation:
             raise InputError("the simulation has no body; add one with add_body")
         model = _core.Model(self.dimension, getattr(_core.PlaneMode, self.plane))
         material_ids: dict[tuple[int, float], int] = {}
-        for body, positions, volumes in zip(self.bodies, self._positions, self._volumes, strict=True):
+        for body, positions, volumes in zip(
+            self.bodies, self._positions, self._volumes, strict=True
+        ):
             key = (id(body.material), body.material.resolved_horizon(body.mesh_size))
             if key not in material_ids:
                 material_ids[key] = model.add_material(body.material.core_params(body.mesh_size))
@@ -559,8 +591,12 @@ class Simulation:
         """
         labels = self._build().fragments()
         order = np.argsort(labels, kind="stable")
-        roots, starts, counts = np.unique(labels[order], return_index=True, return_counts=True)
-        pieces = [order[s : s + c].astype(np.uint32) for s, c in zip(starts, counts, strict=True) if c >= min_nodes]
+        _roots, starts, counts = np.unique(labels[order], return_index=True, return_counts=True)
+        pieces = [
+            order[s : s + c].astype(np.uint32)
+            for s, c in zip(starts, counts, strict=True)
+            if c >= min_nodes
+        ]
         return sorted(pieces, key=lambda piece: (-len(piece), int(piece[0])))
 
     @property

@@ -16,15 +16,23 @@ def vibrating_body(dimension: int, model: str, dt_safety: float = 0.8) -> gr.Sim
     )
     sim = gr.Simulation(dimension, dt_safety=dt_safety)
     h = 1e-3
-    shape = gr.Rectangle((0, 0), (0.04, 0.012)) if dimension == 2 else gr.Box((0, 0, 0), (0.02, 0.008, 0.006))
+    shape = (
+        gr.Rectangle((0, 0), (0.04, 0.012))
+        if dimension == 2
+        else gr.Box((0, 0, 0), (0.02, 0.008, 0.006))
+    )
     sim.add_body(shape, material, h)
     X = sim.reference_positions
     size = X.max(axis=0) - X.min(axis=0)
     # A mix of bending, stretching and twisting, no rigid-body motion.
     sim.velocities[:, 1] = 0.05 * np.sin(2 * np.pi * X[:, 0] / size[0])
-    sim.velocities[:, 0] = 0.03 * np.cos(np.pi * X[:, 0] / size[0]) * (X[:, 1] - X[:, 1].mean()) / size[1]
+    sim.velocities[:, 0] = (
+        0.03 * np.cos(np.pi * X[:, 0] / size[0]) * (X[:, 1] - X[:, 1].mean()) / size[1]
+    )
     if dimension == 3:
-        sim.velocities[:, 2] = 0.02 * np.sin(np.pi * X[:, 0] / size[0]) * (X[:, 1] - X[:, 1].mean()) / size[1]
+        sim.velocities[:, 2] = (
+            0.02 * np.sin(np.pi * X[:, 0] / size[0]) * (X[:, 1] - X[:, 1].mean()) / size[1]
+        )
     sim.velocities[:] -= np.average(sim.velocities, axis=0, weights=sim.volumes)
     return sim
 
@@ -54,7 +62,7 @@ def test_verlet_energy_error_is_second_order() -> None:
     errors = []
     for safety in (0.8, 0.4):
         sim = vibrating_body(2, "lps", dt_safety=safety)
-        steps = int(round(600 * 0.8 / safety))
+        steps = round(600 * 0.8 / safety)
         errors.append(energy_drift(sim, steps))
     ratio = errors[0] / errors[1]
     assert 3.0 < ratio < 5.5, f"halving dt reduced the energy error by {ratio:.2f}, expected ~4"

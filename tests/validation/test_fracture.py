@@ -18,7 +18,9 @@ import granulate as gr
 GC = 50.0
 
 
-def separation_work(material: gr.Material, dimension: int, lengths: tuple[float, float], h: float) -> float:
+def separation_work(
+    material: gr.Material, dimension: int, lengths: tuple[float, float], h: float
+) -> float:
     """Work [J, or J/m in 2D] to pull the upper half of a block rigidly off the lower half."""
     delta = material.resolved_horizon(h)
     half = delta + 2 * h
@@ -82,8 +84,12 @@ def test_separation_work_equals_fracture_energy(
     dimension: int, model: str, influence: str, nu: float, full: bool
 ) -> None:
     material = gr.Material(
-        density=1000, youngs_modulus=1e9, poisson_ratio=nu, fracture_energy=GC,
-        model=model, influence=influence,
+        density=1000,
+        youngs_modulus=1e9,
+        poisson_ratio=nu,
+        fracture_energy=GC,
+        model=model,
+        influence=influence,
     )
     measured = measured_fracture_energy(material, dimension, 1e-3, full)
     error = measured / GC - 1
@@ -96,7 +102,10 @@ def test_fracture_energy_converges_with_horizon_ratio() -> None:
     errors = []
     for m in (3, 6):
         material = gr.Material(
-            density=1000, youngs_modulus=1e9, poisson_ratio=0.25, fracture_energy=GC,
+            density=1000,
+            youngs_modulus=1e9,
+            poisson_ratio=0.25,
+            fracture_energy=GC,
             horizon_factor=m,
         )
         errors.append(abs(measured_fracture_energy(material, 2, 1e-3, False) / GC - 1))

@@ -16,7 +16,7 @@ STRAIN_3D = np.array([[1e-4, 3e-5, -4e-5], [3e-5, -2e-4, 0], [-4e-5, 0, 1.5e-4]]
 
 
 def classical_energy_density(strain: np.ndarray, dimension: int, plane: str) -> float:
-    """W = lambda/2 (tr eps)^2 + mu eps:eps, with lambda* = 2 lambda mu/(lambda + 2 mu) in plane stress."""
+    """W = lambda/2 (tr eps)^2 + mu eps:eps; plane stress: lambda* = 2 lambda mu/(lambda + 2 mu)."""
     lam = K - 2 * G / 3
     if dimension == 2 and plane == "stress":
         lam = 2 * lam * G / (lam + 2 * G)
@@ -70,7 +70,9 @@ def test_patch_interior_forces_vanish_and_energy_is_classical(dimension: int, pl
 
 @pytest.mark.validation
 @pytest.mark.parametrize(("dimension", "plane"), CASES)
-def test_patch_surface_error_converges_first_order_in_h(dimension: int, plane: str, full: bool) -> None:
+def test_patch_surface_error_converges_first_order_in_h(
+    dimension: int, plane: str, full: bool
+) -> None:
     """At a fixed horizon ratio the interior energy density does not depend on h; what the
     surface layer (thickness delta = 3h) adds to the total energy must vanish like h:
     |E_total / (W_interior V) - 1| falls with a rate of at least 0.8 in h."""
@@ -102,7 +104,9 @@ def test_patch_interior_error_shrinks_with_horizon_ratio(dimension: int, plane: 
         n = 4 * m + 3
         size = n * h
         sim = gr.Simulation(dimension, plane)
-        shape = gr.Rectangle((0, 0), (size, size)) if dimension == 2 else gr.Box((0, 0, 0), (size,) * 3)
+        shape = (
+            gr.Rectangle((0, 0), (size, size)) if dimension == 2 else gr.Box((0, 0, 0), (size,) * 3)
+        )
         sim.add_body(shape, material, h)
         X = sim.reference_positions
         centre = X.mean(axis=0)

@@ -37,7 +37,9 @@ def first_mode_period(dimension: int, plane: str, length: float, width: float, h
         sim.run(5)
         amplitude = float(np.sum(sim.displacements[:, 0] * mode * V))
         if previous > 0 and amplitude <= 0:
-            crossing = previous_time + previous * (sim.time - previous_time) / (previous - amplitude)
+            crossing = previous_time + previous * (sim.time - previous_time) / (
+                previous - amplitude
+            )
             return 2 * crossing
         previous_time, previous = sim.time, amplitude
         assert sim.time < 2 * length / np.sqrt(E / RHO), "no zero crossing within a period"

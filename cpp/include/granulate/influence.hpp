@@ -17,14 +17,10 @@ enum class InfluenceKind : std::uint8_t { constant, linear, gaussian, inverse };
 /// J(xi) for xi = r / horizon; dimensionless.
 inline real influence(InfluenceKind kind, real xi) {
   switch (kind) {
-    case InfluenceKind::constant:
-      return 1.0;
-    case InfluenceKind::linear:
-      return 1.0 - xi;
-    case InfluenceKind::gaussian:
-      return std::exp(-xi * xi / 0.16);
-    case InfluenceKind::inverse:
-      return 1.0 / xi;
+    case InfluenceKind::constant: return 1.0;
+    case InfluenceKind::linear: return 1.0 - xi;
+    case InfluenceKind::gaussian: return std::exp(-xi * xi / 0.16);
+    case InfluenceKind::inverse: return 1.0 / xi;
   }
   return 1.0;
 }

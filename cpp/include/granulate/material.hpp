@@ -14,14 +14,14 @@ enum class ForceModel : std::uint8_t { lps, pmb };
 /// What the user gives (SI units).
 struct MaterialParams {
   ForceModel model = ForceModel::lps;
-  real density = 0;         ///< rho [kg/m^3]
-  real bulk_modulus = 0;    ///< K, 3D bulk modulus [Pa]
-  real shear_modulus = 0;   ///< G [Pa]
-  real horizon = 0;         ///< delta [m], absolute
-  real fracture_energy = 0; ///< critical energy release rate Gc [J/m^2]
+  real density = 0;          ///< rho [kg/m^3]
+  real bulk_modulus = 0;     ///< K, 3D bulk modulus [Pa]
+  real shear_modulus = 0;    ///< G [Pa]
+  real horizon = 0;          ///< delta [m], absolute
+  real fracture_energy = 0;  ///< critical energy release rate Gc [J/m^2]
   InfluenceKind influence = InfluenceKind::linear;
-  bool fracture = true;              ///< false: elastic, bonds never break
-  bool break_in_compression = false; ///< true: |s| > s0 breaks, not only s > s0
+  bool fracture = true;               ///< false: elastic, bonds never break
+  bool break_in_compression = false;  ///< true: |s| > s0 breaks, not only s > s0
 };
 
 /// Constants a force loop needs, derived once from MaterialParams for one dimension and plane.
@@ -52,8 +52,7 @@ struct FractureCoefficients {
   real pair = 0;
   real dilatation = 0;
 };
-FractureCoefficients fracture_coefficients(ForceModel model, InfluenceKind influence,
-                                           int dimension);
+FractureCoefficients fracture_coefficients(ForceModel model, InfluenceKind influence, int dimension);
 
 /// Continuum moment int_0^1 J(xi) xi^p dxi of an influence function (midpoint quadrature).
 real influence_moment(InfluenceKind influence, int power);

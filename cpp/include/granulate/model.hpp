@@ -23,16 +23,16 @@ struct Particle {
 /// Bond families in CSR form: the bonds of node i are offsets[i] .. offsets[i+1]-1, each bond
 /// stored once per end (i's copy and j's copy), so force loops gather without atomics.
 struct BondFamilies {
-  std::vector<index_t> offsets;   ///< size nodes + 1
-  std::vector<index_t> neighbors; ///< j, sorted ascending within a family
-  std::vector<real> weights;      ///< w_ij = J(r/delta) V_j beta_ij [m^d]
-  std::vector<real> lengths;      ///< r = |X_j - X_i| [m]
+  std::vector<index_t> offsets;    ///< size nodes + 1
+  std::vector<index_t> neighbors;  ///< j, sorted ascending within a family
+  std::vector<real> weights;       ///< w_ij = J(r/delta) V_j beta_ij [m^d]
+  std::vector<real> lengths;       ///< r = |X_j - X_i| [m]
 
   std::size_t size() const { return neighbors.size(); }
 };
 
 class Model {
-public:
+ public:
   explicit Model(int dimension, PlaneMode plane = PlaneMode::strain);
 
   /// Registers a material; returns its index. Validates the parameters (InputError).
@@ -40,8 +40,8 @@ public:
 
   /// Adds a particle of n nodes: positions is n x 3 row-major [m] (z = 0 in 2D), volumes n
   /// [m^3, or m^2 per unit thickness in 2D]. Returns the particle index.
-  index_t add_particle(std::span<const real> positions, std::span<const real> volumes,
-                       index_t material, real mesh_size);
+  index_t add_particle(std::span<const real> positions, std::span<const real> volumes, index_t material,
+                       real mesh_size);
 
   /// Builds bond families (cell list, O(nodes)), partial volumes and LPS constants.
   void finalize();
@@ -68,7 +68,7 @@ public:
   /// 2005, with the LPS dilatation coupling bounded by Gershgorin) [s].
   real stable_time_step() const;
 
-private:
+ private:
   void require_not_finalized(const char* what) const;
   void build_bonds();
 

@@ -19,7 +19,7 @@ struct PhaseTimes {
 };
 
 class Simulation {
-public:
+ public:
   /// Finalizes the model if needed; the state starts at rest in the reference configuration.
   explicit Simulation(std::shared_ptr<Model> model);
 
@@ -61,7 +61,7 @@ public:
   std::vector<std::uint8_t> fixity() const;
   const PhaseTimes& phase_times() const { return phase_times_; }
 
-private:
+ private:
   void apply_prescribed_motion(bool positions_too);
   void check_stability() const;
   real bond_extension(index_t i, index_t bond, const std::vector<real>& x) const;

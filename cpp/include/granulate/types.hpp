@@ -14,13 +14,13 @@ using index_t = std::uint32_t;
 
 /// Bad input: names the offending value and the fix. Python sees it as granulate.InputError.
 class InputError : public std::invalid_argument {
-public:
+ public:
   using std::invalid_argument::invalid_argument;
 };
 
 /// The time integration became unstable (non-finite values or runaway motion).
 class InstabilityError : public std::runtime_error {
-public:
+ public:
   using std::runtime_error::runtime_error;
 };
 

@@ -20,7 +20,9 @@ class HistoryWriter:
         self._handle.flush()
 
     def write(self, row: Mapping[str, float | int]) -> None:
-        self._writer.writerow([repr(row[c]) if isinstance(row[c], float) else row[c] for c in self.columns])
+        self._writer.writerow(
+            [repr(row[c]) if isinstance(row[c], float) else row[c] for c in self.columns]
+        )
         self._handle.flush()
 
     def close(self) -> None:

@@ -9,8 +9,8 @@
 namespace granulate {
 
 struct CriticalStretch {
-  real limit;                ///< s0 (infinity: the material never breaks)
-  bool break_in_compression; ///< also break when s < -s0
+  real limit;                 ///< s0 (infinity: the material never breaks)
+  bool break_in_compression;  ///< also break when s < -s0
 
   bool breaks(real stretch) const {
     return break_in_compression ? std::abs(stretch) > limit : stretch > limit;

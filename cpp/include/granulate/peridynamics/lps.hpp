@@ -18,9 +18,9 @@ namespace granulate::lps {
 
 /// Per-node constants, fixed after Model::finalize().
 struct NodeCoefficients {
-  real dilatation_scale = 0;    ///< d / m_i                      [1/m^(d+2)]
-  real dilatation_coupling = 0; ///< A_i = (d kappa_d - a_d G/d)/m_i [Pa/m^(d+2)]
-  real deviatoric_stiffness = 0;///< B_i = a_d G / m_i            [Pa/m^(d+2)]
+  real dilatation_scale = 0;      ///< d / m_i                      [1/m^(d+2)]
+  real dilatation_coupling = 0;   ///< A_i = (d kappa_d - a_d G/d)/m_i [Pa/m^(d+2)]
+  real deviatoric_stiffness = 0;  ///< B_i = a_d G / m_i            [Pa/m^(d+2)]
 };
 
 /// One bond's contribution to sum_j w r e (multiply the sum by d/m_i to get theta_i).

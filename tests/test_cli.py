@@ -1,0 +1,73 @@
+"""The command line: info, running a script, exit codes and one-line errors."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+
+def granulate(*args: str, cwd: Path | None = None) -> subprocess.CompletedProcess[str]:
+    return subprocess.run(
+        [sys.executable, "-m", "granulate", *args],
+        capture_output=True,
+        text=True,
+        cwd=cwd,
+        check=False,
+    )
+
+
+def test_info() -> None:
+    result = granulate("info")
+    assert result.returncode == 0
+    assert "granulate 0.1.0" in result.stdout and "threads:" in result.stdout
+
+
+def test_run_script_and_input_error_exit_codes(tmp_path: Path) -> None:
+    good = tmp_path / "good.py"
+    good.write_text(
+        "import granulate as gr\n"
+        "m = gr.Material(density=1000, youngs_modulus=1e9, poisson_ratio=0.25, fracture=False)\n"
+        "s = gr.Simulation(2)\n"
+        "s.add_body(gr.Rectangle((0, 0), (0.01, 0.01)), m, 1e-3)\n"
+        "s.run(10)\n"
+        "print('done', s.step)\n"
+    )
+    result = granulate("--threads", "1", "run", str(good))
+    assert result.returncode == 0 and "done 10" in result.stdout
+
+    bad = tmp_path / "bad.py"
+    bad.write_text(
+        "import granulate as gr\n"
+        "m = gr.Material(density=1000, youngs_modulus=1e9, poisson_ratio=0.25,\n"
+        "                fracture=False, horizon=1e-4)\n"
+        "s = gr.Simulation(2)\n"
+        "s.add_body(gr.Rectangle((0, 0), (0.01, 0.01)), m, 1e-3)\n"
+        "s.run(10)\n"
+    )
+    result = granulate("run", str(bad))
+    assert result.returncode == 2
+    assert result.stderr.strip().startswith("granulate: error:")
+    assert "smaller than the mesh size" in result.stderr
+    assert "Traceback" not in result.stderr
+
+
+def test_blow_up_exits_1(tmp_path: Path) -> None:
+    script = tmp_path / "unstable.py"
+    script.write_text(
+        "import warnings, granulate as gr\n"
+        "warnings.simplefilter('ignore')\n"
+        "m = gr.Material(density=1000, youngs_modulus=1e9, poisson_ratio=0.25, fracture=False)\n"
+        "s = gr.Simulation(2, dt=1e-4)\n"
+        "b = s.add_body(gr.Rectangle((0, 0), (0.01, 0.01)), m, 1e-3, velocity=(0, 1))\n"
+        "s.velocities[:5, 0] = 1.0\n"
+        "s.run(1000)\n"
+    )
+    result = granulate("run", str(script))
+    assert result.returncode == 1
+    assert "unstable" in result.stderr and "Traceback" not in result.stderr
+
+
+def test_missing_script_is_a_user_error() -> None:
+    result = granulate("run", "does_not_exist.py")
+    assert result.returncode == 2 and "does not exist" in result.stderr
