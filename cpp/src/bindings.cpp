@@ -154,8 +154,58 @@ NB_MODULE(_core, m) {
         return view(const_cast<real*>(self.weighted_volume().data()), self.node_count(), 0, nb::find(self));
       });
 
+  nb::class_<contact::Law>(m, "ContactLaw")
+      .def(nb::init<>())
+      .def_rw("contact_radius", &contact::Law::contact_radius)
+      .def_rw("normal_stiffness", &contact::Law::normal_stiffness)
+      .def_rw("damping_ratio", &contact::Law::damping_ratio)
+      .def_rw("friction", &contact::Law::friction)
+      .def_rw("slip_velocity", &contact::Law::slip_velocity);
+  m.def("damping_ratio_from_restitution", &contact::damping_ratio_from_restitution, "restitution"_a);
+
+  nb::enum_<WallSurface::Kind>(m, "WallSurfaceKind")
+      .value("plane", WallSurface::Kind::plane)
+      .value("box_inside", WallSurface::Kind::box_inside)
+      .value("box_outside", WallSurface::Kind::box_outside)
+      .value("circle_inside", WallSurface::Kind::circle_inside)
+      .value("circle_outside", WallSurface::Kind::circle_outside)
+      .value("polygon", WallSurface::Kind::polygon);
+  nb::class_<WallSurface>(m, "WallSurface")
+      .def(nb::init<>())
+      .def_rw("kind", &WallSurface::kind)
+      .def_rw("point", &WallSurface::point)
+      .def_rw("normal", &WallSurface::normal)
+      .def_rw("lower", &WallSurface::lower)
+      .def_rw("upper", &WallSurface::upper)
+      .def_rw("radius", &WallSurface::radius)
+      .def_rw("vertices", &WallSurface::vertices)
+      .def_rw("inside", &WallSurface::inside);
+  nb::enum_<Wall::Motion>(m, "WallMotion")
+      .value("fixed", Wall::Motion::fixed)
+      .value("translation", Wall::Motion::translation)
+      .value("rotation", Wall::Motion::rotation);
+  nb::class_<Wall>(m, "Wall")
+      .def(nb::init<>())
+      .def_rw("name", &Wall::name)
+      .def_rw("surfaces", &Wall::surfaces)
+      .def_rw("motion", &Wall::motion)
+      .def_rw("direction", &Wall::direction)
+      .def_rw("center", &Wall::center)
+      .def_rw("axis", &Wall::axis)
+      .def(
+          "set_function", [](Wall& self, TimeFunction::Kind kind, real a, real b) { self.function = make_function(kind, a, b); },
+          "kind"_a, "a"_a, "b"_a)
+      .def("displacement", [](const Wall& self, real t) { return self.function.value(t); }, "time"_a);
+
+  nb::class_<ContactStatistics>(m, "ContactStatistics")
+      .def_ro("rebuilds", &ContactStatistics::rebuilds)
+      .def_ro("list_entries", &ContactStatistics::list_entries)
+      .def_ro("node_contacts", &ContactStatistics::node_contacts)
+      .def_ro("wall_contacts", &ContactStatistics::wall_contacts);
+
   nb::class_<PhaseTimes>(m, "PhaseTimes")
       .def_ro("peridynamics", &PhaseTimes::peridynamics)
+      .def_ro("contact", &PhaseTimes::contact)
       .def_ro("integration", &PhaseTimes::integration)
       .def_ro("loading", &PhaseTimes::loading);
 
@@ -206,6 +256,24 @@ NB_MODULE(_core, m) {
             self.add_nodal_force(std::move(force));
           },
           "nodes"_a, "vector"_a, "kind"_a, "a"_a, "b"_a)
+      .def(
+          "set_contact_law",
+          [](Simulation& self, index_t a, index_t b, const contact::Law& law) { self.contact().set_law(a, b, law); },
+          "material_a"_a, "material_b"_a, "law"_a)
+      .def(
+          "add_wall", [](Simulation& self, Wall wall) { return self.contact().add_wall(std::move(wall), self.model().dimension()); },
+          "wall"_a)
+      .def(
+          "set_wall_law",
+          [](Simulation& self, index_t wall, index_t material, const contact::Law& law) {
+            self.contact().set_wall_law(wall, material, law);
+          },
+          "wall"_a, "material"_a, "law"_a)
+      .def("set_contact_skin", [](Simulation& self, real skin) { self.contact().set_skin(skin); }, "skin"_a)
+      .def("wall_reactions", [](const Simulation& self) { return self.contact().wall_reactions(); })
+      .def_prop_ro("walls", [](const Simulation& self) { return self.contact().walls(); })
+      .def_prop_ro("contact_statistics", [](const Simulation& self) { return self.contact().statistics(); })
+      .def("particle_masses", [](const Simulation& self) { return copy_out(self.contact().particle_mass()); })
       .def("run", &Simulation::run, "steps"_a, nb::call_guard<nb::gil_scoped_release>())
       .def("compute_forces", &Simulation::compute_forces, nb::call_guard<nb::gil_scoped_release>())
       .def("kinetic_energy", &Simulation::kinetic_energy)

@@ -1,5 +1,7 @@
 #include "granulate/model.hpp"
 
+#include "granulate/cell_grid.hpp"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -8,93 +10,6 @@
 
 namespace granulate {
 namespace {
-
-/// Uniform grid of cells of one particle, nodes sorted by cell (counting sort).
-struct CellGrid {
-  std::array<real, 3> origin{};
-  real cell_size = 1;
-  std::array<std::int64_t, 3> dims{1, 1, 1};
-  std::vector<index_t> cell_start;  // size cells + 1
-  std::vector<index_t> cell_nodes;  // global node ids
-
-  std::array<std::int64_t, 3> cell_of(const real* x) const {
-    std::array<std::int64_t, 3> c{};
-    for (int k = 0; k < 3; ++k) {
-      c[k] =
-          std::clamp<std::int64_t>(static_cast<std::int64_t>((x[k] - origin[k]) / cell_size), 0, dims[k] - 1);
-    }
-    return c;
-  }
-  std::int64_t linear(const std::array<std::int64_t, 3>& c) const {
-    return (c[2] * dims[1] + c[1]) * dims[0] + c[0];
-  }
-};
-
-CellGrid build_grid(const std::vector<real>& x, const Particle& p, real cell_size) {
-  CellGrid grid;
-  grid.cell_size = cell_size;
-  std::array<real, 3> lo{}, hi{};
-  lo.fill(std::numeric_limits<real>::max());
-  hi.fill(std::numeric_limits<real>::lowest());
-  for (index_t i = p.first_node; i < p.first_node + p.node_count; ++i) {
-    for (int k = 0; k < 3; ++k) {
-      lo[k] = std::min(lo[k], x[3 * i + k]);
-      hi[k] = std::max(hi[k], x[3 * i + k]);
-    }
-  }
-  std::int64_t cells = 1;
-  for (int k = 0; k < 3; ++k) {
-    grid.origin[k] = lo[k];
-    grid.dims[k] = std::max<std::int64_t>(1, static_cast<std::int64_t>((hi[k] - lo[k]) / cell_size) + 1);
-    cells *= grid.dims[k];
-  }
-  if (cells > 64 * static_cast<std::int64_t>(p.node_count) + 1024) {
-    // Very sparse particle relative to its horizon; cap the grid by enlarging the cells.
-    const real factor = std::cbrt(static_cast<real>(cells) / (64.0 * p.node_count + 1024));
-    return build_grid(x, p, cell_size * factor * 1.01);
-  }
-  grid.cell_start.assign(static_cast<std::size_t>(cells) + 1, 0);
-  std::vector<std::int64_t> node_cell(p.node_count);
-  for (index_t a = 0; a < p.node_count; ++a) {
-    node_cell[a] = grid.linear(grid.cell_of(&x[3 * (p.first_node + a)]));
-    ++grid.cell_start[node_cell[a] + 1];
-  }
-  for (std::size_t c = 0; c + 1 < grid.cell_start.size(); ++c) grid.cell_start[c + 1] += grid.cell_start[c];
-  grid.cell_nodes.resize(p.node_count);
-  std::vector<index_t> fill(grid.cell_start.begin(), grid.cell_start.end() - 1);
-  for (index_t a = 0; a < p.node_count; ++a) grid.cell_nodes[fill[node_cell[a]]++] = p.first_node + a;
-  return grid;
-}
-
-/// Calls visit(j, r^2) for every node j != i of the grid with |X_j - X_i| <= radius.
-template <class Visit>
-void for_each_within(const CellGrid& grid, const std::vector<real>& x, index_t i, real radius, int dimension,
-                     Visit&& visit) {
-  const real* xi = &x[3 * i];
-  const auto c = grid.cell_of(xi);
-  const real limit = radius * radius * (1.0 + 1e-10);
-  const std::int64_t z_reach = dimension == 3 ? 1 : 0;
-  for (std::int64_t dz = -z_reach; dz <= z_reach; ++dz) {
-    for (std::int64_t dy = -1; dy <= 1; ++dy) {
-      for (std::int64_t dx = -1; dx <= 1; ++dx) {
-        const std::array<std::int64_t, 3> n{c[0] + dx, c[1] + dy, c[2] + dz};
-        if (n[0] < 0 || n[1] < 0 || n[2] < 0 || n[0] >= grid.dims[0] || n[1] >= grid.dims[1] ||
-            n[2] >= grid.dims[2]) {
-          continue;
-        }
-        const std::int64_t cell = grid.linear(n);
-        for (index_t k = grid.cell_start[cell]; k < grid.cell_start[cell + 1]; ++k) {
-          const index_t j = grid.cell_nodes[k];
-          if (j == i) continue;
-          const real* xj = &x[3 * j];
-          const real r2 = (xj[0] - xi[0]) * (xj[0] - xi[0]) + (xj[1] - xi[1]) * (xj[1] - xi[1]) +
-                          (xj[2] - xi[2]) * (xj[2] - xi[2]);
-          if (r2 <= limit) visit(j, r2);
-        }
-      }
-    }
-  }
-}
 
 std::string str(real v) {
   std::ostringstream o;
@@ -196,7 +111,7 @@ void Model::build_bonds() {
   // Cells slightly larger than the horizon: two nodes exactly one horizon apart (common on
   // lattices) are then never two cells apart after rounding.
   for (const Particle& p : particles_) {
-    grids.push_back(build_grid(x, p, materials_[p.material].params.horizon * (1.0 + 1e-6)));
+    grids.push_back(CellGrid::build(x, p.first_node, p.node_count, materials_[p.material].params.horizon * (1.0 + 1e-6)));
   }
 
   bonds_.offsets.assign(nodes + 1, 0);
@@ -205,7 +120,7 @@ void Model::build_bonds() {
     const index_t i = static_cast<index_t>(ii);
     const index_t p = node_particle_[i];
     index_t count = 0;
-    for_each_within(grids[p], x, i, materials_[particles_[p].material].params.horizon, dimension_,
+    grids[p].for_each_within(x, i, materials_[particles_[p].material].params.horizon, dimension_,
                     [&](index_t, real) { ++count; });
     bonds_.offsets[i + 1] = count;
   }
@@ -229,7 +144,7 @@ void Model::build_bonds() {
     const real h = particle.mesh_size;
     index_t* family = bonds_.neighbors.data() + bonds_.offsets[i];
     index_t filled = 0;
-    for_each_within(grids[node_particle_[i]], x, i, horizon, dimension_,
+    grids[node_particle_[i]].for_each_within(x, i, horizon, dimension_,
                     [&](index_t j, real) { family[filled++] = j; });
     std::sort(family, family + filled);
     real m = 0, first_moment = 0;

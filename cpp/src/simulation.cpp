@@ -37,8 +37,15 @@ Simulation::Simulation(std::shared_ptr<Model> model) : model_(std::move(model)) 
   for (const Particle& p : m.particles()) {
     std::fill_n(mesh_size_.begin() + p.first_node, p.node_count, p.mesh_size);
   }
+  contact_.configure(m);
   stable_time_step_ = m.stable_time_step();
   time_step_ = 0.8 * stable_time_step_;
+}
+
+real Simulation::stable_time_step() const {
+  const real contact = contact_.stable_time_step(*model_);
+  if (!std::isfinite(contact)) return stable_time_step_;
+  return 1.0 / std::sqrt(1.0 / (stable_time_step_ * stable_time_step_) + 1.0 / (contact * contact));
 }
 
 void Simulation::set_time_step(real dt) {
@@ -155,7 +162,8 @@ void Simulation::compute_forces() {
 
   // Pass 1: stretch, irreversible breaking, dilatation. Each node updates only its own bond
   // copies; both copies of a bond see bitwise the same stretch, so they break together.
-#pragma omp parallel for schedule(static)
+  std::uint64_t newly_broken = 0;
+#pragma omp parallel for schedule(static) reduction(+ : newly_broken)
   for (std::int64_t ii = 0; ii < n; ++ii) {
     const index_t i = static_cast<index_t>(ii);
     const Material& material = materials[node_material[i]];
@@ -168,6 +176,7 @@ void Simulation::compute_forces() {
       const real e = bond_extension(i, k, x);
       if (can_break && criterion.breaks(e / r)) {
         intact[k] = 0;
+        ++newly_broken;
         continue;
       }
       sum += lps::dilatation_term(bonds.weights[k], r, e);
@@ -210,6 +219,12 @@ void Simulation::compute_forces() {
     f[3 * i + 2] = fz + density[i] * g[2];
   }
 
+  broken_bond_copies_ += newly_broken;
+
+  const auto contact_start = clock_type::now();
+  contact_.add_forces(m, state_, broken_bond_copies_);
+  phase_times_.contact += seconds_since(contact_start);
+
   const real t = state_.time;
   for (const NodalForce& load : nodal_forces_) {
     const real scale = load.function.value(t);
@@ -247,8 +262,9 @@ void Simulation::run(std::uint64_t steps) {
     phase_times_.loading += seconds_since(start);
 
     start = clock_type::now();
+    const double contact_before = phase_times_.contact;
     compute_forces();
-    phase_times_.peridynamics += seconds_since(start);
+    phase_times_.peridynamics += seconds_since(start) - (phase_times_.contact - contact_before);
 
     start = clock_type::now();
 #pragma omp parallel for schedule(static)
@@ -274,7 +290,7 @@ void Simulation::check_stability() const {
           << " s): node " << i
           << (finite ? " moved more than its mesh size in one step"
                      : " has a non-finite position or velocity")
-          << ". The time step is " << time_step_ << " s and the stable estimate is " << stable_time_step_
+          << ". The time step is " << time_step_ << " s and the stable estimate is " << stable_time_step()
           << " s; use a smaller time step (or a slower loading)";
       throw InstabilityError(msg.str());
     }
@@ -345,11 +361,7 @@ void Simulation::damage(real* phi, real* z) const {
   }
 }
 
-std::uint64_t Simulation::broken_bonds() const {
-  std::uint64_t broken = 0;
-  for (std::uint8_t b : state_.bond_intact) broken += b ? 0 : 1;
-  return broken / 2;
-}
+std::uint64_t Simulation::broken_bonds() const { return broken_bond_copies_ / 2; }
 
 index_t Simulation::fragments(index_t* labels) const {
   // Union-find; the root of a set is always its smallest node, so labels are deterministic.

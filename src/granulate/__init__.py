@@ -10,7 +10,8 @@ a C++ core (OpenMP), set-up and output from Python.
     >>> body = sim.add_body(gr.Rectangle((0, 0), (0.05, 0.01)), rock, mesh_size=1e-3)
 """
 
-from granulate import _core
+from granulate import _core, walls
+from granulate.contact import Contact
 from granulate.errors import GranulateWarning, InputError, InstabilityError
 from granulate.functions import (
     Constant,
@@ -34,6 +35,18 @@ from granulate.shapes import (
     lattice,
 )
 from granulate.simulation import FIELDS, Body, Simulation
+from granulate.walls import (
+    BoxContainer,
+    BoxObstacle,
+    CircleContainer,
+    CircleObstacle,
+    Plane,
+    PolygonContainer,
+    PolygonObstacle,
+    Rotation,
+    Translation,
+    Wall,
+)
 
 __version__ = "0.1.0"
 
@@ -52,7 +65,12 @@ __all__ = [
     "FIELDS",
     "Body",
     "Box",
+    "BoxContainer",
+    "BoxObstacle",
+    "CircleContainer",
+    "CircleObstacle",
     "Constant",
+    "Contact",
     "Difference",
     "Disc",
     "GranulateWarning",
@@ -60,19 +78,26 @@ __all__ = [
     "InstabilityError",
     "Linear",
     "Material",
+    "Plane",
     "Polygon",
+    "PolygonContainer",
+    "PolygonObstacle",
     "Quadratic",
     "Rectangle",
+    "Rotation",
     "Shape",
     "Simulation",
     "Sine",
     "SmoothRamp",
     "Sphere",
     "TimeFunction",
+    "Translation",
     "Union",
     "VelocityRamp",
+    "Wall",
     "__version__",
     "get_num_threads",
     "lattice",
     "set_num_threads",
+    "walls",
 ]

@@ -23,11 +23,13 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from granulate import _core
+from granulate.contact import Contact, default_normal_stiffness
 from granulate.errors import GranulateWarning, InputError
 from granulate.functions import Constant, Linear, TimeFunction, VelocityRamp
 from granulate.io import HistoryWriter, PvdSeries, atomic_write, write_vtu
 from granulate.materials import Material
 from granulate.shapes import Shape, lattice
+from granulate.walls import Surface, Wall
 
 Components = str  # any of "x", "y", "z", e.g. "xy"
 
@@ -50,6 +52,9 @@ HISTORY_COLUMNS = (
     "strain_energy",
     "total_energy",
     "broken_bonds",
+    "node_contacts",
+    "wall_contacts",
+    "list_rebuilds",
 )
 
 
@@ -76,7 +81,7 @@ class _Output:
     every: int
     fields: tuple[str, ...]
     pvd: PvdSeries
-    history: HistoryWriter
+    history: HistoryWriter | None = None
     frames: int = 0
 
 
@@ -134,6 +139,11 @@ class Simulation:
         ] = []
         self._loads: list[tuple[str, tuple]] = []
         self._output: _Output | None = None
+        self._contact: Contact | None = Contact()
+        self._pair_contacts: dict[tuple[int, int], Contact | None] = {}
+        self._walls: list[tuple[str, Wall]] = []
+        self._skin: float | None = None
+        self._core_materials: list[tuple[Material, float, float]] = []  # (material, h, horizon)
         self._core: _core.Simulation | None = None
         self._model: _core.Model | None = None
         self._reference: NDArray[np.float64] | None = None
@@ -377,6 +387,63 @@ class Simulation:
         if self._core is not None:
             self._core.set_body_acceleration(tuple(self._gravity))
 
+    @property
+    def contact(self) -> Contact | None:
+        """Contact between all particles (and fragments) unless set per pair; None: no contact."""
+        return self._contact
+
+    @contact.setter
+    def contact(self, value: Contact | None) -> None:
+        self._require_building("change contact")
+        if value is not None and not isinstance(value, Contact):
+            raise InputError(
+                f"contact must be a granulate.Contact or None, got {type(value).__name__}"
+            )
+        self._contact = value
+
+    def set_contact(self, a: Material, b: Material, contact: Contact | None) -> None:
+        """Contact between bodies of materials a and b (None: they pass through each other)."""
+        self._require_building("change contact")
+        if contact is not None and not isinstance(contact, Contact):
+            raise InputError(
+                f"contact must be a granulate.Contact or None, got {type(contact).__name__}"
+            )
+        self._pair_contacts[(id(a), id(b))] = contact
+        self._pair_contacts[(id(b), id(a))] = contact
+
+    def set_neighbor_skin(self, skin: float) -> None:
+        """Verlet skin of the contact neighbour lists [m] (default: half the contact radius)."""
+        if not (np.isfinite(skin) and skin > 0):
+            raise InputError(f"skin must be a positive length, got {skin}")
+        self._skin = float(skin)
+        if self._core is not None:
+            self._core.set_contact_skin(self._skin)
+
+    def add_wall(self, wall: Wall | Surface, *, name: str | None = None) -> str:
+        """Add a rigid wall (or one fixed surface); returns its name, used in history.csv."""
+        self._require_building("add a wall")
+        if isinstance(wall, Surface):
+            wall = Wall((wall,))
+        if not isinstance(wall, Wall):
+            raise InputError(
+                f"add_wall takes a granulate Wall or surface, got {type(wall).__name__}"
+            )
+        label = name or wall.name or f"wall{len(self._walls)}"
+        if any(label == existing for existing, _ in self._walls):
+            raise InputError(f"a wall named {label!r} exists already; give each wall its own name")
+        if not label.replace("_", "").isalnum():
+            raise InputError(f"wall name {label!r} must be letters, digits and underscores")
+        wall.core(label)  # checks the description now rather than at the first run
+        self._walls.append((label, wall))
+        return label
+
+    def wall_reactions(self) -> dict[str, NDArray[np.float64]]:
+        """Per wall: (fx, fy, fz, tx, ty, tz), the force and torque the particles exert on it
+        at the last step [N, N m; per unit thickness in 2D]."""
+        core = self._build()
+        names = [name for name, _ in self._walls]
+        return {name: np.asarray(r) for name, r in zip(names, core.wall_reactions(), strict=True)}
+
     def output(
         self,
         directory: str | Path,
@@ -404,13 +471,7 @@ class Simulation:
         if overwrite:
             for old in (path / "frames").glob("frame_*.vtu"):
                 old.unlink()
-        self._output = _Output(
-            path,
-            every,
-            tuple(fields),
-            PvdSeries(path / "simulation.pvd"),
-            HistoryWriter(path / "history.csv", HISTORY_COLUMNS),
-        )
+        self._output = _Output(path, every, tuple(fields), PvdSeries(path / "simulation.pvd"))
 
     # ------------------------------------------------------------------ the core
     def _build(self) -> _core.Simulation:
@@ -419,16 +480,19 @@ class Simulation:
         if not self.bodies:
             raise InputError("the simulation has no body; add one with add_body")
         model = _core.Model(self.dimension, getattr(_core.PlaneMode, self.plane))
-        material_ids: dict[tuple[int, float], int] = {}
+        material_ids: dict[tuple[int, float, float], int] = {}
         for body, positions, volumes in zip(
             self.bodies, self._positions, self._volumes, strict=True
         ):
-            key = (id(body.material), body.material.resolved_horizon(body.mesh_size))
+            horizon = body.material.resolved_horizon(body.mesh_size)
+            key = (id(body.material), horizon, body.mesh_size)
             if key not in material_ids:
                 material_ids[key] = model.add_material(body.material.core_params(body.mesh_size))
+                self._core_materials.append((body.material, body.mesh_size, horizon))
             model.add_particle(positions, volumes, material_ids[key], body.mesh_size)
         model.finalize()
         core = _core.Simulation(model)
+        self._set_contact_laws(model, core)
         if self._dt is None:
             core.time_step = self._dt_safety * core.stable_time_step
         else:
@@ -464,6 +528,41 @@ class Simulation:
         self._core = core
         self._reference = model.reference_positions
         return core
+
+    def _law(
+        self, contact: Contact, mesh_size: float, moduli: tuple[float, float], horizon: float
+    ) -> _core.ContactLaw:
+        law = _core.ContactLaw()
+        law.contact_radius = contact.contact_radius or contact.contact_radius_factor * mesh_size
+        law.normal_stiffness = contact.normal_stiffness or (
+            contact.stiffness_factor * default_normal_stiffness(*moduli, horizon, self.dimension)
+        )
+        law.damping_ratio = _core.damping_ratio_from_restitution(contact.restitution)
+        law.friction = contact.friction
+        law.slip_velocity = contact.slip_velocity
+        return law
+
+    def _set_contact_laws(self, model: _core.Model, core: _core.Simulation) -> None:
+        """Laws for every pair of core materials and every wall-material pair."""
+        moduli = [m.dilatation_modulus for m in model.materials]
+        materials = self._core_materials
+        for a, (material_a, h_a, horizon_a) in enumerate(materials):
+            for b, (material_b, h_b, horizon_b) in enumerate(materials[: a + 1]):
+                contact = self._pair_contacts.get((id(material_a), id(material_b)), self._contact)
+                if contact is None:
+                    continue
+                horizon = horizon_a if h_a <= h_b else horizon_b
+                law = self._law(contact, min(h_a, h_b), (moduli[a], moduli[b]), horizon)
+                core.set_contact_law(a, b, law)
+        for name, wall in self._walls:
+            index = core.add_wall(wall.core(name))
+            contact = wall.contact or self._contact or Contact()
+            for a, (_, h_a, horizon_a) in enumerate(materials):
+                core.set_wall_law(
+                    index, a, self._law(contact, h_a, (moduli[a], moduli[a]), horizon_a)
+                )
+        if self._skin is not None:
+            core.set_contact_skin(self._skin)
 
     @property
     def core(self) -> _core.Simulation:
@@ -627,6 +726,8 @@ class Simulation:
             "peridynamics_seconds": phases.peridynamics,
             "integration_seconds": phases.integration,
             "loading_seconds": phases.loading,
+            "contact_seconds": phases.contact,
+            "neighbor_list_rebuilds": core.contact_statistics.rebuilds,
         }
 
     def _write_output(self) -> None:
@@ -655,15 +756,30 @@ class Simulation:
         )
         out.pvd.add(core.time, Path("frames") / name)
         kinetic, strain = core.kinetic_energy(), core.strain_energy()
-        out.history.write(
-            {
-                "step": core.step,
-                "time": core.time,
-                "kinetic_energy": kinetic,
-                "strain_energy": strain,
-                "total_energy": kinetic + strain,
-                "broken_bonds": core.broken_bonds(),
-            }
+        statistics = core.contact_statistics
+        row: dict[str, float | int] = {
+            "step": core.step,
+            "time": core.time,
+            "kinetic_energy": kinetic,
+            "strain_energy": strain,
+            "total_energy": kinetic + strain,
+            "broken_bonds": core.broken_bonds(),
+            "node_contacts": statistics.node_contacts,
+            "wall_contacts": statistics.wall_contacts,
+            "list_rebuilds": statistics.rebuilds,
+        }
+        components = (
+            ("fx", "fy", "tz") if self.dimension == 2 else ("fx", "fy", "fz", "tx", "ty", "tz")
         )
+        index = {"fx": 0, "fy": 1, "fz": 2, "tx": 3, "ty": 4, "tz": 5}
+        for (name, _), reaction, wall in zip(
+            self._walls, core.wall_reactions(), core.walls, strict=True
+        ):
+            for c in components:
+                row[f"{name}_{c}"] = float(reaction[index[c]])
+            row[f"{name}_displacement"] = wall.displacement(core.time)
+        if out.history is None:
+            out.history = HistoryWriter(out.directory / "history.csv", list(row))
+        out.history.write(row)
         out.frames += 1
         atomic_write(out.directory / "run.json", json.dumps(self.summary(), indent=2).encode())

@@ -5,6 +5,7 @@
 #include <memory>
 #include <vector>
 
+#include "granulate/contact/contact_model.hpp"
 #include "granulate/loading.hpp"
 #include "granulate/model.hpp"
 #include "granulate/state.hpp"
@@ -14,6 +15,7 @@ namespace granulate {
 /// Wall-clock seconds spent in each phase of the step loop.
 struct PhaseTimes {
   double peridynamics = 0;
+  double contact = 0;
   double integration = 0;
   double loading = 0;
 };
@@ -30,12 +32,16 @@ class Simulation {
   /// Time step [s]; by default safety 0.8 times the stable estimate.
   real time_step() const { return time_step_; }
   void set_time_step(real dt);
-  real stable_time_step() const { return stable_time_step_; }
+  /// Stable estimate combining peridynamics and contact: 1/dt^2 = 1/dt_pd^2 + 1/dt_contact^2.
+  real stable_time_step() const;
 
   /// Uniform body acceleration g (gravity) [m/s^2]: adds rho g to every node's force density.
   void set_body_acceleration(const std::array<real, 3>& g);
   void add_prescribed_motion(PrescribedMotion motion);
   void add_nodal_force(NodalForce force);
+  /// Contact laws, walls and neighbour lists (configured for the model's materials).
+  ContactModel& contact() { return contact_; }
+  const ContactModel& contact() const { return contact_; }
 
   /// Advances n steps of velocity Verlet:
   ///   v += dt/2 f/rho; x += dt v; prescribed motion; f = F(x); v += dt/2 f/rho; prescribed v.
@@ -75,6 +81,8 @@ class Simulation {
   std::vector<NodalForce> nodal_forces_;
   std::vector<real> pressure_;   // A_i theta_i of LPS nodes
   std::vector<real> mesh_size_;  // per node, for the stability check
+  std::uint64_t broken_bond_copies_ = 0;  // both copies of a broken bond count
+  ContactModel contact_;
   bool forces_current_ = false;
   PhaseTimes phase_times_;
 };

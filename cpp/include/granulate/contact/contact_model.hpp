@@ -1,0 +1,102 @@
+// Contact between nodes of different particles (and unbonded fragments of one particle) and
+// between nodes and walls: neighbour lists with a Verlet skin, the contact law of
+// contact_law.hpp, damping aggregated per pair of bodies, wall reactions.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "granulate/contact/contact_law.hpp"
+#include "granulate/model.hpp"
+#include "granulate/state.hpp"
+#include "granulate/walls.hpp"
+
+namespace granulate {
+
+struct ContactStatistics {
+  std::uint64_t rebuilds = 0;        ///< neighbour-list builds so far
+  std::uint64_t list_entries = 0;    ///< node-pair entries in the current lists (both directions)
+  std::uint64_t node_contacts = 0;   ///< node pairs in contact at the last evaluation (once each)
+  std::uint64_t wall_contacts = 0;   ///< node-wall contacts at the last evaluation
+};
+
+class ContactModel {
+public:
+  /// Sizes the law tables for the model's materials (no contact until laws are set).
+  void configure(const Model& model);
+
+  /// Law between nodes of materials a and b (symmetric).
+  void set_law(index_t a, index_t b, const contact::Law& law);
+  const contact::Law& law(index_t a, index_t b) const { return laws_[a * material_count_ + b]; }
+  /// Adds a wall; returns its index. Give each wall a law per material with set_wall_law.
+  index_t add_wall(Wall wall, int dimension);
+  void set_wall_law(index_t wall, index_t material, const contact::Law& law);
+  /// Verlet skin [m]; lists are rebuilt when a node moves more than skin/2 relative to its
+  /// last build, a wall moves more than skin/2, or a bond breaks.
+  void set_skin(real skin);
+  real skin() const { return skin_; }
+
+  bool active() const { return any_law_ || !walls_.empty(); }
+
+  /// Stable time step of the contact springs alone [s]: per material, sqrt(2 rho / S) with the
+  /// Gershgorin bound S = 2 n kn V_max of a node touching n partners (n = 4 in 2D, 6 in 3D; a
+  /// node meets at most that many lattice neighbours within Rc < h). Infinity without contact.
+  real stable_time_step(const Model& model) const;
+  const std::vector<Wall>& walls() const { return walls_; }
+
+  /// Adds contact force densities to state.forces at time t; updates wall reactions.
+  void add_forces(const Model& model, State& state, std::uint64_t broken_bonds);
+
+  /// Per wall: force (x, y, z) and torque about its centre (x, y, z) exerted by the particles
+  /// [N, N m; per unit thickness in 2D], from the last evaluation.
+  const std::vector<std::array<real, 6>>& wall_reactions() const { return wall_reactions_; }
+  const ContactStatistics& statistics() const { return statistics_; }
+  /// Particle masses [kg; kg/m in 2D].
+  const std::vector<real>& particle_mass() const { return particle_mass_; }
+
+private:
+  bool needs_rebuild(const Model& model, const State& state, std::uint64_t broken_bonds) const;
+  void rebuild(const Model& model, const State& state, std::uint64_t broken_bonds);
+
+  index_t material_count_ = 0;
+  std::vector<contact::Law> laws_;            // material x material
+  std::vector<std::uint8_t> law_set_;
+  bool any_law_ = false;
+  real max_contact_radius_ = 0;
+  std::vector<Wall> walls_;
+  std::vector<contact::Law> wall_laws_;       // wall x material
+  std::vector<std::uint8_t> wall_law_set_;
+  real skin_ = -1;                            // < 0: 0.5 x the largest contact radius
+  std::vector<real> particle_mass_;
+  int dimension_ = 3;
+
+  // Lists (rebuilt): node pairs and node-wall-surface candidates, CSR by node.
+  bool built_ = false;
+  std::vector<real> positions_at_build_;
+  real time_at_build_ = 0;
+  std::uint64_t broken_at_build_ = 0;
+  std::vector<index_t> pair_offsets_, pair_partner_, pair_slot_;
+  std::vector<index_t> wall_offsets_;
+  std::vector<std::array<index_t, 2>> wall_entry_;  // (wall, surface)
+  std::vector<index_t> wall_slot_;
+  // Bodies in contact: one slot per (particle, particle) or (particle, wall) pair in the lists.
+  std::vector<std::array<index_t, 2>> slots_;        // particle pairs (p <= q), then (p, wall)
+  std::size_t particle_slot_count_ = 0;
+  std::vector<real> slot_reduced_mass_;
+  std::vector<real> slot_stiffness_;                 // K: sum of the contact springs, last evaluation
+  // Collision history per pair of bodies, kept across list rebuilds: the approach x of the two
+  // bodies since they touched (for the secant stiffness F / x of the dashpot).
+  std::vector<real> slot_approach_;
+  real last_time_ = 0;
+  bool has_last_time_ = false;
+  // Scratch, per entry.
+  std::vector<real> pair_stiffness_;
+  std::vector<real> pair_damping_;
+  std::vector<real> wall_entry_stiffness_;
+  std::vector<std::array<real, 6>> wall_entry_reaction_;
+  std::vector<std::array<real, 6>> wall_reactions_;
+  ContactStatistics statistics_;
+};
+
+}  // namespace granulate

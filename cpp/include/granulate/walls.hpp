@@ -1,0 +1,69 @@
+// Rigid kinematic walls: surfaces (plane, box, circle/cylinder, polygon), moved as one body by a
+// translation or a rotation given by a time function. Node-wall contact uses contact_law.hpp
+// with the distance from the node to the surface.
+#pragma once
+
+#include <array>
+#include <string>
+#include <vector>
+
+#include "granulate/loading.hpp"
+#include "granulate/types.hpp"
+
+namespace granulate {
+
+/// One surface of a wall, in the wall's reference frame (its position at t = 0).
+///   plane:          point, normal (unit, pointing into the region where particles are)
+///   box_inside:     lower, upper; particles inside (each face is a plane)
+///   box_outside:    lower, upper; particles outside (an obstacle)
+///   circle_inside:  center, radius, axis; particles inside a circle (2D) or cylinder (3D)
+///   circle_outside: the same, particles outside (a post, a roller)
+///   polygon:        vertices (2D, in order), particles inside when inside == true
+struct WallSurface {
+  enum class Kind : std::uint8_t { plane, box_inside, box_outside, circle_inside, circle_outside, polygon };
+  Kind kind = Kind::plane;
+  std::array<real, 3> point{0, 0, 0};  ///< plane point, circle centre
+  std::array<real, 3> normal{0, 1, 0}; ///< plane normal; circle/cylinder axis
+  std::array<real, 3> lower{0, 0, 0};
+  std::array<real, 3> upper{0, 0, 0};
+  real radius = 0;
+  std::vector<std::array<real, 2>> vertices;  ///< polygon
+  bool inside = true;                          ///< polygon: particles inside
+};
+
+/// A contact candidate between a point and a surface: signed distance (positive on the
+/// particles' side) and the unit normal pointing from the surface towards the particles.
+struct WallContact {
+  real distance = 0;
+  std::array<real, 3> normal{0, 0, 0};
+};
+
+struct Wall {
+  enum class Motion : std::uint8_t { fixed, translation, rotation };
+  std::string name;
+  std::vector<WallSurface> surfaces;
+  Motion motion = Motion::fixed;
+  std::array<real, 3> direction{1, 0, 0};  ///< translation: x = X + f(t) direction
+  std::array<real, 3> center{0, 0, 0};     ///< rotation centre; also the torque reference point
+  std::array<real, 3> axis{0, 0, 1};       ///< rotation axis (unit)
+  TimeFunction function;                   ///< displacement [m] or angle [rad]
+  real extent = 0;  ///< largest distance of the wall's finite features from `center` (set by validate)
+
+  /// Throws InputError for meaningless geometry; normalises directions.
+  void validate(int dimension);
+
+  /// Maps a world point at time t into the reference frame (undoes the motion).
+  std::array<real, 3> to_reference(const real* x, real t) const;
+  /// Maps a reference-frame vector to the world frame at time t.
+  std::array<real, 3> rotate_to_world(const std::array<real, 3>& v, real t) const;
+  /// Velocity of the wall's material point at world position x, time t.
+  std::array<real, 3> velocity_at(const real* x, real t) const;
+  /// Largest distance any wall point has moved between times t0 and t1 (bound) [m].
+  real motion_bound(real t0, real t1) const;
+
+  /// Contacts of a reference-frame point with surface s within `reach` (appends to out).
+  void contacts(std::size_t surface, const std::array<real, 3>& p, real reach, int dimension,
+                std::vector<WallContact>& out) const;
+};
+
+}  // namespace granulate

@@ -1,0 +1,615 @@
+#include "granulate/contact/contact_model.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "granulate/cell_grid.hpp"
+
+namespace granulate {
+namespace {
+
+using vec = std::array<real, 3>;
+
+/// Rigid-body motion of a particle: centre of mass, velocity and angular velocity (least-squares
+/// fit of its node velocities: V = sum m v / M, omega = I^-1 sum m (x - X) x (v - V)).
+struct RigidMotion {
+  vec centre{0, 0, 0};
+  vec velocity{0, 0, 0};
+  vec angular_velocity{0, 0, 0};
+
+  vec velocity_at(const real* x) const {
+    const vec r{x[0] - centre[0], x[1] - centre[1], x[2] - centre[2]};
+    return {velocity[0] + angular_velocity[1] * r[2] - angular_velocity[2] * r[1],
+            velocity[1] + angular_velocity[2] * r[0] - angular_velocity[0] * r[2],
+            velocity[2] + angular_velocity[0] * r[1] - angular_velocity[1] * r[0]};
+  }
+};
+
+RigidMotion rigid_motion(const Model& model, const State& state, const Particle& particle, int dimension) {
+  RigidMotion motion;
+  const auto& x = state.positions;
+  const auto& v = state.velocities;
+  real mass = 0;
+  for (index_t i = particle.first_node; i < particle.first_node + particle.node_count; ++i) {
+    const real m = model.node_density()[i] * model.volumes()[i];
+    mass += m;
+    for (int k = 0; k < 3; ++k) {
+      motion.centre[k] += m * x[3 * i + k];
+      motion.velocity[k] += m * v[3 * i + k];
+    }
+  }
+  for (int k = 0; k < 3; ++k) {
+    motion.centre[k] /= mass;
+    motion.velocity[k] /= mass;
+  }
+  vec momentum{0, 0, 0};
+  real I[3][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
+  for (index_t i = particle.first_node; i < particle.first_node + particle.node_count; ++i) {
+    const real m = model.node_density()[i] * model.volumes()[i];
+    const vec r{x[3 * i] - motion.centre[0], x[3 * i + 1] - motion.centre[1], x[3 * i + 2] - motion.centre[2]};
+    const vec u{v[3 * i] - motion.velocity[0], v[3 * i + 1] - motion.velocity[1], v[3 * i + 2] - motion.velocity[2]};
+    momentum[0] += m * (r[1] * u[2] - r[2] * u[1]);
+    momentum[1] += m * (r[2] * u[0] - r[0] * u[2]);
+    momentum[2] += m * (r[0] * u[1] - r[1] * u[0]);
+    const real r2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+    for (int a = 0; a < 3; ++a) {
+      for (int b = 0; b < 3; ++b) I[a][b] += m * ((a == b ? r2 : 0.0) - r[a] * r[b]);
+    }
+  }
+  if (dimension == 2) {
+    if (I[2][2] > 0) motion.angular_velocity[2] = momentum[2] / I[2][2];
+    return motion;
+  }
+  const real det = I[0][0] * (I[1][1] * I[2][2] - I[1][2] * I[2][1]) - I[0][1] * (I[1][0] * I[2][2] - I[1][2] * I[2][0]) +
+                   I[0][2] * (I[1][0] * I[2][1] - I[1][1] * I[2][0]);
+  if (!(std::abs(det) > 0)) return motion;
+  const real inverse[3][3] = {
+      {(I[1][1] * I[2][2] - I[1][2] * I[2][1]) / det, (I[0][2] * I[2][1] - I[0][1] * I[2][2]) / det,
+       (I[0][1] * I[1][2] - I[0][2] * I[1][1]) / det},
+      {(I[1][2] * I[2][0] - I[1][0] * I[2][2]) / det, (I[0][0] * I[2][2] - I[0][2] * I[2][0]) / det,
+       (I[0][2] * I[1][0] - I[0][0] * I[1][2]) / det},
+      {(I[1][0] * I[2][1] - I[1][1] * I[2][0]) / det, (I[0][1] * I[2][0] - I[0][0] * I[2][1]) / det,
+       (I[0][0] * I[1][1] - I[0][1] * I[1][0]) / det}};
+  for (int a = 0; a < 3; ++a) {
+    motion.angular_velocity[a] = inverse[a][0] * momentum[0] + inverse[a][1] * momentum[1] + inverse[a][2] * momentum[2];
+  }
+  return motion;
+}
+
+bool intact_bond(const Model& model, const State& state, index_t i, index_t j) {
+  const BondFamilies& bonds = model.bonds();
+  const auto begin = bonds.neighbors.begin() + bonds.offsets[i];
+  const auto end = bonds.neighbors.begin() + bonds.offsets[i + 1];
+  const auto found = std::lower_bound(begin, end, j);
+  if (found == end || *found != j) return false;
+  return state.bond_intact[static_cast<std::size_t>(found - bonds.neighbors.begin())] != 0;
+}
+
+}  // namespace
+
+void ContactModel::configure(const Model& model) {
+  material_count_ = static_cast<index_t>(model.materials().size());
+  laws_.assign(static_cast<std::size_t>(material_count_) * material_count_, {});
+  law_set_.assign(laws_.size(), 0);
+  dimension_ = model.dimension();
+  particle_mass_.assign(model.particles().size(), 0);
+  for (std::size_t p = 0; p < model.particles().size(); ++p) {
+    const Particle& particle = model.particles()[p];
+    for (index_t i = particle.first_node; i < particle.first_node + particle.node_count; ++i) {
+      particle_mass_[p] += model.node_density()[i] * model.volumes()[i];
+    }
+  }
+  built_ = false;
+}
+
+void ContactModel::set_law(index_t a, index_t b, const contact::Law& law) {
+  if (a >= material_count_ || b >= material_count_) throw InputError("contact law names an unknown material");
+  if (!(law.contact_radius > 0) || !(law.normal_stiffness > 0) || !(law.damping_ratio >= 0) ||
+      !(law.damping_ratio < 1) || !(law.friction >= 0) || !(law.slip_velocity > 0)) {
+    throw InputError("contact law needs a positive contact radius, stiffness and slip velocity, a damping "
+                     "ratio in [0, 1) and a non-negative friction coefficient");
+  }
+  laws_[a * material_count_ + b] = law;
+  laws_[b * material_count_ + a] = law;
+  law_set_[a * material_count_ + b] = law_set_[b * material_count_ + a] = 1;
+  any_law_ = true;
+  max_contact_radius_ = std::max(max_contact_radius_, law.contact_radius);
+  built_ = false;
+}
+
+index_t ContactModel::add_wall(Wall wall, int dimension) {
+  wall.validate(dimension);
+  walls_.push_back(std::move(wall));
+  wall_laws_.resize(walls_.size() * material_count_);
+  wall_law_set_.resize(walls_.size() * material_count_, 0);
+  wall_reactions_.assign(walls_.size(), {0, 0, 0, 0, 0, 0});
+  built_ = false;
+  return static_cast<index_t>(walls_.size() - 1);
+}
+
+void ContactModel::set_wall_law(index_t wall, index_t material, const contact::Law& law) {
+  if (wall >= walls_.size() || material >= material_count_) throw InputError("wall law names an unknown wall or material");
+  if (!(law.contact_radius > 0) || !(law.normal_stiffness > 0) || !(law.damping_ratio >= 0) ||
+      !(law.damping_ratio < 1) || !(law.friction >= 0) || !(law.slip_velocity > 0)) {
+    throw InputError("wall contact law needs a positive contact radius, stiffness and slip velocity, a damping "
+                     "ratio in [0, 1) and a non-negative friction coefficient");
+  }
+  wall_laws_[wall * material_count_ + material] = law;
+  wall_law_set_[wall * material_count_ + material] = 1;
+  max_contact_radius_ = std::max(max_contact_radius_, law.contact_radius);
+  built_ = false;
+}
+
+void ContactModel::set_skin(real skin) {
+  if (!(skin > 0) || !std::isfinite(skin)) throw InputError("the neighbour-list skin must be positive");
+  skin_ = skin;
+  built_ = false;
+}
+
+real ContactModel::stable_time_step(const Model& model) const {
+  const real partners = dimension_ == 2 ? 4.0 : 6.0;
+  std::vector<real> largest_volume(material_count_, 0), density(material_count_, 0);
+  for (index_t i = 0; i < model.node_count(); ++i) {
+    const index_t a = model.node_material()[i];
+    largest_volume[a] = std::max(largest_volume[a], model.volumes()[i]);
+    density[a] = model.node_density()[i];
+  }
+  real dt = std::numeric_limits<real>::infinity();
+  for (index_t a = 0; a < material_count_; ++a) {
+    if (largest_volume[a] == 0) continue;
+    real stiffness = 0;  // S of a node of material a: its stiffest partner material or wall
+    for (index_t b = 0; b < material_count_; ++b) {
+      if (law_set_[a * material_count_ + b]) {
+        stiffness = std::max(stiffness, laws_[a * material_count_ + b].normal_stiffness * largest_volume[b]);
+      }
+    }
+    for (std::size_t w = 0; w < walls_.size(); ++w) {
+      if (wall_law_set_[w * material_count_ + a]) {
+        stiffness = std::max(stiffness, wall_laws_[w * material_count_ + a].normal_stiffness * largest_volume[a]);
+      }
+    }
+    if (stiffness > 0) dt = std::min(dt, std::sqrt(2.0 * density[a] / (2.0 * partners * stiffness)));
+  }
+  return dt;
+}
+
+bool ContactModel::needs_rebuild(const Model& model, const State& state, std::uint64_t broken_bonds) const {
+  if (!built_ || broken_bonds != broken_at_build_) return true;
+  const real half_skin = 0.5 * skin_;
+  for (const Wall& wall : walls_) {
+    if (wall.motion_bound(time_at_build_, state.time) > half_skin) return true;
+  }
+  const auto& x = state.positions;
+  const std::int64_t n = model.node_count();
+  real worst = 0;
+#pragma omp parallel for schedule(static) reduction(max : worst)
+  for (std::int64_t i = 0; i < n; ++i) {
+    real d2 = 0;
+    for (int k = 0; k < 3; ++k) {
+      const real d = x[3 * i + k] - positions_at_build_[3 * i + k];
+      d2 += d * d;
+    }
+    worst = std::max(worst, d2);
+  }
+  return worst > half_skin * half_skin;
+}
+
+void ContactModel::rebuild(const Model& model, const State& state, std::uint64_t broken_bonds) {
+  if (skin_ < 0) skin_ = 0.5 * max_contact_radius_;
+  const auto& x = state.positions;
+  const index_t n = model.node_count();
+  const auto& particles = model.particles();
+  const auto& node_particle = model.node_particle();
+  const auto& node_material = model.node_material();
+  const std::size_t particle_count = particles.size();
+  const real reach = max_contact_radius_ + skin_;
+
+  // Broad phase: bounding spheres of particles; a particle takes part when another particle's
+  // sphere or a wall is within reach, or when it has broken bonds (fragments may touch).
+  std::vector<real> centres(3 * particle_count, 0), radii(particle_count, 0);
+  for (std::size_t p = 0; p < particle_count; ++p) {
+    const Particle& particle = particles[p];
+    for (index_t i = particle.first_node; i < particle.first_node + particle.node_count; ++i) {
+      for (int k = 0; k < 3; ++k) centres[3 * p + k] += x[3 * i + k];
+    }
+    for (int k = 0; k < 3; ++k) centres[3 * p + k] /= particle.node_count;
+    for (index_t i = particle.first_node; i < particle.first_node + particle.node_count; ++i) {
+      real d2 = 0;
+      for (int k = 0; k < 3; ++k) d2 += (x[3 * i + k] - centres[3 * p + k]) * (x[3 * i + k] - centres[3 * p + k]);
+      radii[p] = std::max(radii[p], std::sqrt(d2));
+    }
+  }
+  std::vector<std::uint8_t> near_particle(particle_count, 0), near_wall(particle_count, 0);
+  if (any_law_) {
+    const real largest = *std::max_element(radii.begin(), radii.end());
+    const CellGrid centre_grid = CellGrid::build(centres, 0, static_cast<index_t>(particle_count), 2 * largest + reach);
+    for (std::size_t p = 0; p < particle_count; ++p) {
+      centre_grid.for_each_within(centres, static_cast<index_t>(p), 2 * largest + reach, dimension_,
+                                  [&](index_t q, real r2) {
+                                    if (std::sqrt(r2) <= radii[p] + radii[q] + reach) near_particle[p] = 1;
+                                  });
+      if (broken_bonds > 0 && !near_particle[p]) {
+        const Particle& particle = particles[p];
+        const auto begin = state.bond_intact.begin() + model.bonds().offsets[particle.first_node];
+        const auto end = state.bond_intact.begin() + model.bonds().offsets[particle.first_node + particle.node_count];
+        if (std::find(begin, end, std::uint8_t{0}) != end) near_particle[p] = 1;
+      }
+    }
+  }
+  std::vector<WallContact> found;
+  for (std::size_t p = 0; p < particle_count; ++p) {
+    for (std::size_t w = 0; w < walls_.size(); ++w) {
+      const auto centre = walls_[w].to_reference(&centres[3 * p], state.time);
+      for (std::size_t s = 0; s < walls_[w].surfaces.size(); ++s) {
+        found.clear();
+        walls_[w].contacts(s, centre, radii[p] + reach, dimension_, found);
+        if (!found.empty()) near_wall[p] = 1;
+      }
+    }
+  }
+
+  // Node pairs: a grid over the nodes of particles near another particle or broken.
+  std::vector<index_t> searched;
+  for (std::size_t p = 0; p < particle_count; ++p) {
+    if (!near_particle[p]) continue;
+    for (index_t i = particles[p].first_node; i < particles[p].first_node + particles[p].node_count; ++i) {
+      searched.push_back(i);
+    }
+  }
+  const CellGrid grid = CellGrid::build(x, searched, reach);
+  pair_offsets_.assign(n + 1, 0);
+  auto accept = [&](index_t i, index_t j, real r2) {
+    const index_t mi = node_material[i], mj = node_material[j];
+    if (!law_set_[mi * material_count_ + mj]) return false;
+    const real limit = laws_[mi * material_count_ + mj].contact_radius + skin_;
+    if (r2 > limit * limit) return false;
+    return node_particle[i] != node_particle[j] || !intact_bond(model, state, i, j);
+  };
+  const std::int64_t searched_count = static_cast<std::int64_t>(searched.size());
+#pragma omp parallel for schedule(static)
+  for (std::int64_t a = 0; a < searched_count; ++a) {
+    const index_t i = searched[a];
+    index_t count = 0;
+    grid.for_each_within(x, i, reach, dimension_, [&](index_t j, real r2) { count += accept(i, j, r2) ? 1 : 0; });
+    pair_offsets_[i + 1] = count;
+  }
+  for (index_t i = 0; i < n; ++i) pair_offsets_[i + 1] += pair_offsets_[i];
+  pair_partner_.resize(pair_offsets_[n]);
+#pragma omp parallel for schedule(static)
+  for (std::int64_t a = 0; a < searched_count; ++a) {
+    const index_t i = searched[a];
+    index_t* out = pair_partner_.data() + pair_offsets_[i];
+    index_t filled = 0;
+    grid.for_each_within(x, i, reach, dimension_, [&](index_t j, real r2) {
+      if (accept(i, j, r2)) out[filled++] = j;
+    });
+    std::sort(out, out + filled);
+  }
+
+  // Node-wall candidates.
+  wall_offsets_.assign(n + 1, 0);
+  std::vector<std::vector<std::array<index_t, 2>>> per_node(n);
+  std::vector<index_t> wall_nodes;
+  for (std::size_t p = 0; p < particle_count; ++p) {
+    if (!near_wall[p]) continue;
+    for (index_t i = particles[p].first_node; i < particles[p].first_node + particles[p].node_count; ++i) {
+      wall_nodes.push_back(i);
+    }
+  }
+  const std::int64_t wall_node_count = static_cast<std::int64_t>(wall_nodes.size());
+#pragma omp parallel for schedule(static)
+  for (std::int64_t a = 0; a < wall_node_count; ++a) {
+    const index_t i = wall_nodes[a];
+    std::vector<WallContact> local;
+    for (std::size_t w = 0; w < walls_.size(); ++w) {
+      if (!wall_law_set_[w * material_count_ + node_material[i]]) continue;
+      const real limit = wall_laws_[w * material_count_ + node_material[i]].contact_radius + skin_;
+      const auto p = walls_[w].to_reference(&x[3 * i], state.time);
+      for (std::size_t s = 0; s < walls_[w].surfaces.size(); ++s) {
+        local.clear();
+        walls_[w].contacts(s, p, limit, dimension_, local);
+        if (!local.empty()) per_node[i].push_back({static_cast<index_t>(w), static_cast<index_t>(s)});
+      }
+    }
+  }
+  for (index_t i = 0; i < n; ++i) wall_offsets_[i + 1] = wall_offsets_[i] + static_cast<index_t>(per_node[i].size());
+  wall_entry_.clear();
+  wall_entry_.reserve(wall_offsets_[n]);
+  for (index_t i = 0; i < n; ++i) wall_entry_.insert(wall_entry_.end(), per_node[i].begin(), per_node[i].end());
+
+  // Slots: one per pair of bodies that appear in the lists, in sorted order.
+  const std::vector<std::array<index_t, 2>> old_slots = slots_;
+  const std::vector<real> old_approach = slot_approach_;
+  const std::size_t old_particle_slots = particle_slot_count_;
+  slots_.clear();
+  for (index_t i = 0; i < n; ++i) {
+    for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
+      const index_t p = node_particle[i], q = node_particle[pair_partner_[e]];
+      slots_.push_back({std::min(p, q), std::max(p, q)});
+    }
+  }
+  std::sort(slots_.begin(), slots_.end());
+  slots_.erase(std::unique(slots_.begin(), slots_.end()), slots_.end());
+  const std::size_t particle_slots = slots_.size();
+  particle_slot_count_ = particle_slots;
+  pair_slot_.resize(pair_partner_.size());
+  for (index_t i = 0; i < n; ++i) {
+    for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
+      const index_t p = node_particle[i], q = node_particle[pair_partner_[e]];
+      const std::array<index_t, 2> key{std::min(p, q), std::max(p, q)};
+      pair_slot_[e] = static_cast<index_t>(std::lower_bound(slots_.begin(), slots_.end(), key) - slots_.begin());
+    }
+  }
+  std::vector<std::array<index_t, 2>> wall_keys;
+  for (index_t i = 0; i < n; ++i) {
+    for (index_t e = wall_offsets_[i]; e < wall_offsets_[i + 1]; ++e) wall_keys.push_back({node_particle[i], wall_entry_[e][0]});
+  }
+  std::sort(wall_keys.begin(), wall_keys.end());
+  wall_keys.erase(std::unique(wall_keys.begin(), wall_keys.end()), wall_keys.end());
+  slots_.insert(slots_.end(), wall_keys.begin(), wall_keys.end());
+  wall_slot_.resize(wall_entry_.size());
+  for (index_t i = 0; i < n; ++i) {
+    for (index_t e = wall_offsets_[i]; e < wall_offsets_[i + 1]; ++e) {
+      const std::array<index_t, 2> key{node_particle[i], wall_entry_[e][0]};
+      wall_slot_[e] = static_cast<index_t>(particle_slots + (std::lower_bound(wall_keys.begin(), wall_keys.end(), key) -
+                                                             wall_keys.begin()));
+    }
+  }
+  // Reduced masses: two particles m_p m_q / (m_p + m_q); two fragments of one particle, about
+  // m_p / 4 (two halves); a particle and a rigid wall, m_p.
+  slot_reduced_mass_.resize(slots_.size());
+  for (std::size_t s = 0; s < slots_.size(); ++s) {
+    const real mp = particle_mass_[slots_[s][0]];
+    if (s >= particle_slots) {
+      slot_reduced_mass_[s] = mp;
+    } else if (slots_[s][0] == slots_[s][1]) {
+      slot_reduced_mass_[s] = 0.25 * mp;
+    } else {
+      const real mq = particle_mass_[slots_[s][1]];
+      slot_reduced_mass_[s] = mp * mq / (mp + mq);
+    }
+  }
+  slot_stiffness_.assign(slots_.size(), 0);
+  slot_approach_.assign(slots_.size(), 0);
+  for (std::size_t slot = 0; slot < slots_.size(); ++slot) {
+    const bool wall = slot >= particle_slots;
+    const auto begin = old_slots.begin() + (wall ? old_particle_slots : 0);
+    const auto end = wall ? old_slots.end() : old_slots.begin() + old_particle_slots;
+    const auto previous = std::lower_bound(begin, end, slots_[slot]);
+    if (previous != end && *previous == slots_[slot]) slot_approach_[slot] = old_approach[previous - old_slots.begin()];
+  }
+  pair_stiffness_.assign(pair_partner_.size(), 0);
+  wall_entry_stiffness_.assign(wall_entry_.size(), 0);
+  wall_entry_reaction_.assign(wall_entry_.size(), {0, 0, 0, 0, 0, 0});
+
+  positions_at_build_ = x;
+  time_at_build_ = state.time;
+  broken_at_build_ = broken_bonds;
+  built_ = true;
+  ++statistics_.rebuilds;
+  statistics_.list_entries = pair_partner_.size();
+}
+
+void ContactModel::add_forces(const Model& model, State& state, std::uint64_t broken_bonds) {
+  if (!active()) return;
+  if (needs_rebuild(model, state, broken_bonds)) rebuild(model, state, broken_bonds);
+  const auto& x = state.positions;
+  const auto& v = state.velocities;
+  auto& f = state.forces;
+  const auto& volume = model.volumes();
+  const auto& node_material = model.node_material();
+  const std::int64_t n = model.node_count();
+  const real t = state.time;
+
+  // Pass A: pair stiffness k = kn V_i V_j of every entry in contact.
+#pragma omp parallel for schedule(static)
+  for (std::int64_t ii = 0; ii < n; ++ii) {
+    const index_t i = static_cast<index_t>(ii);
+    for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
+      const index_t j = pair_partner_[e];
+      const contact::Law& law = laws_[node_material[i] * material_count_ + node_material[j]];
+      const real dx = x[3 * j] - x[3 * i], dy = x[3 * j + 1] - x[3 * i + 1], dz = x[3 * j + 2] - x[3 * i + 2];
+      const real r2 = dx * dx + dy * dy + dz * dz;
+      pair_stiffness_[e] = r2 < law.contact_radius * law.contact_radius
+                               ? law.normal_stiffness * volume[i] * volume[j]
+                               : 0.0;
+    }
+    std::vector<WallContact> local;
+    for (index_t e = wall_offsets_[i]; e < wall_offsets_[i + 1]; ++e) {
+      const Wall& wall = walls_[wall_entry_[e][0]];
+      const contact::Law& law = wall_laws_[wall_entry_[e][0] * material_count_ + node_material[i]];
+      local.clear();
+      wall.contacts(wall_entry_[e][1], wall.to_reference(&x[3 * i], t), law.contact_radius, dimension_, local);
+      wall_entry_stiffness_[e] = static_cast<real>(local.size()) * law.normal_stiffness * volume[i] * volume[i];
+    }
+  }
+  // Pass B: K per pair of bodies, summed in node order (each node pair is listed twice).
+  std::fill(slot_stiffness_.begin(), slot_stiffness_.end(), 0.0);
+  std::uint64_t touching = 0, wall_touching = 0;
+  for (std::size_t e = 0; e < pair_stiffness_.size(); ++e) {
+    slot_stiffness_[pair_slot_[e]] += 0.5 * pair_stiffness_[e];
+    touching += pair_stiffness_[e] > 0 ? 1 : 0;
+  }
+  for (std::size_t e = 0; e < wall_entry_stiffness_.size(); ++e) {
+    slot_stiffness_[wall_slot_[e]] += wall_entry_stiffness_[e];
+    wall_touching += wall_entry_stiffness_[e] > 0 ? 1 : 0;
+  }
+  statistics_.node_contacts = touching / 2;
+  statistics_.wall_contacts = wall_touching;
+
+  // Damping between bodies (see contact_law.hpp): per pair of touching bodies, a dashpot
+  // 2 zeta sqrt(M K_s) along the mean contact normal on the bodies' approach speed, applied to
+  // each body as a uniform acceleration. K_s = F / x is the secant stiffness of the collision
+  // (contact force over the approach since the bodies touched); the sum of the contact springs
+  // K overestimates it when the bodies deform, and the dashpot would then overdamp.
+  const auto& node_particle = model.node_particle();
+  const std::size_t slot_count = slots_.size();
+  std::vector<std::uint8_t> touching_body(model.particles().size(), 0);
+  for (std::size_t slot = 0; slot < slot_count; ++slot) {
+    if (slot_stiffness_[slot] == 0) continue;
+    touching_body[slots_[slot][0]] = 1;
+    if (slot < particle_slot_count_) touching_body[slots_[slot][1]] = 1;
+  }
+  std::vector<RigidMotion> bodies(model.particles().size());
+  const std::int64_t particle_count = static_cast<std::int64_t>(model.particles().size());
+#pragma omp parallel for schedule(dynamic, 16)
+  for (std::int64_t p = 0; p < particle_count; ++p) {
+    if (touching_body[p]) bodies[p] = rigid_motion(model, state, model.particles()[p], dimension_);
+  }
+  // Spring force and stiffness-weighted normal per slot (from the first body to the second, or
+  // from the wall to the particle), summed in node order.
+  std::vector<vec> slot_normal(slot_count, vec{0, 0, 0});
+  std::vector<real> slot_force(slot_count, 0);
+  for (index_t i = 0; i < static_cast<index_t>(n); ++i) {
+    for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
+      const index_t j = pair_partner_[e];
+      const std::size_t slot = pair_slot_[e];
+      if (pair_stiffness_[e] == 0 || node_particle[i] == node_particle[j] || node_particle[i] != slots_[slot][0]) continue;
+      const contact::Law& law = laws_[node_material[i] * material_count_ + node_material[j]];
+      const vec d{x[3 * j] - x[3 * i], x[3 * j + 1] - x[3 * i + 1], x[3 * j + 2] - x[3 * i + 2]};
+      const real distance = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+      if (!(distance > 0)) continue;
+      const real spring = contact::normal_force(pair_stiffness_[e], law.contact_radius - distance);
+      slot_force[slot] += spring;
+      for (int k = 0; k < 3; ++k) slot_normal[slot][k] += spring * d[k] / distance;
+    }
+    std::vector<WallContact> local;
+    for (index_t e = wall_offsets_[i]; e < wall_offsets_[i + 1]; ++e) {
+      if (wall_entry_stiffness_[e] == 0) continue;
+      const Wall& wall = walls_[wall_entry_[e][0]];
+      const contact::Law& law = wall_laws_[wall_entry_[e][0] * material_count_ + node_material[i]];
+      local.clear();
+      wall.contacts(wall_entry_[e][1], wall.to_reference(&x[3 * i], t), law.contact_radius, dimension_, local);
+      for (const WallContact& point : local) {
+        const vec normal = wall.rotate_to_world(point.normal, t);
+        const real spring = contact::normal_force(law.normal_stiffness * volume[i] * volume[i],
+                                                  law.contact_radius - point.distance);
+        slot_force[wall_slot_[e]] += spring;
+        for (int k = 0; k < 3; ++k) slot_normal[wall_slot_[e]][k] += spring * normal[k];
+      }
+    }
+  }
+  const real dt = has_last_time_ ? t - last_time_ : 0.0;
+  last_time_ = t;
+  has_last_time_ = true;
+  std::vector<real> body_damping(3 * model.particles().size(), 0.0);
+  std::vector<std::array<real, 6>> wall_damping(walls_.size(), {0, 0, 0, 0, 0, 0});
+  for (std::size_t slot = 0; slot < slot_count; ++slot) {
+    const bool wall_slot = slot >= particle_slot_count_;
+    const index_t p = slots_[slot][0], q = slots_[slot][1];
+    const real norm = std::sqrt(slot_normal[slot][0] * slot_normal[slot][0] + slot_normal[slot][1] * slot_normal[slot][1] +
+                                slot_normal[slot][2] * slot_normal[slot][2]);
+    if (slot_stiffness_[slot] == 0 || (!wall_slot && p == q) || !(norm > 0)) {
+      slot_approach_[slot] = 0;  // not touching (or fragments, damped node by node)
+      continue;
+    }
+    const vec normal{slot_normal[slot][0] / norm, slot_normal[slot][1] / norm, slot_normal[slot][2] / norm};
+    real approach;  // closing speed of the two bodies along the normal
+    real zeta;
+    if (wall_slot) {
+      const vec wall_velocity = walls_[q].velocity_at(bodies[p].centre.data(), t);
+      approach = -((bodies[p].velocity[0] - wall_velocity[0]) * normal[0] +
+                   (bodies[p].velocity[1] - wall_velocity[1]) * normal[1] +
+                   (bodies[p].velocity[2] - wall_velocity[2]) * normal[2]);
+      zeta = wall_laws_[q * material_count_ + model.particles()[p].material].damping_ratio;
+    } else {
+      approach = (bodies[p].velocity[0] - bodies[q].velocity[0]) * normal[0] +
+                 (bodies[p].velocity[1] - bodies[q].velocity[1]) * normal[1] +
+                 (bodies[p].velocity[2] - bodies[q].velocity[2]) * normal[2];
+      zeta = laws_[model.particles()[p].material * material_count_ + model.particles()[q].material].damping_ratio;
+    }
+    slot_approach_[slot] += approach * dt;
+    if (zeta == 0) continue;
+    const real K = slot_stiffness_[slot];
+    const real secant = slot_approach_[slot] > 0 ? std::min(K, slot_force[slot] / slot_approach_[slot]) : K;
+    const real damping = 2.0 * zeta * std::sqrt(slot_reduced_mass_[slot] * secant) * approach;
+    for (int k = 0; k < 3; ++k) body_damping[3 * p + k] += (wall_slot ? damping : -damping) * normal[k];
+    if (wall_slot) {  // the wall takes the opposite force, at the body's centre of mass
+      const vec arm{bodies[p].centre[0] - walls_[q].center[0], bodies[p].centre[1] - walls_[q].center[1],
+                    bodies[p].centre[2] - walls_[q].center[2]};
+      const vec on_wall{-damping * normal[0], -damping * normal[1], -damping * normal[2]};
+      auto& r = wall_damping[q];
+      for (int k = 0; k < 3; ++k) r[k] += on_wall[k];
+      r[3] += arm[1] * on_wall[2] - arm[2] * on_wall[1];
+      r[4] += arm[2] * on_wall[0] - arm[0] * on_wall[2];
+      r[5] += arm[0] * on_wall[1] - arm[1] * on_wall[0];
+    } else {
+      for (int k = 0; k < 3; ++k) body_damping[3 * q + k] += damping * normal[k];
+    }
+  }
+
+  // Pass C: forces; each node gathers its own.
+#pragma omp parallel for schedule(static)
+  for (std::int64_t ii = 0; ii < n; ++ii) {
+    const index_t i = static_cast<index_t>(ii);
+    const real* xi = &x[3 * i];
+    const real* vi = &v[3 * i];
+    const index_t particle = node_particle[i];
+    vec total{0, 0, 0};
+    if (touching_body[particle]) {
+      for (int k = 0; k < 3; ++k) total[k] = body_damping[3 * particle + k] * model.node_density()[i] * volume[i] / particle_mass_[particle];
+    }
+    for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
+      if (pair_stiffness_[e] == 0) continue;
+      const index_t j = pair_partner_[e];
+      const contact::Law& law = laws_[node_material[i] * material_count_ + node_material[j]];
+      const vec d{x[3 * j] - xi[0], x[3 * j + 1] - xi[1], x[3 * j + 2] - xi[2]};
+      const real distance = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+      if (!(distance > 0)) continue;
+      const vec normal{d[0] / distance, d[1] / distance, d[2] / distance};  // from i to j
+      const vec relative{vi[0] - v[3 * j], vi[1] - v[3 * j + 1], vi[2] - v[3 * j + 2]};
+      const real approach = relative[0] * normal[0] + relative[1] * normal[1] + relative[2] * normal[2];
+      const real k = pair_stiffness_[e];
+      real push = contact::normal_force(k, law.contact_radius - distance);
+      if (particle == node_particle[j]) {  // fragments of one particle: a node-pair dashpot
+        const real K = slot_stiffness_[pair_slot_[e]];
+        const real c = 2.0 * law.damping_ratio * k * std::sqrt(slot_reduced_mass_[pair_slot_[e]] / K);
+        push = std::max(0.0, push + contact::damping_force(c, approach));
+      }
+      const real tangential[3] = {relative[0] - approach * normal[0], relative[1] - approach * normal[1],
+                                  relative[2] - approach * normal[2]};
+      real friction[3];
+      contact::friction_force(law, push, tangential, friction);
+      for (int k3 = 0; k3 < 3; ++k3) total[k3] += -push * normal[k3] + friction[k3];
+    }
+    std::vector<WallContact> local;
+    for (index_t e = wall_offsets_[i]; e < wall_offsets_[i + 1]; ++e) {
+      std::array<real, 6>& reaction = wall_entry_reaction_[e];
+      reaction = {0, 0, 0, 0, 0, 0};
+      if (wall_entry_stiffness_[e] == 0) continue;
+      const Wall& wall = walls_[wall_entry_[e][0]];
+      const contact::Law& law = wall_laws_[wall_entry_[e][0] * material_count_ + node_material[i]];
+      local.clear();
+      wall.contacts(wall_entry_[e][1], wall.to_reference(xi, t), law.contact_radius, dimension_, local);
+      const vec wall_velocity = wall.velocity_at(xi, t);
+      const vec relative{vi[0] - wall_velocity[0], vi[1] - wall_velocity[1], vi[2] - wall_velocity[2]};
+      const real k = law.normal_stiffness * volume[i] * volume[i];
+      vec force{0, 0, 0};
+      for (const WallContact& contact_point : local) {
+        const vec normal = wall.rotate_to_world(contact_point.normal, t);  // towards the particle
+        const real push = contact::normal_force(k, law.contact_radius - contact_point.distance);
+        const real normal_speed = relative[0] * normal[0] + relative[1] * normal[1] + relative[2] * normal[2];
+        const real tangential[3] = {relative[0] - normal_speed * normal[0], relative[1] - normal_speed * normal[1],
+                                    relative[2] - normal_speed * normal[2]};
+        real friction[3];
+        contact::friction_force(law, push, tangential, friction);
+        for (int k3 = 0; k3 < 3; ++k3) force[k3] += push * normal[k3] + friction[k3];
+      }
+      for (int k3 = 0; k3 < 3; ++k3) total[k3] += force[k3];
+      const vec arm{xi[0] - wall.center[0], xi[1] - wall.center[1], xi[2] - wall.center[2]};
+      reaction = {-force[0], -force[1], -force[2], -(arm[1] * force[2] - arm[2] * force[1]),
+                  -(arm[2] * force[0] - arm[0] * force[2]), -(arm[0] * force[1] - arm[1] * force[0])};
+    }
+    for (int k3 = 0; k3 < 3; ++k3) f[3 * i + k3] += total[k3] / volume[i];
+  }
+
+  // Pass D: wall reactions, summed in node order, plus the dashpots' share.
+  wall_reactions_ = wall_damping;
+  for (std::size_t e = 0; e < wall_entry_.size(); ++e) {
+    auto& reaction = wall_reactions_[wall_entry_[e][0]];
+    for (int k = 0; k < 6; ++k) reaction[k] += wall_entry_reaction_[e][k];
+  }
+}
+
+}  // namespace granulate

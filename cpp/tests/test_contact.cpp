@@ -1,0 +1,133 @@
+// Contact law sub-models, walls' distance queries, Newton's third law of node contacts.
+#include <memory>
+#include <random>
+
+#include "check.hpp"
+#include "granulate/simulation.hpp"
+
+using namespace granulate;
+
+TEST_CASE("damping ratio from restitution: e = exp(-pi zeta / sqrt(1 - zeta^2))") {
+  for (double e : {0.2, 0.5, 0.8, 0.95}) {
+    const double zeta = contact::damping_ratio_from_restitution(e);
+    CHECK_CLOSE(std::exp(-std::numbers::pi * zeta / std::sqrt(1 - zeta * zeta)), e, 1e-12);
+  }
+  CHECK(contact::damping_ratio_from_restitution(1.0) == 0.0);
+}
+
+TEST_CASE("friction opposes slip, saturates at mu N, is regularised near zero slip") {
+  contact::Law law;
+  law.friction = 0.5;
+  law.slip_velocity = 1e-3;
+  const real fast[3] = {2.0, 0, 0}, slow[3] = {0, 5e-4, 0};
+  real force[3];
+  contact::friction_force(law, 10.0, fast, force);
+  CHECK_CLOSE(force[0], -5.0, 1e-15);
+  contact::friction_force(law, 10.0, slow, force);
+  CHECK_CLOSE(force[1], -2.5, 1e-12);
+  CHECK(force[0] == 0.0);
+}
+
+TEST_CASE("wall distance queries: plane, box, circle, polygon") {
+  Wall wall;
+  wall.name = "w";
+  WallSurface plane;
+  plane.kind = WallSurface::Kind::plane;
+  plane.point = {0, 1, 0};
+  plane.normal = {0, 2, 0};
+  WallSurface box;
+  box.kind = WallSurface::Kind::box_inside;
+  box.lower = {0, 0, 0};
+  box.upper = {4, 2, 0};
+  WallSurface circle;
+  circle.kind = WallSurface::Kind::circle_outside;
+  circle.point = {10, 0, 0};
+  circle.radius = 1;
+  WallSurface polygon;
+  polygon.kind = WallSurface::Kind::polygon;
+  polygon.vertices = {{0, 0}, {2, 0}, {2, 2}, {0, 2}};
+  polygon.inside = true;
+  wall.surfaces = {plane, box, circle, polygon};
+  wall.validate(2);
+  std::vector<WallContact> out;
+  wall.contacts(0, {3, 1.25, 0}, 1.0, 2, out);
+  CHECK(out.size() == 1 && std::abs(out[0].distance - 0.25) < 1e-15 && out[0].normal[1] == 1.0);
+  out.clear();
+  wall.contacts(1, {0.1, 1.95, 0}, 0.2, 2, out);  // near the left and top faces
+  CHECK(out.size() == 2);
+  out.clear();
+  wall.contacts(2, {12, 0, 0}, 2.0, 2, out);
+  CHECK(out.size() == 1 && std::abs(out[0].distance - 1.0) < 1e-15 && out[0].normal[0] == 1.0);
+  out.clear();
+  wall.contacts(3, {1.9, 1.0, 0}, 0.5, 2, out);  // inside the square, 0.1 from the right edge
+  CHECK(out.size() == 1 && std::abs(out[0].distance - 0.1) < 1e-12 && std::abs(out[0].normal[0] + 1.0) < 1e-15);
+  out.clear();
+  wall.contacts(3, {2.5, 1.0, 0}, 0.5, 2, out);  // outside: negative distance (penetration)
+  CHECK(out.size() == 1 && std::abs(out[0].distance + 0.5) < 1e-12);
+}
+
+TEST_CASE("moving walls: reference frame and surface velocity") {
+  Wall wall;
+  wall.name = "drum";
+  WallSurface circle;
+  circle.kind = WallSurface::Kind::circle_inside;
+  circle.radius = 1;
+  wall.surfaces = {circle};
+  wall.motion = Wall::Motion::rotation;
+  wall.function = {TimeFunction::Kind::linear, 2.0, 0};  // 2 rad/s
+  wall.validate(2);
+  const real x[3] = {1, 0, 0};
+  const auto v = wall.velocity_at(x, 0.3);
+  CHECK_CLOSE(v[1], 2.0, 1e-15);
+  const auto p = wall.to_reference(x, std::numbers::pi / 4);  // rotated back by 90 degrees
+  CHECK(std::abs(p[0]) < 1e-15 && std::abs(p[1] + 1.0) < 1e-15);
+  CHECK_CLOSE(wall.motion_bound(0, std::numbers::pi / 4), 2 * std::sin(std::numbers::pi / 4), 1e-12);
+}
+
+TEST_CASE("node contact forces obey Newton's third law to round-off") {
+  auto model = std::make_shared<Model>(2, PlaneMode::strain);
+  MaterialParams p;
+  p.density = 1000;
+  p.bulk_modulus = 1e9;
+  p.shear_modulus = 6e8;
+  p.horizon = 3e-3;
+  p.fracture = false;
+  model->add_material(p);
+  for (int body = 0; body < 2; ++body) {
+    std::vector<double> x, v;
+    for (int j = 0; j < 6; ++j)
+      for (int i = 0; i < 6; ++i) {
+        x.insert(x.end(), {(i + 0.5) * 1e-3 + body * 6.5e-3, (j + 0.5) * 1e-3 + body * 0.3e-3, 0.0});
+        v.push_back(1e-6);
+      }
+    model->add_particle(x, v, 0, 1e-3);
+  }
+  Simulation sim(model);
+  contact::Law law;
+  law.contact_radius = 0.95e-3;
+  law.normal_stiffness = 1e20;
+  law.damping_ratio = 0.3;
+  law.friction = 0.4;
+  sim.contact().set_law(0, 0, law);
+  std::mt19937 rng(1);
+  std::uniform_real_distribution<double> speed(-1, 1);
+  for (auto& c : sim.state().velocities) c = speed(rng);
+  for (std::size_t k = 2; k < sim.state().velocities.size(); k += 3) sim.state().velocities[k] = 0;
+  sim.state().positions[3 * 36] -= 1.3e-3;  // push a node of body 1 into body 0
+  sim.compute_forces();
+  // Contact forces alone: subtract the peridynamic forces of a contact-free copy.
+  Simulation free(model);
+  free.state().positions = sim.state().positions;
+  free.compute_forces();
+  double sum[3] = {0, 0, 0}, scale = 0;
+  for (index_t i = 0; i < model->node_count(); ++i) {
+    for (int c = 0; c < 3; ++c) {
+      const double contact_force = (sim.state().forces[3 * i + c] - free.state().forces[3 * i + c]) * 1e-6;
+      sum[c] += contact_force;
+      scale = std::max(scale, std::abs(contact_force));
+    }
+  }
+  CHECK(scale > 0);
+  CHECK(sim.contact().statistics().node_contacts > 0);
+  for (double s : sum) CHECK(std::abs(s) < 1e-12 * scale);
+}

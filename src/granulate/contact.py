@@ -1,0 +1,68 @@
+"""Contact parameters between particles, and between particles and walls.
+
+Two nodes interact when they are closer than the contact radius Rc and no intact bond joins
+them (nodes of different particles, or of fragments of one particle). The pair force is a
+spring kn (Rc - R) V_i V_j, a dashpot sized so that two bodies colliding head-on rebound with
+the requested coefficient of restitution, and regularised Coulomb friction (see
+cpp/include/granulate/contact/contact_law.hpp for the formulas).
+
+Defaults: Rc = 0.95 times the smaller mesh size of the two bodies; kn = c / delta, the stiffness
+of a peridynamic bond one horizon long (PMB micromodulus c, constant influence) for the
+harmonic mean of the two moduli: 18 K_eff / (pi delta^5) in 3D and 12 kappa_eff / (pi delta^4)
+in 2D (kappa: the planar bulk modulus), with delta the smaller horizon.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from granulate.errors import InputError
+
+
+@dataclass(frozen=True)
+class Contact:
+    """Contact parameters.
+
+    Attributes:
+        restitution: coefficient of restitution e of a head-on collision, in (0, 1].
+        friction: Coulomb friction coefficient mu >= 0.
+        contact_radius_factor: Rc as a multiple of the smaller mesh size (default 0.95).
+        contact_radius: absolute Rc [m]; overrides the factor.
+        normal_stiffness: absolute kn [N/m^7 in 3D, N/m^6 in 2D]; overrides the default.
+        stiffness_factor: multiplies the default kn.
+        slip_velocity: friction regularisation: below this slip speed [m/s] friction grows
+            linearly from zero (keep it well below the velocities of interest).
+    """
+
+    restitution: float = 1.0
+    friction: float = 0.0
+    contact_radius_factor: float = 0.95
+    contact_radius: float | None = None
+    normal_stiffness: float | None = None
+    stiffness_factor: float = 1.0
+    slip_velocity: float = 1e-4
+
+    def __post_init__(self) -> None:
+        if not 0 < self.restitution <= 1:
+            raise InputError(f"restitution must be in (0, 1], got {self.restitution}")
+        if not (self.friction >= 0 and math.isfinite(self.friction)):
+            raise InputError(f"friction must be a non-negative number, got {self.friction}")
+        for name in ("contact_radius_factor", "stiffness_factor", "slip_velocity"):
+            value = getattr(self, name)
+            if not (value > 0 and math.isfinite(value)):
+                raise InputError(f"{name} must be positive, got {value}")
+        for name in ("contact_radius", "normal_stiffness"):
+            value = getattr(self, name)
+            if value is not None and not (value > 0 and math.isfinite(value)):
+                raise InputError(f"{name} must be positive, got {value}")
+
+
+def default_normal_stiffness(
+    modulus_a: float, modulus_b: float, horizon: float, dimension: int
+) -> float:
+    """kn = 18 K_eff / (pi delta^5) in 3D, 12 kappa_eff / (pi delta^4) in 2D (K_eff harmonic mean x 2)."""
+    effective = 2 * modulus_a * modulus_b / (modulus_a + modulus_b)
+    if dimension == 3:
+        return 18 * effective / (math.pi * horizon**5)
+    return 12 * effective / (math.pi * horizon**4)

@@ -1,0 +1,209 @@
+"""Rigid walls: surfaces that particles cannot cross, fixed or moved by a time function.
+
+A wall is one or more surfaces moving together (``Wall(surfaces, motion=...)``). Surfaces:
+
+===========================  ===================================================================
+``Plane(point, normal)``     a half-space boundary; particles on the side the normal points to
+``BoxContainer(lo, hi)``     particles inside an axis-aligned box
+``BoxObstacle(lo, hi)``      particles outside a box
+``CircleContainer(c, r)``    particles inside a circle (2D) or cylinder (3D, ``axis``)
+``CircleObstacle(c, r)``     particles outside a circle or cylinder (posts, rollers)
+``PolygonContainer(v)``      particles inside a 2D polygon (concave allowed)
+``PolygonObstacle(v)``       particles outside a 2D polygon (lifters, blades)
+===========================  ===================================================================
+
+Motions: ``Translation(direction, function)`` moves the wall by function(t) metres along the
+direction; ``Rotation(angle, center, axis)`` turns it by angle(t) radians about the axis
+through ``center`` (``Rotation.steady(omega, center)`` for a constant angular velocity). The
+force and torque (about ``center``, or the origin) that the particles exert on each wall are
+recorded in history.csv.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from granulate import _core
+from granulate.contact import Contact
+from granulate.errors import InputError
+from granulate.functions import Constant, Linear, TimeFunction
+
+
+def _vec3(value: ArrayLike, name: str) -> tuple[float, float, float]:
+    array = np.asarray(value, dtype=float).reshape(-1)
+    if array.shape not in ((2,), (3,)) or not np.all(np.isfinite(array)):
+        raise InputError(f"{name} must be 2 or 3 finite numbers, got {value!r}")
+    return (float(array[0]), float(array[1]), float(array[2]) if len(array) == 3 else 0.0)
+
+
+class Surface:
+    """Base class of wall surfaces."""
+
+    def core(self) -> _core.WallSurface:
+        raise TypeError(f"{type(self).__name__} is not a concrete surface")
+
+
+@dataclass(frozen=True)
+class Plane(Surface):
+    point: ArrayLike
+    normal: ArrayLike
+
+    def core(self) -> _core.WallSurface:
+        s = _core.WallSurface()
+        s.kind = _core.WallSurfaceKind.plane
+        s.point, s.normal = _vec3(self.point, "plane point"), _vec3(self.normal, "plane normal")
+        return s
+
+
+@dataclass(frozen=True)
+class _Box(Surface):
+    lower: ArrayLike
+    upper: ArrayLike
+    inside: bool = field(default=True, init=False)
+
+    def core(self) -> _core.WallSurface:
+        s = _core.WallSurface()
+        s.kind = (
+            _core.WallSurfaceKind.box_inside if self.inside else _core.WallSurfaceKind.box_outside
+        )
+        s.lower, s.upper = _vec3(self.lower, "box lower"), _vec3(self.upper, "box upper")
+        return s
+
+
+@dataclass(frozen=True)
+class BoxContainer(_Box):
+    """Particles inside the box [lower, upper]."""
+
+
+@dataclass(frozen=True)
+class BoxObstacle(_Box):
+    """Particles outside the box [lower, upper]."""
+
+    inside: bool = field(default=False, init=False)
+
+
+@dataclass(frozen=True)
+class _Circle(Surface):
+    center: ArrayLike
+    radius: float
+    axis: ArrayLike = (0.0, 0.0, 1.0)
+    inside: bool = field(default=True, init=False)
+
+    def core(self) -> _core.WallSurface:
+        s = _core.WallSurface()
+        s.kind = (
+            _core.WallSurfaceKind.circle_inside
+            if self.inside
+            else _core.WallSurfaceKind.circle_outside
+        )
+        s.point, s.normal = _vec3(self.center, "circle center"), _vec3(self.axis, "cylinder axis")
+        s.radius = float(self.radius)
+        return s
+
+
+@dataclass(frozen=True)
+class CircleContainer(_Circle):
+    """Particles inside a circle (2D) or an infinite cylinder along ``axis`` (3D)."""
+
+
+@dataclass(frozen=True)
+class CircleObstacle(_Circle):
+    """Particles outside a circle (2D) or an infinite cylinder along ``axis`` (3D)."""
+
+    inside: bool = field(default=False, init=False)
+
+
+@dataclass(frozen=True)
+class _Polygon(Surface):
+    vertices: ArrayLike
+    inside: bool = field(default=True, init=False)
+
+    def core(self) -> _core.WallSurface:
+        v = np.asarray(self.vertices, dtype=float)
+        if v.ndim != 2 or v.shape[1] != 2 or len(v) < 3 or not np.all(np.isfinite(v)):
+            raise InputError("a polygon wall needs at least 3 finite (x, y) vertices")
+        s = _core.WallSurface()
+        s.kind = _core.WallSurfaceKind.polygon
+        s.vertices = [(float(x), float(y)) for x, y in v]
+        s.inside = self.inside
+        return s
+
+
+@dataclass(frozen=True)
+class PolygonContainer(_Polygon):
+    """Particles inside a 2D polygon."""
+
+
+@dataclass(frozen=True)
+class PolygonObstacle(_Polygon):
+    """Particles outside a 2D polygon."""
+
+    inside: bool = field(default=False, init=False)
+
+
+@dataclass(frozen=True)
+class Translation:
+    """x = X + function(t) * direction (direction normalised)."""
+
+    direction: ArrayLike
+    function: TimeFunction
+
+
+@dataclass(frozen=True)
+class Rotation:
+    """Rotation by angle(t) [rad] about ``axis`` through ``center`` (z in 2D)."""
+
+    angle: TimeFunction
+    center: ArrayLike = (0.0, 0.0, 0.0)
+    axis: ArrayLike = (0.0, 0.0, 1.0)
+
+    @staticmethod
+    def steady(
+        angular_velocity: float,
+        center: ArrayLike = (0.0, 0.0, 0.0),
+        axis: ArrayLike = (0.0, 0.0, 1.0),
+    ) -> Rotation:
+        """Constant angular velocity omega [rad/s]."""
+        return Rotation(Linear(angular_velocity), center, axis)
+
+
+@dataclass(frozen=True)
+class Wall:
+    """Surfaces moving together, with an optional motion and contact parameters.
+
+    ``contact`` defaults to the simulation's contact settings; ``center`` is the torque
+    reference point (the rotation centre for rotating walls).
+    """
+
+    surfaces: tuple[Surface, ...]
+    motion: Translation | Rotation | None = None
+    name: str | None = None
+    contact: Contact | None = None
+    center: ArrayLike = (0.0, 0.0, 0.0)
+
+    def core(self, name: str) -> _core.Wall:
+        wall = _core.Wall()
+        wall.name = name
+        if not self.surfaces:
+            raise InputError(f"wall {name!r} has no surface")
+        wall.surfaces = [s.core() for s in self.surfaces]
+        wall.center = _vec3(self.center, "wall center")
+        if isinstance(self.motion, Translation):
+            wall.motion = _core.WallMotion.translation
+            wall.direction = _vec3(self.motion.direction, "translation direction")
+            wall.set_function(*self.motion.function.core())
+        elif isinstance(self.motion, Rotation):
+            wall.motion = _core.WallMotion.rotation
+            wall.center = _vec3(self.motion.center, "rotation center")
+            wall.axis = _vec3(self.motion.axis, "rotation axis")
+            wall.set_function(*self.motion.angle.core())
+        elif self.motion is None:
+            wall.set_function(*Constant(0.0).core())
+        else:
+            raise InputError(
+                f"wall motion must be a Translation or a Rotation, got {self.motion!r}"
+            )
+        return wall
