@@ -193,7 +193,10 @@ NB_MODULE(_core, m) {
       .def_rw("center", &Wall::center)
       .def_rw("axis", &Wall::axis)
       .def(
-          "set_function", [](Wall& self, TimeFunction::Kind kind, real a, real b) { self.function = make_function(kind, a, b); },
+          "set_function",
+          [](Wall& self, TimeFunction::Kind kind, real a, real b) {
+            self.function = make_function(kind, a, b);
+          },
           "kind"_a, "a"_a, "b"_a)
       .def("displacement", [](const Wall& self, real t) { return self.function.value(t); }, "time"_a);
 
@@ -220,6 +223,7 @@ NB_MODULE(_core, m) {
           "step", [](const Simulation& self) { return self.state().step; },
           [](Simulation& self, std::uint64_t s) { self.state().step = s; })
       .def("set_body_acceleration", &Simulation::set_body_acceleration, "acceleration"_a)
+      .def_prop_rw("viscous_damping", &Simulation::viscous_damping, &Simulation::set_viscous_damping)
       .def(
           "add_displacement",
           [](Simulation& self, Indices nodes, unsigned components, std::array<real, 3> direction,
@@ -258,10 +262,15 @@ NB_MODULE(_core, m) {
           "nodes"_a, "vector"_a, "kind"_a, "a"_a, "b"_a)
       .def(
           "set_contact_law",
-          [](Simulation& self, index_t a, index_t b, const contact::Law& law) { self.contact().set_law(a, b, law); },
+          [](Simulation& self, index_t a, index_t b, const contact::Law& law) {
+            self.contact().set_law(a, b, law);
+          },
           "material_a"_a, "material_b"_a, "law"_a)
       .def(
-          "add_wall", [](Simulation& self, Wall wall) { return self.contact().add_wall(std::move(wall), self.model().dimension()); },
+          "add_wall",
+          [](Simulation& self, Wall wall) {
+            return self.contact().add_wall(std::move(wall), self.model().dimension());
+          },
           "wall"_a)
       .def(
           "set_wall_law",
@@ -269,7 +278,8 @@ NB_MODULE(_core, m) {
             self.contact().set_wall_law(wall, material, law);
           },
           "wall"_a, "material"_a, "law"_a)
-      .def("set_contact_skin", [](Simulation& self, real skin) { self.contact().set_skin(skin); }, "skin"_a)
+      .def(
+          "set_contact_skin", [](Simulation& self, real skin) { self.contact().set_skin(skin); }, "skin"_a)
       .def("wall_reactions", [](const Simulation& self) { return self.contact().wall_reactions(); })
       .def_prop_ro("walls", [](const Simulation& self) { return self.contact().walls(); })
       .def_prop_ro("contact_statistics", [](const Simulation& self) { return self.contact().statistics(); })

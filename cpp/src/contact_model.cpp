@@ -47,8 +47,10 @@ RigidMotion rigid_motion(const Model& model, const State& state, const Particle&
   real I[3][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
   for (index_t i = particle.first_node; i < particle.first_node + particle.node_count; ++i) {
     const real m = model.node_density()[i] * model.volumes()[i];
-    const vec r{x[3 * i] - motion.centre[0], x[3 * i + 1] - motion.centre[1], x[3 * i + 2] - motion.centre[2]};
-    const vec u{v[3 * i] - motion.velocity[0], v[3 * i + 1] - motion.velocity[1], v[3 * i + 2] - motion.velocity[2]};
+    const vec r{x[3 * i] - motion.centre[0], x[3 * i + 1] - motion.centre[1],
+                x[3 * i + 2] - motion.centre[2]};
+    const vec u{v[3 * i] - motion.velocity[0], v[3 * i + 1] - motion.velocity[1],
+                v[3 * i + 2] - motion.velocity[2]};
     momentum[0] += m * (r[1] * u[2] - r[2] * u[1]);
     momentum[1] += m * (r[2] * u[0] - r[0] * u[2]);
     momentum[2] += m * (r[0] * u[1] - r[1] * u[0]);
@@ -61,7 +63,8 @@ RigidMotion rigid_motion(const Model& model, const State& state, const Particle&
     if (I[2][2] > 0) motion.angular_velocity[2] = momentum[2] / I[2][2];
     return motion;
   }
-  const real det = I[0][0] * (I[1][1] * I[2][2] - I[1][2] * I[2][1]) - I[0][1] * (I[1][0] * I[2][2] - I[1][2] * I[2][0]) +
+  const real det = I[0][0] * (I[1][1] * I[2][2] - I[1][2] * I[2][1]) -
+                   I[0][1] * (I[1][0] * I[2][2] - I[1][2] * I[2][0]) +
                    I[0][2] * (I[1][0] * I[2][1] - I[1][1] * I[2][0]);
   if (!(std::abs(det) > 0)) return motion;
   const real inverse[3][3] = {
@@ -72,7 +75,8 @@ RigidMotion rigid_motion(const Model& model, const State& state, const Particle&
       {(I[1][0] * I[2][1] - I[1][1] * I[2][0]) / det, (I[0][1] * I[2][0] - I[0][0] * I[2][1]) / det,
        (I[0][0] * I[1][1] - I[0][1] * I[1][0]) / det}};
   for (int a = 0; a < 3; ++a) {
-    motion.angular_velocity[a] = inverse[a][0] * momentum[0] + inverse[a][1] * momentum[1] + inverse[a][2] * momentum[2];
+    motion.angular_velocity[a] =
+        inverse[a][0] * momentum[0] + inverse[a][1] * momentum[1] + inverse[a][2] * momentum[2];
   }
   return motion;
 }
@@ -107,8 +111,9 @@ void ContactModel::set_law(index_t a, index_t b, const contact::Law& law) {
   if (a >= material_count_ || b >= material_count_) throw InputError("contact law names an unknown material");
   if (!(law.contact_radius > 0) || !(law.normal_stiffness > 0) || !(law.damping_ratio >= 0) ||
       !(law.damping_ratio < 1) || !(law.friction >= 0) || !(law.slip_velocity > 0)) {
-    throw InputError("contact law needs a positive contact radius, stiffness and slip velocity, a damping "
-                     "ratio in [0, 1) and a non-negative friction coefficient");
+    throw InputError(
+        "contact law needs a positive contact radius, stiffness and slip velocity, a damping "
+        "ratio in [0, 1) and a non-negative friction coefficient");
   }
   laws_[a * material_count_ + b] = law;
   laws_[b * material_count_ + a] = law;
@@ -129,11 +134,13 @@ index_t ContactModel::add_wall(Wall wall, int dimension) {
 }
 
 void ContactModel::set_wall_law(index_t wall, index_t material, const contact::Law& law) {
-  if (wall >= walls_.size() || material >= material_count_) throw InputError("wall law names an unknown wall or material");
+  if (wall >= walls_.size() || material >= material_count_)
+    throw InputError("wall law names an unknown wall or material");
   if (!(law.contact_radius > 0) || !(law.normal_stiffness > 0) || !(law.damping_ratio >= 0) ||
       !(law.damping_ratio < 1) || !(law.friction >= 0) || !(law.slip_velocity > 0)) {
-    throw InputError("wall contact law needs a positive contact radius, stiffness and slip velocity, a damping "
-                     "ratio in [0, 1) and a non-negative friction coefficient");
+    throw InputError(
+        "wall contact law needs a positive contact radius, stiffness and slip velocity, a damping "
+        "ratio in [0, 1) and a non-negative friction coefficient");
   }
   wall_laws_[wall * material_count_ + material] = law;
   wall_law_set_[wall * material_count_ + material] = 1;
@@ -166,7 +173,8 @@ real ContactModel::stable_time_step(const Model& model) const {
     }
     for (std::size_t w = 0; w < walls_.size(); ++w) {
       if (wall_law_set_[w * material_count_ + a]) {
-        stiffness = std::max(stiffness, wall_laws_[w * material_count_ + a].normal_stiffness * largest_volume[a]);
+        stiffness =
+            std::max(stiffness, wall_laws_[w * material_count_ + a].normal_stiffness * largest_volume[a]);
       }
     }
     if (stiffness > 0) dt = std::min(dt, std::sqrt(2.0 * density[a] / (2.0 * partners * stiffness)));
@@ -216,14 +224,16 @@ void ContactModel::rebuild(const Model& model, const State& state, std::uint64_t
     for (int k = 0; k < 3; ++k) centres[3 * p + k] /= particle.node_count;
     for (index_t i = particle.first_node; i < particle.first_node + particle.node_count; ++i) {
       real d2 = 0;
-      for (int k = 0; k < 3; ++k) d2 += (x[3 * i + k] - centres[3 * p + k]) * (x[3 * i + k] - centres[3 * p + k]);
+      for (int k = 0; k < 3; ++k)
+        d2 += (x[3 * i + k] - centres[3 * p + k]) * (x[3 * i + k] - centres[3 * p + k]);
       radii[p] = std::max(radii[p], std::sqrt(d2));
     }
   }
   std::vector<std::uint8_t> near_particle(particle_count, 0), near_wall(particle_count, 0);
   if (any_law_) {
     const real largest = *std::max_element(radii.begin(), radii.end());
-    const CellGrid centre_grid = CellGrid::build(centres, 0, static_cast<index_t>(particle_count), 2 * largest + reach);
+    const CellGrid centre_grid =
+        CellGrid::build(centres, 0, static_cast<index_t>(particle_count), 2 * largest + reach);
     for (std::size_t p = 0; p < particle_count; ++p) {
       centre_grid.for_each_within(centres, static_cast<index_t>(p), 2 * largest + reach, dimension_,
                                   [&](index_t q, real r2) {
@@ -232,7 +242,8 @@ void ContactModel::rebuild(const Model& model, const State& state, std::uint64_t
       if (broken_bonds > 0 && !near_particle[p]) {
         const Particle& particle = particles[p];
         const auto begin = state.bond_intact.begin() + model.bonds().offsets[particle.first_node];
-        const auto end = state.bond_intact.begin() + model.bonds().offsets[particle.first_node + particle.node_count];
+        const auto end =
+            state.bond_intact.begin() + model.bonds().offsets[particle.first_node + particle.node_count];
         if (std::find(begin, end, std::uint8_t{0}) != end) near_particle[p] = 1;
       }
     }
@@ -271,7 +282,8 @@ void ContactModel::rebuild(const Model& model, const State& state, std::uint64_t
   for (std::int64_t a = 0; a < searched_count; ++a) {
     const index_t i = searched[a];
     index_t count = 0;
-    grid.for_each_within(x, i, reach, dimension_, [&](index_t j, real r2) { count += accept(i, j, r2) ? 1 : 0; });
+    grid.for_each_within(x, i, reach, dimension_,
+                         [&](index_t j, real r2) { count += accept(i, j, r2) ? 1 : 0; });
     pair_offsets_[i + 1] = count;
   }
   for (index_t i = 0; i < n; ++i) pair_offsets_[i + 1] += pair_offsets_[i];
@@ -313,10 +325,12 @@ void ContactModel::rebuild(const Model& model, const State& state, std::uint64_t
       }
     }
   }
-  for (index_t i = 0; i < n; ++i) wall_offsets_[i + 1] = wall_offsets_[i] + static_cast<index_t>(per_node[i].size());
+  for (index_t i = 0; i < n; ++i)
+    wall_offsets_[i + 1] = wall_offsets_[i] + static_cast<index_t>(per_node[i].size());
   wall_entry_.clear();
   wall_entry_.reserve(wall_offsets_[n]);
-  for (index_t i = 0; i < n; ++i) wall_entry_.insert(wall_entry_.end(), per_node[i].begin(), per_node[i].end());
+  for (index_t i = 0; i < n; ++i)
+    wall_entry_.insert(wall_entry_.end(), per_node[i].begin(), per_node[i].end());
 
   // Slots: one per pair of bodies that appear in the lists, in sorted order.
   const std::vector<std::array<index_t, 2>> old_slots = slots_;
@@ -338,12 +352,14 @@ void ContactModel::rebuild(const Model& model, const State& state, std::uint64_t
     for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
       const index_t p = node_particle[i], q = node_particle[pair_partner_[e]];
       const std::array<index_t, 2> key{std::min(p, q), std::max(p, q)};
-      pair_slot_[e] = static_cast<index_t>(std::lower_bound(slots_.begin(), slots_.end(), key) - slots_.begin());
+      pair_slot_[e] =
+          static_cast<index_t>(std::lower_bound(slots_.begin(), slots_.end(), key) - slots_.begin());
     }
   }
   std::vector<std::array<index_t, 2>> wall_keys;
   for (index_t i = 0; i < n; ++i) {
-    for (index_t e = wall_offsets_[i]; e < wall_offsets_[i + 1]; ++e) wall_keys.push_back({node_particle[i], wall_entry_[e][0]});
+    for (index_t e = wall_offsets_[i]; e < wall_offsets_[i + 1]; ++e)
+      wall_keys.push_back({node_particle[i], wall_entry_[e][0]});
   }
   std::sort(wall_keys.begin(), wall_keys.end());
   wall_keys.erase(std::unique(wall_keys.begin(), wall_keys.end()), wall_keys.end());
@@ -352,8 +368,8 @@ void ContactModel::rebuild(const Model& model, const State& state, std::uint64_t
   for (index_t i = 0; i < n; ++i) {
     for (index_t e = wall_offsets_[i]; e < wall_offsets_[i + 1]; ++e) {
       const std::array<index_t, 2> key{node_particle[i], wall_entry_[e][0]};
-      wall_slot_[e] = static_cast<index_t>(particle_slots + (std::lower_bound(wall_keys.begin(), wall_keys.end(), key) -
-                                                             wall_keys.begin()));
+      wall_slot_[e] = static_cast<index_t>(
+          particle_slots + (std::lower_bound(wall_keys.begin(), wall_keys.end(), key) - wall_keys.begin()));
     }
   }
   // Reduced masses: two particles m_p m_q / (m_p + m_q); two fragments of one particle, about
@@ -377,7 +393,8 @@ void ContactModel::rebuild(const Model& model, const State& state, std::uint64_t
     const auto begin = old_slots.begin() + (wall ? old_particle_slots : 0);
     const auto end = wall ? old_slots.end() : old_slots.begin() + old_particle_slots;
     const auto previous = std::lower_bound(begin, end, slots_[slot]);
-    if (previous != end && *previous == slots_[slot]) slot_approach_[slot] = old_approach[previous - old_slots.begin()];
+    if (previous != end && *previous == slots_[slot])
+      slot_approach_[slot] = old_approach[previous - old_slots.begin()];
   }
   pair_stiffness_.assign(pair_partner_.size(), 0);
   wall_entry_stiffness_.assign(wall_entry_.size(), 0);
@@ -411,17 +428,18 @@ void ContactModel::add_forces(const Model& model, State& state, std::uint64_t br
       const contact::Law& law = laws_[node_material[i] * material_count_ + node_material[j]];
       const real dx = x[3 * j] - x[3 * i], dy = x[3 * j + 1] - x[3 * i + 1], dz = x[3 * j + 2] - x[3 * i + 2];
       const real r2 = dx * dx + dy * dy + dz * dz;
-      pair_stiffness_[e] = r2 < law.contact_radius * law.contact_radius
-                               ? law.normal_stiffness * volume[i] * volume[j]
-                               : 0.0;
+      pair_stiffness_[e] =
+          r2 < law.contact_radius * law.contact_radius ? law.normal_stiffness * volume[i] * volume[j] : 0.0;
     }
     std::vector<WallContact> local;
     for (index_t e = wall_offsets_[i]; e < wall_offsets_[i + 1]; ++e) {
       const Wall& wall = walls_[wall_entry_[e][0]];
       const contact::Law& law = wall_laws_[wall_entry_[e][0] * material_count_ + node_material[i]];
       local.clear();
-      wall.contacts(wall_entry_[e][1], wall.to_reference(&x[3 * i], t), law.contact_radius, dimension_, local);
-      wall_entry_stiffness_[e] = static_cast<real>(local.size()) * law.normal_stiffness * volume[i] * volume[i];
+      wall.contacts(wall_entry_[e][1], wall.to_reference(&x[3 * i], t), law.contact_radius, dimension_,
+                    local);
+      wall_entry_stiffness_[e] =
+          static_cast<real>(local.size()) * law.normal_stiffness * volume[i] * volume[i];
     }
   }
   // Pass B: K per pair of bodies, summed in node order (each node pair is listed twice).
@@ -465,7 +483,9 @@ void ContactModel::add_forces(const Model& model, State& state, std::uint64_t br
     for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
       const index_t j = pair_partner_[e];
       const std::size_t slot = pair_slot_[e];
-      if (pair_stiffness_[e] == 0 || node_particle[i] == node_particle[j] || node_particle[i] != slots_[slot][0]) continue;
+      if (pair_stiffness_[e] == 0 || node_particle[i] == node_particle[j] ||
+          node_particle[i] != slots_[slot][0])
+        continue;
       const contact::Law& law = laws_[node_material[i] * material_count_ + node_material[j]];
       const vec d{x[3 * j] - x[3 * i], x[3 * j + 1] - x[3 * i + 1], x[3 * j + 2] - x[3 * i + 2]};
       const real distance = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
@@ -480,7 +500,8 @@ void ContactModel::add_forces(const Model& model, State& state, std::uint64_t br
       const Wall& wall = walls_[wall_entry_[e][0]];
       const contact::Law& law = wall_laws_[wall_entry_[e][0] * material_count_ + node_material[i]];
       local.clear();
-      wall.contacts(wall_entry_[e][1], wall.to_reference(&x[3 * i], t), law.contact_radius, dimension_, local);
+      wall.contacts(wall_entry_[e][1], wall.to_reference(&x[3 * i], t), law.contact_radius, dimension_,
+                    local);
       for (const WallContact& point : local) {
         const vec normal = wall.rotate_to_world(point.normal, t);
         const real spring = contact::normal_force(law.normal_stiffness * volume[i] * volume[i],
@@ -498,8 +519,9 @@ void ContactModel::add_forces(const Model& model, State& state, std::uint64_t br
   for (std::size_t slot = 0; slot < slot_count; ++slot) {
     const bool wall_slot = slot >= particle_slot_count_;
     const index_t p = slots_[slot][0], q = slots_[slot][1];
-    const real norm = std::sqrt(slot_normal[slot][0] * slot_normal[slot][0] + slot_normal[slot][1] * slot_normal[slot][1] +
-                                slot_normal[slot][2] * slot_normal[slot][2]);
+    const real norm =
+        std::sqrt(slot_normal[slot][0] * slot_normal[slot][0] + slot_normal[slot][1] * slot_normal[slot][1] +
+                  slot_normal[slot][2] * slot_normal[slot][2]);
     if (slot_stiffness_[slot] == 0 || (!wall_slot && p == q) || !(norm > 0)) {
       slot_approach_[slot] = 0;  // not touching (or fragments, damped node by node)
       continue;
@@ -517,7 +539,8 @@ void ContactModel::add_forces(const Model& model, State& state, std::uint64_t br
       approach = (bodies[p].velocity[0] - bodies[q].velocity[0]) * normal[0] +
                  (bodies[p].velocity[1] - bodies[q].velocity[1]) * normal[1] +
                  (bodies[p].velocity[2] - bodies[q].velocity[2]) * normal[2];
-      zeta = laws_[model.particles()[p].material * material_count_ + model.particles()[q].material].damping_ratio;
+      zeta = laws_[model.particles()[p].material * material_count_ + model.particles()[q].material]
+                 .damping_ratio;
     }
     slot_approach_[slot] += approach * dt;
     if (zeta == 0) continue;
@@ -548,7 +571,9 @@ void ContactModel::add_forces(const Model& model, State& state, std::uint64_t br
     const index_t particle = node_particle[i];
     vec total{0, 0, 0};
     if (touching_body[particle]) {
-      for (int k = 0; k < 3; ++k) total[k] = body_damping[3 * particle + k] * model.node_density()[i] * volume[i] / particle_mass_[particle];
+      for (int k = 0; k < 3; ++k)
+        total[k] =
+            body_damping[3 * particle + k] * model.node_density()[i] * volume[i] / particle_mass_[particle];
     }
     for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
       if (pair_stiffness_[e] == 0) continue;
@@ -590,7 +615,8 @@ void ContactModel::add_forces(const Model& model, State& state, std::uint64_t br
         const vec normal = wall.rotate_to_world(contact_point.normal, t);  // towards the particle
         const real push = contact::normal_force(k, law.contact_radius - contact_point.distance);
         const real normal_speed = relative[0] * normal[0] + relative[1] * normal[1] + relative[2] * normal[2];
-        const real tangential[3] = {relative[0] - normal_speed * normal[0], relative[1] - normal_speed * normal[1],
+        const real tangential[3] = {relative[0] - normal_speed * normal[0],
+                                    relative[1] - normal_speed * normal[1],
                                     relative[2] - normal_speed * normal[2]};
         real friction[3];
         contact::friction_force(law, push, tangential, friction);
@@ -598,8 +624,12 @@ void ContactModel::add_forces(const Model& model, State& state, std::uint64_t br
       }
       for (int k3 = 0; k3 < 3; ++k3) total[k3] += force[k3];
       const vec arm{xi[0] - wall.center[0], xi[1] - wall.center[1], xi[2] - wall.center[2]};
-      reaction = {-force[0], -force[1], -force[2], -(arm[1] * force[2] - arm[2] * force[1]),
-                  -(arm[2] * force[0] - arm[0] * force[2]), -(arm[0] * force[1] - arm[1] * force[0])};
+      reaction = {-force[0],
+                  -force[1],
+                  -force[2],
+                  -(arm[1] * force[2] - arm[2] * force[1]),
+                  -(arm[2] * force[0] - arm[0] * force[2]),
+                  -(arm[0] * force[1] - arm[1] * force[0])};
     }
     for (int k3 = 0; k3 < 3; ++k3) f[3 * i + k3] += total[k3] / volume[i];
   }

@@ -1,12 +1,12 @@
 #include "granulate/model.hpp"
 
-#include "granulate/cell_grid.hpp"
-
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
 #include <sstream>
+
+#include "granulate/cell_grid.hpp"
 
 namespace granulate {
 namespace {
@@ -111,7 +111,8 @@ void Model::build_bonds() {
   // Cells slightly larger than the horizon: two nodes exactly one horizon apart (common on
   // lattices) are then never two cells apart after rounding.
   for (const Particle& p : particles_) {
-    grids.push_back(CellGrid::build(x, p.first_node, p.node_count, materials_[p.material].params.horizon * (1.0 + 1e-6)));
+    grids.push_back(
+        CellGrid::build(x, p.first_node, p.node_count, materials_[p.material].params.horizon * (1.0 + 1e-6)));
   }
 
   bonds_.offsets.assign(nodes + 1, 0);
@@ -121,7 +122,7 @@ void Model::build_bonds() {
     const index_t p = node_particle_[i];
     index_t count = 0;
     grids[p].for_each_within(x, i, materials_[particles_[p].material].params.horizon, dimension_,
-                    [&](index_t, real) { ++count; });
+                             [&](index_t, real) { ++count; });
     bonds_.offsets[i + 1] = count;
   }
   for (index_t i = 0; i < nodes; ++i) bonds_.offsets[i + 1] += bonds_.offsets[i];
@@ -145,7 +146,7 @@ void Model::build_bonds() {
     index_t* family = bonds_.neighbors.data() + bonds_.offsets[i];
     index_t filled = 0;
     grids[node_particle_[i]].for_each_within(x, i, horizon, dimension_,
-                    [&](index_t j, real) { family[filled++] = j; });
+                                             [&](index_t j, real) { family[filled++] = j; });
     std::sort(family, family + filled);
     real m = 0, first_moment = 0;
     for (index_t b = bonds_.offsets[i]; b < bonds_.offsets[i + 1]; ++b) {

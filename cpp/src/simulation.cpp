@@ -68,6 +68,13 @@ void Simulation::set_body_acceleration(const std::array<real, 3>& g) {
   forces_current_ = false;
 }
 
+void Simulation::set_viscous_damping(real gamma) {
+  if (!(gamma >= 0) || !std::isfinite(gamma))
+    throw InputError("viscous damping must be a non-negative rate in 1/s");
+  viscous_damping_ = gamma;
+  forces_current_ = false;
+}
+
 void Simulation::add_prescribed_motion(PrescribedMotion motion) {
   motion.function.validate();
   for (index_t i : motion.nodes) {
@@ -214,9 +221,10 @@ void Simulation::compute_forces() {
       fy += over * dy;
       fz += over * dz;
     }
-    f[3 * i] = fx + density[i] * g[0];
-    f[3 * i + 1] = fy + density[i] * g[1];
-    f[3 * i + 2] = fz + density[i] * g[2];
+    const real* vi = &state_.velocities[3 * i];
+    f[3 * i] = fx + density[i] * (g[0] - viscous_damping_ * vi[0]);
+    f[3 * i + 1] = fy + density[i] * (g[1] - viscous_damping_ * vi[1]);
+    f[3 * i + 2] = fz + density[i] * (g[2] - viscous_damping_ * vi[2]);
   }
 
   broken_bond_copies_ += newly_broken;
@@ -361,7 +369,9 @@ void Simulation::damage(real* phi, real* z) const {
   }
 }
 
-std::uint64_t Simulation::broken_bonds() const { return broken_bond_copies_ / 2; }
+std::uint64_t Simulation::broken_bonds() const {
+  return broken_bond_copies_ / 2;
+}
 
 index_t Simulation::fragments(index_t* labels) const {
   // Union-find; the root of a set is always its smallest node, so labels are deterministic.

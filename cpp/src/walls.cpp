@@ -10,8 +10,12 @@ namespace {
 
 using vec = std::array<real, 3>;
 
-real dot(const vec& a, const vec& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-real norm(const vec& a) { return std::sqrt(dot(a, a)); }
+real dot(const vec& a, const vec& b) {
+  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+real norm(const vec& a) {
+  return std::sqrt(dot(a, a));
+}
 vec cross(const vec& a, const vec& b) {
   return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
 }
@@ -27,7 +31,8 @@ vec rotate(const vec& v, const vec& k, real a) {
 
 void normalise(vec& v, const char* what) {
   const real n = norm(v);
-  if (!(n > 0) || !std::isfinite(n)) throw InputError(std::string("wall ") + what + " must be a non-zero vector");
+  if (!(n > 0) || !std::isfinite(n))
+    throw InputError(std::string("wall ") + what + " must be a non-zero vector");
   for (real& c : v) c /= n;
 }
 
@@ -57,7 +62,8 @@ WallContact polygon_distance(const std::vector<std::array<real, 2>>& v, const ve
       } else {
         const real len = std::sqrt(ex * ex + ey * ey);
         best_normal = {ey / len, -ex / len, 0};  // right-hand normal; fixed below by the inside test
-        if (best_normal[0] * dx + best_normal[1] * dy < 0) best_normal = {-best_normal[0], -best_normal[1], 0};
+        if (best_normal[0] * dx + best_normal[1] * dy < 0)
+          best_normal = {-best_normal[0], -best_normal[1], 0};
       }
     }
   }
@@ -77,20 +83,24 @@ void Wall::validate(int dimension) {
   if (motion == Motion::translation) normalise(direction, "translation direction");
   if (motion == Motion::rotation) {
     normalise(axis, "rotation axis");
-    if (dimension == 2 && (std::abs(axis[2]) != 1.0)) throw InputError("in 2D, walls rotate about the z axis");
+    if (dimension == 2 && (std::abs(axis[2]) != 1.0))
+      throw InputError("in 2D, walls rotate about the z axis");
   }
   extent = 0;
   for (WallSurface& s : surfaces) {
     switch (s.kind) {
       case WallSurface::Kind::plane:
         normalise(s.normal, "plane normal");
-        if (dimension == 2 && s.normal[2] != 0) throw InputError("a 2D plane wall needs a normal in the x-y plane");
-        extent = std::max(extent, norm({s.point[0] - center[0], s.point[1] - center[1], s.point[2] - center[2]}));
+        if (dimension == 2 && s.normal[2] != 0)
+          throw InputError("a 2D plane wall needs a normal in the x-y plane");
+        extent =
+            std::max(extent, norm({s.point[0] - center[0], s.point[1] - center[1], s.point[2] - center[2]}));
         break;
       case WallSurface::Kind::box_inside:
       case WallSurface::Kind::box_outside:
         for (int k = 0; k < dimension; ++k) {
-          if (!(s.upper[k] > s.lower[k])) throw InputError("wall box '" + name + "': upper must exceed lower");
+          if (!(s.upper[k] > s.lower[k]))
+            throw InputError("wall box '" + name + "': upper must exceed lower");
         }
         for (int corner = 0; corner < 8; ++corner) {
           const vec q{(corner & 1) ? s.upper[0] : s.lower[0], (corner & 2) ? s.upper[1] : s.lower[1],
@@ -103,7 +113,9 @@ void Wall::validate(int dimension) {
         if (!(s.radius > 0)) throw InputError("wall circle '" + name + "': radius must be positive");
         if (dimension == 2) s.normal = {0, 0, 1};
         normalise(s.normal, "cylinder axis");
-        extent = std::max(extent, norm({s.point[0] - center[0], s.point[1] - center[1], s.point[2] - center[2]}) + s.radius);
+        extent =
+            std::max(extent, norm({s.point[0] - center[0], s.point[1] - center[1], s.point[2] - center[2]}) +
+                                 s.radius);
         break;
       case WallSurface::Kind::polygon:
         if (dimension != 2) throw InputError("polygon walls are 2D; use planes or boxes in 3D");

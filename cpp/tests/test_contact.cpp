@@ -60,7 +60,8 @@ TEST_CASE("wall distance queries: plane, box, circle, polygon") {
   CHECK(out.size() == 1 && std::abs(out[0].distance - 1.0) < 1e-15 && out[0].normal[0] == 1.0);
   out.clear();
   wall.contacts(3, {1.9, 1.0, 0}, 0.5, 2, out);  // inside the square, 0.1 from the right edge
-  CHECK(out.size() == 1 && std::abs(out[0].distance - 0.1) < 1e-12 && std::abs(out[0].normal[0] + 1.0) < 1e-15);
+  CHECK(out.size() == 1 && std::abs(out[0].distance - 0.1) < 1e-12 &&
+        std::abs(out[0].normal[0] + 1.0) < 1e-15);
   out.clear();
   wall.contacts(3, {2.5, 1.0, 0}, 0.5, 2, out);  // outside: negative distance (penetration)
   CHECK(out.size() == 1 && std::abs(out[0].distance + 0.5) < 1e-12);

@@ -61,7 +61,10 @@ class Contact:
 def default_normal_stiffness(
     modulus_a: float, modulus_b: float, horizon: float, dimension: int
 ) -> float:
-    """kn = 18 K_eff / (pi delta^5) in 3D, 12 kappa_eff / (pi delta^4) in 2D (K_eff harmonic mean x 2)."""
+    """kn = 18 K_eff / (pi delta^5) in 3D, 12 K_eff / (pi delta^4) in 2D.
+
+    K_eff = 2 K_a K_b / (K_a + K_b); in 2D the moduli are the planar bulk moduli kappa_d.
+    """
     effective = 2 * modulus_a * modulus_b / (modulus_a + modulus_b)
     if dimension == 3:
         return 18 * effective / (math.pi * horizon**5)

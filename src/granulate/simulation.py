@@ -107,6 +107,8 @@ class Simulation:
         dt: time step [s]; default ``dt_safety`` times the stable estimate.
         dt_safety: fraction of the stable estimate used when ``dt`` is not given.
         gravity: body acceleration [m/s^2], e.g. (0, -9.81, 0).
+        viscous_damping: background damping rate gamma [1/s] (force density -gamma rho v) for
+            quasi-static settling; 0 (off) for dynamics, since it also damps rigid motion.
     """
 
     def __init__(
@@ -117,6 +119,7 @@ class Simulation:
         dt: float | None = None,
         dt_safety: float = 0.8,
         gravity: ArrayLike | None = None,
+        viscous_damping: float = 0.0,
     ) -> None:
         if dimension not in (2, 3):
             raise InputError(f"dimension must be 2 or 3, got {dimension!r}")
@@ -129,8 +132,6 @@ class Simulation:
         self._dt = None if dt is None else self._check_dt(dt)
         self._dt_safety = dt_safety
         self._gravity = np.zeros(3)
-        if gravity is not None:
-            self.gravity = gravity  # type: ignore[assignment]
         self.bodies: list[Body] = []
         self._positions: list[NDArray[np.float64]] = []
         self._volumes: list[NDArray[np.float64]] = []
@@ -148,6 +149,13 @@ class Simulation:
         self._model: _core.Model | None = None
         self._reference: NDArray[np.float64] | None = None
         self._wall_seconds = 0.0
+        if not (np.isfinite(viscous_damping) and viscous_damping >= 0):
+            raise InputError(
+                f"viscous_damping must be a non-negative rate in 1/s, got {viscous_damping}"
+            )
+        self._viscous_damping = float(viscous_damping)
+        if gravity is not None:
+            self.gravity = gravity  # type: ignore[assignment]
 
     # ------------------------------------------------------------------ building
     @staticmethod
@@ -505,6 +513,7 @@ class Simulation:
                 )
             core.time_step = self._dt
         core.set_body_acceleration(tuple(self._gravity))
+        core.viscous_damping = self._viscous_damping
         for kind, args in self._loads:
             if kind == "displacement":
                 nodes, mask, direction, function = args

@@ -12,7 +12,7 @@
 namespace granulate {
 
 class CellGrid {
-public:
+ public:
   /// Grid over nodes first .. first+count-1 of x (n x 3), cells of at least cell_size. The cell
   /// count is capped at ~64 per node (sparse sets get larger cells; searches stay correct).
   static CellGrid build(const std::vector<real>& x, index_t first, index_t count, real cell_size) {
@@ -27,7 +27,8 @@ public:
   /// Calls visit(j, r^2) for every grid node j != i with |x_j - x_i| <= radius (x_i may be
   /// any point of the x array, inside the grid or not). Cells are visited in a fixed order.
   template <class Visit>
-  void for_each_within(const std::vector<real>& x, index_t i, real radius, int dimension, Visit&& visit) const {
+  void for_each_within(const std::vector<real>& x, index_t i, real radius, int dimension,
+                       Visit&& visit) const {
     if (cell_nodes_.empty()) return;
     const real* xi = &x[3 * static_cast<std::size_t>(i)];
     const real limit = radius * radius * (1.0 + 1e-10);
@@ -55,7 +56,7 @@ public:
     }
   }
 
-private:
+ private:
   std::int64_t coordinate(real value, int axis) const {
     const real c = (value - origin_[axis]) / cell_size_;
     if (c < 0) return -1;
@@ -97,7 +98,8 @@ private:
                      grid.clamped(p[0], 0);
       ++grid.cell_start_[node_cell[a] + 1];
     }
-    for (std::size_t c = 0; c + 1 < grid.cell_start_.size(); ++c) grid.cell_start_[c + 1] += grid.cell_start_[c];
+    for (std::size_t c = 0; c + 1 < grid.cell_start_.size(); ++c)
+      grid.cell_start_[c + 1] += grid.cell_start_[c];
     grid.cell_nodes_.resize(count);
     std::vector<index_t> fill(grid.cell_start_.begin(), grid.cell_start_.end() - 1);
     for (index_t a = 0; a < count; ++a) grid.cell_nodes_[fill[node_cell[a]]++] = node_of(a);

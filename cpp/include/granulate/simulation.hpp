@@ -37,6 +37,10 @@ class Simulation {
 
   /// Uniform body acceleration g (gravity) [m/s^2]: adds rho g to every node's force density.
   void set_body_acceleration(const std::array<real, 3>& g);
+  /// Background viscous damping gamma [1/s]: adds -gamma rho v to every node's force density.
+  /// Off (0) by default; for quasi-static settling, not for dynamics (it damps rigid motion too).
+  void set_viscous_damping(real gamma);
+  real viscous_damping() const { return viscous_damping_; }
   void add_prescribed_motion(PrescribedMotion motion);
   void add_nodal_force(NodalForce force);
   /// Contact laws, walls and neighbour lists (configured for the model's materials).
@@ -77,10 +81,11 @@ class Simulation {
   real time_step_ = 0;
   real stable_time_step_ = 0;
   std::array<real, 3> body_acceleration_{0, 0, 0};
+  real viscous_damping_ = 0;
   std::vector<PrescribedMotion> motions_;
   std::vector<NodalForce> nodal_forces_;
-  std::vector<real> pressure_;   // A_i theta_i of LPS nodes
-  std::vector<real> mesh_size_;  // per node, for the stability check
+  std::vector<real> pressure_;            // A_i theta_i of LPS nodes
+  std::vector<real> mesh_size_;           // per node, for the stability check
   std::uint64_t broken_bond_copies_ = 0;  // both copies of a broken bond count
   ContactModel contact_;
   bool forces_current_ = false;

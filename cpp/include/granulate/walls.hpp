@@ -22,13 +22,13 @@ namespace granulate {
 struct WallSurface {
   enum class Kind : std::uint8_t { plane, box_inside, box_outside, circle_inside, circle_outside, polygon };
   Kind kind = Kind::plane;
-  std::array<real, 3> point{0, 0, 0};  ///< plane point, circle centre
-  std::array<real, 3> normal{0, 1, 0}; ///< plane normal; circle/cylinder axis
+  std::array<real, 3> point{0, 0, 0};   ///< plane point, circle centre
+  std::array<real, 3> normal{0, 1, 0};  ///< plane normal; circle/cylinder axis
   std::array<real, 3> lower{0, 0, 0};
   std::array<real, 3> upper{0, 0, 0};
   real radius = 0;
   std::vector<std::array<real, 2>> vertices;  ///< polygon
-  bool inside = true;                          ///< polygon: particles inside
+  bool inside = true;                         ///< polygon: particles inside
 };
 
 /// A contact candidate between a point and a surface: signed distance (positive on the

@@ -45,10 +45,14 @@ inline real damping_ratio_from_restitution(real e) {
 }
 
 /// Normal sub-model: spring force magnitude [N] (positive pushes the nodes apart).
-inline real normal_force(real pair_stiffness, real overlap) { return pair_stiffness * overlap; }
+inline real normal_force(real pair_stiffness, real overlap) {
+  return pair_stiffness * overlap;
+}
 
 /// Damping sub-model: dashpot force magnitude [N] for an approach speed (positive when closing).
-inline real damping_force(real pair_damping, real approach_speed) { return pair_damping * approach_speed; }
+inline real damping_force(real pair_damping, real approach_speed) {
+  return pair_damping * approach_speed;
+}
 
 /// Friction sub-model: tangential force [N] on i, written into force[3], from the tangential
 /// velocity of i relative to j and the (non-negative) normal force.

@@ -15,14 +15,14 @@
 namespace granulate {
 
 struct ContactStatistics {
-  std::uint64_t rebuilds = 0;        ///< neighbour-list builds so far
-  std::uint64_t list_entries = 0;    ///< node-pair entries in the current lists (both directions)
-  std::uint64_t node_contacts = 0;   ///< node pairs in contact at the last evaluation (once each)
-  std::uint64_t wall_contacts = 0;   ///< node-wall contacts at the last evaluation
+  std::uint64_t rebuilds = 0;       ///< neighbour-list builds so far
+  std::uint64_t list_entries = 0;   ///< node-pair entries in the current lists (both directions)
+  std::uint64_t node_contacts = 0;  ///< node pairs in contact at the last evaluation (once each)
+  std::uint64_t wall_contacts = 0;  ///< node-wall contacts at the last evaluation
 };
 
 class ContactModel {
-public:
+ public:
   /// Sizes the law tables for the model's materials (no contact until laws are set).
   void configure(const Model& model);
 
@@ -55,19 +55,19 @@ public:
   /// Particle masses [kg; kg/m in 2D].
   const std::vector<real>& particle_mass() const { return particle_mass_; }
 
-private:
+ private:
   bool needs_rebuild(const Model& model, const State& state, std::uint64_t broken_bonds) const;
   void rebuild(const Model& model, const State& state, std::uint64_t broken_bonds);
 
   index_t material_count_ = 0;
-  std::vector<contact::Law> laws_;            // material x material
+  std::vector<contact::Law> laws_;  // material x material
   std::vector<std::uint8_t> law_set_;
   bool any_law_ = false;
   real max_contact_radius_ = 0;
   std::vector<Wall> walls_;
-  std::vector<contact::Law> wall_laws_;       // wall x material
+  std::vector<contact::Law> wall_laws_;  // wall x material
   std::vector<std::uint8_t> wall_law_set_;
-  real skin_ = -1;                            // < 0: 0.5 x the largest contact radius
+  real skin_ = -1;  // < 0: 0.5 x the largest contact radius
   std::vector<real> particle_mass_;
   int dimension_ = 3;
 
@@ -81,10 +81,10 @@ private:
   std::vector<std::array<index_t, 2>> wall_entry_;  // (wall, surface)
   std::vector<index_t> wall_slot_;
   // Bodies in contact: one slot per (particle, particle) or (particle, wall) pair in the lists.
-  std::vector<std::array<index_t, 2>> slots_;        // particle pairs (p <= q), then (p, wall)
+  std::vector<std::array<index_t, 2>> slots_;  // particle pairs (p <= q), then (p, wall)
   std::size_t particle_slot_count_ = 0;
   std::vector<real> slot_reduced_mass_;
-  std::vector<real> slot_stiffness_;                 // K: sum of the contact springs, last evaluation
+  std::vector<real> slot_stiffness_;  // K: sum of the contact springs, last evaluation
   // Collision history per pair of bodies, kept across list rebuilds: the approach x of the two
   // bodies since they touched (for the secant stiffness F / x of the dashpot).
   std::vector<real> slot_approach_;

@@ -1,0 +1,223 @@
+"""Contact validation (DESIGN.md section 6): restitution of two-particle collisions, energy of
+elastic collisions, Newton's third law (momentum), Coulomb friction of a sliding block, the
+floor load of particles at rest, and a particle carried up a rotating drum by friction."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import granulate as gr
+
+SOFT = gr.Material(density=1200, bulk_modulus=2.16e7, shear_modulus=1.296e7, fracture=False)
+STIFF = gr.Material(density=3000, bulk_modulus=5e8, shear_modulus=3e8, fracture=False)
+
+
+def body_velocity(sim: gr.Simulation, body: gr.Body) -> np.ndarray:
+    nodes = slice(body.first_node, body.first_node + body.node_count)
+    return np.average(sim.velocities[nodes], axis=0, weights=sim.volumes[nodes])
+
+
+def body_centre(sim: gr.Simulation, body: gr.Body) -> np.ndarray:
+    nodes = slice(body.first_node, body.first_node + body.node_count)
+    return np.average(sim.positions[nodes], axis=0, weights=sim.volumes[nodes])
+
+
+def collide(
+    dimension: int,
+    restitution: float,
+    *,
+    radius: float = 1e-3,
+    other_radius: float = 1e-3,
+    other: gr.Material = SOFT,
+    offset: float = 0.0,
+    speed: float = 0.2,
+    nodes_across_radius: int = 10,
+    friction: float = 0.0,
+) -> tuple[float, float, gr.Simulation, tuple[gr.Body, gr.Body], np.ndarray]:
+    """Two particles approach head-on (offset: lateral shift of the second, for oblique impacts).
+
+    Returns (normal restitution, final/initial total energy, simulation, bodies, initial momentum).
+    """
+    sim = gr.Simulation(dimension)
+    sim.contact = gr.Contact(restitution=restitution, friction=friction)
+    h = radius / nodes_across_radius
+    x2 = radius + other_radius + 1.5 * h
+    if dimension == 2:
+        a = sim.add_body(gr.Disc((0, 0), radius), SOFT, h, velocity=(speed / 2, 0))
+        b = sim.add_body(gr.Disc((x2, offset), other_radius), other, h, velocity=(-speed / 2, 0))
+    else:
+        a = sim.add_body(gr.Sphere((0, 0, 0), radius), SOFT, h, velocity=(speed / 2, 0, 0))
+        b = sim.add_body(
+            gr.Sphere((x2, offset, 0), other_radius), other, h, velocity=(-speed / 2, 0, 0)
+        )
+    masses = sim.volumes * np.where(
+        np.arange(sim.node_count) < a.node_count, SOFT.density, other.density
+    )
+    momentum = (masses[:, None] * sim.velocities).sum(axis=0)
+    energy = sim.kinetic_energy()
+    velocity_b = body_velocity(sim, b)
+    before = body_velocity(sim, a) - velocity_b
+    touched = False
+    for _ in range(100_000):
+        sim.run(10)
+        in_contact = sim.core.contact_statistics.node_contacts > 0
+        touched = touched or in_contact
+        if touched and not in_contact:
+            break
+    assert touched, "the particles never touched"
+    sim.run(100)
+    after = body_velocity(sim, a) - body_velocity(sim, b)
+    # The normal of a finite-duration contact is the direction of its impulse.
+    normal = body_velocity(sim, b) - velocity_b
+    normal /= np.linalg.norm(normal)
+    e = -float(after @ normal) / float(before @ normal)
+    total = (sim.kinetic_energy() + sim.strain_energy()) / energy
+    return e, total, sim, (a, b), momentum
+
+
+@pytest.mark.validation
+@pytest.mark.parametrize("dimension", [2, 3])
+@pytest.mark.parametrize("restitution", [0.5, 0.8, 0.95])
+def test_head_on_restitution(dimension: int, restitution: float) -> None:
+    e, _, _, _, _ = collide(dimension, restitution, nodes_across_radius=10 if dimension == 2 else 6)
+    assert abs(e - restitution) < 0.05, f"measured e = {e:.3f} for requested {restitution}"
+
+
+@pytest.mark.validation
+@pytest.mark.parametrize("restitution", [0.5, 0.8, 0.95])
+def test_restitution_with_different_sizes_materials_and_resolutions(
+    restitution: float, full: bool
+) -> None:
+    cases = [dict(other_radius=0.6e-3, other=STIFF), dict(nodes_across_radius=6), dict(speed=1.0)]
+    if full:
+        cases += [dict(nodes_across_radius=16), dict(nodes_across_radius=20)]
+    for case in cases:
+        e, _, _, _, _ = collide(2, restitution, **case)
+        assert abs(e - restitution) < 0.05, (
+            f"{case}: measured e = {e:.3f} for requested {restitution}"
+        )
+
+
+@pytest.mark.validation
+@pytest.mark.parametrize("restitution", [0.5, 0.8, 0.95])
+def test_oblique_restitution(restitution: float) -> None:
+    """Normal restitution of an oblique impact (centres offset by 0.6 radius; the normal is the
+    direction of the impulse).
+
+    Known limitation: lattice discs have staircase surfaces, so even frictionless node-pair
+    contacts pass some tangential impulse and spin the discs. At an offset of 0.3 radius an
+    elastic (e = 1) impact returns 0.90 of the normal speed at R/h = 10 and 0.80 at R/h = 30
+    (energy is conserved; the rest is rotation and vibration). This case stays within the
+    tolerance; smoother particle surfaces are needed for the others.
+    """
+    e, _, _, _, _ = collide(2, restitution, offset=0.6e-3)
+    assert abs(e - restitution) < 0.05, f"measured e = {e:.3f} for requested {restitution}"
+
+
+@pytest.mark.validation
+@pytest.mark.parametrize("dimension", [2, 3])
+def test_elastic_collision_conserves_energy(dimension: int) -> None:
+    e, total, _, _, _ = collide(dimension, 1.0, nodes_across_radius=10 if dimension == 2 else 6)
+    assert abs(total - 1) < 0.01, f"total energy changed by {total - 1:.3%}"
+    assert e > 0.97
+
+
+@pytest.mark.validation
+def test_momentum_is_conserved_with_damping_and_friction() -> None:
+    """Newton's third law for every contact force: momentum is conserved to round-off."""
+    _, _, sim, (a, _), momentum = collide(2, 0.6, offset=0.8e-3, friction=0.5)
+    masses = sim.volumes * np.where(
+        np.arange(sim.node_count) < a.node_count, SOFT.density, SOFT.density
+    )
+    after = (masses[:, None] * sim.velocities).sum(axis=0)
+    scale = np.abs(masses[:, None] * sim.velocities).sum()
+    np.testing.assert_allclose(after, momentum, rtol=0, atol=1e-12 * scale)
+
+
+def sliding_block(dimension: int, friction: float, speed: float):
+    rubber = gr.Material(density=1000, youngs_modulus=5e6, poisson_ratio=0.25, fracture=False)
+    g = 9.81
+    sim = gr.Simulation(dimension, gravity=(0, -g, 0)[:dimension])
+    sim.contact = gr.Contact(restitution=0.3, friction=friction)
+    h = 1e-3
+    if dimension == 2:
+        block = sim.add_body(gr.Rectangle((0, 0.5 * h), (10 * h, 5.5 * h)), rubber, h)
+        sim.add_wall(gr.Plane((0, 0), (0, 1)), name="floor")
+    else:
+        block = sim.add_body(gr.Box((0, 0.5 * h, 0), (8 * h, 4.5 * h, 8 * h)), rubber, h)
+        sim.add_wall(gr.Plane((0, 0, 0), (0, 1, 0)), name="floor")
+    sim.run(until=0.02)  # land and settle
+    return sim, block, g
+
+
+@pytest.mark.validation
+@pytest.mark.parametrize("dimension", [2, 3])
+def test_sliding_block_stops_at_coulomb_distance(dimension: int) -> None:
+    mu, v0 = 0.4, 0.3
+    sim, block, g = sliding_block(dimension, mu, v0)
+    start = body_centre(sim, block)[0]
+    launched = sim.time
+    sim.velocities[:, 0] += v0
+    while body_velocity(sim, block)[0] > 1e-3:
+        sim.run(50)
+    distance = body_centre(sim, block)[0] - start
+    expected = v0**2 / (2 * mu * g)
+    assert abs(distance / expected - 1) < 0.05, f"slid {distance:.5f} m, expected {expected:.5f} m"
+    assert abs((sim.time - launched) / (v0 / (mu * g)) - 1) < 0.05  # deceleration mu g
+
+
+@pytest.mark.validation
+@pytest.mark.parametrize("dimension", [2, 3])
+def test_particles_at_rest_load_the_floor_with_their_weight(dimension: int) -> None:
+    """A pile of particles settled in a box (background damping removes the elastic vibrations
+    that peridynamic bodies otherwise keep): the floor carries the total weight within 1 %."""
+    g = 9.81
+    sim = gr.Simulation(dimension, gravity=(0, -g, 0)[:dimension], viscous_damping=30.0)
+    sim.contact = gr.Contact(restitution=0.3, friction=0.3)
+    h = 0.5e-3
+    centres = [
+        (-1.3e-3, 1.6e-3),
+        (1.3e-3, 1.6e-3),
+        (0.0, 4.0e-3),
+        (-1.5e-3, 6.6e-3),
+        (1.5e-3, 6.8e-3),
+    ]
+    for x, y in centres:
+        shape = gr.Disc((x, y), 1e-3) if dimension == 2 else gr.Sphere((x, y, 0), 1e-3)
+        sim.add_body(shape, SOFT, h)
+    if dimension == 2:
+        sim.add_wall(gr.BoxContainer((-3e-3, 0), (3e-3, 20e-3)), name="box")
+    else:
+        sim.add_wall(gr.BoxContainer((-3e-3, 0, -1.5e-3), (3e-3, 20e-3, 1.5e-3)), name="box")
+    weight = float(np.sum(sim.volumes) * SOFT.density * g)
+    sim.run(until=0.08)
+    loads = []
+    for _ in range(50):
+        sim.run(20)
+        loads.append(-sim.wall_reactions()["box"][1])
+    assert abs(np.mean(loads) / weight - 1) < 0.01, (
+        f"floor load {np.mean(loads) / weight:.4f} x weight"
+    )
+
+
+@pytest.mark.validation
+def test_rotating_drum_carries_a_particle_up_by_friction() -> None:
+    """A disc at the bottom of a drum turning counter-clockwise rides up the rising side with
+    friction, and stays at the bottom without it."""
+
+    def final_angle(friction: float) -> float:
+        sim = gr.Simulation(2, gravity=(0, -9.81))
+        sim.contact = gr.Contact(restitution=0.3, friction=friction)
+        disc = sim.add_body(gr.Disc((0, -8.85e-3), 1e-3), SOFT, 0.25e-3)
+        sim.add_wall(
+            gr.Wall((gr.CircleContainer((0, 0), 10e-3),), motion=gr.Rotation.steady(2.0)),
+            name="drum",
+        )
+        sim.run(until=0.15)
+        x, y, _ = body_centre(sim, disc)
+        return float(np.degrees(np.arctan2(x, -y)))  # 0 at the bottom, positive towards +x
+
+    with_friction, frictionless = final_angle(0.8), final_angle(0.0)
+    assert with_friction > 10.0, f"carried only {with_friction:.1f} degrees"
+    assert abs(frictionless) < 2.0, f"frictionless disc moved {frictionless:.1f} degrees"
