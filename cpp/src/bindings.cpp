@@ -117,11 +117,34 @@ NB_MODULE(_core, m) {
                                      {volumes.data(), volumes.shape(0)}, material, mesh_size);
           },
           "positions"_a, "volumes"_a, "material"_a, "mesh_size"_a)
+      .def(
+          "add_shape",
+          [](Model& self, Points positions, Scalars volumes, real mesh_size) {
+            return self.add_shape({positions.data(), positions.shape(0) * 3}, {volumes.data(), volumes.shape(0)},
+                                  mesh_size);
+          },
+          "positions"_a, "volumes"_a, "mesh_size"_a)
+      .def(
+          "place_shape",
+          [](Model& self, index_t shape, index_t material, Points positions, real scale) {
+            return self.add_particle(shape, material, {positions.data(), positions.shape(0) * 3}, scale);
+          },
+          "shape"_a, "material"_a, "positions"_a, "scale"_a)
+      .def_prop_ro("shape_count", [](const Model& self) { return self.shapes().size(); })
+      .def_prop_ro("family_count", [](const Model& self) { return self.families().size(); })
+      .def("shared_bond_bytes",
+           [](const Model& self) {
+             std::size_t bytes = 0;
+             for (const BondFamilies& f : self.families()) {
+               bytes += f.neighbors.size() * (sizeof(index_t) + 2 * sizeof(real)) + f.offsets.size() * sizeof(index_t);
+             }
+             return bytes;
+           })
       .def("finalize", &Model::finalize, nb::call_guard<nb::gil_scoped_release>())
       .def_prop_ro("finalized", &Model::finalized)
       .def_prop_ro("dimension", &Model::dimension)
       .def_prop_ro("node_count", &Model::node_count)
-      .def_prop_ro("bond_count", [](const Model& self) { return self.bonds().size(); })
+      .def_prop_ro("bond_count", &Model::bond_count)
       .def_prop_ro("particle_count", [](const Model& self) { return self.particles().size(); })
       .def_prop_ro("materials", &Model::materials)
       .def("stable_time_step", &Model::stable_time_step)
@@ -142,14 +165,18 @@ NB_MODULE(_core, m) {
                    })
       .def_prop_ro("bond_offsets",
                    [](Model& self) {
-                     return view(const_cast<index_t*>(self.bonds().offsets.data()),
-                                 self.bonds().offsets.size(), 0, nb::find(self));
-                   })
-      .def_prop_ro("bond_neighbors",
-                   [](Model& self) {
-                     return view(const_cast<index_t*>(self.bonds().neighbors.data()), self.bonds().size(), 0,
+                     return view(const_cast<std::size_t*>(self.bond_offsets().data()), self.bond_offsets().size(), 0,
                                  nb::find(self));
                    })
+      .def("bond_neighbors",
+           [](const Model& self) {
+             std::vector<index_t> neighbors(self.bond_count());
+             for (index_t i = 0; i < self.node_count(); ++i) {
+               const NodeBonds bonds = self.node_bonds(i);
+               for (index_t b = 0; b < bonds.count; ++b) neighbors[bonds.first + b] = bonds.neighbor(b);
+             }
+             return copy_out(neighbors);
+           })
       .def_prop_ro("weighted_volume", [](Model& self) {
         return view(const_cast<real*>(self.weighted_volume().data()), self.node_count(), 0, nb::find(self));
       });

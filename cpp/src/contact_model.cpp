@@ -82,12 +82,11 @@ RigidMotion rigid_motion(const Model& model, const State& state, const Particle&
 }
 
 bool intact_bond(const Model& model, const State& state, index_t i, index_t j) {
-  const BondFamilies& bonds = model.bonds();
-  const auto begin = bonds.neighbors.begin() + bonds.offsets[i];
-  const auto end = bonds.neighbors.begin() + bonds.offsets[i + 1];
-  const auto found = std::lower_bound(begin, end, j);
-  if (found == end || *found != j) return false;
-  return state.bond_intact[static_cast<std::size_t>(found - bonds.neighbors.begin())] != 0;
+  const NodeBonds bonds = model.node_bonds(i);
+  const index_t local = j - bonds.first_node;  // j is in i's particle
+  const index_t* found = std::lower_bound(bonds.neighbors, bonds.neighbors + bonds.count, local);
+  if (found == bonds.neighbors + bonds.count || *found != local) return false;
+  return state.bond_intact[bonds.first + static_cast<std::size_t>(found - bonds.neighbors)] != 0;
 }
 
 }  // namespace
@@ -241,9 +240,9 @@ void ContactModel::rebuild(const Model& model, const State& state, std::uint64_t
                                   });
       if (broken_bonds > 0 && !near_particle[p]) {
         const Particle& particle = particles[p];
-        const auto begin = state.bond_intact.begin() + model.bonds().offsets[particle.first_node];
+        const auto begin = state.bond_intact.begin() + model.bond_offsets()[particle.first_node];
         const auto end =
-            state.bond_intact.begin() + model.bonds().offsets[particle.first_node + particle.node_count];
+            state.bond_intact.begin() + model.bond_offsets()[particle.first_node + particle.node_count];
         if (std::find(begin, end, std::uint8_t{0}) != end) near_particle[p] = 1;
       }
     }

@@ -39,61 +39,103 @@ index_t Model::add_material(const MaterialParams& params) {
   return static_cast<index_t>(materials_.size() - 1);
 }
 
-index_t Model::add_particle(std::span<const real> positions, std::span<const real> volumes, index_t material,
-                            real mesh_size) {
-  require_not_finalized("add a particle");
+index_t Model::add_shape(std::span<const real> positions, std::span<const real> volumes, real mesh_size) {
+  require_not_finalized("add a shape");
   const std::size_t n = volumes.size();
-  const index_t id = static_cast<index_t>(particles_.size());
-  if (n == 0) throw InputError("particle " + std::to_string(id) + " has no nodes");
-  if (positions.size() != 3 * n) {
-    throw InputError("particle positions must be an n x 3 array matching n volumes");
-  }
-  if (material >= materials_.size()) {
-    throw InputError("particle " + std::to_string(id) + " refers to material " + std::to_string(material) +
-                     ", but only " + std::to_string(materials_.size()) + " materials exist");
-  }
+  const std::string name = "shape " + std::to_string(shapes_.size());
+  if (n == 0) throw InputError(name + " has no nodes");
+  if (positions.size() != 3 * n) throw InputError(name + ": positions must be an n x 3 array matching n volumes");
   if (!(mesh_size > 0) || !std::isfinite(mesh_size)) {
-    throw InputError("particle " + std::to_string(id) + ": mesh size must be positive, got " +
-                     str(mesh_size));
-  }
-  const real horizon = materials_[material].params.horizon;
-  if (horizon < mesh_size * (1.0 - 1e-9)) {
-    throw InputError("particle " + std::to_string(id) + ": horizon " + str(horizon) +
-                     " is smaller than the mesh size " + str(mesh_size) +
-                     "; use a horizon of about 3 mesh sizes");
+    throw InputError(name + ": mesh size must be positive, got " + str(mesh_size));
   }
   for (std::size_t a = 0; a < n; ++a) {
     if (!(volumes[a] > 0) || !std::isfinite(volumes[a])) {
-      throw InputError("particle " + std::to_string(id) + ": node " + std::to_string(a) + " has volume " +
-                       str(volumes[a]) +
+      throw InputError(name + ": node " + std::to_string(a) + " has volume " + str(volumes[a]) +
                        "; every node needs a positive volume (check the mesh for degenerate elements)");
     }
     for (int k = 0; k < 3; ++k) {
       if (!std::isfinite(positions[3 * a + k])) {
-        throw InputError("particle " + std::to_string(id) + ": node " + std::to_string(a) +
-                         " has a non-finite coordinate");
+        throw InputError(name + ": node " + std::to_string(a) + " has a non-finite coordinate");
       }
     }
     if (dimension_ == 2 && positions[3 * a + 2] != 0.0) {
-      throw InputError("particle " + std::to_string(id) + ": node " + std::to_string(a) +
-                       " has z != 0 in a 2D model");
+      throw InputError(name + ": node " + std::to_string(a) + " has z != 0 in a 2D model");
     }
   }
-  if (node_count() + n > std::numeric_limits<index_t>::max() / 2) {
-    throw InputError("too many nodes for 32-bit indices");
+  Shape shape;
+  shape.positions.assign(positions.begin(), positions.end());
+  shape.volumes.assign(volumes.begin(), volumes.end());
+  shape.mesh_size = mesh_size;
+  shapes_.push_back(std::move(shape));
+  return static_cast<index_t>(shapes_.size() - 1);
+}
+
+index_t Model::add_particle(index_t shape_index, index_t material, std::span<const real> positions, real scale) {
+  require_not_finalized("add a particle");
+  const index_t id = static_cast<index_t>(particles_.size());
+  const std::string name = "particle " + std::to_string(id);
+  if (shape_index >= shapes_.size()) throw InputError(name + " refers to an unknown shape");
+  const Shape& shape = shapes_[shape_index];
+  const std::size_t n = shape.node_count();
+  if (positions.size() != 3 * n) {
+    throw InputError(name + ": " + std::to_string(positions.size() / 3) + " placed positions for a shape of " +
+                     std::to_string(n) + " nodes");
   }
+  if (material >= materials_.size()) {
+    throw InputError(name + " refers to material " + std::to_string(material) + ", but only " +
+                     std::to_string(materials_.size()) + " materials exist");
+  }
+  if (!(scale > 0) || !std::isfinite(scale)) throw InputError(name + ": scale must be positive, got " + str(scale));
+  const real mesh_size = scale * shape.mesh_size;
+  const real horizon = materials_[material].params.horizon;
+  if (horizon < mesh_size * (1.0 - 1e-9)) {
+    throw InputError(name + ": horizon " + str(horizon) + " is smaller than the mesh size " + str(mesh_size) +
+                     "; use a horizon of about 3 mesh sizes");
+  }
+  // A rigid placement keeps every distance times the scale; check consecutive nodes.
+  for (std::size_t a = 0; a < n; ++a) {
+    for (int k = 0; k < 3; ++k) {
+      if (!std::isfinite(positions[3 * a + k])) throw InputError(name + ": a placed position is not finite");
+    }
+    if (dimension_ == 2 && positions[3 * a + 2] != 0.0) throw InputError(name + ": placed with z != 0 in 2D");
+    if (a + 1 == n) continue;
+    real placed = 0, reference = 0;
+    for (int k = 0; k < 3; ++k) {
+      placed += (positions[3 * a + 3 + k] - positions[3 * a + k]) * (positions[3 * a + 3 + k] - positions[3 * a + k]);
+      reference += (shape.positions[3 * a + 3 + k] - shape.positions[3 * a + k]) *
+                   (shape.positions[3 * a + 3 + k] - shape.positions[3 * a + k]);
+    }
+    if (std::abs(std::sqrt(placed) - scale * std::sqrt(reference)) > 1e-9 * scale * (std::sqrt(reference) + shape.mesh_size)) {
+      throw InputError(name + ": the positions are not the shape scaled by " + str(scale) +
+                       ", rotated and translated");
+    }
+  }
+  if (node_count() + n > std::numeric_limits<index_t>::max() / 2) throw InputError("too many nodes for 32-bit indices");
   Particle p;
   p.first_node = node_count();
   p.node_count = static_cast<index_t>(n);
   p.material = material;
   p.mesh_size = mesh_size;
+  p.shape = shape_index;
+  p.scale = scale;
   particles_.push_back(p);
+  particle_weight_scale_.push_back(std::pow(scale, dimension_));
   reference_positions_.insert(reference_positions_.end(), positions.begin(), positions.end());
-  volumes_.insert(volumes_.end(), volumes.begin(), volumes.end());
+  for (real v : shape.volumes) volumes_.push_back(particle_weight_scale_.back() * v);
   node_particle_.insert(node_particle_.end(), n, id);
   node_material_.insert(node_material_.end(), n, material);
   node_density_.insert(node_density_.end(), n, materials_[material].params.density);
   return id;
+}
+
+index_t Model::add_particle(std::span<const real> positions, std::span<const real> volumes, index_t material,
+                            real mesh_size) {
+  if (material >= materials_.size()) {
+    throw InputError("particle " + std::to_string(particles_.size()) + " refers to material " +
+                     std::to_string(material) + ", but only " + std::to_string(materials_.size()) +
+                     " materials exist");
+  }
+  return add_particle(add_shape(positions, volumes, mesh_size), material, positions, 1.0);
 }
 
 void Model::finalize() {
@@ -103,70 +145,102 @@ void Model::finalize() {
   finalized_ = true;
 }
 
-void Model::build_bonds() {
-  const index_t nodes = node_count();
-  const auto& x = reference_positions_;
-  std::vector<CellGrid> grids;
-  grids.reserve(particles_.size());
+BondFamilies Model::build_family(index_t shape_index, real horizon, InfluenceKind influence_kind) const {
+  const Shape& shape = shapes_[shape_index];
+  const auto& x = shape.positions;
+  const index_t nodes = shape.node_count();
+  const real h = shape.mesh_size;
+  BondFamilies family;
+  family.shape = shape_index;
+  family.horizon = horizon;
+  family.influence = influence_kind;
   // Cells slightly larger than the horizon: two nodes exactly one horizon apart (common on
   // lattices) are then never two cells apart after rounding.
-  for (const Particle& p : particles_) {
-    grids.push_back(
-        CellGrid::build(x, p.first_node, p.node_count, materials_[p.material].params.horizon * (1.0 + 1e-6)));
-  }
-
-  bonds_.offsets.assign(nodes + 1, 0);
+  const CellGrid grid = CellGrid::build(x, 0, nodes, horizon * (1.0 + 1e-6));
+  family.offsets.assign(nodes + 1, 0);
 #pragma omp parallel for schedule(static)
-  for (std::int64_t ii = 0; ii < static_cast<std::int64_t>(nodes); ++ii) {
-    const index_t i = static_cast<index_t>(ii);
-    const index_t p = node_particle_[i];
+  for (std::int64_t aa = 0; aa < static_cast<std::int64_t>(nodes); ++aa) {
+    const index_t a = static_cast<index_t>(aa);
     index_t count = 0;
-    grids[p].for_each_within(x, i, materials_[particles_[p].material].params.horizon, dimension_,
-                             [&](index_t, real) { ++count; });
-    bonds_.offsets[i + 1] = count;
+    grid.for_each_within(x, a, horizon, dimension_, [&](index_t, real) { ++count; });
+    family.offsets[a + 1] = count;
   }
-  for (index_t i = 0; i < nodes; ++i) bonds_.offsets[i + 1] += bonds_.offsets[i];
-  const std::size_t bond_count = bonds_.offsets[nodes];
-  bonds_.neighbors.resize(bond_count);
-  bonds_.weights.resize(bond_count);
-  bonds_.lengths.resize(bond_count);
+  for (index_t a = 0; a < nodes; ++a) family.offsets[a + 1] += family.offsets[a];
+  const std::size_t bonds = family.offsets[nodes];
+  family.neighbors.resize(bonds);
+  family.weights.resize(bonds);
+  family.lengths.resize(bonds);
+  std::vector<std::pair<index_t, index_t>> coincident;
+#pragma omp parallel for schedule(static)
+  for (std::int64_t aa = 0; aa < static_cast<std::int64_t>(nodes); ++aa) {
+    const index_t a = static_cast<index_t>(aa);
+    index_t* out = family.neighbors.data() + family.offsets[a];
+    index_t filled = 0;
+    grid.for_each_within(x, a, horizon, dimension_, [&](index_t j, real) { out[filled++] = j; });
+    std::sort(out, out + filled);
+    for (index_t b = family.offsets[a]; b < family.offsets[a + 1]; ++b) {
+      const index_t j = family.neighbors[b];
+      const real r = std::sqrt((x[3 * j] - x[3 * a]) * (x[3 * j] - x[3 * a]) +
+                               (x[3 * j + 1] - x[3 * a + 1]) * (x[3 * j + 1] - x[3 * a + 1]) +
+                               (x[3 * j + 2] - x[3 * a + 2]) * (x[3 * j + 2] - x[3 * a + 2]));
+      if (r == 0) {
+#pragma omp critical(granulate_coincident)
+        coincident.emplace_back(a, j);
+      }
+      // Partial volume: a neighbour cell cut by the horizon counts for its share inside.
+      const real partial = r > horizon - 0.5 * h ? std::min(1.0, (horizon + 0.5 * h - r) / h) : 1.0;
+      family.lengths[b] = r;
+      family.weights[b] = influence(influence_kind, std::min(r / horizon, 1.0)) * shape.volumes[j] * partial;
+    }
+  }
+  if (!coincident.empty()) {
+    std::sort(coincident.begin(), coincident.end());
+    throw InputError("nodes " + std::to_string(coincident[0].first) + " and " + std::to_string(coincident[0].second) +
+                     " of shape " + std::to_string(shape_index) +
+                     " are at the same position; remove duplicate nodes from the mesh");
+  }
+  return family;
+}
+
+void Model::build_bonds() {
+  // One family per (shape, horizon in shape units, influence), shared by its particles.
+  for (Particle& p : particles_) {
+    const Material& material = materials_[p.material];
+    const real horizon = material.params.horizon / p.scale;
+    const InfluenceKind kind = material.params.influence;
+    std::size_t found = families_.size();
+    for (std::size_t f = 0; f < families_.size(); ++f) {
+      if (families_[f].shape == p.shape && families_[f].horizon == horizon && families_[f].influence == kind) found = f;
+    }
+    if (found == families_.size()) families_.push_back(build_family(p.shape, horizon, kind));
+    p.family = static_cast<index_t>(found);
+  }
+  const index_t nodes = node_count();
+  bond_offsets_.assign(static_cast<std::size_t>(nodes) + 1, 0);
+  for (const Particle& p : particles_) {
+    const BondFamilies& f = families_[p.family];
+    for (index_t a = 0; a < p.node_count; ++a) {
+      bond_offsets_[p.first_node + a + 1] = f.offsets[a + 1] - f.offsets[a];
+    }
+  }
+  for (index_t i = 0; i < nodes; ++i) bond_offsets_[i + 1] += bond_offsets_[i];
+
   weighted_volume_.assign(nodes, 0);
   lps_coefficients_.assign(nodes, {});
   pmb_stiffness_.assign(nodes, 0);
-
   std::vector<index_t> isolated;
-  std::vector<std::pair<index_t, index_t>> coincident;
 #pragma omp parallel for schedule(static)
   for (std::int64_t ii = 0; ii < static_cast<std::int64_t>(nodes); ++ii) {
     const index_t i = static_cast<index_t>(ii);
-    const Particle& particle = particles_[node_particle_[i]];
-    const Material& material = materials_[particle.material];
-    const real horizon = material.params.horizon;
-    const real h = particle.mesh_size;
-    index_t* family = bonds_.neighbors.data() + bonds_.offsets[i];
-    index_t filled = 0;
-    grids[node_particle_[i]].for_each_within(x, i, horizon, dimension_,
-                                             [&](index_t j, real) { family[filled++] = j; });
-    std::sort(family, family + filled);
+    const Material& material = materials_[node_material_[i]];
+    const NodeBonds bonds = node_bonds(i);
     real m = 0, first_moment = 0;
-    for (index_t b = bonds_.offsets[i]; b < bonds_.offsets[i + 1]; ++b) {
-      const index_t j = bonds_.neighbors[b];
-      const real r = std::sqrt((x[3 * j] - x[3 * i]) * (x[3 * j] - x[3 * i]) +
-                               (x[3 * j + 1] - x[3 * i + 1]) * (x[3 * j + 1] - x[3 * i + 1]) +
-                               (x[3 * j + 2] - x[3 * i + 2]) * (x[3 * j + 2] - x[3 * i + 2]));
-      if (r == 0) {
-#pragma omp critical(granulate_coincident)
-        coincident.emplace_back(i, j);
-      }
-      const real partial = r > horizon - 0.5 * h ? std::min(1.0, (horizon + 0.5 * h - r) / h) : 1.0;
-      const real weight =
-          influence(material.params.influence, std::min(r / horizon, 1.0)) * volumes_[j] * partial;
-      bonds_.lengths[b] = r;
-      bonds_.weights[b] = weight;
-      m += weight * r * r;
-      first_moment += weight * r;
+    for (index_t b = 0; b < bonds.count; ++b) {
+      const real r = bonds.length(b), w = bonds.weight(b);
+      m += w * r * r;
+      first_moment += w * r;
     }
-    if (filled == 0) {
+    if (bonds.count == 0) {
 #pragma omp critical(granulate_isolated)
       isolated.push_back(i);
     }
@@ -183,12 +257,6 @@ void Model::build_bonds() {
       lps_coefficients_[i].deviatoric_stiffness = a * G / m;
     }
   }
-  if (!coincident.empty()) {
-    std::sort(coincident.begin(), coincident.end());
-    throw InputError("nodes " + std::to_string(coincident[0].first) + " and " +
-                     std::to_string(coincident[0].second) +
-                     " are at the same position; remove duplicate nodes from the mesh");
-  }
   if (!isolated.empty()) {
     std::sort(isolated.begin(), isolated.end());
     const index_t i = isolated[0];
@@ -199,23 +267,22 @@ void Model::build_bonds() {
 }
 
 real Model::stable_time_step() const {
-  const auto& b = bonds_;
   real dt = std::numeric_limits<real>::infinity();
   for (index_t i = 0; i < node_count(); ++i) {
     const Material& material = materials_[node_material_[i]];
+    const NodeBonds bonds = node_bonds(i);
     real stiffness = 0;
     if (material.params.model == ForceModel::lps) {
       const auto& ci = lps_coefficients_[i];
       real moment = 0;
-      for (index_t k = b.offsets[i]; k < b.offsets[i + 1]; ++k) {
-        const index_t j = b.neighbors[k];
-        stiffness += b.weights[k] * (ci.deviatoric_stiffness + lps_coefficients_[j].deviatoric_stiffness);
-        moment += b.weights[k] * b.lengths[k];
+      for (index_t b = 0; b < bonds.count; ++b) {
+        stiffness += bonds.weight(b) * (ci.deviatoric_stiffness + lps_coefficients_[bonds.neighbor(b)].deviatoric_stiffness);
+        moment += bonds.weight(b) * bonds.length(b);
       }
       stiffness += 2.0 * std::abs(ci.dilatation_coupling) * ci.dilatation_scale * moment * moment;
     } else {
-      for (index_t k = b.offsets[i]; k < b.offsets[i + 1]; ++k) {
-        stiffness += (pmb_stiffness_[i] + pmb_stiffness_[b.neighbors[k]]) * b.weights[k] / b.lengths[k];
+      for (index_t b = 0; b < bonds.count; ++b) {
+        stiffness += (pmb_stiffness_[i] + pmb_stiffness_[bonds.neighbor(b)]) * bonds.weight(b) / bonds.length(b);
       }
     }
     if (stiffness > 0) dt = std::min(dt, std::sqrt(2.0 * node_density_[i] / stiffness));

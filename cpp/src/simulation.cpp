@@ -30,7 +30,7 @@ Simulation::Simulation(std::shared_ptr<Model> model) : model_(std::move(model)) 
   state_.positions = m.reference_positions();
   state_.velocities.assign(3 * static_cast<std::size_t>(n), 0);
   state_.forces.assign(3 * static_cast<std::size_t>(n), 0);
-  state_.bond_intact.assign(m.bonds().size(), 1);
+  state_.bond_intact.assign(m.bond_count(), 1);
   state_.dilatation.assign(n, 0);
   pressure_.assign(n, 0);
   mesh_size_.resize(n);
@@ -147,15 +147,13 @@ void Simulation::apply_prescribed_motion(bool positions_too) {
   }
 }
 
-real Simulation::bond_extension(index_t i, index_t bond, const std::vector<real>& x) const {
-  const index_t j = model_->bonds().neighbors[bond];
+real Simulation::bond_extension(index_t i, index_t j, real length, const std::vector<real>& x) const {
   const real dx = x[3 * j] - x[3 * i], dy = x[3 * j + 1] - x[3 * i + 1], dz = x[3 * j + 2] - x[3 * i + 2];
-  return std::sqrt(dx * dx + dy * dy + dz * dz) - model_->bonds().lengths[bond];
+  return std::sqrt(dx * dx + dy * dy + dz * dz) - length;
 }
 
 void Simulation::compute_forces() {
   const Model& m = *model_;
-  const BondFamilies& bonds = m.bonds();
   const auto& materials = m.materials();
   const auto& node_material = m.node_material();
   const auto& lps_coefficients = m.lps_coefficients();
@@ -176,17 +174,19 @@ void Simulation::compute_forces() {
     const Material& material = materials[node_material[i]];
     const CriticalStretch criterion{material.critical_stretch, material.params.break_in_compression};
     const bool can_break = material.params.fracture;
+    const NodeBonds bonds = m.node_bonds(i);
+    std::uint8_t* bond_intact = intact.data() + bonds.first;
     real sum = 0;
-    for (index_t k = bonds.offsets[i]; k < bonds.offsets[i + 1]; ++k) {
-      if (!intact[k]) continue;
-      const real r = bonds.lengths[k];
-      const real e = bond_extension(i, k, x);
+    for (index_t b = 0; b < bonds.count; ++b) {
+      if (!bond_intact[b]) continue;
+      const real r = bonds.length(b);
+      const real e = bond_extension(i, bonds.neighbor(b), r, x);
       if (can_break && criterion.breaks(e / r)) {
-        intact[k] = 0;
+        bond_intact[b] = 0;
         ++newly_broken;
         continue;
       }
-      sum += lps::dilatation_term(bonds.weights[k], r, e);
+      sum += lps::dilatation_term(bonds.weight(b), r, e);
     }
     if (material.params.model == ForceModel::lps) {
       theta[i] = lps_coefficients[i].dilatation_scale * sum;
@@ -203,19 +203,21 @@ void Simulation::compute_forces() {
     const real stiffness_i = m.pmb_stiffness()[i];
     const real pressure_i = pressure_[i];
     const real deviatoric_i = lps_coefficients[i].deviatoric_stiffness;
+    const NodeBonds bonds = m.node_bonds(i);
+    const std::uint8_t* bond_intact = intact.data() + bonds.first;
     real fx = 0, fy = 0, fz = 0;
-    for (index_t k = bonds.offsets[i]; k < bonds.offsets[i + 1]; ++k) {
-      if (!intact[k]) continue;
-      const index_t j = bonds.neighbors[k];
+    for (index_t b = 0; b < bonds.count; ++b) {
+      if (!bond_intact[b]) continue;
+      const index_t j = bonds.neighbor(b);
       const real dx = x[3 * j] - x[3 * i], dy = x[3 * j + 1] - x[3 * i + 1], dz = x[3 * j + 2] - x[3 * i + 2];
       const real length = std::sqrt(dx * dx + dy * dy + dz * dz);
       if (!(length > 0)) continue;
-      const real r = bonds.lengths[k];
+      const real r = bonds.length(b);
+      const real w = bonds.weight(b);
       const real e = length - r;
-      const real scalar = is_lps
-                              ? lps::pair_force(bonds.weights[k], r, e, pressure_i, pressure_[j],
-                                                deviatoric_i, lps_coefficients[j].deviatoric_stiffness)
-                              : pmb::pair_force(stiffness_i + m.pmb_stiffness()[j], bonds.weights[k], e / r);
+      const real scalar = is_lps ? lps::pair_force(w, r, e, pressure_i, pressure_[j], deviatoric_i,
+                                                   lps_coefficients[j].deviatoric_stiffness)
+                                 : pmb::pair_force(stiffness_i + m.pmb_stiffness()[j], w, e / r);
       const real over = scalar / length;
       fx += over * dx;
       fy += over * dy;
@@ -319,7 +321,6 @@ real Simulation::kinetic_energy() const {
 
 void Simulation::strain_energy_density(real* out) const {
   const Model& m = *model_;
-  const BondFamilies& bonds = m.bonds();
   const real inverse_dimension = 1.0 / m.dimension();
 #pragma omp parallel for schedule(static)
   for (std::int64_t ii = 0; ii < static_cast<std::int64_t>(m.node_count()); ++ii) {
@@ -327,14 +328,15 @@ void Simulation::strain_energy_density(real* out) const {
     const Material& material = m.materials()[m.node_material()[i]];
     const bool is_lps = material.params.model == ForceModel::lps;
     const real theta = state_.dilatation[i];
+    const NodeBonds bonds = m.node_bonds(i);
     real sum = 0;
-    for (index_t k = bonds.offsets[i]; k < bonds.offsets[i + 1]; ++k) {
-      if (!state_.bond_intact[k]) continue;
-      const real r = bonds.lengths[k];
-      const real e = bond_extension(i, k, state_.positions);
-      sum += is_lps ? lps::deviatoric_energy_term(bonds.weights[k], r, e, theta, inverse_dimension)
-                    : pmb::energy_term(m.pmb_stiffness()[i] + m.pmb_stiffness()[bonds.neighbors[k]],
-                                       bonds.weights[k], e / r, r);
+    for (index_t b = 0; b < bonds.count; ++b) {
+      if (!state_.bond_intact[bonds.first + b]) continue;
+      const index_t j = bonds.neighbor(b);
+      const real r = bonds.length(b);
+      const real e = bond_extension(i, j, r, state_.positions);
+      sum += is_lps ? lps::deviatoric_energy_term(bonds.weight(b), r, e, theta, inverse_dimension)
+                    : pmb::energy_term(m.pmb_stiffness()[i] + m.pmb_stiffness()[j], bonds.weight(b), e / r, r);
     }
     out[i] = is_lps ? 0.5 * material.dilatation_modulus * theta * theta +
                           0.5 * m.lps_coefficients()[i].deviatoric_stiffness * sum
@@ -352,17 +354,17 @@ real Simulation::strain_energy() const {
 
 void Simulation::damage(real* phi, real* z) const {
   const Model& m = *model_;
-  const BondFamilies& bonds = m.bonds();
 #pragma omp parallel for schedule(static)
   for (std::int64_t ii = 0; ii < static_cast<std::int64_t>(m.node_count()); ++ii) {
     const index_t i = static_cast<index_t>(ii);
     const real s0 = m.materials()[m.node_material()[i]].critical_stretch;
+    const NodeBonds bonds = m.node_bonds(i);
     real all = 0, intact = 0, max_stretch = 0;
-    for (index_t k = bonds.offsets[i]; k < bonds.offsets[i + 1]; ++k) {
-      all += bonds.weights[k];
-      if (state_.bond_intact[k]) intact += bonds.weights[k];
-      max_stretch =
-          std::max(max_stretch, std::abs(bond_extension(i, k, state_.positions) / bonds.lengths[k]));
+    for (index_t b = 0; b < bonds.count; ++b) {
+      const real w = bonds.weight(b), r = bonds.length(b);
+      all += w;
+      if (state_.bond_intact[bonds.first + b]) intact += w;
+      max_stretch = std::max(max_stretch, std::abs(bond_extension(i, bonds.neighbor(b), r, state_.positions) / r));
     }
     if (phi) phi[i] = all > 0 ? 1.0 - intact / all : 0.0;
     if (z) z[i] = std::isfinite(s0) ? max_stretch / s0 : 0.0;
@@ -376,7 +378,6 @@ std::uint64_t Simulation::broken_bonds() const {
 index_t Simulation::fragments(index_t* labels) const {
   // Union-find; the root of a set is always its smallest node, so labels are deterministic.
   const index_t n = model_->node_count();
-  const BondFamilies& bonds = model_->bonds();
   std::vector<index_t> parent(n);
   for (index_t i = 0; i < n; ++i) parent[i] = i;
   auto root = [&](index_t i) {
@@ -387,9 +388,10 @@ index_t Simulation::fragments(index_t* labels) const {
     return i;
   };
   for (index_t i = 0; i < n; ++i) {
-    for (index_t k = bonds.offsets[i]; k < bonds.offsets[i + 1]; ++k) {
-      if (!state_.bond_intact[k]) continue;
-      const index_t a = root(i), b = root(bonds.neighbors[k]);
+    const NodeBonds bonds = model_->node_bonds(i);
+    for (index_t k = 0; k < bonds.count; ++k) {
+      if (!state_.bond_intact[bonds.first + k]) continue;
+      const index_t a = root(i), b = root(bonds.neighbor(k));
       if (a < b) parent[b] = a;
       if (b < a) parent[a] = b;
     }

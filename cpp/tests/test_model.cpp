@@ -42,39 +42,78 @@ std::shared_ptr<Model> lattice_block(int dimension, int n, ForceModel force_mode
 TEST_CASE("bond families: interior counts, symmetry, partial volumes") {
   auto model2 = lattice_block(2, 11, ForceModel::lps, InfluenceKind::constant);
   model2->finalize();
-  const auto& b = model2->bonds();
   const index_t centre = 5 * 11 + 5;
-  CHECK(b.offsets[centre + 1] - b.offsets[centre] == 28);  // lattice points with |(i,j)| <= 3
+  CHECK(model2->node_bonds(centre).count == 28);  // lattice points with |(i,j)| <= 3
   auto model3 = lattice_block(3, 9, ForceModel::lps, InfluenceKind::constant);
   model3->finalize();
-  const index_t centre3 = (4 * 9 + 4) * 9 + 4;
-  CHECK(model3->bonds().offsets[centre3 + 1] - model3->bonds().offsets[centre3] == 122);
+  CHECK(model3->node_bonds((4 * 9 + 4) * 9 + 4).count == 122);
   // every node at least one horizon inside has the full family, wherever the lattice sits
   for (double offset : {0.0, -0.0123, 0.37}) {
     auto shifted = lattice_block(2, 24, ForceModel::lps, InfluenceKind::constant, false, offset);
     shifted->finalize();
     for (int j = 3; j < 21; ++j)
-      for (int i = 3; i < 21; ++i) {
-        const index_t node = j * 24 + i;
-        CHECK(shifted->bonds().offsets[node + 1] - shifted->bonds().offsets[node] == 28);
-      }
+      for (int i = 3; i < 21; ++i) CHECK(shifted->node_bonds(j * 24 + i).count == 28);
   }
   // every bond i->j has j->i with the same length
   for (index_t i = 0; i < model2->node_count(); ++i) {
-    for (index_t k = b.offsets[i]; k < b.offsets[i + 1]; ++k) {
-      const index_t j = b.neighbors[k];
+    const NodeBonds bi = model2->node_bonds(i);
+    for (index_t k = 0; k < bi.count; ++k) {
+      const NodeBonds bj = model2->node_bonds(bi.neighbor(k));
       bool found = false;
-      for (index_t q = b.offsets[j]; q < b.offsets[j + 1]; ++q) {
-        if (b.neighbors[q] == i) found = (b.lengths[q] == b.lengths[k]);
+      for (index_t q = 0; q < bj.count; ++q) {
+        if (bj.neighbor(q) == i) found = (bj.length(q) == bi.length(k));
       }
       CHECK(found);
     }
   }
   // a bond of length exactly delta keeps half its volume; one of length 2h all of it
-  for (index_t k = b.offsets[centre]; k < b.offsets[centre + 1]; ++k) {
-    const double r = b.lengths[k] / 1e-3;
-    if (std::abs(r - 3.0) < 1e-9) CHECK_CLOSE(b.weights[k], 0.5e-6, 1e-9);
-    if (std::abs(r - 2.0) < 1e-9) CHECK_CLOSE(b.weights[k], 1e-6, 1e-12);
+  const NodeBonds bc = model2->node_bonds(centre);
+  for (index_t k = 0; k < bc.count; ++k) {
+    const double r = bc.length(k) / 1e-3;
+    if (std::abs(r - 3.0) < 1e-9) CHECK_CLOSE(bc.weight(k), 0.5e-6, 1e-9);
+    if (std::abs(r - 2.0) < 1e-9) CHECK_CLOSE(bc.weight(k), 1e-6, 1e-12);
+  }
+}
+
+TEST_CASE("a shape placed many times shares one bond family; lengths and weights scale") {
+  auto model = std::make_shared<Model>(2, PlaneMode::strain);
+  MaterialParams p;
+  p.density = 1000;
+  p.bulk_modulus = 1e9;
+  p.shear_modulus = 6e8;
+  p.horizon = 3e-3;  // absolute: scale 2 needs a family of its own (horizon 1.5 h in shape units)
+  p.fracture = false;
+  const index_t absolute = model->add_material(p);
+  std::vector<double> x, v;
+  for (int j = 0; j < 8; ++j)
+    for (int i = 0; i < 8; ++i) {
+      x.insert(x.end(), {(i + 0.5) * 1e-3, (j + 0.5) * 1e-3, 0.0});
+      v.push_back(1e-6);
+    }
+  const index_t shape = model->add_shape(x, v, 1e-3);
+  auto placed = [&](double scale, double angle, double shift) {
+    std::vector<double> out(x.size());
+    for (std::size_t a = 0; a < x.size(); a += 3) {
+      out[a] = scale * (std::cos(angle) * x[a] - std::sin(angle) * x[a + 1]) + shift;
+      out[a + 1] = scale * (std::sin(angle) * x[a] + std::cos(angle) * x[a + 1]);
+    }
+    return out;
+  };
+  model->add_particle(shape, absolute, placed(1.0, 0.0, 0.0), 1.0);
+  model->add_particle(shape, absolute, placed(1.0, 0.7, 0.05), 1.0);
+  model->add_particle(shape, absolute, placed(1.5, 1.1, 0.10), 1.5);
+  CHECK_THROWS(model->add_particle(shape, absolute, placed(1.5, 0.0, 0.2), 1.0), InputError);  // not rigid
+  model->finalize();
+  CHECK(model->families().size() == 2);
+  const NodeBonds a = model->node_bonds(27), b = model->node_bonds(64 + 27), c = model->node_bonds(128 + 27);
+  CHECK(a.count == b.count && a.neighbors == b.neighbors);  // shared storage
+  CHECK(a.count == 28 && c.count == 12);  // horizons 3 h and (3 mm / 1.5) = 2 h in shape units
+  CHECK_CLOSE(model->volumes()[128 + 27], 2.25e-6, 1e-12);
+  for (index_t k = 0; k < c.count; ++k) {
+    const index_t j = c.neighbor(k);
+    const auto& X = model->reference_positions();
+    const double r = std::hypot(X[3 * j] - X[3 * (128 + 27)], X[3 * j + 1] - X[3 * (128 + 27) + 1]);
+    CHECK_CLOSE(c.length(k), r, 1e-9);
   }
 }
 
@@ -155,12 +194,12 @@ TEST_CASE("fragments are the connected components of intact bonds") {
   std::vector<index_t> labels(model->node_count());
   CHECK(sim.fragments(labels.data()) == 1);
   // Cut every bond crossing x = 6h: two fragments labelled by their smallest node.
-  const auto& b = model->bonds();
   const auto& X = model->reference_positions();
   for (index_t i = 0; i < model->node_count(); ++i) {
-    for (index_t k = b.offsets[i]; k < b.offsets[i + 1]; ++k) {
-      const index_t j = b.neighbors[k];
-      if ((X[3 * i] < 6e-3) != (X[3 * j] < 6e-3)) sim.state().bond_intact[k] = 0;
+    const NodeBonds b = model->node_bonds(i);
+    for (index_t k = 0; k < b.count; ++k) {
+      const index_t j = b.neighbor(k);
+      if ((X[3 * i] < 6e-3) != (X[3 * j] < 6e-3)) sim.state().bond_intact[b.first + k] = 0;
     }
   }
   CHECK(sim.fragments(labels.data()) == 2);

@@ -12,23 +12,57 @@
 
 namespace granulate {
 
-/// A particle is a contiguous range of nodes with one material and one mesh size.
+/// A reference shape: nodes (local coordinates) and volumes, discretised once and placed as
+/// many particles as wanted (translated, rotated, scaled); its bond families are shared.
+struct Shape {
+  std::vector<real> positions;  ///< n x 3 [m], local frame
+  std::vector<real> volumes;    ///< n [m^d]
+  real mesh_size = 0;           ///< h [m] of the reference discretisation
+  index_t node_count() const { return static_cast<index_t>(volumes.size()); }
+};
+
+/// A particle is a contiguous range of nodes: a shape placed with a scale, one material.
 struct Particle {
   index_t first_node = 0;
   index_t node_count = 0;
   index_t material = 0;
-  real mesh_size = 0;  ///< h [m], lattice spacing or typical edge length
+  real mesh_size = 0;  ///< h [m] = scale x the shape's mesh size
+  index_t shape = 0;
+  real scale = 1;
+  index_t family = 0;  ///< shared bond family (see Model::node_bonds)
 };
 
-/// Bond families in CSR form: the bonds of node i are offsets[i] .. offsets[i+1]-1, each bond
-/// stored once per end (i's copy and j's copy), so force loops gather without atomics.
+/// Bond families of one shape for one horizon (in shape units) and influence function, in CSR
+/// form over the shape's nodes: the bonds of local node a are offsets[a] .. offsets[a+1]-1, each
+/// bond stored once per end, so force loops gather without atomics. Shared by every particle
+/// placed from the shape with the same horizon/scale: lengths scale with the particle, weights
+/// with its scale^d.
 struct BondFamilies {
-  std::vector<index_t> offsets;    ///< size nodes + 1
-  std::vector<index_t> neighbors;  ///< j, sorted ascending within a family
-  std::vector<real> weights;       ///< w_ij = J(r/delta) V_j beta_ij [m^d]
-  std::vector<real> lengths;       ///< r = |X_j - X_i| [m]
+  std::vector<index_t> offsets;   ///< size shape nodes + 1
+  std::vector<index_t> neighbors; ///< local j, sorted ascending within a family
+  std::vector<real> weights;      ///< w_ij = J(r/delta) V_j beta_ij at scale 1 [m^d]
+  std::vector<real> lengths;      ///< r = |X_j - X_i| at scale 1 [m]
+  index_t shape = 0;
+  real horizon = 0;               ///< in shape units (the material horizon / scale)
+  InfluenceKind influence = InfluenceKind::linear;
+};
 
-  std::size_t size() const { return neighbors.size(); }
+/// The bonds of one node, as seen by the force loops: bond b (0 <= b < count) joins the node to
+/// neighbor(b), has reference length length(b) and weight weight(b); its state (intact or not)
+/// is State::bond_intact[first + b].
+struct NodeBonds {
+  const index_t* neighbors = nullptr;
+  const real* lengths = nullptr;
+  const real* weights = nullptr;
+  index_t count = 0;
+  index_t first_node = 0;
+  real length_scale = 1;
+  real weight_scale = 1;
+  std::size_t first = 0;
+
+  index_t neighbor(index_t b) const { return first_node + neighbors[b]; }
+  real length(index_t b) const { return length_scale * lengths[b]; }
+  real weight(index_t b) const { return weight_scale * weights[b]; }
 };
 
 class Model {
@@ -38,8 +72,16 @@ class Model {
   /// Registers a material; returns its index. Validates the parameters (InputError).
   index_t add_material(const MaterialParams& params);
 
-  /// Adds a particle of n nodes: positions is n x 3 row-major [m] (z = 0 in 2D), volumes n
-  /// [m^3, or m^2 per unit thickness in 2D]. Returns the particle index.
+  /// Adds a reference shape: positions n x 3 row-major [m] (z = 0 in 2D), volumes n [m^3, or
+  /// m^2 per unit thickness in 2D], its mesh size h [m]. Returns the shape index.
+  index_t add_shape(std::span<const real> positions, std::span<const real> volumes, real mesh_size);
+
+  /// Places a shape as a particle: `positions` (n x 3) are the shape's nodes after scaling by
+  /// `scale`, rotating and translating (the caller places them; they are checked to be a rigid
+  /// placement). Volumes are scale^d times the shape's. Returns the particle index.
+  index_t add_particle(index_t shape, index_t material, std::span<const real> positions, real scale);
+
+  /// Adds a particle of its own (a shape used once): add_shape then add_particle at scale 1.
   index_t add_particle(std::span<const real> positions, std::span<const real> volumes, index_t material,
                        real mesh_size);
 
@@ -58,7 +100,27 @@ class Model {
   const std::vector<index_t>& node_particle() const { return node_particle_; }
   const std::vector<index_t>& node_material() const { return node_material_; }
   const std::vector<real>& node_density() const { return node_density_; }
-  const BondFamilies& bonds() const { return bonds_; }
+  const std::vector<Shape>& shapes() const { return shapes_; }
+  const std::vector<BondFamilies>& families() const { return families_; }
+  /// Global bond numbering: the bonds of node i are bond_offsets()[i] .. bond_offsets()[i+1]-1.
+  const std::vector<std::size_t>& bond_offsets() const { return bond_offsets_; }
+  std::size_t bond_count() const { return bond_offsets_.empty() ? 0 : bond_offsets_.back(); }
+  /// The bonds of node i (valid after finalize()).
+  NodeBonds node_bonds(index_t i) const {
+    const Particle& p = particles_[node_particle_[i]];
+    const BondFamilies& f = families_[p.family];
+    const index_t a = i - p.first_node;
+    NodeBonds b;
+    b.neighbors = f.neighbors.data() + f.offsets[a];
+    b.lengths = f.lengths.data() + f.offsets[a];
+    b.weights = f.weights.data() + f.offsets[a];
+    b.count = f.offsets[a + 1] - f.offsets[a];
+    b.first_node = p.first_node;
+    b.length_scale = p.scale;
+    b.weight_scale = particle_weight_scale_[node_particle_[i]];
+    b.first = bond_offsets_[i];
+    return b;
+  }
   const std::vector<real>& weighted_volume() const { return weighted_volume_; }
   const std::vector<lps::NodeCoefficients>& lps_coefficients() const { return lps_coefficients_; }
   /// k_i = d^2 kappa_d / sum_j w_ij r_ij of PMB nodes (0 for LPS nodes), see pmb.hpp.
@@ -71,18 +133,22 @@ class Model {
  private:
   void require_not_finalized(const char* what) const;
   void build_bonds();
+  BondFamilies build_family(index_t shape, real horizon, InfluenceKind influence) const;
 
   int dimension_;
   PlaneMode plane_;
   bool finalized_ = false;
   std::vector<Material> materials_;
+  std::vector<Shape> shapes_;
   std::vector<Particle> particles_;
+  std::vector<real> particle_weight_scale_;  // scale^d
   std::vector<real> reference_positions_;
   std::vector<real> volumes_;
   std::vector<index_t> node_particle_;
   std::vector<index_t> node_material_;
   std::vector<real> node_density_;
-  BondFamilies bonds_;
+  std::vector<BondFamilies> families_;
+  std::vector<std::size_t> bond_offsets_;
   std::vector<real> weighted_volume_;
   std::vector<lps::NodeCoefficients> lps_coefficients_;
   std::vector<real> pmb_stiffness_;

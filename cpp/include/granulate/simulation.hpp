@@ -74,7 +74,8 @@ class Simulation {
  private:
   void apply_prescribed_motion(bool positions_too);
   void check_stability() const;
-  real bond_extension(index_t i, index_t bond, const std::vector<real>& x) const;
+  /// |x_j - x_i| - length.
+  real bond_extension(index_t i, index_t j, real length, const std::vector<real>& x) const;
 
   std::shared_ptr<Model> model_;
   State state_;
