@@ -100,7 +100,12 @@ NB_MODULE(_core, m) {
       .def_rw("break_in_compression", &MaterialParams::break_in_compression);
 
   nb::class_<Material>(m, "Material")
-      .def_static("make", &Material::make, "params"_a, "dimension"_a, "plane"_a)
+      .def_static(
+          "make",
+          [](const MaterialParams& params, int dimension, PlaneMode plane) {
+            return Material::make(params, dimension, plane);
+          },
+          "params"_a, "dimension"_a, "plane"_a)
       .def_ro("params", &Material::params)
       .def_ro("dilatation_modulus", &Material::dilatation_modulus)
       .def_ro("deviatoric_factor", &Material::deviatoric_factor)
@@ -120,8 +125,8 @@ NB_MODULE(_core, m) {
       .def(
           "add_shape",
           [](Model& self, Points positions, Scalars volumes, real mesh_size) {
-            return self.add_shape({positions.data(), positions.shape(0) * 3}, {volumes.data(), volumes.shape(0)},
-                                  mesh_size);
+            return self.add_shape({positions.data(), positions.shape(0) * 3},
+                                  {volumes.data(), volumes.shape(0)}, mesh_size);
           },
           "positions"_a, "volumes"_a, "mesh_size"_a)
       .def(
@@ -136,7 +141,8 @@ NB_MODULE(_core, m) {
            [](const Model& self) {
              std::size_t bytes = 0;
              for (const BondFamilies& f : self.families()) {
-               bytes += f.neighbors.size() * (sizeof(index_t) + 2 * sizeof(real)) + f.offsets.size() * sizeof(index_t);
+               bytes += f.neighbors.size() * (sizeof(index_t) + 2 * sizeof(real)) +
+                        f.offsets.size() * sizeof(index_t);
              }
              return bytes;
            })
@@ -165,8 +171,8 @@ NB_MODULE(_core, m) {
                    })
       .def_prop_ro("bond_offsets",
                    [](Model& self) {
-                     return view(const_cast<std::size_t*>(self.bond_offsets().data()), self.bond_offsets().size(), 0,
-                                 nb::find(self));
+                     return view(const_cast<std::size_t*>(self.bond_offsets().data()),
+                                 self.bond_offsets().size(), 0, nb::find(self));
                    })
       .def("bond_neighbors",
            [](const Model& self) {

@@ -101,7 +101,8 @@ FractureCoefficients fracture_coefficients(ForceModel model, InfluenceKind influ
   return result;
 }
 
-Material Material::make(const MaterialParams& params, int dimension, PlaneMode plane) {
+Material Material::make(const MaterialParams& params, int dimension, PlaneMode plane,
+                        const FractureCoefficients* known) {
   if (dimension != 2 && dimension != 3) {
     throw InputError("dimension must be 2 or 3, got " + std::to_string(dimension));
   }
@@ -153,7 +154,7 @@ Material Material::make(const MaterialParams& params, int dimension, PlaneMode p
   m.critical_stretch = std::numeric_limits<real>::infinity();
   if (params.fracture) {
     const FractureCoefficients coefficients =
-        fracture_coefficients(params.model, params.influence, dimension);
+        known ? *known : fracture_coefficients(params.model, params.influence, dimension);
     real energy_per_stretch2;  // Gc / s0^2
     if (params.model == ForceModel::lps) {
       const real d = dimension;

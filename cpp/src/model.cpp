@@ -35,7 +35,15 @@ void Model::require_not_finalized(const char* what) const {
 
 index_t Model::add_material(const MaterialParams& params) {
   require_not_finalized("add a material");
-  materials_.push_back(Material::make(params, dimension_, plane_));
+  const auto key = std::make_pair(params.model, params.influence);
+  auto known = fracture_coefficients_.find(key);
+  if (params.fracture && known == fracture_coefficients_.end()) {
+    known =
+        fracture_coefficients_.emplace(key, fracture_coefficients(params.model, params.influence, dimension_))
+            .first;
+  }
+  materials_.push_back(Material::make(params, dimension_, plane_,
+                                      known == fracture_coefficients_.end() ? nullptr : &known->second));
   return static_cast<index_t>(materials_.size() - 1);
 }
 
@@ -44,7 +52,8 @@ index_t Model::add_shape(std::span<const real> positions, std::span<const real> 
   const std::size_t n = volumes.size();
   const std::string name = "shape " + std::to_string(shapes_.size());
   if (n == 0) throw InputError(name + " has no nodes");
-  if (positions.size() != 3 * n) throw InputError(name + ": positions must be an n x 3 array matching n volumes");
+  if (positions.size() != 3 * n)
+    throw InputError(name + ": positions must be an n x 3 array matching n volumes");
   if (!(mesh_size > 0) || !std::isfinite(mesh_size)) {
     throw InputError(name + ": mesh size must be positive, got " + str(mesh_size));
   }
@@ -70,7 +79,8 @@ index_t Model::add_shape(std::span<const real> positions, std::span<const real> 
   return static_cast<index_t>(shapes_.size() - 1);
 }
 
-index_t Model::add_particle(index_t shape_index, index_t material, std::span<const real> positions, real scale) {
+index_t Model::add_particle(index_t shape_index, index_t material, std::span<const real> positions,
+                            real scale) {
   require_not_finalized("add a particle");
   const index_t id = static_cast<index_t>(particles_.size());
   const std::string name = "particle " + std::to_string(id);
@@ -78,14 +88,15 @@ index_t Model::add_particle(index_t shape_index, index_t material, std::span<con
   const Shape& shape = shapes_[shape_index];
   const std::size_t n = shape.node_count();
   if (positions.size() != 3 * n) {
-    throw InputError(name + ": " + std::to_string(positions.size() / 3) + " placed positions for a shape of " +
-                     std::to_string(n) + " nodes");
+    throw InputError(name + ": " + std::to_string(positions.size() / 3) +
+                     " placed positions for a shape of " + std::to_string(n) + " nodes");
   }
   if (material >= materials_.size()) {
     throw InputError(name + " refers to material " + std::to_string(material) + ", but only " +
                      std::to_string(materials_.size()) + " materials exist");
   }
-  if (!(scale > 0) || !std::isfinite(scale)) throw InputError(name + ": scale must be positive, got " + str(scale));
+  if (!(scale > 0) || !std::isfinite(scale))
+    throw InputError(name + ": scale must be positive, got " + str(scale));
   const real mesh_size = scale * shape.mesh_size;
   const real horizon = materials_[material].params.horizon;
   if (horizon < mesh_size * (1.0 - 1e-9)) {
@@ -101,16 +112,19 @@ index_t Model::add_particle(index_t shape_index, index_t material, std::span<con
     if (a + 1 == n) continue;
     real placed = 0, reference = 0;
     for (int k = 0; k < 3; ++k) {
-      placed += (positions[3 * a + 3 + k] - positions[3 * a + k]) * (positions[3 * a + 3 + k] - positions[3 * a + k]);
+      placed += (positions[3 * a + 3 + k] - positions[3 * a + k]) *
+                (positions[3 * a + 3 + k] - positions[3 * a + k]);
       reference += (shape.positions[3 * a + 3 + k] - shape.positions[3 * a + k]) *
                    (shape.positions[3 * a + 3 + k] - shape.positions[3 * a + k]);
     }
-    if (std::abs(std::sqrt(placed) - scale * std::sqrt(reference)) > 1e-9 * scale * (std::sqrt(reference) + shape.mesh_size)) {
+    if (std::abs(std::sqrt(placed) - scale * std::sqrt(reference)) >
+        1e-9 * scale * (std::sqrt(reference) + shape.mesh_size)) {
       throw InputError(name + ": the positions are not the shape scaled by " + str(scale) +
                        ", rotated and translated");
     }
   }
-  if (node_count() + n > std::numeric_limits<index_t>::max() / 2) throw InputError("too many nodes for 32-bit indices");
+  if (node_count() + n > std::numeric_limits<index_t>::max() / 2)
+    throw InputError("too many nodes for 32-bit indices");
   Particle p;
   p.first_node = node_count();
   p.node_count = static_cast<index_t>(n);
@@ -195,8 +209,8 @@ BondFamilies Model::build_family(index_t shape_index, real horizon, InfluenceKin
   }
   if (!coincident.empty()) {
     std::sort(coincident.begin(), coincident.end());
-    throw InputError("nodes " + std::to_string(coincident[0].first) + " and " + std::to_string(coincident[0].second) +
-                     " of shape " + std::to_string(shape_index) +
+    throw InputError("nodes " + std::to_string(coincident[0].first) + " and " +
+                     std::to_string(coincident[0].second) + " of shape " + std::to_string(shape_index) +
                      " are at the same position; remove duplicate nodes from the mesh");
   }
   return family;
@@ -210,7 +224,8 @@ void Model::build_bonds() {
     const InfluenceKind kind = material.params.influence;
     std::size_t found = families_.size();
     for (std::size_t f = 0; f < families_.size(); ++f) {
-      if (families_[f].shape == p.shape && families_[f].horizon == horizon && families_[f].influence == kind) found = f;
+      if (families_[f].shape == p.shape && families_[f].horizon == horizon && families_[f].influence == kind)
+        found = f;
     }
     if (found == families_.size()) families_.push_back(build_family(p.shape, horizon, kind));
     p.family = static_cast<index_t>(found);
@@ -276,13 +291,15 @@ real Model::stable_time_step() const {
       const auto& ci = lps_coefficients_[i];
       real moment = 0;
       for (index_t b = 0; b < bonds.count; ++b) {
-        stiffness += bonds.weight(b) * (ci.deviatoric_stiffness + lps_coefficients_[bonds.neighbor(b)].deviatoric_stiffness);
+        stiffness += bonds.weight(b) *
+                     (ci.deviatoric_stiffness + lps_coefficients_[bonds.neighbor(b)].deviatoric_stiffness);
         moment += bonds.weight(b) * bonds.length(b);
       }
       stiffness += 2.0 * std::abs(ci.dilatation_coupling) * ci.dilatation_scale * moment * moment;
     } else {
       for (index_t b = 0; b < bonds.count; ++b) {
-        stiffness += (pmb_stiffness_[i] + pmb_stiffness_[bonds.neighbor(b)]) * bonds.weight(b) / bonds.length(b);
+        stiffness +=
+            (pmb_stiffness_[i] + pmb_stiffness_[bonds.neighbor(b)]) * bonds.weight(b) / bonds.length(b);
       }
     }
     if (stiffness > 0) dt = std::min(dt, std::sqrt(2.0 * node_density_[i] / stiffness));

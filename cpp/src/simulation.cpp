@@ -335,8 +335,9 @@ void Simulation::strain_energy_density(real* out) const {
       const index_t j = bonds.neighbor(b);
       const real r = bonds.length(b);
       const real e = bond_extension(i, j, r, state_.positions);
-      sum += is_lps ? lps::deviatoric_energy_term(bonds.weight(b), r, e, theta, inverse_dimension)
-                    : pmb::energy_term(m.pmb_stiffness()[i] + m.pmb_stiffness()[j], bonds.weight(b), e / r, r);
+      sum += is_lps
+                 ? lps::deviatoric_energy_term(bonds.weight(b), r, e, theta, inverse_dimension)
+                 : pmb::energy_term(m.pmb_stiffness()[i] + m.pmb_stiffness()[j], bonds.weight(b), e / r, r);
     }
     out[i] = is_lps ? 0.5 * material.dilatation_modulus * theta * theta +
                           0.5 * m.lps_coefficients()[i].deviatoric_stiffness * sum
@@ -364,7 +365,8 @@ void Simulation::damage(real* phi, real* z) const {
       const real w = bonds.weight(b), r = bonds.length(b);
       all += w;
       if (state_.bond_intact[bonds.first + b]) intact += w;
-      max_stretch = std::max(max_stretch, std::abs(bond_extension(i, bonds.neighbor(b), r, state_.positions) / r));
+      max_stretch =
+          std::max(max_stretch, std::abs(bond_extension(i, bonds.neighbor(b), r, state_.positions) / r));
     }
     if (phi) phi[i] = all > 0 ? 1.0 - intact / all : 0.0;
     if (z) z[i] = std::isfinite(s0) ? max_stretch / s0 : 0.0;

@@ -306,3 +306,72 @@ def _same_dimension(shapes: tuple[Shape, ...], name: str) -> None:
     dimensions = {s.dimension for s in shapes}
     if len(dimensions) != 1:
         raise InputError(f"{name} mixes 2D and 3D shapes")
+
+
+@dataclass(frozen=True, eq=False)
+class ReferenceShape:
+    """A particle shape discretised once, to be placed as many particles (translated, rotated,
+    scaled); all of them share one set of bonds in memory.
+
+    Positions are in the shape's local frame: rotation and scale act about its origin.
+    Use ``ReferenceShape.from_shape(shape, mesh_size)`` (lattice) or ``from_nodes``.
+    """
+
+    positions: NDArray[np.float64]  # (n, 3) [m]
+    volumes: NDArray[np.float64]  # (n,) [m^d]
+    mesh_size: float  # [m]
+    dimension: int
+
+    @staticmethod
+    def from_shape(
+        shape: Shape, mesh_size: float, *, jitter: float = 0.0, seed: int = 0
+    ) -> ReferenceShape:
+        positions, volumes = lattice(shape, mesh_size, jitter=jitter, seed=seed)
+        return ReferenceShape(positions, volumes, float(mesh_size), shape.dimension)
+
+    @staticmethod
+    def from_nodes(
+        positions: ArrayLike, volumes: ArrayLike, mesh_size: float, dimension: int
+    ) -> ReferenceShape:
+        p = np.asarray(positions, dtype=np.float64)
+        if p.ndim != 2 or p.shape[1] not in (2, 3):
+            raise InputError(f"positions must be an (n, 2) or (n, 3) array, got shape {p.shape}")
+        if p.shape[1] == 2:
+            p = np.column_stack([p, np.zeros(len(p))])
+        v = np.asarray(volumes, dtype=np.float64).reshape(-1)
+        if len(v) != len(p):
+            raise InputError(f"{len(p)} positions but {len(v)} volumes")
+        if dimension not in (2, 3):
+            raise InputError(f"dimension must be 2 or 3, got {dimension}")
+        return ReferenceShape(np.ascontiguousarray(p), v, float(mesh_size), dimension)
+
+    @property
+    def node_count(self) -> int:
+        return len(self.volumes)
+
+
+def rotation_matrix(rotation: float | ArrayLike | None, dimension: int) -> NDArray[np.float64]:
+    """3 x 3 rotation: an angle [rad] about z (2D or 3D), a rotation vector (axis times angle,
+    3D) or a 3 x 3 matrix (3D, checked to be a rotation)."""
+    if rotation is None:
+        return np.eye(3)
+    array = np.asarray(rotation, dtype=np.float64)
+    if array.ndim == 0:
+        c, s = np.cos(float(array)), np.sin(float(array))
+        return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+    if dimension == 2:
+        raise InputError("in 2D, rotation is an angle in radians")
+    if array.shape == (3,):
+        angle = float(np.linalg.norm(array))
+        if angle == 0:
+            return np.eye(3)
+        k = array / angle
+        K = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
+        return np.eye(3) + np.sin(angle) * K + (1 - np.cos(angle)) * K @ K
+    if array.shape == (3, 3):
+        if not (np.allclose(array @ array.T, np.eye(3), atol=1e-9) and np.linalg.det(array) > 0):
+            raise InputError("rotation matrix must be orthogonal with determinant +1")
+        return array
+    raise InputError(
+        f"rotation must be an angle, a rotation vector or a 3x3 matrix, got {rotation!r}"
+    )

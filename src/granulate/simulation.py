@@ -28,7 +28,7 @@ from granulate.errors import GranulateWarning, InputError
 from granulate.functions import Constant, Linear, TimeFunction, VelocityRamp
 from granulate.io import HistoryWriter, PvdSeries, atomic_write, write_vtu
 from granulate.materials import Material
-from granulate.shapes import Shape, lattice
+from granulate.shapes import ReferenceShape, Shape, lattice, rotation_matrix
 from granulate.walls import Surface, Wall
 
 Components = str  # any of "x", "y", "z", e.g. "xy"
@@ -68,6 +68,8 @@ class Body:
     node_count: int
     material: Material
     mesh_size: float
+    reference: ReferenceShape | None = None
+    scale: float = 1.0
 
     @property
     def nodes(self) -> NDArray[np.uint32]:
@@ -203,6 +205,53 @@ class Simulation:
             name=name,
         )
 
+    def add_particle(
+        self,
+        reference: ReferenceShape,
+        material: Material,
+        *,
+        position: ArrayLike = (0.0, 0.0, 0.0),
+        rotation: float | ArrayLike | None = None,
+        scale: float = 1.0,
+        velocity: ArrayLike | None = None,
+        angular_velocity: float | ArrayLike | None = None,
+        name: str | None = None,
+    ) -> Body:
+        """Place a reference shape: x = position + R (scale p) for its local nodes p.
+
+        ``rotation``: an angle [rad] about z (2D), or in 3D a rotation vector or a 3x3 matrix.
+        Particles placed from one reference shape share its bonds in memory (per distinct
+        scale when the material's horizon is absolute). The mesh size is scale times the
+        shape's; volumes scale with scale^d.
+        """
+        if not isinstance(reference, ReferenceShape):
+            raise InputError(
+                f"add_particle takes a granulate.ReferenceShape, got {type(reference).__name__}"
+            )
+        if reference.dimension != self.dimension:
+            raise InputError(
+                f"the reference shape is {reference.dimension}D but the simulation is {self.dimension}D"
+            )
+        if not (np.isfinite(scale) and scale > 0):
+            raise InputError(f"scale must be positive, got {scale}")
+        placed = (
+            self._vector(position, "position")
+            + (scale * reference.positions) @ rotation_matrix(rotation, self.dimension).T
+        )
+        if self.dimension == 2:
+            placed[:, 2] = 0.0
+        return self._add(
+            placed,
+            reference.volumes * scale**self.dimension,
+            material,
+            scale * reference.mesh_size,
+            velocity,
+            angular_velocity,
+            name,
+            reference,
+            float(scale),
+        )
+
     def add_body_from_nodes(
         self,
         positions: ArrayLike,
@@ -232,9 +281,37 @@ class Simulation:
             raise InputError(f"{len(p)} positions but {len(v)} volumes")
         if not (np.isfinite(mesh_size) and mesh_size > 0):
             raise InputError(f"mesh size must be positive, got {mesh_size}")
+        return self._add(p, v, material, mesh_size, velocity, angular_velocity, name, None, 1.0)
+
+    def _add(
+        self,
+        p: NDArray[np.float64],
+        v: NDArray[np.float64],
+        material: Material,
+        mesh_size: float,
+        velocity: ArrayLike | None,
+        angular_velocity: float | ArrayLike | None,
+        name: str | None,
+        reference: ReferenceShape | None,
+        scale: float,
+    ) -> Body:
+        self._require_building("add a body")
+        if not isinstance(material, Material):
+            raise InputError(
+                f"material must be a granulate.Material, got {type(material).__name__}"
+            )
         index = len(self.bodies)
         first = sum(b.node_count for b in self.bodies)
-        body = Body(index, name or f"body{index}", first, len(p), material, float(mesh_size))
+        body = Body(
+            index,
+            name or f"body{index}",
+            first,
+            len(p),
+            material,
+            float(mesh_size),
+            reference,
+            scale,
+        )
         self.bodies.append(body)
         self._positions.append(np.ascontiguousarray(p))
         self._volumes.append(np.ascontiguousarray(v))
@@ -489,6 +566,7 @@ class Simulation:
             raise InputError("the simulation has no body; add one with add_body")
         model = _core.Model(self.dimension, getattr(_core.PlaneMode, self.plane))
         material_ids: dict[tuple[int, float, float], int] = {}
+        shape_ids: dict[int, int] = {}
         for body, positions, volumes in zip(
             self.bodies, self._positions, self._volumes, strict=True
         ):
@@ -497,7 +575,15 @@ class Simulation:
             if key not in material_ids:
                 material_ids[key] = model.add_material(body.material.core_params(body.mesh_size))
                 self._core_materials.append((body.material, body.mesh_size, horizon))
-            model.add_particle(positions, volumes, material_ids[key], body.mesh_size)
+            if body.reference is None:
+                model.add_particle(positions, volumes, material_ids[key], body.mesh_size)
+                continue
+            reference = body.reference
+            if id(reference) not in shape_ids:
+                shape_ids[id(reference)] = model.add_shape(
+                    reference.positions, reference.volumes, reference.mesh_size
+                )
+            model.place_shape(shape_ids[id(reference)], material_ids[key], positions, body.scale)
         model.finalize()
         core = _core.Simulation(model)
         self._set_contact_laws(model, core)

@@ -24,6 +24,15 @@ struct MaterialParams {
   bool break_in_compression = false;  ///< true: |s| > s0 breaks, not only s > s0
 };
 
+/// Dimensionless energy-release coefficients of a model, such that rigidly separating two
+/// half-spaces (every bond crossing the plane stretched until it breaks at s0) dissipates
+///   Gc = s0^2 * delta * (pair * G + dilatation * (kappa_d - a_d G / d^2))          (LPS)
+///   Gc = s0^2 * c * delta^(d+2) * pair                                            (PMB)
+/// Computed by quadrature of the continuum bond integrals for the given influence function.
+struct FractureCoefficients {
+  real pair = 0;
+  real dilatation = 0;
+};
 /// Constants a force loop needs, derived once from MaterialParams for one dimension and plane.
 struct Material {
   MaterialParams params;
@@ -40,18 +49,12 @@ struct Material {
   real critical_stretch = 0;
 
   /// Validates the parameters (throws InputError naming the bad one) and derives the constants.
-  static Material make(const MaterialParams& params, int dimension, PlaneMode plane);
+  /// `coefficients`: fracture_coefficients(params.model, params.influence, dimension) if already
+  /// known (they cost a quadrature of ~10^7 points), otherwise computed.
+  static Material make(const MaterialParams& params, int dimension, PlaneMode plane,
+                       const FractureCoefficients* coefficients = nullptr);
 };
 
-/// Dimensionless energy-release coefficients of a model, such that rigidly separating two
-/// half-spaces (every bond crossing the plane stretched until it breaks at s0) dissipates
-///   Gc = s0^2 * delta * (pair * G + dilatation * (kappa_d - a_d G / d^2))          (LPS)
-///   Gc = s0^2 * c * delta^(d+2) * pair                                            (PMB)
-/// Computed by quadrature of the continuum bond integrals for the given influence function.
-struct FractureCoefficients {
-  real pair = 0;
-  real dilatation = 0;
-};
 FractureCoefficients fracture_coefficients(ForceModel model, InfluenceKind influence, int dimension);
 
 /// Continuum moment int_0^1 J(xi) xi^p dxi of an influence function (midpoint quadrature).

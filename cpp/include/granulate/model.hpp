@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <span>
 #include <vector>
 
@@ -38,12 +39,12 @@ struct Particle {
 /// placed from the shape with the same horizon/scale: lengths scale with the particle, weights
 /// with its scale^d.
 struct BondFamilies {
-  std::vector<index_t> offsets;   ///< size shape nodes + 1
-  std::vector<index_t> neighbors; ///< local j, sorted ascending within a family
-  std::vector<real> weights;      ///< w_ij = J(r/delta) V_j beta_ij at scale 1 [m^d]
-  std::vector<real> lengths;      ///< r = |X_j - X_i| at scale 1 [m]
+  std::vector<index_t> offsets;    ///< size shape nodes + 1
+  std::vector<index_t> neighbors;  ///< local j, sorted ascending within a family
+  std::vector<real> weights;       ///< w_ij = J(r/delta) V_j beta_ij at scale 1 [m^d]
+  std::vector<real> lengths;       ///< r = |X_j - X_i| at scale 1 [m]
   index_t shape = 0;
-  real horizon = 0;               ///< in shape units (the material horizon / scale)
+  real horizon = 0;  ///< in shape units (the material horizon / scale)
   InfluenceKind influence = InfluenceKind::linear;
 };
 
@@ -139,6 +140,7 @@ class Model {
   PlaneMode plane_;
   bool finalized_ = false;
   std::vector<Material> materials_;
+  std::map<std::pair<ForceModel, InfluenceKind>, FractureCoefficients> fracture_coefficients_;
   std::vector<Shape> shapes_;
   std::vector<Particle> particles_;
   std::vector<real> particle_weight_scale_;  // scale^d

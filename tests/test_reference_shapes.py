@@ -1,0 +1,101 @@
+"""A reference shape discretised once and placed many times (translated, rotated, scaled)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import granulate as gr
+
+ROCK = gr.Material(density=2000, youngs_modulus=1e8, poisson_ratio=0.25, fracture_energy=5.0)
+
+
+def test_placed_particles_share_one_bond_family() -> None:
+    """Shared bond storage does not grow with the number of particles."""
+    reference = gr.ReferenceShape.from_shape(gr.Disc((0, 0), 1e-3), 1e-4)
+    bytes_for, bonds_for = {}, {}
+    for count in (1, 50):
+        sim = gr.Simulation(2)
+        for k in range(count):
+            sim.add_particle(reference, ROCK, position=(3e-3 * k, 0), rotation=0.37 * k)
+        sim.run(1)
+        assert sim.core.contact_statistics.rebuilds == 1
+        bytes_for[count] = sim._model.shared_bond_bytes()
+        assert sim._model.family_count == 1 and sim._model.shape_count == 1
+        bonds_for[count] = sim.bond_count
+    assert bytes_for[50] == bytes_for[1]
+    assert bonds_for[50] == 50 * bonds_for[1]  # every particle has all its bonds
+
+
+@pytest.mark.parametrize("dimension", [2, 3])
+def test_a_rotated_placement_behaves_as_the_rotated_body(dimension: int) -> None:
+    """Pulling a placed, rotated particle gives the rotated displacements of the unrotated one."""
+    shape = (
+        gr.Rectangle((-2e-3, -1e-3), (2e-3, 1e-3))
+        if dimension == 2
+        else gr.Box((-2e-3, -1e-3, -1e-3), (2e-3, 1e-3, 1e-3))
+    )
+    reference = gr.ReferenceShape.from_shape(shape, 0.5e-3)
+    angle = 0.6
+    rotation = angle if dimension == 2 else np.array([0.0, 0.0, angle])
+    R = gr.shapes.rotation_matrix(angle, 3)
+
+    def pulled(rotated: bool) -> np.ndarray:
+        sim = gr.Simulation(dimension, dt=2e-8)
+        body = sim.add_particle(
+            reference,
+            ROCK,
+            position=(0.01, 0.02, 0)[:dimension],
+            rotation=rotation if rotated else None,
+        )
+        local = (sim.reference_positions - (0.01, 0.02, 0)) @ (R if rotated else np.eye(3))
+        right = np.flatnonzero(local[:, 0] > 1.5e-3)
+        left = np.flatnonzero(local[:, 0] < -1.5e-3)
+        direction = (R if rotated else np.eye(3)) @ np.array([1.0, 0, 0])
+        sim.prescribe_displacement(right, direction[:dimension], gr.Linear(0.5))
+        sim.fix(left)
+        sim.run(300)
+        assert body.node_count == reference.node_count
+        return sim.displacements @ (R if rotated else np.eye(3))  # back to the local frame
+
+    np.testing.assert_allclose(pulled(True), pulled(False), rtol=0, atol=1e-12)
+
+
+def test_a_scaled_placement_keeps_the_material_behaviour() -> None:
+    """Scale s: the horizon follows the mesh (factor 3), so a homogeneous strain gives the same
+    energy density; volumes grow as s^d."""
+    reference = gr.ReferenceShape.from_shape(gr.Rectangle((0, 0), (6e-3, 6e-3)), 0.25e-3)
+    densities = []
+    for scale in (1.0, 2.5):
+        material = gr.Material(density=2000, youngs_modulus=1e8, poisson_ratio=0.25, fracture=False)
+        sim = gr.Simulation(2)
+        sim.add_particle(reference, material, scale=scale)
+        np.testing.assert_allclose(sim.volumes, reference.volumes * scale**2)
+        X = sim.reference_positions
+        sim.positions[:] = X * (1 + 1e-4)
+        sim.positions[:, 2] = 0
+        sim.core.compute_forces()
+        densities.append(sim.core.strain_energy_density())
+    np.testing.assert_allclose(densities[1], densities[0], rtol=1e-9)
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "message"),
+    [
+        ({"scale": 0.0}, "scale must be positive"),
+        ({"rotation": np.eye(3)}, "in 2D, rotation is an angle"),
+        ({"position": (1.0,)}, "position must be 2 finite numbers"),
+    ],
+)
+def test_bad_placements_are_refused(kwargs: dict, message: str) -> None:
+    reference = gr.ReferenceShape.from_shape(gr.Disc((0, 0), 1e-3), 2e-4)
+    with pytest.raises(gr.InputError, match=message):
+        gr.Simulation(2).add_particle(reference, ROCK, **kwargs)
+
+
+def test_bad_rotation_matrix_and_dimension_mismatch() -> None:
+    sphere = gr.ReferenceShape.from_shape(gr.Sphere((0, 0, 0), 1e-3), 2.5e-4)
+    with pytest.raises(gr.InputError, match="determinant"):
+        gr.Simulation(3).add_particle(sphere, ROCK, rotation=np.diag([1.0, 1.0, -1.0]))
+    with pytest.raises(gr.InputError, match="3D but the simulation is 2D"):
+        gr.Simulation(2).add_particle(sphere, ROCK)
