@@ -230,7 +230,8 @@ class Simulation:
             )
         if reference.dimension != self.dimension:
             raise InputError(
-                f"the reference shape is {reference.dimension}D but the simulation is {self.dimension}D"
+                f"the reference shape is {reference.dimension}D "
+                f"but the simulation is {self.dimension}D"
             )
         if not (np.isfinite(scale) and scale > 0):
             raise InputError(f"scale must be positive, got {scale}")
