@@ -202,7 +202,8 @@ NB_MODULE(_core, m) {
       .value("box_outside", WallSurface::Kind::box_outside)
       .value("circle_inside", WallSurface::Kind::circle_inside)
       .value("circle_outside", WallSurface::Kind::circle_outside)
-      .value("polygon", WallSurface::Kind::polygon);
+      .value("polygon", WallSurface::Kind::polygon)
+      .value("triangles", WallSurface::Kind::triangles);
   nb::class_<WallSurface>(m, "WallSurface")
       .def(nb::init<>())
       .def_rw("kind", &WallSurface::kind)
@@ -212,7 +213,9 @@ NB_MODULE(_core, m) {
       .def_rw("upper", &WallSurface::upper)
       .def_rw("radius", &WallSurface::radius)
       .def_rw("vertices", &WallSurface::vertices)
-      .def_rw("inside", &WallSurface::inside);
+      .def_rw("inside", &WallSurface::inside)
+      .def_rw("mesh_vertices", &WallSurface::mesh_vertices)
+      .def_rw("mesh_triangles", &WallSurface::mesh_triangles);
   nb::enum_<Wall::Motion>(m, "WallMotion")
       .value("fixed", Wall::Motion::fixed)
       .value("translation", Wall::Motion::translation)

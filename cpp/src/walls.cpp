@@ -75,7 +75,148 @@ WallContact polygon_distance(const std::vector<std::array<real, 2>>& v, const ve
   return c;
 }
 
+void build_triangle_grid(WallSurface& s) {
+  auto& g = s.grid;
+  std::array<real, 3> lo{}, hi{};
+  lo.fill(std::numeric_limits<real>::max());
+  hi.fill(std::numeric_limits<real>::lowest());
+  real extent = 0;
+  auto bounds = [&](const std::array<index_t, 3>& t, int k) {
+    real tlo = std::numeric_limits<real>::max(), thi = std::numeric_limits<real>::lowest();
+    for (index_t v : t) {
+      tlo = std::min(tlo, s.mesh_vertices[v][k]);
+      thi = std::max(thi, s.mesh_vertices[v][k]);
+    }
+    return std::make_pair(tlo, thi);
+  };
+  for (const auto& t : s.mesh_triangles) {
+    for (int k = 0; k < 3; ++k) {
+      const auto [tlo, thi] = bounds(t, k);
+      lo[k] = std::min(lo[k], tlo);
+      hi[k] = std::max(hi[k], thi);
+      extent = std::max(extent, thi - tlo);
+    }
+  }
+  // Cells about the size of the largest triangle, at most ~64 per triangle in all.
+  real cell = std::max(extent, 1e-12);
+  for (;;) {
+    std::int64_t cells = 1;
+    for (int k = 0; k < 3; ++k) {
+      g.dims[k] = std::max<std::int64_t>(1, static_cast<std::int64_t>((hi[k] - lo[k]) / cell) + 1);
+      cells *= g.dims[k];
+    }
+    if (cells <= 64 * static_cast<std::int64_t>(s.mesh_triangles.size()) + 64) break;
+    cell *= 1.5;
+  }
+  g.origin = lo;
+  g.cell_size = cell;
+  const std::size_t cells = static_cast<std::size_t>(g.dims[0] * g.dims[1] * g.dims[2]);
+  std::vector<std::vector<index_t>> bins(cells);
+  for (index_t t = 0; t < s.mesh_triangles.size(); ++t) {
+    std::array<std::int64_t, 3> a{}, b{};
+    for (int k = 0; k < 3; ++k) {
+      const auto [tlo, thi] = bounds(s.mesh_triangles[t], k);
+      a[k] = std::clamp<std::int64_t>(static_cast<std::int64_t>((tlo - lo[k]) / cell), 0, g.dims[k] - 1);
+      b[k] = std::clamp<std::int64_t>(static_cast<std::int64_t>((thi - lo[k]) / cell), 0, g.dims[k] - 1);
+    }
+    for (std::int64_t z = a[2]; z <= b[2]; ++z)
+      for (std::int64_t y = a[1]; y <= b[1]; ++y)
+        for (std::int64_t x = a[0]; x <= b[0]; ++x) bins[(z * g.dims[1] + y) * g.dims[0] + x].push_back(t);
+  }
+  g.cell_start.assign(cells + 1, 0);
+  g.cell_triangles.clear();
+  for (std::size_t c = 0; c < cells; ++c) {
+    g.cell_triangles.insert(g.cell_triangles.end(), bins[c].begin(), bins[c].end());
+    g.cell_start[c + 1] = static_cast<index_t>(g.cell_triangles.size());
+  }
+}
+
+/// Closest triangle to p within reach: signed distance (positive on the particles' side) and
+/// the normal towards the particles. Returns false when no triangle is within reach.
+bool triangle_mesh_contact(const WallSurface& s, const vec& p, real reach, WallContact& out) {
+  const auto& g = s.grid;
+  std::array<std::int64_t, 3> a{}, b{};
+  for (int k = 0; k < 3; ++k) {
+    const real lo = (p[k] - reach - g.origin[k]) / g.cell_size,
+               hi = (p[k] + reach - g.origin[k]) / g.cell_size;
+    if (hi < 0 || lo >= static_cast<real>(g.dims[k])) return false;
+    a[k] = std::max<std::int64_t>(0, static_cast<std::int64_t>(lo));
+    b[k] = std::min<std::int64_t>(g.dims[k] - 1, static_cast<std::int64_t>(hi));
+  }
+  real best = reach * reach;
+  bool found = false;
+  vec best_point{}, best_face{};
+  for (std::int64_t z = a[2]; z <= b[2]; ++z)
+    for (std::int64_t y = a[1]; y <= b[1]; ++y)
+      for (std::int64_t x = a[0]; x <= b[0]; ++x) {
+        const std::int64_t cell = (z * g.dims[1] + y) * g.dims[0] + x;
+        for (index_t k = g.cell_start[cell]; k < g.cell_start[cell + 1]; ++k) {
+          const auto& t = s.mesh_triangles[g.cell_triangles[k]];
+          const vec& va = s.mesh_vertices[t[0]];
+          const vec& vb = s.mesh_vertices[t[1]];
+          const vec& vc = s.mesh_vertices[t[2]];
+          const vec q = closest_point_on_triangle(p, va, vb, vc);
+          const real d2 =
+              (p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) + (p[2] - q[2]) * (p[2] - q[2]);
+          if (d2 < best) {
+            best = d2;
+            found = true;
+            best_point = q;
+            best_face = cross({vb[0] - va[0], vb[1] - va[1], vb[2] - va[2]},
+                              {vc[0] - va[0], vc[1] - va[1], vc[2] - va[2]});
+          }
+        }
+      }
+  if (!found) return false;
+  const real face_norm = norm(best_face);
+  vec face{best_face[0] / face_norm, best_face[1] / face_norm, best_face[2] / face_norm};
+  if (s.inside) face = {-face[0], -face[1], -face[2]};  // towards the particles
+  const vec offset{p[0] - best_point[0], p[1] - best_point[1], p[2] - best_point[2]};
+  const real distance = std::sqrt(best);
+  const real side = dot(offset, face);
+  if (distance > 0 && std::abs(side) > 1e-12 * distance) {
+    const real sign = side > 0 ? 1.0 : -1.0;
+    out = {sign * distance,
+           {sign * offset[0] / distance, sign * offset[1] / distance, sign * offset[2] / distance}};
+  } else {
+    out = {side >= 0 ? distance : -distance, face};
+  }
+  return true;
+}
+
 }  // namespace
+
+std::array<real, 3> closest_point_on_triangle(const std::array<real, 3>& p, const std::array<real, 3>& a,
+                                              const std::array<real, 3>& b, const std::array<real, 3>& c) {
+  const vec ab{b[0] - a[0], b[1] - a[1], b[2] - a[2]}, ac{c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+  const vec ap{p[0] - a[0], p[1] - a[1], p[2] - a[2]};
+  const real d1 = dot(ab, ap), d2 = dot(ac, ap);
+  if (d1 <= 0 && d2 <= 0) return a;
+  const vec bp{p[0] - b[0], p[1] - b[1], p[2] - b[2]};
+  const real d3 = dot(ab, bp), d4 = dot(ac, bp);
+  if (d3 >= 0 && d4 <= d3) return b;
+  const real vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) {
+    const real v = d1 / (d1 - d3);
+    return {a[0] + v * ab[0], a[1] + v * ab[1], a[2] + v * ab[2]};
+  }
+  const vec cp{p[0] - c[0], p[1] - c[1], p[2] - c[2]};
+  const real d5 = dot(ab, cp), d6 = dot(ac, cp);
+  if (d6 >= 0 && d5 <= d6) return c;
+  const real vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) {
+    const real w = d2 / (d2 - d6);
+    return {a[0] + w * ac[0], a[1] + w * ac[1], a[2] + w * ac[2]};
+  }
+  const real va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) {
+    const real w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+    return {b[0] + w * (c[0] - b[0]), b[1] + w * (c[1] - b[1]), b[2] + w * (c[2] - b[2])};
+  }
+  const real denominator = 1 / (va + vb + vc);
+  const real v = vb * denominator, w = vc * denominator;
+  return {a[0] + ab[0] * v + ac[0] * w, a[1] + ab[1] * v + ac[1] * w, a[2] + ab[2] * v + ac[2] * w};
+}
 
 void Wall::validate(int dimension) {
   if (surfaces.empty()) throw InputError("wall '" + name + "' has no surface");
@@ -116,6 +257,32 @@ void Wall::validate(int dimension) {
         extent =
             std::max(extent, norm({s.point[0] - center[0], s.point[1] - center[1], s.point[2] - center[2]}) +
                                  s.radius);
+        break;
+      case WallSurface::Kind::triangles:
+        if (dimension != 3) throw InputError("triangle-mesh walls are 3D; use polygons in 2D");
+        if (s.mesh_triangles.empty())
+          throw InputError("wall '" + name + "': the triangle mesh has no triangles");
+        for (std::size_t t = 0; t < s.mesh_triangles.size(); ++t) {
+          const auto& tri = s.mesh_triangles[t];
+          for (index_t v : tri) {
+            if (v >= s.mesh_vertices.size()) {
+              throw InputError("wall '" + name + "': triangle " + std::to_string(t) +
+                               " refers to a missing vertex");
+            }
+          }
+          const vec& a = s.mesh_vertices[tri[0]];
+          const vec& b = s.mesh_vertices[tri[1]];
+          const vec& c = s.mesh_vertices[tri[2]];
+          if (!(norm(cross({b[0] - a[0], b[1] - a[1], b[2] - a[2]},
+                           {c[0] - a[0], c[1] - a[1], c[2] - a[2]})) > 0)) {
+            throw InputError("wall '" + name + "': triangle " + std::to_string(t) +
+                             " has zero area; remove degenerate triangles from the mesh");
+          }
+        }
+        for (const auto& v : s.mesh_vertices) {
+          extent = std::max(extent, norm({v[0] - center[0], v[1] - center[1], v[2] - center[2]}));
+        }
+        build_triangle_grid(s);
         break;
       case WallSurface::Kind::polygon:
         if (dimension != 2) throw InputError("polygon walls are 2D; use planes or boxes in 3D");
@@ -228,6 +395,11 @@ void Wall::contacts(std::size_t surface, const std::array<real, 3>& p, real reac
       } else if (rho - s.radius < reach) {
         out.push_back({rho - s.radius, radial});
       }
+      break;
+    }
+    case WallSurface::Kind::triangles: {
+      WallContact c;
+      if (triangle_mesh_contact(s, p, reach, c) && c.distance < reach) out.push_back(c);
       break;
     }
     case WallSurface::Kind::polygon: {

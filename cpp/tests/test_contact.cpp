@@ -132,3 +132,44 @@ TEST_CASE("node contact forces obey Newton's third law to round-off") {
   CHECK(sim.contact().statistics().node_contacts > 0);
   for (double s : sum) CHECK(std::abs(s) < 1e-12 * scale);
 }
+
+TEST_CASE("closest point on a triangle: face, edge and vertex regions") {
+  const std::array<real, 3> a{0, 0, 0}, b{1, 0, 0}, c{0, 1, 0};
+  const auto face = closest_point_on_triangle({0.2, 0.3, 5.0}, a, b, c);
+  CHECK(std::abs(face[0] - 0.2) < 1e-15 && std::abs(face[1] - 0.3) < 1e-15 && face[2] == 0.0);
+  const auto edge = closest_point_on_triangle({0.5, -2.0, 1.0}, a, b, c);
+  CHECK(std::abs(edge[0] - 0.5) < 1e-15 && edge[1] == 0.0 && edge[2] == 0.0);
+  const auto vertex = closest_point_on_triangle({2.0, -1.0, 0.0}, a, b, c);
+  CHECK(vertex == b);
+  const auto hypotenuse = closest_point_on_triangle({1.0, 1.0, 0.0}, a, b, c);
+  CHECK(std::abs(hypotenuse[0] - 0.5) < 1e-15 && std::abs(hypotenuse[1] - 0.5) < 1e-15);
+}
+
+TEST_CASE("triangle-mesh wall: signed distance and normal towards the particles") {
+  // A unit cube with outward normals (right-hand rule), particles inside.
+  Wall wall;
+  wall.name = "cube";
+  WallSurface mesh;
+  mesh.kind = WallSurface::Kind::triangles;
+  mesh.mesh_vertices = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0},
+                        {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}};
+  mesh.mesh_triangles = {{0, 2, 1}, {0, 3, 2}, {4, 5, 6}, {4, 6, 7}, {0, 1, 5}, {0, 5, 4},
+                         {2, 3, 7}, {2, 7, 6}, {1, 2, 6}, {1, 6, 5}, {0, 4, 7}, {0, 7, 3}};
+  mesh.inside = true;
+  wall.surfaces = {mesh};
+  wall.validate(3);
+  std::vector<WallContact> out;
+  wall.contacts(0, {0.5, 0.5, 0.1}, 0.2, 3, out);  // 0.1 above the floor, inside
+  CHECK(out.size() == 1 && std::abs(out[0].distance - 0.1) < 1e-12 &&
+        std::abs(out[0].normal[2] - 1.0) < 1e-12);
+  out.clear();
+  wall.contacts(0, {0.5, 0.5, -0.05}, 0.2, 3, out);  // below the floor: penetrated
+  CHECK(out.size() == 1 && std::abs(out[0].distance + 0.05) < 1e-12 &&
+        std::abs(out[0].normal[2] - 1.0) < 1e-12);
+  out.clear();
+  wall.contacts(0, {0.5, 0.5, 0.5}, 0.2, 3, out);  // the centre is far from every face
+  CHECK(out.empty());
+  Wall degenerate = wall;
+  degenerate.surfaces[0].mesh_triangles.push_back({0, 1, 1});
+  CHECK_THROWS(degenerate.validate(3), InputError);
+}

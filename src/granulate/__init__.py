@@ -46,6 +46,7 @@ from granulate.walls import (
     PolygonObstacle,
     Rotation,
     Translation,
+    TriangleMesh,
     Wall,
 )
 
@@ -94,6 +95,7 @@ __all__ = [
     "Sphere",
     "TimeFunction",
     "Translation",
+    "TriangleMesh",
     "Union",
     "VelocityRamp",
     "Wall",

@@ -10,6 +10,9 @@ A wall is one or more surfaces moving together (``Wall(surfaces, motion=...)``).
 ``CircleObstacle(c, r)``     particles outside a circle or cylinder (posts, rollers)
 ``PolygonContainer(v)``      particles inside a 2D polygon (concave allowed)
 ``PolygonObstacle(v)``       particles outside a 2D polygon (lifters, blades)
+``TriangleMesh(v, t)``       a 3D triangle surface (``TriangleMesh.from_file`` reads STL/OBJ/PLY);
+                             particles inside a closed mesh with outward normals (``inside``) or
+                             outside it
 ===========================  ===================================================================
 
 Motions: ``Translation(direction, function)`` moves the wall by function(t) metres along the
@@ -21,8 +24,11 @@ recorded in history.csv.
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass, field
+from pathlib import Path
 
+import meshio
 import numpy as np
 from numpy.typing import ArrayLike
 
@@ -142,6 +148,58 @@ class PolygonObstacle(_Polygon):
     """Particles outside a 2D polygon."""
 
     inside: bool = field(default=False, init=False)
+
+
+@dataclass(frozen=True, eq=False)
+class TriangleMesh(Surface):
+    """A triangle surface (3D). ``vertices`` (n, 3) [m], ``triangles`` (m, 3) vertex indices.
+
+    With ``inside=True`` the particles are inside a closed surface whose triangles face outwards
+    (right-hand rule, as STL files are written); with ``inside=False`` they are outside it.
+    """
+
+    vertices: ArrayLike
+    triangles: ArrayLike
+    inside: bool = True
+
+    @staticmethod
+    def from_file(path: str | Path, *, inside: bool = True, scale: float = 1.0) -> TriangleMesh:
+        """Read the triangles of an STL, OBJ, PLY (or any meshio-readable) file; coordinates are
+        multiplied by ``scale`` (e.g. 1e-3 for a file in millimetres)."""
+        source = Path(path)
+        if not source.is_file():
+            raise InputError(f"wall mesh file {source} does not exist")
+        try:
+            with warnings.catch_warnings():
+                # meshio's binary-STL size probe overflows harmlessly on ASCII files.
+                warnings.simplefilter("ignore", RuntimeWarning)
+                mesh = meshio.read(source)
+        except Exception as error:  # meshio raises many types for unreadable files
+            raise InputError(f"cannot read wall mesh {source}: {error}") from None
+        triangles = [block.data for block in mesh.cells if block.type == "triangle"]
+        if not triangles:
+            raise InputError(f"wall mesh {source} has no triangles")
+        return TriangleMesh(
+            np.asarray(mesh.points, dtype=float) * scale, np.concatenate(triangles), inside
+        )
+
+    def core(self) -> _core.WallSurface:
+        vertices = np.asarray(self.vertices, dtype=float)
+        triangles = np.asarray(self.triangles)
+        if vertices.ndim != 2 or vertices.shape[1] != 3 or not np.all(np.isfinite(vertices)):
+            raise InputError("triangle mesh vertices must be an (n, 3) array of finite numbers")
+        if triangles.ndim != 2 or triangles.shape[1] != 3 or len(triangles) == 0:
+            raise InputError(
+                "triangle mesh triangles must be a non-empty (m, 3) array of vertex indices"
+            )
+        if triangles.min() < 0 or triangles.max() >= len(vertices):
+            raise InputError("a triangle refers to a vertex that does not exist")
+        s = _core.WallSurface()
+        s.kind = _core.WallSurfaceKind.triangles
+        s.mesh_vertices = [tuple(map(float, v)) for v in vertices]
+        s.mesh_triangles = [tuple(map(int, t)) for t in triangles]
+        s.inside = self.inside
+        return s
 
 
 @dataclass(frozen=True)

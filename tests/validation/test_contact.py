@@ -221,3 +221,46 @@ def test_rotating_drum_carries_a_particle_up_by_friction() -> None:
     with_friction, frictionless = final_angle(0.8), final_angle(0.0)
     assert with_friction > 10.0, f"carried only {with_friction:.1f} degrees"
     assert abs(frictionless) < 2.0, f"frictionless disc moved {frictionless:.1f} degrees"
+
+
+@pytest.mark.validation
+def test_sphere_rests_on_a_triangle_mesh_floor_read_from_stl(tmp_path) -> None:
+    """3D walls from an STL file: a box-shaped container of 12 triangles (outward normals); a
+    settled sphere loads it with its weight (1 %)."""
+    import meshio
+
+    side = 4e-3
+    corners = np.array([[x, y, z] for z in (0, 1) for y in (0, 1) for x in (0, 1)], dtype=float)
+    corners = (corners - [0.5, 0.0, 0.5]) * side
+    triangles = np.array(
+        [
+            [0, 2, 3],
+            [0, 3, 1],
+            [4, 5, 7],
+            [4, 7, 6],
+            [0, 1, 5],
+            [0, 5, 4],
+            [2, 6, 7],
+            [2, 7, 3],
+            [1, 3, 7],
+            [1, 7, 5],
+            [0, 4, 6],
+            [0, 6, 2],
+        ]
+    )
+    path = tmp_path / "box.stl"
+    meshio.write(path, meshio.Mesh(corners, [("triangle", triangles)]))
+    g = 9.81
+    sim = gr.Simulation(3, gravity=(0, -g, 0), viscous_damping=30.0)
+    sim.contact = gr.Contact(restitution=0.3, friction=0.3)
+    sim.add_body(gr.Sphere((0, 1.6e-3, 0), 1e-3), SOFT, 0.25e-3)
+    sim.add_wall(gr.TriangleMesh.from_file(path), name="box")
+    weight = float(np.sum(sim.volumes) * SOFT.density * g)
+    sim.run(until=0.05)
+    loads = []
+    for _ in range(20):
+        sim.run(20)
+        loads.append(-sim.wall_reactions()["box"][1])
+    assert abs(np.mean(loads) / weight - 1) < 0.01, (
+        f"floor load {np.mean(loads) / weight:.4f} x weight"
+    )

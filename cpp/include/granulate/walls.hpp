@@ -19,8 +19,20 @@ namespace granulate {
 ///   circle_inside:  center, radius, axis; particles inside a circle (2D) or cylinder (3D)
 ///   circle_outside: the same, particles outside (a post, a roller)
 ///   polygon:        vertices (2D, in order), particles inside when inside == true
+///   triangles:      a triangle mesh (3D): mesh_vertices, mesh_triangles; each triangle's normal
+///                   (right-hand rule) points away from the particles when inside == true (a
+///                   closed container with outward normals, as STL files have), towards them
+///                   when inside == false (an obstacle)
 struct WallSurface {
-  enum class Kind : std::uint8_t { plane, box_inside, box_outside, circle_inside, circle_outside, polygon };
+  enum class Kind : std::uint8_t {
+    plane,
+    box_inside,
+    box_outside,
+    circle_inside,
+    circle_outside,
+    polygon,
+    triangles
+  };
   Kind kind = Kind::plane;
   std::array<real, 3> point{0, 0, 0};   ///< plane point, circle centre
   std::array<real, 3> normal{0, 1, 0};  ///< plane normal; circle/cylinder axis
@@ -28,8 +40,22 @@ struct WallSurface {
   std::array<real, 3> upper{0, 0, 0};
   real radius = 0;
   std::vector<std::array<real, 2>> vertices;  ///< polygon
-  bool inside = true;                         ///< polygon: particles inside
+  bool inside = true;                         ///< polygon, triangles: particles inside
+  std::vector<std::array<real, 3>> mesh_vertices;
+  std::vector<std::array<index_t, 3>> mesh_triangles;
+
+  /// Uniform grid of triangle bounding boxes (built by Wall::validate) for closest-point queries.
+  struct TriangleGrid {
+    std::array<real, 3> origin{0, 0, 0};
+    real cell_size = 1;
+    std::array<std::int64_t, 3> dims{1, 1, 1};
+    std::vector<index_t> cell_start, cell_triangles;
+  } grid;
 };
+
+/// Closest point to p on triangle (a, b, c) (Ericson, Real-Time Collision Detection, 5.1.5).
+std::array<real, 3> closest_point_on_triangle(const std::array<real, 3>& p, const std::array<real, 3>& a,
+                                              const std::array<real, 3>& b, const std::array<real, 3>& c);
 
 /// A contact candidate between a point and a surface: signed distance (positive on the
 /// particles' side) and the unit normal pointing from the surface towards the particles.
