@@ -264,3 +264,44 @@ def test_sphere_rests_on_a_triangle_mesh_floor_read_from_stl(tmp_path) -> None:
     assert abs(np.mean(loads) / weight - 1) < 0.01, (
         f"floor load {np.mean(loads) / weight:.4f} x weight"
     )
+
+
+@pytest.mark.validation
+def test_flexible_wall_made_of_a_constrained_particle_carries_a_disc() -> None:
+    """PeriDEM's meshed walls are particles with every node held: a disc settles on one and
+    loads it with its weight (the reaction is the held nodes' force)."""
+    g = 9.81
+    sim = gr.Simulation(2, gravity=(0, -g), viscous_damping=30.0)
+    sim.contact = gr.Contact(restitution=0.3, friction=0.3)
+    slab = sim.add_body(gr.Rectangle((-3e-3, -1e-3), (3e-3, 0)), STIFF, 0.25e-3, name="slab")
+    disc = sim.add_body(gr.Disc((0, 1.4e-3), 1e-3), SOFT, 0.25e-3)
+    sim.fix(slab.nodes)
+    weight = float(np.sum(sim.volumes[disc.nodes]) * SOFT.density * g)
+    sim.run(until=0.05)
+    loads = []
+    for _ in range(20):
+        sim.run(20)
+        # Held nodes: the force density that holds them is minus what acts on them.
+        loads.append(
+            -float(
+                np.sum((sim.forces[slab.nodes, 1] - STIFF.density * -g) * sim.volumes[slab.nodes])
+            )
+        )
+    assert abs(np.mean(loads) / weight - 1) < 0.01, (
+        f"slab load {np.mean(loads) / weight:.4f} x weight"
+    )
+
+
+@pytest.mark.validation
+def test_rotating_cylinder_carries_a_sphere_up_by_friction() -> None:
+    """3D: a sphere in a cylinder turning about z rides up the rising side with friction."""
+    sim = gr.Simulation(3, gravity=(0, -9.81, 0))
+    sim.contact = gr.Contact(restitution=0.3, friction=0.8)
+    sphere = sim.add_body(gr.Sphere((0, -8.8e-3, 0), 1e-3), SOFT, 0.25e-3)
+    drum = gr.Wall(
+        (gr.CircleContainer((0, 0, 0), 10e-3, axis=(0, 0, 1)),), motion=gr.Rotation.steady(2.0)
+    )
+    sim.add_wall(drum, name="drum")
+    sim.run(until=0.1)
+    x, y, _ = body_centre(sim, sphere)
+    assert np.degrees(np.arctan2(x, -y)) > 10.0
