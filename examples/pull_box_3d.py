@@ -19,6 +19,9 @@ import numpy as np
 
 import granulate as gr
 
+# What the full run must show (checked by tests/test_examples.py --full).
+EXPECTED_PIECES = 2
+
 
 def main(argv: list[str] | None = None) -> dict[str, float]:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])

@@ -16,6 +16,9 @@ import time
 
 import granulate as gr
 
+# What the full run must show (checked by tests/test_examples.py --full).
+EXPECTED_PIECES = 1
+
 
 def main(argv: list[str] | None = None) -> dict[str, float]:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])

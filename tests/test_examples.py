@@ -22,8 +22,9 @@ def test_example_smoke(
     assert summary["nodes"] > 0 and summary["steps"] > 0
     assert list((tmp_path / "out").rglob("simulation.pvd"))
     assert list((tmp_path / "out").rglob("history.csv"))
-    if full and "pieces" in summary:
-        assert summary["pieces"] >= 2, "the full example must break the specimen"
+    if full and "EXPECTED_PIECES" in module:
+        assert summary["pieces"] >= module["EXPECTED_PIECES"]
+        assert summary["broken_bonds"] > 0, "the full example must crack the specimen"
     for key, value in summary.items():
         if key.startswith("e_"):  # a restitution example: measured vs requested
             assert abs(value - float(key[2:])) < 0.05
