@@ -81,6 +81,16 @@ RigidMotion rigid_motion(const Model& model, const State& state, const Particle&
   return motion;
 }
 
+void require_valid(const contact::Law& law, const char* what) {
+  if (!(law.contact_radius > 0) || !(law.normal_stiffness > 0) || !(law.damping_ratio >= 0) ||
+      !(law.damping_ratio < 1) || !(law.friction >= 0) || !(law.slip_velocity > 0)) {
+    throw InputError(
+        std::string(what) +
+        " needs a positive contact radius, stiffness and slip velocity, a damping ratio in [0, 1) "
+        "and a non-negative friction coefficient");
+  }
+}
+
 bool intact_bond(const Model& model, const State& state, index_t i, index_t j) {
   const NodeBonds bonds = model.node_bonds(i);
   const index_t local = j - bonds.first_node;  // j is in i's particle
@@ -108,12 +118,7 @@ void ContactModel::configure(const Model& model) {
 
 void ContactModel::set_law(index_t a, index_t b, const contact::Law& law) {
   if (a >= material_count_ || b >= material_count_) throw InputError("contact law names an unknown material");
-  if (!(law.contact_radius > 0) || !(law.normal_stiffness > 0) || !(law.damping_ratio >= 0) ||
-      !(law.damping_ratio < 1) || !(law.friction >= 0) || !(law.slip_velocity > 0)) {
-    throw InputError(
-        "contact law needs a positive contact radius, stiffness and slip velocity, a damping "
-        "ratio in [0, 1) and a non-negative friction coefficient");
-  }
+  require_valid(law, "contact law");
   laws_[a * material_count_ + b] = law;
   laws_[b * material_count_ + a] = law;
   law_set_[a * material_count_ + b] = law_set_[b * material_count_ + a] = 1;
@@ -135,12 +140,7 @@ index_t ContactModel::add_wall(Wall wall, int dimension) {
 void ContactModel::set_wall_law(index_t wall, index_t material, const contact::Law& law) {
   if (wall >= walls_.size() || material >= material_count_)
     throw InputError("wall law names an unknown wall or material");
-  if (!(law.contact_radius > 0) || !(law.normal_stiffness > 0) || !(law.damping_ratio >= 0) ||
-      !(law.damping_ratio < 1) || !(law.friction >= 0) || !(law.slip_velocity > 0)) {
-    throw InputError(
-        "wall contact law needs a positive contact radius, stiffness and slip velocity, a damping "
-        "ratio in [0, 1) and a non-negative friction coefficient");
-  }
+  require_valid(law, "wall contact law");
   wall_laws_[wall * material_count_ + material] = law;
   wall_law_set_[wall * material_count_ + material] = 1;
   max_contact_radius_ = std::max(max_contact_radius_, law.contact_radius);

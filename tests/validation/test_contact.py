@@ -23,6 +23,15 @@ def body_centre(sim: gr.Simulation, body: gr.Body) -> np.ndarray:
     return np.average(sim.positions[nodes], axis=0, weights=sim.volumes[nodes])
 
 
+def mean_vertical_load(sim: gr.Simulation, wall: str, samples: int = 20) -> float:
+    """Mean downward force of the particles on a wall over `samples` x 20 steps [N or N/m]."""
+    loads = []
+    for _ in range(samples):
+        sim.run(20)
+        loads.append(-sim.wall_reactions()[wall][1])
+    return float(np.mean(loads))
+
+
 def collide(
     dimension: int,
     restitution: float,
@@ -192,13 +201,8 @@ def test_particles_at_rest_load_the_floor_with_their_weight(dimension: int) -> N
         sim.add_wall(gr.BoxContainer((-3e-3, 0, -1.5e-3), (3e-3, 20e-3, 1.5e-3)), name="box")
     weight = float(np.sum(sim.volumes) * SOFT.density * g)
     sim.run(until=0.08)
-    loads = []
-    for _ in range(50):
-        sim.run(20)
-        loads.append(-sim.wall_reactions()["box"][1])
-    assert abs(np.mean(loads) / weight - 1) < 0.01, (
-        f"floor load {np.mean(loads) / weight:.4f} x weight"
-    )
+    load = mean_vertical_load(sim, "box", 50)
+    assert abs(load / weight - 1) < 0.01, f"floor load {load / weight:.4f} x weight"
 
 
 @pytest.mark.validation
@@ -257,13 +261,8 @@ def test_sphere_rests_on_a_triangle_mesh_floor_read_from_stl(tmp_path) -> None:
     sim.add_wall(gr.TriangleMesh.from_file(path), name="box")
     weight = float(np.sum(sim.volumes) * SOFT.density * g)
     sim.run(until=0.05)
-    loads = []
-    for _ in range(20):
-        sim.run(20)
-        loads.append(-sim.wall_reactions()["box"][1])
-    assert abs(np.mean(loads) / weight - 1) < 0.01, (
-        f"floor load {np.mean(loads) / weight:.4f} x weight"
-    )
+    load = mean_vertical_load(sim, "box", 20)
+    assert abs(load / weight - 1) < 0.01, f"floor load {load / weight:.4f} x weight"
 
 
 @pytest.mark.validation
