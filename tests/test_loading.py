@@ -67,7 +67,7 @@ def test_free_body_falls_with_gravity() -> None:
 
 def test_force_density_accelerates_the_body() -> None:
     sim = square()
-    b = np.array([1e6, -2e6, 0.0])  # N/m^2 in 2D
+    b = np.array([1e6, -2e6, 0.0])  # N/m^3
     sim.add_force_density(sim.select(body=sim.bodies[0]), b[:2], gr.Constant(1.0))
     sim.run(100)
     velocity = np.average(sim.velocities, axis=0, weights=sim.volumes)

@@ -6,8 +6,9 @@ be added. State arrays (``positions``, ``velocities``, ...) are zero-copy NumPy 
 core: they stay valid as long as the simulation exists, and writing to ``velocities`` before a
 run sets initial conditions.
 
-Units are SI. In 2D, volumes are areas (per unit thickness), force densities are N/m^2 per unit
-thickness and energies J per metre of thickness.
+Units are SI. In 2D a body is a slab of unit thickness: volumes are areas [m^2], force
+densities stay N/m^3, forces (force density x volume) are N per metre of thickness and
+energies J per metre.
 """
 
 from __future__ import annotations
@@ -449,7 +450,7 @@ class Simulation:
     def add_force_density(
         self, nodes: ArrayLike, vector: ArrayLike, function: TimeFunction | None = None
     ) -> None:
-        """Add f(t) * vector [N/m^3; N/m^2 in 2D] to the force density of the nodes."""
+        """Add f(t) * vector [N/m^3, also in 2D] to the force density of the nodes."""
         self._require_building("add loading")
         self._loads.append(
             (
@@ -733,7 +734,7 @@ class Simulation:
 
     @property
     def forces(self) -> NDArray[np.float64]:
-        """(n, 3) net force densities f [N/m^3; N/m^2 in 2D] of the last step (a live view)."""
+        """(n, 3) net force densities f [N/m^3] of the last step (a live view)."""
         return self._build().forces
 
     @property

@@ -42,7 +42,7 @@ struct PrescribedMotion {
   TimeFunction function;
 };
 
-/// Force density b(t) = f(t) vector [N/m^3; N/m^2 in 2D] added to every node of a set.
+/// Force density b(t) = f(t) vector [N/m^3, also in 2D] added to every node of a set.
 struct NodalForce {
   std::vector<index_t> nodes;
   std::array<real, 3> vector{0, 0, 0};

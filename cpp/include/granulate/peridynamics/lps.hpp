@@ -6,7 +6,7 @@
 // volume) and m_i = sum_j w_ij r^2:
 //   theta_i = (d / m_i) sum_j w_ij r e                                   (dilatation, -)
 //   t_ij    = A_i theta_i r + B_i e,  A_i = (d kappa_d - a_d G / d) / m_i,  B_i = a_d G / m_i
-//   f_i     = sum_j w_ij (t_ij + t_ji) y / |y|                 (force density, N/m^3 or N/m^2)
+//   f_i     = sum_j w_ij (t_ij + t_ji) y / |y|                 (force density, N/m^3)
 //   W_i     = kappa_d theta_i^2 / 2 + (a_d G / (2 m_i)) sum_j w_ij (e - theta_i r / d)^2
 // which equals t_ij = (d kappa_d theta / m) J r + (a_d G / m) J (e - theta r / d) of DESIGN.md.
 // kappa_d and a_d: 3D K and 15; plane strain K + G/3 and 8; plane stress 9KG/(3K+4G) and 8.
