@@ -91,3 +91,15 @@ def test_horizon_smaller_than_mesh_is_refused() -> None:
     sim.add_body(gr.Rectangle((0, 0), (0.01, 0.01)), material, 1e-3)
     with pytest.raises(gr.InputError, match=r"horizon .* is smaller than the mesh size"):
         sim.run(1)
+
+
+def test_a_failed_build_can_be_fixed_and_retried() -> None:
+    """An input error while building leaves the simulation usable once the input is fixed."""
+    material = gr.Material(
+        density=1000, youngs_modulus=1e9, poisson_ratio=0.25, fracture=False, horizon=0.5e-3
+    )
+    sim = gr.Simulation(2)
+    sim.add_body(gr.Rectangle((0, 0), (0.01, 0.01)), material, 1e-3)
+    for _ in range(2):
+        with pytest.raises(gr.InputError, match="smaller than the mesh size"):
+            sim.run(1)

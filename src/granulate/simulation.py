@@ -147,7 +147,6 @@ class Simulation:
         self._pair_contacts: dict[tuple[int, int], Contact | None] = {}
         self._walls: list[tuple[str, Wall]] = []
         self._skin: float | None = None
-        self._core_materials: list[tuple[Material, float, float]] = []  # (material, h, horizon)
         self._core: _core.Simulation | None = None
         self._model: _core.Model | None = None
         self._reference: NDArray[np.float64] | None = None
@@ -568,6 +567,7 @@ class Simulation:
             raise InputError("the simulation has no body; add one with add_body")
         model = _core.Model(self.dimension, getattr(_core.PlaneMode, self.plane))
         material_ids: dict[tuple[int, float, float], int] = {}
+        core_materials: list[tuple[Material, float, float]] = []  # (material, h, horizon)
         shape_ids: dict[int, int] = {}
         for body, positions, volumes in zip(
             self.bodies, self._positions, self._volumes, strict=True
@@ -576,7 +576,7 @@ class Simulation:
             key = (id(body.material), horizon, body.mesh_size)
             if key not in material_ids:
                 material_ids[key] = model.add_material(body.material.core_params(body.mesh_size))
-                self._core_materials.append((body.material, body.mesh_size, horizon))
+                core_materials.append((body.material, body.mesh_size, horizon))
             if body.reference is None:
                 model.add_particle(positions, volumes, material_ids[key], body.mesh_size)
                 continue
@@ -588,7 +588,7 @@ class Simulation:
             model.place_shape(shape_ids[id(reference)], material_ids[key], positions, body.scale)
         model.finalize()
         core = _core.Simulation(model)
-        self._set_contact_laws(model, core)
+        self._set_contact_laws(model, core, core_materials)
         if self._dt is None:
             core.time_step = self._dt_safety * core.stable_time_step
         else:
@@ -639,10 +639,14 @@ class Simulation:
         law.slip_velocity = contact.slip_velocity
         return law
 
-    def _set_contact_laws(self, model: _core.Model, core: _core.Simulation) -> None:
-        """Laws for every pair of core materials and every wall-material pair."""
+    def _set_contact_laws(
+        self,
+        model: _core.Model,
+        core: _core.Simulation,
+        materials: list[tuple[Material, float, float]],
+    ) -> None:
+        """Laws for every pair of core materials (material, h, horizon) and every wall."""
         moduli = [m.dilatation_modulus for m in model.materials]
-        materials = self._core_materials
         for a, (material_a, h_a, horizon_a) in enumerate(materials):
             for b, (material_b, h_b, horizon_b) in enumerate(materials[: a + 1]):
                 contact = self._pair_contacts.get((id(material_a), id(material_b)), self._contact)
