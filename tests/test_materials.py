@@ -93,8 +93,8 @@ def test_horizon_smaller_than_mesh_is_refused() -> None:
         sim.run(1)
 
 
-def test_a_failed_build_can_be_fixed_and_retried() -> None:
-    """An input error while building leaves the simulation usable once the input is fixed."""
+def test_a_failed_build_fails_again_the_same_way() -> None:
+    """An input error while building leaves no half-built state: a retry fails the same way."""
     material = gr.Material(
         density=1000, youngs_modulus=1e9, poisson_ratio=0.25, fracture=False, horizon=0.5e-3
     )
