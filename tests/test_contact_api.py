@@ -104,3 +104,14 @@ def test_bad_walls_are_refused() -> None:
     bad_normal.add_wall(gr.Plane((0, 0), (0, 0)))
     with pytest.raises(gr.InputError, match="non-zero vector"):
         bad_normal.run(1)
+
+
+def test_break_bonds_refuses_unbonded_pairs_and_the_state_view_is_read_only() -> None:
+    sim = gr.Simulation(2)
+    sim.add_body(gr.Rectangle((0, 0), (4e-3, 1e-3)), SOFT, 0.25e-3)
+    with pytest.raises(gr.InputError, match="are not bonded"):
+        sim.core.break_bonds(np.array([[0, sim.node_count - 1]], dtype=np.uint32))
+    with pytest.raises(ValueError, match="read-only"):
+        sim.core.bond_intact[0] = 0
+    assert sim.precrack((2e-3, 0), (1, 0), region=gr.Rectangle((1e-3, -1), (3e-3, 0.5e-3))) > 0
+    assert len(sim.fragments()) == 1  # a partial crack leaves the block in one piece

@@ -363,7 +363,18 @@ NB_MODULE(_core, m) {
                      return view(self.state().dilatation.data(), self.model().node_count(), 0,
                                  nb::find(self));
                    })
-      .def_prop_ro("bond_intact", [](Simulation& self) {
-        return view(self.state().bond_intact.data(), self.state().bond_intact.size(), 0, nb::find(self));
-      });
+      .def_prop_ro("bond_intact",
+                   [](Simulation& self) {  // read-only: break bonds with break_bonds()
+                     const std::size_t size[1] = {self.state().bond_intact.size()};
+                     return nb::ndarray<nb::numpy, const std::uint8_t, nb::ndim<1>>(
+                         self.state().bond_intact.data(), 1, size, nb::find(self));
+                   })
+      .def(
+          "break_bonds",
+          [](Simulation& self, nb::ndarray<const std::uint32_t, nb::shape<-1, 2>, nb::c_contig> pairs) {
+            std::vector<std::array<index_t, 2>> list(pairs.shape(0));
+            for (std::size_t k = 0; k < list.size(); ++k) list[k] = {pairs(k, 0), pairs(k, 1)};
+            self.break_bonds(list);
+          },
+          "pairs"_a);
 }

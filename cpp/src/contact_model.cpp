@@ -26,12 +26,14 @@ struct RigidMotion {
   }
 };
 
-RigidMotion rigid_motion(const Model& model, const State& state, const Particle& particle, int dimension) {
+RigidMotion rigid_motion(const Model& model, const State& state, const index_t* nodes, index_t count,
+                         int dimension) {
   RigidMotion motion;
   const auto& x = state.positions;
   const auto& v = state.velocities;
   real mass = 0;
-  for (index_t i = particle.first_node; i < particle.first_node + particle.node_count; ++i) {
+  for (index_t slot = 0; slot < count; ++slot) {
+    const index_t i = nodes[slot];
     const real m = model.node_density()[i] * model.volumes()[i];
     mass += m;
     for (int k = 0; k < 3; ++k) {
@@ -45,7 +47,8 @@ RigidMotion rigid_motion(const Model& model, const State& state, const Particle&
   }
   vec momentum{0, 0, 0};
   real I[3][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
-  for (index_t i = particle.first_node; i < particle.first_node + particle.node_count; ++i) {
+  for (index_t slot = 0; slot < count; ++slot) {
+    const index_t i = nodes[slot];
     const real m = model.node_density()[i] * model.volumes()[i];
     const vec r{x[3 * i] - motion.centre[0], x[3 * i + 1] - motion.centre[1],
                 x[3 * i + 2] - motion.centre[2]};
@@ -202,6 +205,35 @@ bool ContactModel::needs_rebuild(const Model& model, const State& state, std::ui
   return worst > half_skin * half_skin;
 }
 
+void ContactModel::label_bodies(const Model& model, const State& state, std::uint64_t broken_bonds) {
+  const index_t n = model.node_count();
+  node_body_.resize(n);
+  if (broken_bonds == 0) {  // every particle is whole: the bodies are the particles
+    for (index_t i = 0; i < n; ++i) node_body_[i] = model.node_particle()[i];
+  } else {  // fragments, numbered in the order of their smallest node
+    model.fragments(state.bond_intact, node_body_.data());
+    std::vector<index_t> number(n, 0);
+    index_t next = 0;
+    for (index_t i = 0; i < n; ++i) {
+      if (node_body_[i] == i) number[i] = next++;
+      node_body_[i] = number[node_body_[i]];
+    }
+  }
+  const index_t count = n == 0 ? 0 : *std::max_element(node_body_.begin(), node_body_.end()) + 1;
+  body_mass_.assign(count, 0);
+  body_material_.assign(count, 0);
+  body_node_offsets_.assign(static_cast<std::size_t>(count) + 1, 0);
+  for (index_t i = 0; i < n; ++i) {
+    body_mass_[node_body_[i]] += model.node_density()[i] * model.volumes()[i];
+    body_material_[node_body_[i]] = model.node_material()[i];
+    ++body_node_offsets_[node_body_[i] + 1];
+  }
+  for (index_t b = 0; b < count; ++b) body_node_offsets_[b + 1] += body_node_offsets_[b];
+  body_nodes_.resize(n);
+  std::vector<index_t> fill(body_node_offsets_.begin(), body_node_offsets_.end() - 1);
+  for (index_t i = 0; i < n; ++i) body_nodes_[fill[node_body_[i]]++] = i;
+}
+
 void ContactModel::rebuild(const Model& model, const State& state, std::uint64_t broken_bonds) {
   if (skin_ < 0) skin_ = 0.5 * max_contact_radius_;
   const auto& x = state.positions;
@@ -211,6 +243,8 @@ void ContactModel::rebuild(const Model& model, const State& state, std::uint64_t
   const auto& node_material = model.node_material();
   const std::size_t particle_count = particles.size();
   const real reach = max_contact_radius_ + skin_;
+  label_bodies(model, state, broken_bonds);
+  const auto& node_body = node_body_;
 
   // Broad phase: bounding spheres of particles; a particle takes part when another particle's
   // sphere or a wall is within reach, or when it has broken bonds (fragments may touch).
@@ -338,7 +372,7 @@ void ContactModel::rebuild(const Model& model, const State& state, std::uint64_t
   slots_.clear();
   for (index_t i = 0; i < n; ++i) {
     for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
-      const index_t p = node_particle[i], q = node_particle[pair_partner_[e]];
+      const index_t p = node_body[i], q = node_body[pair_partner_[e]];
       slots_.push_back({std::min(p, q), std::max(p, q)});
     }
   }
@@ -349,7 +383,7 @@ void ContactModel::rebuild(const Model& model, const State& state, std::uint64_t
   pair_slot_.resize(pair_partner_.size());
   for (index_t i = 0; i < n; ++i) {
     for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
-      const index_t p = node_particle[i], q = node_particle[pair_partner_[e]];
+      const index_t p = node_body[i], q = node_body[pair_partner_[e]];
       const std::array<index_t, 2> key{std::min(p, q), std::max(p, q)};
       pair_slot_[e] =
           static_cast<index_t>(std::lower_bound(slots_.begin(), slots_.end(), key) - slots_.begin());
@@ -358,7 +392,7 @@ void ContactModel::rebuild(const Model& model, const State& state, std::uint64_t
   std::vector<std::array<index_t, 2>> wall_keys;
   for (index_t i = 0; i < n; ++i) {
     for (index_t e = wall_offsets_[i]; e < wall_offsets_[i + 1]; ++e)
-      wall_keys.push_back({node_particle[i], wall_entry_[e][0]});
+      wall_keys.push_back({node_body[i], wall_entry_[e][0]});
   }
   std::sort(wall_keys.begin(), wall_keys.end());
   wall_keys.erase(std::unique(wall_keys.begin(), wall_keys.end()), wall_keys.end());
@@ -366,22 +400,23 @@ void ContactModel::rebuild(const Model& model, const State& state, std::uint64_t
   wall_slot_.resize(wall_entry_.size());
   for (index_t i = 0; i < n; ++i) {
     for (index_t e = wall_offsets_[i]; e < wall_offsets_[i + 1]; ++e) {
-      const std::array<index_t, 2> key{node_particle[i], wall_entry_[e][0]};
+      const std::array<index_t, 2> key{node_body[i], wall_entry_[e][0]};
       wall_slot_[e] = static_cast<index_t>(
           particle_slots + (std::lower_bound(wall_keys.begin(), wall_keys.end(), key) - wall_keys.begin()));
     }
   }
-  // Reduced masses: two particles m_p m_q / (m_p + m_q); two fragments of one particle, about
-  // m_p / 4 (two halves); a particle and a rigid wall, m_p.
+  // Reduced masses of the bodies (particles, or fragments once bonds break): two bodies
+  // m_p m_q / (m_p + m_q); unbonded nodes of one body (a crack that has not separated it),
+  // about m_p / 4; a body and a rigid wall, m_p.
   slot_reduced_mass_.resize(slots_.size());
   for (std::size_t s = 0; s < slots_.size(); ++s) {
-    const real mp = particle_mass_[slots_[s][0]];
+    const real mp = body_mass_[slots_[s][0]];
     if (s >= particle_slots) {
       slot_reduced_mass_[s] = mp;
     } else if (slots_[s][0] == slots_[s][1]) {
       slot_reduced_mass_[s] = 0.25 * mp;
     } else {
-      const real mq = particle_mass_[slots_[s][1]];
+      const real mq = body_mass_[slots_[s][1]];
       slot_reduced_mass_[s] = mp * mq / (mp + mq);
     }
   }
@@ -460,19 +495,22 @@ void ContactModel::add_forces(const Model& model, State& state, std::uint64_t br
   // each body as a uniform acceleration. K_s = F / x is the secant stiffness of the collision
   // (contact force over the approach since the bodies touched); the sum of the contact springs
   // K overestimates it when the bodies deform, and the dashpot would then overdamp.
-  const auto& node_particle = model.node_particle();
+  const auto& node_body = node_body_;
   const std::size_t slot_count = slots_.size();
-  std::vector<std::uint8_t> touching_body(model.particles().size(), 0);
+  std::vector<std::uint8_t> touching_body(body_mass_.size(), 0);
   for (std::size_t slot = 0; slot < slot_count; ++slot) {
     if (slot_stiffness_[slot] == 0) continue;
     touching_body[slots_[slot][0]] = 1;
     if (slot < particle_slot_count_) touching_body[slots_[slot][1]] = 1;
   }
-  std::vector<RigidMotion> bodies(model.particles().size());
-  const std::int64_t particle_count = static_cast<std::int64_t>(model.particles().size());
+  std::vector<RigidMotion> bodies(body_mass_.size());
+  const std::int64_t body_count = static_cast<std::int64_t>(body_mass_.size());
 #pragma omp parallel for schedule(dynamic, 16)
-  for (std::int64_t p = 0; p < particle_count; ++p) {
-    if (touching_body[p]) bodies[p] = rigid_motion(model, state, model.particles()[p], dimension_);
+  for (std::int64_t p = 0; p < body_count; ++p) {
+    if (touching_body[p]) {
+      bodies[p] = rigid_motion(model, state, body_nodes_.data() + body_node_offsets_[p],
+                               body_node_offsets_[p + 1] - body_node_offsets_[p], dimension_);
+    }
   }
   // Spring force and stiffness-weighted normal per slot (from the first body to the second, or
   // from the wall to the particle), summed in node order.
@@ -482,8 +520,7 @@ void ContactModel::add_forces(const Model& model, State& state, std::uint64_t br
     for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
       const index_t j = pair_partner_[e];
       const std::size_t slot = pair_slot_[e];
-      if (pair_stiffness_[e] == 0 || node_particle[i] == node_particle[j] ||
-          node_particle[i] != slots_[slot][0])
+      if (pair_stiffness_[e] == 0 || node_body[i] == node_body[j] || node_body[i] != slots_[slot][0])
         continue;
       const contact::Law& law = laws_[node_material[i] * material_count_ + node_material[j]];
       const vec d{x[3 * j] - x[3 * i], x[3 * j + 1] - x[3 * i + 1], x[3 * j + 2] - x[3 * i + 2]};
@@ -513,7 +550,7 @@ void ContactModel::add_forces(const Model& model, State& state, std::uint64_t br
   const real dt = has_last_time_ ? t - last_time_ : 0.0;
   last_time_ = t;
   has_last_time_ = true;
-  std::vector<real> body_damping(3 * model.particles().size(), 0.0);
+  std::vector<real> body_damping(3 * body_mass_.size(), 0.0);
   std::vector<std::array<real, 6>> wall_damping(walls_.size(), {0, 0, 0, 0, 0, 0});
   for (std::size_t slot = 0; slot < slot_count; ++slot) {
     const bool wall_slot = slot >= particle_slot_count_;
@@ -533,13 +570,12 @@ void ContactModel::add_forces(const Model& model, State& state, std::uint64_t br
       approach = -((bodies[p].velocity[0] - wall_velocity[0]) * normal[0] +
                    (bodies[p].velocity[1] - wall_velocity[1]) * normal[1] +
                    (bodies[p].velocity[2] - wall_velocity[2]) * normal[2]);
-      zeta = wall_laws_[q * material_count_ + model.particles()[p].material].damping_ratio;
+      zeta = wall_laws_[q * material_count_ + body_material_[p]].damping_ratio;
     } else {
       approach = (bodies[p].velocity[0] - bodies[q].velocity[0]) * normal[0] +
                  (bodies[p].velocity[1] - bodies[q].velocity[1]) * normal[1] +
                  (bodies[p].velocity[2] - bodies[q].velocity[2]) * normal[2];
-      zeta = laws_[model.particles()[p].material * material_count_ + model.particles()[q].material]
-                 .damping_ratio;
+      zeta = laws_[body_material_[p] * material_count_ + body_material_[q]].damping_ratio;
     }
     slot_approach_[slot] += approach * dt;
     if (zeta == 0) continue;
@@ -567,12 +603,11 @@ void ContactModel::add_forces(const Model& model, State& state, std::uint64_t br
     const index_t i = static_cast<index_t>(ii);
     const real* xi = &x[3 * i];
     const real* vi = &v[3 * i];
-    const index_t particle = node_particle[i];
+    const index_t body = node_body[i];
     vec total{0, 0, 0};
-    if (touching_body[particle]) {
+    if (touching_body[body]) {
       for (int k = 0; k < 3; ++k)
-        total[k] =
-            body_damping[3 * particle + k] * model.node_density()[i] * volume[i] / particle_mass_[particle];
+        total[k] = body_damping[3 * body + k] * model.node_density()[i] * volume[i] / body_mass_[body];
     }
     for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
       if (pair_stiffness_[e] == 0) continue;
@@ -586,7 +621,7 @@ void ContactModel::add_forces(const Model& model, State& state, std::uint64_t br
       const real approach = relative[0] * normal[0] + relative[1] * normal[1] + relative[2] * normal[2];
       const real k = pair_stiffness_[e];
       real push = contact::normal_force(k, law.contact_radius - distance);
-      if (particle == node_particle[j]) {  // fragments of one particle: a node-pair dashpot
+      if (body == node_body[j]) {  // unbonded nodes of one body: a node-pair dashpot
         const real K = slot_stiffness_[pair_slot_[e]];
         const real c = 2.0 * law.damping_ratio * k * std::sqrt(slot_reduced_mass_[pair_slot_[e]] / K);
         push = std::max(0.0, push + contact::damping_force(c, approach));

@@ -281,6 +281,35 @@ void Model::build_bonds() {
   }
 }
 
+index_t Model::fragments(const std::vector<std::uint8_t>& intact, index_t* labels) const {
+  // Union-find; the root of a set is always its smallest node, so labels are deterministic.
+  const index_t n = node_count();
+  std::vector<index_t> parent(n);
+  for (index_t i = 0; i < n; ++i) parent[i] = i;
+  auto root = [&](index_t i) {
+    while (parent[i] != i) {
+      parent[i] = parent[parent[i]];
+      i = parent[i];
+    }
+    return i;
+  };
+  for (index_t i = 0; i < n; ++i) {
+    const NodeBonds bonds = node_bonds(i);
+    for (index_t k = 0; k < bonds.count; ++k) {
+      if (!intact[bonds.first + k]) continue;
+      const index_t a = root(i), b = root(bonds.neighbor(k));
+      if (a < b) parent[b] = a;
+      if (b < a) parent[a] = b;
+    }
+  }
+  index_t count = 0;
+  for (index_t i = 0; i < n; ++i) {
+    labels[i] = root(i);
+    if (labels[i] == i) ++count;
+  }
+  return count;
+}
+
 real Model::stable_time_step() const {
   real dt = std::numeric_limits<real>::infinity();
   for (index_t i = 0; i < node_count(); ++i) {

@@ -1,6 +1,7 @@
 #include "granulate/simulation.hpp"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <sstream>
@@ -373,37 +374,36 @@ void Simulation::damage(real* phi, real* z) const {
   }
 }
 
+void Simulation::break_bonds(const std::vector<std::array<index_t, 2>>& pairs) {
+  const Model& m = *model_;
+  auto copy_of = [&](index_t i, index_t j) -> std::size_t {
+    if (i >= m.node_count() || j >= m.node_count() || m.node_particle()[i] != m.node_particle()[j]) {
+      throw InputError("nodes " + std::to_string(i) + " and " + std::to_string(j) + " are not bonded");
+    }
+    const NodeBonds bonds = m.node_bonds(i);
+    const index_t local = j - bonds.first_node;
+    const index_t* found = std::lower_bound(bonds.neighbors, bonds.neighbors + bonds.count, local);
+    if (found == bonds.neighbors + bonds.count || *found != local) {
+      throw InputError("nodes " + std::to_string(i) + " and " + std::to_string(j) + " are not bonded");
+    }
+    return bonds.first + static_cast<std::size_t>(found - bonds.neighbors);
+  };
+  for (const auto& [i, j] : pairs) {
+    const std::size_t forward = copy_of(i, j), backward = copy_of(j, i);
+    if (state_.bond_intact[forward]) {
+      state_.bond_intact[forward] = state_.bond_intact[backward] = 0;
+      broken_bond_copies_ += 2;
+    }
+  }
+  forces_current_ = false;
+}
+
 std::uint64_t Simulation::broken_bonds() const {
   return broken_bond_copies_ / 2;
 }
 
 index_t Simulation::fragments(index_t* labels) const {
-  // Union-find; the root of a set is always its smallest node, so labels are deterministic.
-  const index_t n = model_->node_count();
-  std::vector<index_t> parent(n);
-  for (index_t i = 0; i < n; ++i) parent[i] = i;
-  auto root = [&](index_t i) {
-    while (parent[i] != i) {
-      parent[i] = parent[parent[i]];
-      i = parent[i];
-    }
-    return i;
-  };
-  for (index_t i = 0; i < n; ++i) {
-    const NodeBonds bonds = model_->node_bonds(i);
-    for (index_t k = 0; k < bonds.count; ++k) {
-      if (!state_.bond_intact[bonds.first + k]) continue;
-      const index_t a = root(i), b = root(bonds.neighbor(k));
-      if (a < b) parent[b] = a;
-      if (b < a) parent[a] = b;
-    }
-  }
-  index_t count = 0;
-  for (index_t i = 0; i < n; ++i) {
-    labels[i] = root(i);
-    if (labels[i] == i) ++count;
-  }
-  return count;
+  return model_->fragments(state_.bond_intact, labels);
 }
 
 std::vector<std::uint8_t> Simulation::fixity() const {

@@ -784,6 +784,29 @@ class Simulation:
         """Number of broken bonds, each counted once."""
         return self._build().broken_bonds()
 
+    def precrack(self, point: ArrayLike, normal: ArrayLike, *, region: Shape | None = None) -> int:
+        """Break the bonds that cross the plane through ``point`` with ``normal`` (in the reference
+        configuration), only those whose midpoint lies in ``region`` if given: a pre-crack or a
+        notch without removing material. Returns the number of bonds broken."""
+        core = self._build()
+        assert self._model is not None
+        X = self._model.reference_positions
+        side = (X - self._vector(point, "point")) @ self._vector(normal, "normal")
+        offsets = self._model.bond_offsets
+        owner = np.repeat(
+            np.arange(len(offsets) - 1, dtype=np.uint32), np.diff(offsets).astype(np.int64)
+        )
+        neighbor = self._model.bond_neighbors()
+        crossing = (side[owner] < 0) & (side[neighbor] >= 0)
+        if region is not None:
+            crossing &= region.contains(0.5 * (X[owner] + X[neighbor]))
+        pairs = np.ascontiguousarray(
+            np.column_stack([owner[crossing], neighbor[crossing]]), dtype=np.uint32
+        )
+        before = core.broken_bonds()
+        core.break_bonds(pairs)
+        return core.broken_bonds() - before
+
     def fragments(self, min_nodes: int = 1) -> list[NDArray[np.uint32]]:
         """Pieces held together by intact bonds, largest first, each as its node indices.
 

@@ -304,3 +304,23 @@ def test_rotating_cylinder_carries_a_sphere_up_by_friction() -> None:
     sim.run(until=0.1)
     x, y, _ = body_centre(sim, sphere)
     assert np.degrees(np.arctan2(x, -y)) > 10.0
+
+
+@pytest.mark.validation
+def test_damping_acts_on_the_fragment_in_contact_not_on_the_whole_particle() -> None:
+    """A block cut in two: the left half bounces off a damped wall, the right half flies on.
+    The dashpot acts on the left fragment only, so the right one keeps its velocity exactly."""
+    sim = gr.Simulation(2)
+    sim.contact = gr.Contact(restitution=0.5)
+    block = sim.add_body(gr.Rectangle((0.3e-3, 0), (4.3e-3, 1e-3)), SOFT, 0.25e-3)
+    sim.add_wall(gr.Plane((0, 0), (1, 0)), name="left")
+    assert sim.precrack((2.3e-3, 0), (1, 0)) > 0
+    assert len(sim.fragments()) == 2
+    X = sim.reference_positions
+    left, right = np.flatnonzero(X[:, 0] < 2.3e-3), np.flatnonzero(X[:, 0] > 2.3e-3)
+    sim.velocities[left, 0] = -0.2
+    sim.velocities[right, 0] = 0.2
+    sim.run(until=4e-3)
+    assert np.mean(sim.velocities[left, 0]) > 0.05  # bounced
+    np.testing.assert_allclose(np.mean(sim.velocities[right, 0]), 0.2, rtol=1e-12)
+    assert block.node_count == len(left) + len(right)

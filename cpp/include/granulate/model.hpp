@@ -127,6 +127,11 @@ class Model {
   /// k_i = d^2 kappa_d / sum_j w_ij r_ij of PMB nodes (0 for LPS nodes), see pmb.hpp.
   const std::vector<real>& pmb_stiffness() const { return pmb_stiffness_; }
 
+  /// Fragments: connected components of the graph of intact bonds (`intact` per bond, see
+  /// bond_offsets()). Writes each node's label, the smallest node index of its fragment, and
+  /// returns the number of fragments. Deterministic (sequential union-find).
+  index_t fragments(const std::vector<std::uint8_t>& intact, index_t* labels) const;
+
   /// Per-node stable time step sqrt(2 rho / sum_j C_ij w_ij), minimised (Silling & Askari
   /// 2005, with the LPS dilatation coupling bounded by Gershgorin) [s].
   real stable_time_step() const;

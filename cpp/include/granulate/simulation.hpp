@@ -64,6 +64,9 @@ class Simulation {
   /// phi_i = 1 - (intact weighted volume)/(initial weighted volume); z_i = max_j |s_ij| / s0.
   void damage(real* phi, real* z) const;
   std::uint64_t broken_bonds() const;  ///< broken bonds, each counted once
+  /// Breaks the bonds between the given node pairs (both copies; pre-cracks, notches). Pairs
+  /// that are not bonded are an InputError; already broken ones are left as they are.
+  void break_bonds(const std::vector<std::array<index_t, 2>>& pairs);
   /// Fragments: connected components of the graph of intact bonds. Writes each node's label
   /// (the smallest node index of its fragment) and returns the number of fragments.
   index_t fragments(index_t* labels) const;

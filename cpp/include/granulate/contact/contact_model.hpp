@@ -58,6 +58,9 @@ class ContactModel {
  private:
   bool needs_rebuild(const Model& model, const State& state, std::uint64_t broken_bonds) const;
   void rebuild(const Model& model, const State& state, std::uint64_t broken_bonds);
+  /// Bodies for the dashpots: particles while whole, fragments (connected components of intact
+  /// bonds) once bonds break; labelled at every list build (a break forces a build).
+  void label_bodies(const Model& model, const State& state, std::uint64_t broken_bonds);
 
   index_t material_count_ = 0;
   std::vector<contact::Law> laws_;  // material x material
@@ -69,6 +72,10 @@ class ContactModel {
   std::vector<std::uint8_t> wall_law_set_;
   real skin_ = -1;  // < 0: 0.5 x the largest contact radius
   std::vector<real> particle_mass_;
+  std::vector<index_t> node_body_;  // body of each node
+  std::vector<real> body_mass_;
+  std::vector<index_t> body_material_;
+  std::vector<index_t> body_node_offsets_, body_nodes_;  // CSR: nodes of each body
   int dimension_ = 3;
 
   // Lists (rebuilt): node pairs and node-wall-surface candidates, CSR by node.
