@@ -319,7 +319,6 @@ NB_MODULE(_core, m) {
       .def("wall_reactions", [](const Simulation& self) { return self.contact().wall_reactions(); })
       .def_prop_ro("walls", [](const Simulation& self) { return self.contact().walls(); })
       .def_prop_ro("contact_statistics", [](const Simulation& self) { return self.contact().statistics(); })
-      .def("particle_masses", [](const Simulation& self) { return copy_out(self.contact().particle_mass()); })
       .def("run", &Simulation::run, "steps"_a, nb::call_guard<nb::gil_scoped_release>())
       .def("compute_forces", &Simulation::compute_forces, nb::call_guard<nb::gil_scoped_release>())
       .def("kinetic_energy", &Simulation::kinetic_energy)

@@ -109,13 +109,6 @@ void ContactModel::configure(const Model& model) {
   laws_.assign(static_cast<std::size_t>(material_count_) * material_count_, {});
   law_set_.assign(laws_.size(), 0);
   dimension_ = model.dimension();
-  particle_mass_.assign(model.particles().size(), 0);
-  for (std::size_t p = 0; p < model.particles().size(); ++p) {
-    const Particle& particle = model.particles()[p];
-    for (index_t i = particle.first_node; i < particle.first_node + particle.node_count; ++i) {
-      particle_mass_[p] += model.node_density()[i] * model.volumes()[i];
-    }
-  }
   built_ = false;
 }
 
@@ -432,6 +425,8 @@ void ContactModel::rebuild(const Model& model, const State& state, std::uint64_t
   }
   pair_stiffness_.assign(pair_partner_.size(), 0);
   wall_entry_stiffness_.assign(wall_entry_.size(), 0);
+  pair_distance_.assign(pair_partner_.size(), 0);
+  wall_points_.assign(wall_entry_.size(), {});
   wall_entry_reaction_.assign(wall_entry_.size(), {0, 0, 0, 0, 0, 0});
 
   positions_at_build_ = x;
@@ -453,27 +448,40 @@ void ContactModel::add_forces(const Model& model, State& state, std::uint64_t br
   const std::int64_t n = model.node_count();
   const real t = state.time;
 
-  // Pass A: pair stiffness k = kn V_i V_j of every entry in contact.
-#pragma omp parallel for schedule(static)
-  for (std::int64_t ii = 0; ii < n; ++ii) {
-    const index_t i = static_cast<index_t>(ii);
-    for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
-      const index_t j = pair_partner_[e];
-      const contact::Law& law = laws_[node_material[i] * material_count_ + node_material[j]];
-      const real dx = x[3 * j] - x[3 * i], dy = x[3 * j + 1] - x[3 * i + 1], dz = x[3 * j + 2] - x[3 * i + 2];
-      const real r2 = dx * dx + dy * dy + dz * dz;
-      pair_stiffness_[e] =
-          r2 < law.contact_radius * law.contact_radius ? law.normal_stiffness * volume[i] * volume[j] : 0.0;
-    }
-    std::vector<WallContact> local;
-    for (index_t e = wall_offsets_[i]; e < wall_offsets_[i + 1]; ++e) {
-      const Wall& wall = walls_[wall_entry_[e][0]];
-      const contact::Law& law = wall_laws_[wall_entry_[e][0] * material_count_ + node_material[i]];
-      local.clear();
-      wall.contacts(wall_entry_[e][1], wall.to_reference(&x[3 * i], t), law.contact_radius, dimension_,
-                    local);
-      wall_entry_stiffness_[e] =
-          static_cast<real>(local.size()) * law.normal_stiffness * volume[i] * volume[i];
+  // Pass A, the only geometry pass: distance and spring stiffness k = kn V_i V_j of every pair
+  // entry in contact, and the contact points (normals in the world frame) of every wall entry.
+  // The later passes read these back.
+#pragma omp parallel
+  {
+    std::vector<WallContact> found;  // scratch of this thread
+#pragma omp for schedule(static)
+    for (std::int64_t ii = 0; ii < n; ++ii) {
+      const index_t i = static_cast<index_t>(ii);
+      for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
+        const index_t j = pair_partner_[e];
+        const contact::Law& law = laws_[node_material[i] * material_count_ + node_material[j]];
+        const real dx = x[3 * j] - x[3 * i], dy = x[3 * j + 1] - x[3 * i + 1],
+                   dz = x[3 * j + 2] - x[3 * i + 2];
+        const real distance = std::sqrt(dx * dx + dy * dy + dz * dz);
+        pair_distance_[e] = distance;
+        pair_stiffness_[e] = distance < law.contact_radius && distance > 0
+                                 ? law.normal_stiffness * volume[i] * volume[j]
+                                 : 0.0;
+      }
+      for (index_t e = wall_offsets_[i]; e < wall_offsets_[i + 1]; ++e) {
+        const Wall& wall = walls_[wall_entry_[e][0]];
+        const contact::Law& law = wall_laws_[wall_entry_[e][0] * material_count_ + node_material[i]];
+        found.clear();
+        wall.contacts(wall_entry_[e][1], wall.to_reference(&x[3 * i], t), law.contact_radius, dimension_,
+                      found);
+        WallPoints& points = wall_points_[e];
+        points.count = static_cast<std::uint8_t>(std::min(found.size(), points.points.size()));
+        for (std::size_t k = 0; k < points.count; ++k) {
+          points.points[k] = {found[k].distance, wall.rotate_to_world(found[k].normal, t)};
+        }
+        wall_entry_stiffness_[e] =
+            static_cast<real>(points.count) * law.normal_stiffness * volume[i] * volume[i];
+      }
     }
   }
   // Pass B: K per pair of bodies, summed in node order (each node pair is listed twice).
@@ -524,26 +532,19 @@ void ContactModel::add_forces(const Model& model, State& state, std::uint64_t br
         continue;
       const contact::Law& law = laws_[node_material[i] * material_count_ + node_material[j]];
       const vec d{x[3 * j] - x[3 * i], x[3 * j + 1] - x[3 * i + 1], x[3 * j + 2] - x[3 * i + 2]};
-      const real distance = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-      if (!(distance > 0)) continue;
+      const real distance = pair_distance_[e];
       const real spring = contact::normal_force(pair_stiffness_[e], law.contact_radius - distance);
       slot_force[slot] += spring;
       for (int k = 0; k < 3; ++k) slot_normal[slot][k] += spring * d[k] / distance;
     }
-    std::vector<WallContact> local;
     for (index_t e = wall_offsets_[i]; e < wall_offsets_[i + 1]; ++e) {
-      if (wall_entry_stiffness_[e] == 0) continue;
-      const Wall& wall = walls_[wall_entry_[e][0]];
       const contact::Law& law = wall_laws_[wall_entry_[e][0] * material_count_ + node_material[i]];
-      local.clear();
-      wall.contacts(wall_entry_[e][1], wall.to_reference(&x[3 * i], t), law.contact_radius, dimension_,
-                    local);
-      for (const WallContact& point : local) {
-        const vec normal = wall.rotate_to_world(point.normal, t);
+      const WallPoints& points = wall_points_[e];
+      for (std::size_t k = 0; k < points.count; ++k) {
         const real spring = contact::normal_force(law.normal_stiffness * volume[i] * volume[i],
-                                                  law.contact_radius - point.distance);
+                                                  law.contact_radius - points.points[k].distance);
         slot_force[wall_slot_[e]] += spring;
-        for (int k = 0; k < 3; ++k) slot_normal[wall_slot_[e]][k] += spring * normal[k];
+        for (int c = 0; c < 3; ++c) slot_normal[wall_slot_[e]][c] += spring * points.points[k].normal[c];
       }
     }
   }
@@ -614,8 +615,7 @@ void ContactModel::add_forces(const Model& model, State& state, std::uint64_t br
       const index_t j = pair_partner_[e];
       const contact::Law& law = laws_[node_material[i] * material_count_ + node_material[j]];
       const vec d{x[3 * j] - xi[0], x[3 * j + 1] - xi[1], x[3 * j + 2] - xi[2]};
-      const real distance = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-      if (!(distance > 0)) continue;
+      const real distance = pair_distance_[e];
       const vec normal{d[0] / distance, d[1] / distance, d[2] / distance};  // from i to j
       const vec relative{vi[0] - v[3 * j], vi[1] - v[3 * j + 1], vi[2] - v[3 * j + 2]};
       const real approach = relative[0] * normal[0] + relative[1] * normal[1] + relative[2] * normal[2];
@@ -632,22 +632,20 @@ void ContactModel::add_forces(const Model& model, State& state, std::uint64_t br
       contact::friction_force(law, push, tangential, friction);
       for (int k3 = 0; k3 < 3; ++k3) total[k3] += -push * normal[k3] + friction[k3];
     }
-    std::vector<WallContact> local;
     for (index_t e = wall_offsets_[i]; e < wall_offsets_[i + 1]; ++e) {
       std::array<real, 6>& reaction = wall_entry_reaction_[e];
       reaction = {0, 0, 0, 0, 0, 0};
       if (wall_entry_stiffness_[e] == 0) continue;
       const Wall& wall = walls_[wall_entry_[e][0]];
       const contact::Law& law = wall_laws_[wall_entry_[e][0] * material_count_ + node_material[i]];
-      local.clear();
-      wall.contacts(wall_entry_[e][1], wall.to_reference(xi, t), law.contact_radius, dimension_, local);
+      const WallPoints& points = wall_points_[e];
       const vec wall_velocity = wall.velocity_at(xi, t);
       const vec relative{vi[0] - wall_velocity[0], vi[1] - wall_velocity[1], vi[2] - wall_velocity[2]};
       const real k = law.normal_stiffness * volume[i] * volume[i];
       vec force{0, 0, 0};
-      for (const WallContact& contact_point : local) {
-        const vec normal = wall.rotate_to_world(contact_point.normal, t);  // towards the particle
-        const real push = contact::normal_force(k, law.contact_radius - contact_point.distance);
+      for (std::size_t point = 0; point < points.count; ++point) {
+        const vec& normal = points.points[point].normal;  // towards the particle
+        const real push = contact::normal_force(k, law.contact_radius - points.points[point].distance);
         const real normal_speed = relative[0] * normal[0] + relative[1] * normal[1] + relative[2] * normal[2];
         const real tangential[3] = {relative[0] - normal_speed * normal[0],
                                     relative[1] - normal_speed * normal[1],

@@ -52,8 +52,6 @@ class ContactModel {
   /// [N, N m; per unit thickness in 2D], from the last evaluation.
   const std::vector<std::array<real, 6>>& wall_reactions() const { return wall_reactions_; }
   const ContactStatistics& statistics() const { return statistics_; }
-  /// Particle masses [kg; kg/m in 2D].
-  const std::vector<real>& particle_mass() const { return particle_mass_; }
 
  private:
   bool needs_rebuild(const Model& model, const State& state, std::uint64_t broken_bonds) const;
@@ -70,8 +68,7 @@ class ContactModel {
   std::vector<Wall> walls_;
   std::vector<contact::Law> wall_laws_;  // wall x material
   std::vector<std::uint8_t> wall_law_set_;
-  real skin_ = -1;  // < 0: 0.5 x the largest contact radius
-  std::vector<real> particle_mass_;
+  real skin_ = -1;                  // < 0: 0.5 x the largest contact radius
   std::vector<index_t> node_body_;  // body of each node
   std::vector<real> body_mass_;
   std::vector<index_t> body_material_;
@@ -99,6 +96,13 @@ class ContactModel {
   bool has_last_time_ = false;
   // Scratch, per entry.
   std::vector<real> pair_stiffness_;
+  std::vector<real> pair_distance_;
+  /// Contact points of a wall entry (at most one per box face), normals in the world frame.
+  struct WallPoints {
+    std::uint8_t count = 0;
+    std::array<WallContact, 6> points{};
+  };
+  std::vector<WallPoints> wall_points_;
   std::vector<real> pair_damping_;
   std::vector<real> wall_entry_stiffness_;
   std::vector<std::array<real, 6>> wall_entry_reaction_;
