@@ -115,3 +115,72 @@ def test_break_bonds_refuses_unbonded_pairs_and_the_state_view_is_read_only() ->
         sim.core.bond_intact[0] = 0
     assert sim.precrack((2e-3, 0), (1, 0), region=gr.Rectangle((1e-3, -1), (3e-3, 0.5e-3))) > 0
     assert len(sim.fragments()) == 1  # a partial crack leaves the block in one piece
+
+
+def _mixture(dimension: int) -> tuple[gr.Simulation, list[gr.Material]]:
+    """Particles of three materials, sizes varying continuously, one with an absolute horizon."""
+    rng = np.random.default_rng(7)
+    stiff = gr.Material(density=2400, bulk_modulus=6e7, shear_modulus=3e7, fracture_energy=50)
+    absolute = gr.Material(
+        density=1500, bulk_modulus=3e7, shear_modulus=2e7, fracture_energy=20, horizon=0.9e-3
+    )
+    materials = [SOFT, stiff, absolute]
+    if dimension == 2:
+        reference = gr.ReferenceShape.from_shape(gr.Disc((0, 0), 1e-3), 0.25e-3)
+    else:
+        reference = gr.ReferenceShape.from_shape(gr.Sphere((0, 0, 0), 1e-3), 0.3e-3)
+    sim = gr.Simulation(dimension)
+    sim.contact = gr.Contact(restitution=0.8)
+    sim.set_contact(SOFT, stiff, gr.Contact(stiffness_factor=3.0, contact_radius_factor=0.8))
+    sim.add_wall(gr.Plane((0, -2e-3, 0)[:dimension], (0, 1, 0)[:dimension]))
+    for k in range(24):
+        position = [4e-3 * (k % 6), 4e-3 * (k // 6), 0.0][:dimension]
+        sim.add_particle(
+            reference, materials[k % 3], position=position, scale=float(rng.uniform(0.8, 1.5))
+        )
+    return sim, materials
+
+
+@pytest.mark.parametrize("dimension", [2, 3])
+def test_particles_of_any_size_share_one_core_material(dimension: int) -> None:
+    """Continuous size distributions cost no extra materials or laws: the horizon and the
+    critical stretch belong to each particle (s0 ~ delta^-1/2), Rc and kn to each pair."""
+    sim, materials = _mixture(dimension)
+    model = sim.model
+    assert model.material_count == len(materials) == 3
+    for p, body in enumerate(sim.bodies):
+        horizon = body.material.resolved_horizon(body.mesh_size)
+        assert model.particle_horizon(p) == pytest.approx(horizon, rel=1e-14)
+        expected = body.material.critical_stretch(body.mesh_size, dimension)
+        assert model.particle_critical_stretch(p) == pytest.approx(expected, rel=1e-12)
+
+
+@pytest.mark.parametrize("dimension", [2, 3])
+def test_contact_time_step_bound_matches_brute_force_over_particle_pairs(dimension: int) -> None:
+    """The O(P log P) bound equals max over all particle pairs of kn(p, q) V_max(q)."""
+    sim, materials = _mixture(dimension)
+    core = sim.core
+    model = sim.model
+    moduli = {id(m): model.materials[i].dilatation_modulus for i, m in enumerate(materials)}
+    volumes = model.volumes
+    pairs = {(id(SOFT), id(materials[1])), (id(materials[1]), id(SOFT))}
+
+    def kn(a: gr.Body, b: gr.Body, pa: int, pb: int) -> float:
+        ha, hb = a.mesh_size, b.mesh_size
+        da, db = model.particle_horizon(pa), model.particle_horizon(pb)
+        delta = da if ha < hb else db if hb < ha else min(da, db)
+        ka, kb = moduli[id(a.material)], moduli[id(b.material)]
+        effective = 2 * ka * kb / (ka + kb)
+        c = 18 / (np.pi * delta**5) if dimension == 3 else 12 / (np.pi * delta**4)
+        factor = 3.0 if (id(a.material), id(b.material)) in pairs else 1.0
+        return factor * c * effective
+
+    bodies = sim.bodies
+    vmax = [volumes[b.first_node : b.first_node + b.node_count].max() for b in bodies]
+    partners = 6 if dimension == 3 else 4
+    dt = np.inf
+    for p, a in enumerate(bodies):
+        s = max(kn(a, b, p, q) * vmax[q] for q, b in enumerate(bodies))
+        s = max(s, kn(a, a, p, p) * vmax[p])  # the floor (default law)
+        dt = min(dt, np.sqrt(2 * a.material.density / (2 * partners * s)))
+    assert core.contact_stable_time_step == pytest.approx(dt, rel=1e-12)

@@ -117,11 +117,11 @@ NB_MODULE(_core, m) {
       .def("add_material", &Model::add_material, "params"_a)
       .def(
           "add_particle",
-          [](Model& self, Points positions, Scalars volumes, index_t material, real mesh_size) {
+          [](Model& self, Points positions, Scalars volumes, index_t material, real mesh_size, real horizon) {
             return self.add_particle({positions.data(), positions.shape(0) * 3},
-                                     {volumes.data(), volumes.shape(0)}, material, mesh_size);
+                                     {volumes.data(), volumes.shape(0)}, material, mesh_size, horizon);
           },
-          "positions"_a, "volumes"_a, "material"_a, "mesh_size"_a)
+          "positions"_a, "volumes"_a, "material"_a, "mesh_size"_a, "horizon"_a = 0.0)
       .def(
           "add_shape",
           [](Model& self, Points positions, Scalars volumes, real mesh_size) {
@@ -131,10 +131,11 @@ NB_MODULE(_core, m) {
           "positions"_a, "volumes"_a, "mesh_size"_a)
       .def(
           "place_shape",
-          [](Model& self, index_t shape, index_t material, Points positions, real scale) {
-            return self.add_particle(shape, material, {positions.data(), positions.shape(0) * 3}, scale);
+          [](Model& self, index_t shape, index_t material, Points positions, real scale, real horizon) {
+            return self.add_particle(shape, material, {positions.data(), positions.shape(0) * 3}, scale,
+                                     horizon);
           },
-          "shape"_a, "material"_a, "positions"_a, "scale"_a)
+          "shape"_a, "material"_a, "positions"_a, "scale"_a, "horizon"_a = 0.0)
       .def_prop_ro("shape_count", [](const Model& self) { return self.shapes().size(); })
       .def_prop_ro("family_count", [](const Model& self) { return self.families().size(); })
       .def("shared_bond_bytes",
@@ -152,6 +153,13 @@ NB_MODULE(_core, m) {
       .def_prop_ro("node_count", &Model::node_count)
       .def_prop_ro("bond_count", &Model::bond_count)
       .def_prop_ro("particle_count", [](const Model& self) { return self.particles().size(); })
+      .def_prop_ro("material_count", [](const Model& self) { return self.materials().size(); })
+      .def(
+          "particle_horizon", [](const Model& self, index_t p) { return self.particles().at(p).horizon; },
+          "particle"_a)
+      .def(
+          "particle_critical_stretch",
+          [](const Model& self, index_t p) { return self.particles().at(p).critical_stretch; }, "particle"_a)
       .def_prop_ro("materials", &Model::materials)
       .def("stable_time_step", &Model::stable_time_step)
       .def_prop_ro("reference_positions",
@@ -190,7 +198,9 @@ NB_MODULE(_core, m) {
   nb::class_<contact::Law>(m, "ContactLaw")
       .def(nb::init<>())
       .def_rw("contact_radius", &contact::Law::contact_radius)
+      .def_rw("contact_radius_factor", &contact::Law::contact_radius_factor)
       .def_rw("normal_stiffness", &contact::Law::normal_stiffness)
+      .def_rw("stiffness_factor", &contact::Law::stiffness_factor)
       .def_rw("damping_ratio", &contact::Law::damping_ratio)
       .def_rw("friction", &contact::Law::friction)
       .def_rw("slip_velocity", &contact::Law::slip_velocity);
@@ -252,6 +262,8 @@ NB_MODULE(_core, m) {
       .def(nb::init<std::shared_ptr<Model>>(), "model"_a, nb::call_guard<nb::gil_scoped_release>())
       .def_prop_rw("time_step", &Simulation::time_step, &Simulation::set_time_step)
       .def_prop_ro("stable_time_step", &Simulation::stable_time_step)
+      .def_prop_ro("contact_stable_time_step",
+                   [](const Simulation& self) { return self.contact().stable_time_step(self.model()); })
       .def_prop_rw(
           "time", [](const Simulation& self) { return self.state().time; },
           [](Simulation& self, real t) { self.state().time = t; })

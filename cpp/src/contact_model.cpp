@@ -85,12 +85,16 @@ RigidMotion rigid_motion(const Model& model, const State& state, const index_t* 
 }
 
 void require_valid(const contact::Law& law, const char* what) {
-  if (!(law.contact_radius > 0) || !(law.normal_stiffness > 0) || !(law.damping_ratio >= 0) ||
-      !(law.damping_ratio < 1) || !(law.friction >= 0) || !(law.slip_velocity > 0)) {
+  const bool radius = law.contact_radius > 0 || (law.contact_radius == 0 && law.contact_radius_factor > 0);
+  const bool stiffness = law.normal_stiffness > 0 || (law.normal_stiffness == 0 && law.stiffness_factor > 0);
+  if (!radius || !stiffness || !(law.damping_ratio >= 0) || !(law.damping_ratio < 1) ||
+      !(law.friction >= 0) || !(law.slip_velocity > 0) ||
+      !std::isfinite(law.contact_radius + law.contact_radius_factor) ||
+      !std::isfinite(law.normal_stiffness + law.stiffness_factor)) {
     throw InputError(
         std::string(what) +
-        " needs a positive contact radius, stiffness and slip velocity, a damping ratio in [0, 1) "
-        "and a non-negative friction coefficient");
+        " needs a positive contact radius (or factor), stiffness (or factor) and slip velocity, a "
+        "damping ratio in [0, 1) and a non-negative friction coefficient");
   }
 }
 
@@ -109,7 +113,25 @@ void ContactModel::configure(const Model& model) {
   laws_.assign(static_cast<std::size_t>(material_count_) * material_count_, {});
   law_set_.assign(laws_.size(), 0);
   dimension_ = model.dimension();
+  particle_side_.clear();
+  particle_material_.clear();
+  material_max_mesh_size_.assign(material_count_, 0);
+  for (const Particle& p : model.particles()) {
+    particle_side_.push_back({p.mesh_size, p.horizon, model.materials()[p.material].dilatation_modulus});
+    particle_material_.push_back(p.material);
+    material_max_mesh_size_[p.material] = std::max(material_max_mesh_size_[p.material], p.mesh_size);
+  }
   built_ = false;
+}
+
+contact::PairLaw ContactModel::pair_law(index_t p, index_t q) const {
+  return contact::resolve(laws_[particle_material_[p] * material_count_ + particle_material_[q]],
+                          particle_side_[p], particle_side_[q], dimension_);
+}
+
+contact::PairLaw ContactModel::wall_law(index_t wall, index_t p) const {
+  return contact::resolve(wall_laws_[wall * material_count_ + particle_material_[p]], particle_side_[p],
+                          particle_side_[p], dimension_);
 }
 
 void ContactModel::set_law(index_t a, index_t b, const contact::Law& law) {
@@ -119,7 +141,11 @@ void ContactModel::set_law(index_t a, index_t b, const contact::Law& law) {
   laws_[b * material_count_ + a] = law;
   law_set_[a * material_count_ + b] = law_set_[b * material_count_ + a] = 1;
   any_law_ = true;
-  max_contact_radius_ = std::max(max_contact_radius_, law.contact_radius);
+  max_contact_radius_ = std::max(
+      max_contact_radius_,
+      law.contact_radius > 0
+          ? law.contact_radius
+          : law.contact_radius_factor * std::min(material_max_mesh_size_[a], material_max_mesh_size_[b]));
   built_ = false;
 }
 
@@ -139,7 +165,10 @@ void ContactModel::set_wall_law(index_t wall, index_t material, const contact::L
   require_valid(law, "wall contact law");
   wall_laws_[wall * material_count_ + material] = law;
   wall_law_set_[wall * material_count_ + material] = 1;
-  max_contact_radius_ = std::max(max_contact_radius_, law.contact_radius);
+  max_contact_radius_ =
+      std::max(max_contact_radius_, law.contact_radius > 0
+                                        ? law.contact_radius
+                                        : law.contact_radius_factor * material_max_mesh_size_[material]);
   built_ = false;
 }
 
@@ -151,28 +180,74 @@ void ContactModel::set_skin(real skin) {
 
 real ContactModel::stable_time_step(const Model& model) const {
   const real partners = dimension_ == 2 ? 4.0 : 6.0;
-  std::vector<real> largest_volume(material_count_, 0), density(material_count_, 0);
+  const auto& particles = model.particles();
+  const std::size_t count = particles.size();
+  std::vector<real> largest_volume(count, 0);
   for (index_t i = 0; i < model.node_count(); ++i) {
-    const index_t a = model.node_material()[i];
-    largest_volume[a] = std::max(largest_volume[a], model.volumes()[i]);
-    density[a] = model.node_density()[i];
+    const index_t p = model.node_particle()[i];
+    largest_volume[p] = std::max(largest_volume[p], model.volumes()[i]);
+  }
+  // max over partners q of kn(p, q) V_max(q). kn depends on q only through the finer particle's
+  // horizon, so sort each material's particles by mesh size: partners finer than p give
+  // kn(q) V(q) (a prefix maximum), coarser ones kn(p) V(q) (a suffix maximum of V).
+  std::vector<real> stiffness(count, 0);
+  std::vector<std::vector<index_t>> by_material(material_count_);
+  for (std::size_t p = 0; p < count; ++p)
+    by_material[particles[p].material].push_back(static_cast<index_t>(p));
+  for (auto& list : by_material) {
+    std::sort(list.begin(), list.end(), [&](index_t p, index_t q) {
+      return particle_side_[p].mesh_size < particle_side_[q].mesh_size ||
+             (particle_side_[p].mesh_size == particle_side_[q].mesh_size && p < q);
+    });
+  }
+  for (index_t a = 0; a < material_count_; ++a) {
+    for (index_t b = 0; b < material_count_; ++b) {
+      if (!law_set_[a * material_count_ + b] || by_material[b].empty()) continue;
+      const contact::Law& law = laws_[a * material_count_ + b];
+      const real modulus_a = model.materials()[a].dilatation_modulus;
+      const auto& partners_b = by_material[b];
+      std::vector<real> prefix(partners_b.size()), suffix(partners_b.size());
+      for (std::size_t k = 0; k < partners_b.size(); ++k) {
+        const contact::ContactSide& q = particle_side_[partners_b[k]];
+        const real kn =
+            contact::resolve(law, {q.mesh_size, q.horizon, modulus_a}, q, dimension_).normal_stiffness;
+        prefix[k] = std::max(k ? prefix[k - 1] : 0.0, kn * largest_volume[partners_b[k]]);
+      }
+      for (std::size_t k = partners_b.size(); k-- > 0;) {
+        suffix[k] = std::max(k + 1 < partners_b.size() ? suffix[k + 1] : 0.0, largest_volume[partners_b[k]]);
+      }
+      for (const index_t p : by_material[a]) {
+        const real h = particle_side_[p].mesh_size;
+        // Finer-or-equal partners: those up to the last with mesh size <= h.
+        const auto split =
+            std::upper_bound(partners_b.begin(), partners_b.end(), h,
+                             [&](real value, index_t q) { return value < particle_side_[q].mesh_size; });
+        const std::size_t k = static_cast<std::size_t>(split - partners_b.begin());
+        // Same-size partners may have a smaller horizon: count them on both sides.
+        const auto first_equal =
+            std::lower_bound(partners_b.begin(), partners_b.end(), h,
+                             [&](index_t q, real value) { return particle_side_[q].mesh_size < value; });
+        const std::size_t e = static_cast<std::size_t>(first_equal - partners_b.begin());
+        const real finer = k > 0 ? prefix[k - 1] : 0.0;
+        const real coarser =
+            e < partners_b.size() ? pair_law(p, partners_b[e]).normal_stiffness * suffix[e] : 0.0;
+        stiffness[p] = std::max({stiffness[p], finer, coarser});
+      }
+    }
   }
   real dt = std::numeric_limits<real>::infinity();
-  for (index_t a = 0; a < material_count_; ++a) {
-    if (largest_volume[a] == 0) continue;
-    real stiffness = 0;  // S of a node of material a: its stiffest partner material or wall
-    for (index_t b = 0; b < material_count_; ++b) {
-      if (law_set_[a * material_count_ + b]) {
-        stiffness = std::max(stiffness, laws_[a * material_count_ + b].normal_stiffness * largest_volume[b]);
-      }
-    }
+  for (std::size_t p = 0; p < count; ++p) {
     for (std::size_t w = 0; w < walls_.size(); ++w) {
-      if (wall_law_set_[w * material_count_ + a]) {
-        stiffness =
-            std::max(stiffness, wall_laws_[w * material_count_ + a].normal_stiffness * largest_volume[a]);
+      if (wall_law_set_[w * material_count_ + particles[p].material]) {
+        stiffness[p] = std::max(
+            stiffness[p],
+            wall_law(static_cast<index_t>(w), static_cast<index_t>(p)).normal_stiffness * largest_volume[p]);
       }
     }
-    if (stiffness > 0) dt = std::min(dt, std::sqrt(2.0 * density[a] / (2.0 * partners * stiffness)));
+    if (stiffness[p] > 0) {
+      const real density = model.materials()[particles[p].material].params.density;
+      dt = std::min(dt, std::sqrt(2.0 * density / (2.0 * partners * stiffness[p])));
+    }
   }
   return dt;
 }
@@ -215,10 +290,12 @@ void ContactModel::label_bodies(const Model& model, const State& state, std::uin
   const index_t count = n == 0 ? 0 : *std::max_element(node_body_.begin(), node_body_.end()) + 1;
   body_mass_.assign(count, 0);
   body_material_.assign(count, 0);
+  body_particle_.assign(count, 0);
   body_node_offsets_.assign(static_cast<std::size_t>(count) + 1, 0);
   for (index_t i = 0; i < n; ++i) {
     body_mass_[node_body_[i]] += model.node_density()[i] * model.volumes()[i];
     body_material_[node_body_[i]] = model.node_material()[i];
+    body_particle_[node_body_[i]] = model.node_particle()[i];
     ++body_node_offsets_[node_body_[i] + 1];
   }
   for (index_t b = 0; b < count; ++b) body_node_offsets_[b + 1] += body_node_offsets_[b];
@@ -299,7 +376,10 @@ void ContactModel::rebuild(const Model& model, const State& state, std::uint64_t
   auto accept = [&](index_t i, index_t j, real r2) {
     const index_t mi = node_material[i], mj = node_material[j];
     if (!law_set_[mi * material_count_ + mj]) return false;
-    const real limit = laws_[mi * material_count_ + mj].contact_radius + skin_;
+    const real limit =
+        contact::resolve_contact_radius(laws_[mi * material_count_ + mj], particle_side_[node_particle[i]],
+                                        particle_side_[node_particle[j]]) +
+        skin_;
     if (r2 > limit * limit) return false;
     return node_particle[i] != node_particle[j] || !intact_bond(model, state, i, j);
   };
@@ -342,7 +422,7 @@ void ContactModel::rebuild(const Model& model, const State& state, std::uint64_t
     std::vector<WallContact> local;
     for (std::size_t w = 0; w < walls_.size(); ++w) {
       if (!wall_law_set_[w * material_count_ + node_material[i]]) continue;
-      const real limit = wall_laws_[w * material_count_ + node_material[i]].contact_radius + skin_;
+      const real limit = wall_law(static_cast<index_t>(w), node_particle[i]).contact_radius + skin_;
       const auto p = walls_[w].to_reference(&x[3 * i], state.time);
       for (std::size_t s = 0; s < walls_[w].surfaces.size(); ++s) {
         local.clear();
@@ -402,7 +482,10 @@ void ContactModel::rebuild(const Model& model, const State& state, std::uint64_t
   // m_p m_q / (m_p + m_q); unbonded nodes of one body (a crack that has not separated it),
   // about m_p / 4; a body and a rigid wall, m_p.
   slot_reduced_mass_.resize(slots_.size());
+  slot_law_.resize(slots_.size());
   for (std::size_t s = 0; s < slots_.size(); ++s) {
+    slot_law_[s] = s >= particle_slots ? wall_law(slots_[s][1], body_particle_[slots_[s][0]])
+                                       : pair_law(body_particle_[slots_[s][0]], body_particle_[slots_[s][1]]);
     const real mp = body_mass_[slots_[s][0]];
     if (s >= particle_slots) {
       slot_reduced_mass_[s] = mp;
@@ -459,7 +542,7 @@ void ContactModel::add_forces(const Model& model, State& state, std::uint64_t br
       const index_t i = static_cast<index_t>(ii);
       for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
         const index_t j = pair_partner_[e];
-        const contact::Law& law = laws_[node_material[i] * material_count_ + node_material[j]];
+        const contact::PairLaw& law = slot_law_[pair_slot_[e]];
         const real dx = x[3 * j] - x[3 * i], dy = x[3 * j + 1] - x[3 * i + 1],
                    dz = x[3 * j + 2] - x[3 * i + 2];
         const real distance = std::sqrt(dx * dx + dy * dy + dz * dz);
@@ -470,7 +553,7 @@ void ContactModel::add_forces(const Model& model, State& state, std::uint64_t br
       }
       for (index_t e = wall_offsets_[i]; e < wall_offsets_[i + 1]; ++e) {
         const Wall& wall = walls_[wall_entry_[e][0]];
-        const contact::Law& law = wall_laws_[wall_entry_[e][0] * material_count_ + node_material[i]];
+        const contact::PairLaw& law = slot_law_[wall_slot_[e]];
         found.clear();
         wall.contacts(wall_entry_[e][1], wall.to_reference(&x[3 * i], t), law.contact_radius, dimension_,
                       found);
@@ -530,7 +613,7 @@ void ContactModel::add_forces(const Model& model, State& state, std::uint64_t br
       const std::size_t slot = pair_slot_[e];
       if (pair_stiffness_[e] == 0 || node_body[i] == node_body[j] || node_body[i] != slots_[slot][0])
         continue;
-      const contact::Law& law = laws_[node_material[i] * material_count_ + node_material[j]];
+      const contact::PairLaw& law = slot_law_[slot];
       const vec d{x[3 * j] - x[3 * i], x[3 * j + 1] - x[3 * i + 1], x[3 * j + 2] - x[3 * i + 2]};
       const real distance = pair_distance_[e];
       const real spring = contact::normal_force(pair_stiffness_[e], law.contact_radius - distance);
@@ -538,7 +621,7 @@ void ContactModel::add_forces(const Model& model, State& state, std::uint64_t br
       for (int k = 0; k < 3; ++k) slot_normal[slot][k] += spring * d[k] / distance;
     }
     for (index_t e = wall_offsets_[i]; e < wall_offsets_[i + 1]; ++e) {
-      const contact::Law& law = wall_laws_[wall_entry_[e][0] * material_count_ + node_material[i]];
+      const contact::PairLaw& law = slot_law_[wall_slot_[e]];
       const WallPoints& points = wall_points_[e];
       for (std::size_t k = 0; k < points.count; ++k) {
         const real spring = contact::normal_force(law.normal_stiffness * volume[i] * volume[i],
@@ -614,13 +697,14 @@ void ContactModel::add_forces(const Model& model, State& state, std::uint64_t br
       if (pair_stiffness_[e] == 0) continue;
       const index_t j = pair_partner_[e];
       const contact::Law& law = laws_[node_material[i] * material_count_ + node_material[j]];
+      const real contact_radius = slot_law_[pair_slot_[e]].contact_radius;
       const vec d{x[3 * j] - xi[0], x[3 * j + 1] - xi[1], x[3 * j + 2] - xi[2]};
       const real distance = pair_distance_[e];
       const vec normal{d[0] / distance, d[1] / distance, d[2] / distance};  // from i to j
       const vec relative{vi[0] - v[3 * j], vi[1] - v[3 * j + 1], vi[2] - v[3 * j + 2]};
       const real approach = relative[0] * normal[0] + relative[1] * normal[1] + relative[2] * normal[2];
       const real k = pair_stiffness_[e];
-      real push = contact::normal_force(k, law.contact_radius - distance);
+      real push = contact::normal_force(k, contact_radius - distance);
       if (body == node_body[j]) {  // unbonded nodes of one body: a node-pair dashpot
         const real K = slot_stiffness_[pair_slot_[e]];
         const real c = 2.0 * law.damping_ratio * k * std::sqrt(slot_reduced_mass_[pair_slot_[e]] / K);
@@ -638,14 +722,15 @@ void ContactModel::add_forces(const Model& model, State& state, std::uint64_t br
       if (wall_entry_stiffness_[e] == 0) continue;
       const Wall& wall = walls_[wall_entry_[e][0]];
       const contact::Law& law = wall_laws_[wall_entry_[e][0] * material_count_ + node_material[i]];
+      const contact::PairLaw& resolved = slot_law_[wall_slot_[e]];
       const WallPoints& points = wall_points_[e];
       const vec wall_velocity = wall.velocity_at(xi, t);
       const vec relative{vi[0] - wall_velocity[0], vi[1] - wall_velocity[1], vi[2] - wall_velocity[2]};
-      const real k = law.normal_stiffness * volume[i] * volume[i];
+      const real k = resolved.normal_stiffness * volume[i] * volume[i];
       vec force{0, 0, 0};
       for (std::size_t point = 0; point < points.count; ++point) {
         const vec& normal = points.points[point].normal;  // towards the particle
-        const real push = contact::normal_force(k, law.contact_radius - points.points[point].distance);
+        const real push = contact::normal_force(k, resolved.contact_radius - points.points[point].distance);
         const real normal_speed = relative[0] * normal[0] + relative[1] * normal[1] + relative[2] * normal[2];
         const real tangential[3] = {relative[0] - normal_speed * normal[0],
                                     relative[1] - normal_speed * normal[1],

@@ -80,7 +80,7 @@ index_t Model::add_shape(std::span<const real> positions, std::span<const real> 
 }
 
 index_t Model::add_particle(index_t shape_index, index_t material, std::span<const real> positions,
-                            real scale) {
+                            real scale, real horizon) {
   require_not_finalized("add a particle");
   const index_t id = static_cast<index_t>(particles_.size());
   const std::string name = "particle " + std::to_string(id);
@@ -98,7 +98,9 @@ index_t Model::add_particle(index_t shape_index, index_t material, std::span<con
   if (!(scale > 0) || !std::isfinite(scale))
     throw InputError(name + ": scale must be positive, got " + str(scale));
   const real mesh_size = scale * shape.mesh_size;
-  const real horizon = materials_[material].params.horizon;
+  if (horizon == 0) horizon = materials_[material].params.horizon;
+  if (!(horizon > 0) || !std::isfinite(horizon))
+    throw InputError(name + ": horizon must be positive, got " + str(horizon));
   if (horizon < mesh_size * (1.0 - 1e-9)) {
     throw InputError(name + ": horizon " + str(horizon) + " is smaller than the mesh size " + str(mesh_size) +
                      "; use a horizon of about 3 mesh sizes");
@@ -132,6 +134,11 @@ index_t Model::add_particle(index_t shape_index, index_t material, std::span<con
   p.mesh_size = mesh_size;
   p.shape = shape_index;
   p.scale = scale;
+  p.horizon = horizon;
+  const Material& m = materials_[material];
+  p.critical_stretch = std::isfinite(m.critical_stretch)
+                           ? m.critical_stretch * std::sqrt(m.params.horizon / horizon)
+                           : m.critical_stretch;
   particles_.push_back(p);
   particle_weight_scale_.push_back(std::pow(scale, dimension_));
   reference_positions_.insert(reference_positions_.end(), positions.begin(), positions.end());
@@ -143,13 +150,13 @@ index_t Model::add_particle(index_t shape_index, index_t material, std::span<con
 }
 
 index_t Model::add_particle(std::span<const real> positions, std::span<const real> volumes, index_t material,
-                            real mesh_size) {
+                            real mesh_size, real horizon) {
   if (material >= materials_.size()) {
     throw InputError("particle " + std::to_string(particles_.size()) + " refers to material " +
                      std::to_string(material) + ", but only " + std::to_string(materials_.size()) +
                      " materials exist");
   }
-  return add_particle(add_shape(positions, volumes, mesh_size), material, positions, 1.0);
+  return add_particle(add_shape(positions, volumes, mesh_size), material, positions, 1.0, horizon);
 }
 
 void Model::finalize() {
@@ -220,7 +227,7 @@ void Model::build_bonds() {
   // One family per (shape, horizon in shape units, influence), shared by its particles.
   for (Particle& p : particles_) {
     const Material& material = materials_[p.material];
-    const real horizon = material.params.horizon / p.scale;
+    const real horizon = p.horizon / p.scale;
     const InfluenceKind kind = material.params.influence;
     std::size_t found = families_.size();
     for (std::size_t f = 0; f < families_.size(); ++f) {

@@ -173,7 +173,8 @@ void Simulation::compute_forces() {
   for (std::int64_t ii = 0; ii < n; ++ii) {
     const index_t i = static_cast<index_t>(ii);
     const Material& material = materials[node_material[i]];
-    const CriticalStretch criterion{material.critical_stretch, material.params.break_in_compression};
+    const CriticalStretch criterion{m.particles()[m.node_particle()[i]].critical_stretch,
+                                    material.params.break_in_compression};
     const bool can_break = material.params.fracture;
     const NodeBonds bonds = m.node_bonds(i);
     std::uint8_t* bond_intact = intact.data() + bonds.first;
@@ -359,7 +360,7 @@ void Simulation::damage(real* phi, real* z) const {
 #pragma omp parallel for schedule(static)
   for (std::int64_t ii = 0; ii < static_cast<std::int64_t>(m.node_count()); ++ii) {
     const index_t i = static_cast<index_t>(ii);
-    const real s0 = m.materials()[m.node_material()[i]].critical_stretch;
+    const real s0 = m.particles()[m.node_particle()[i]].critical_stretch;
     const NodeBonds bonds = m.node_bonds(i);
     real all = 0, intact = 0, max_stretch = 0;
     for (index_t b = 0; b < bonds.count; ++b) {

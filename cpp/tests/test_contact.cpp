@@ -28,6 +28,34 @@ TEST_CASE("friction opposes slip, saturates at mu N, is regularised near zero sl
   CHECK(force[0] == 0.0);
 }
 
+TEST_CASE("relative contact laws resolve per pair, symmetrically, from the finer particle") {
+  contact::Law law;
+  law.contact_radius_factor = 0.95;
+  law.stiffness_factor = 2.0;
+  const contact::ContactSide fine{1e-3, 3e-3, 1e9}, coarse{2e-3, 6e-3, 3e9};
+  for (int dimension : {2, 3}) {
+    const contact::PairLaw ab = contact::resolve(law, fine, coarse, dimension);
+    const contact::PairLaw ba = contact::resolve(law, coarse, fine, dimension);
+    CHECK(ab.contact_radius == ba.contact_radius && ab.normal_stiffness == ba.normal_stiffness);
+    CHECK_CLOSE(ab.contact_radius, 0.95e-3, 1e-15);
+    const double effective = 2 * 1e9 * 3e9 / 4e9;
+    const double expected = dimension == 3 ? 2 * 18 * effective / (std::numbers::pi * std::pow(3e-3, 5))
+                                           : 2 * 12 * effective / (std::numbers::pi * std::pow(3e-3, 4));
+    CHECK_CLOSE(ab.normal_stiffness, expected, 1e-12);
+  }
+  // Same mesh size: the smaller horizon decides, whichever side it is on.
+  const contact::ContactSide wide{1e-3, 4e-3, 1e9};
+  CHECK(contact::resolve(law, fine, wide, 3).normal_stiffness ==
+        contact::resolve(law, wide, fine, 3).normal_stiffness);
+  CHECK_CLOSE(contact::resolve(law, wide, fine, 3).normal_stiffness,
+              2 * 18 * 1e9 / (std::numbers::pi * std::pow(3e-3, 5)), 1e-12);
+  // Absolute values win over factors.
+  law.contact_radius = 5e-4;
+  law.normal_stiffness = 7.0;
+  const contact::PairLaw absolute = contact::resolve(law, fine, coarse, 3);
+  CHECK(absolute.contact_radius == 5e-4 && absolute.normal_stiffness == 7.0);
+}
+
 TEST_CASE("wall distance queries: plane, box, circle, polygon") {
   Wall wall;
   wall.name = "w";

@@ -9,7 +9,9 @@ cpp/include/granulate/contact/contact_law.hpp for the formulas).
 Defaults: Rc = 0.95 times the smaller mesh size of the two bodies; kn = c / delta, the stiffness
 of a peridynamic bond one horizon long (PMB micromodulus c, constant influence) for the
 harmonic mean of the two moduli: 18 K_eff / (pi delta^5) in 3D and 12 kappa_eff / (pi delta^4)
-in 2D (kappa: the planar bulk modulus), with delta the smaller horizon.
+in 2D (kappa: the planar bulk modulus), with delta the horizon of the finer particle. Both are
+resolved per pair of particles in the core (contact::resolve), so particles of any size share one
+law.
 """
 
 from __future__ import annotations
@@ -56,16 +58,3 @@ class Contact:
             value = getattr(self, name)
             if value is not None and not (value > 0 and math.isfinite(value)):
                 raise InputError(f"{name} must be positive, got {value}")
-
-
-def default_normal_stiffness(
-    modulus_a: float, modulus_b: float, horizon: float, dimension: int
-) -> float:
-    """kn = 18 K_eff / (pi delta^5) in 3D, 12 K_eff / (pi delta^4) in 2D.
-
-    K_eff = 2 K_a K_b / (K_a + K_b); in 2D the moduli are the planar bulk moduli kappa_d.
-    """
-    effective = 2 * modulus_a * modulus_b / (modulus_a + modulus_b)
-    if dimension == 3:
-        return 18 * effective / (math.pi * horizon**5)
-    return 12 * effective / (math.pi * horizon**4)

@@ -24,7 +24,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from granulate import _core
-from granulate.contact import Contact, default_normal_stiffness
+from granulate.contact import Contact
 from granulate.errors import GranulateWarning, InputError
 from granulate.functions import Constant, Linear, TimeFunction, VelocityRamp
 from granulate.io import HistoryWriter, PvdSeries, atomic_write, write_vtu
@@ -566,29 +566,33 @@ class Simulation:
         if not self.bodies:
             raise InputError("the simulation has no body; add one with add_body")
         model = _core.Model(self.dimension, getattr(_core.PlaneMode, self.plane))
-        material_ids: dict[tuple[int, float, float], int] = {}
-        core_materials: list[tuple[Material, float, float]] = []  # (material, h, horizon)
+        # One core material per Material; each particle carries its own horizon (absolute, or
+        # horizon_factor times its mesh size), so particles of any size share one material.
+        material_ids: dict[int, int] = {}
+        core_materials: list[Material] = []
         shape_ids: dict[int, int] = {}
         for body, positions, volumes in zip(
             self.bodies, self._positions, self._volumes, strict=True
         ):
             horizon = body.material.resolved_horizon(body.mesh_size)
-            key = (id(body.material), horizon, body.mesh_size)
+            key = id(body.material)
             if key not in material_ids:
                 material_ids[key] = model.add_material(body.material.core_params(body.mesh_size))
-                core_materials.append((body.material, body.mesh_size, horizon))
+                core_materials.append(body.material)
             if body.reference is None:
-                model.add_particle(positions, volumes, material_ids[key], body.mesh_size)
+                model.add_particle(positions, volumes, material_ids[key], body.mesh_size, horizon)
                 continue
             reference = body.reference
             if id(reference) not in shape_ids:
                 shape_ids[id(reference)] = model.add_shape(
                     reference.positions, reference.volumes, reference.mesh_size
                 )
-            model.place_shape(shape_ids[id(reference)], material_ids[key], positions, body.scale)
+            model.place_shape(
+                shape_ids[id(reference)], material_ids[key], positions, body.scale, horizon
+            )
         model.finalize()
         core = _core.Simulation(model)
-        self._set_contact_laws(model, core, core_materials)
+        self._set_contact_laws(core, core_materials)
         if self._dt is None:
             core.time_step = self._dt_safety * core.stable_time_step
         else:
@@ -626,42 +630,32 @@ class Simulation:
         self._reference = model.reference_positions
         return core
 
-    def _law(
-        self, contact: Contact, mesh_size: float, moduli: tuple[float, float], horizon: float
-    ) -> _core.ContactLaw:
+    @staticmethod
+    def _law(contact: Contact) -> _core.ContactLaw:
+        """The core law: Rc and kn absolute when given, else relative to the two particles
+        (factor x the finer mesh size; factor x the default kn of the finer horizon)."""
         law = _core.ContactLaw()
-        law.contact_radius = contact.contact_radius or contact.contact_radius_factor * mesh_size
-        law.normal_stiffness = contact.normal_stiffness or (
-            contact.stiffness_factor * default_normal_stiffness(*moduli, horizon, self.dimension)
-        )
+        law.contact_radius = contact.contact_radius or 0.0
+        law.contact_radius_factor = contact.contact_radius_factor
+        law.normal_stiffness = contact.normal_stiffness or 0.0
+        law.stiffness_factor = contact.stiffness_factor
         law.damping_ratio = _core.damping_ratio_from_restitution(contact.restitution)
         law.friction = contact.friction
         law.slip_velocity = contact.slip_velocity
         return law
 
-    def _set_contact_laws(
-        self,
-        model: _core.Model,
-        core: _core.Simulation,
-        materials: list[tuple[Material, float, float]],
-    ) -> None:
-        """Laws for every pair of core materials (material, h, horizon) and every wall."""
-        moduli = [m.dilatation_modulus for m in model.materials]
-        for a, (material_a, h_a, horizon_a) in enumerate(materials):
-            for b, (material_b, h_b, horizon_b) in enumerate(materials[: a + 1]):
+    def _set_contact_laws(self, core: _core.Simulation, materials: list[Material]) -> None:
+        """Laws for every pair of materials and every (wall, material)."""
+        for a, material_a in enumerate(materials):
+            for b, material_b in enumerate(materials[: a + 1]):
                 contact = self._pair_contacts.get((id(material_a), id(material_b)), self._contact)
-                if contact is None:
-                    continue
-                horizon = horizon_a if h_a <= h_b else horizon_b
-                law = self._law(contact, min(h_a, h_b), (moduli[a], moduli[b]), horizon)
-                core.set_contact_law(a, b, law)
+                if contact is not None:
+                    core.set_contact_law(a, b, self._law(contact))
         for name, wall in self._walls:
             index = core.add_wall(wall.core(name))
             contact = wall.contact or self._contact or Contact()
-            for a, (_, h_a, horizon_a) in enumerate(materials):
-                core.set_wall_law(
-                    index, a, self._law(contact, h_a, (moduli[a], moduli[a]), horizon_a)
-                )
+            for a in range(len(materials)):
+                core.set_wall_law(index, a, self._law(contact))
         if self._skin is not None:
             core.set_contact_skin(self._skin)
 
@@ -669,6 +663,13 @@ class Simulation:
     def core(self) -> _core.Simulation:
         """The C++ simulation (built on first access)."""
         return self._build()
+
+    @property
+    def model(self) -> _core.Model:
+        """The frozen C++ model: nodes, particles, materials, bonds (built on first access)."""
+        self._build()
+        assert self._model is not None
+        return self._model
 
     @property
     def dt(self) -> float:

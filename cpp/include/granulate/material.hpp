@@ -17,7 +17,7 @@ struct MaterialParams {
   real density = 0;          ///< rho [kg/m^3]
   real bulk_modulus = 0;     ///< K, 3D bulk modulus [Pa]
   real shear_modulus = 0;    ///< G [Pa]
-  real horizon = 0;          ///< delta [m], absolute
+  real horizon = 0;          ///< delta [m], absolute; particles may carry their own (Model::add_particle)
   real fracture_energy = 0;  ///< critical energy release rate Gc [J/m^2]
   InfluenceKind influence = InfluenceKind::linear;
   bool fracture = true;               ///< false: elastic, bonds never break

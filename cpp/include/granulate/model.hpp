@@ -30,7 +30,9 @@ struct Particle {
   real mesh_size = 0;  ///< h [m] = scale x the shape's mesh size
   index_t shape = 0;
   real scale = 1;
-  index_t family = 0;  ///< shared bond family (see Model::node_bonds)
+  real horizon = 0;           ///< delta [m] of this particle's bonds
+  real critical_stretch = 0;  ///< s0 at this horizon (s0 ~ delta^-1/2, see Material::make)
+  index_t family = 0;         ///< shared bond family (see Model::node_bonds)
 };
 
 /// Bond families of one shape for one horizon (in shape units) and influence function, in CSR
@@ -79,12 +81,17 @@ class Model {
 
   /// Places a shape as a particle: `positions` (n x 3) are the shape's nodes after scaling by
   /// `scale`, rotating and translating (the caller places them; they are checked to be a rigid
-  /// placement). Volumes are scale^d times the shape's. Returns the particle index.
-  index_t add_particle(index_t shape, index_t material, std::span<const real> positions, real scale);
+  /// placement). Volumes are scale^d times the shape's. `horizon` [m] is the particle's own
+  /// (0: the material's), so particles of one material may differ in size and resolution; the
+  /// critical stretch follows it as s0 = s0_material sqrt(delta_material / delta), since the
+  /// fracture energy per stretch^2 of both force models is proportional to delta.
+  /// Returns the particle index.
+  index_t add_particle(index_t shape, index_t material, std::span<const real> positions, real scale,
+                       real horizon = 0);
 
   /// Adds a particle of its own (a shape used once): add_shape then add_particle at scale 1.
   index_t add_particle(std::span<const real> positions, std::span<const real> volumes, index_t material,
-                       real mesh_size);
+                       real mesh_size, real horizon = 0);
 
   /// Builds bond families (cell list, O(nodes)), partial volumes and LPS constants.
   void finalize();

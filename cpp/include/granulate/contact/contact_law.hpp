@@ -28,14 +28,63 @@
 
 namespace granulate::contact {
 
-/// Contact parameters of a pair of materials (or of a material and a wall), SI units.
+/// Contact parameters of a pair of materials (or of a material and a wall), SI units. The
+/// contact radius and the normal stiffness are either absolute or relative to the two particles
+/// in contact (see resolve), so one law serves particles of every size.
 struct Law {
-  real contact_radius = 0;    ///< Rc [m]
-  real normal_stiffness = 0;  ///< kn [N/m^7 in 3D; N/m^5 per unit thickness in 2D]
-  real damping_ratio = 0;     ///< zeta, from the restitution coefficient
-  real friction = 0;          ///< mu
-  real slip_velocity = 1e-4;  ///< v_slip [m/s] of the friction regularisation
+  real contact_radius = 0;         ///< Rc [m]; 0: contact_radius_factor x the finer mesh size
+  real contact_radius_factor = 0;  ///< Rc / h, used when contact_radius is 0
+  real normal_stiffness = 0;       ///< kn [N/m^7 in 3D; N/m^6 in 2D]; 0: stiffness_factor x default
+  real stiffness_factor = 0;       ///< multiplies the default kn, used when normal_stiffness is 0
+  real damping_ratio = 0;          ///< zeta, from the restitution coefficient
+  real friction = 0;               ///< mu
+  real slip_velocity = 1e-4;       ///< v_slip [m/s] of the friction regularisation
 };
+
+/// One particle's side of a contact.
+struct ContactSide {
+  real mesh_size = 0;  ///< h [m]
+  real horizon = 0;    ///< delta [m]
+  real modulus = 0;    ///< kappa_d [Pa] (K in 3D, the planar bulk modulus in 2D)
+};
+
+/// Rc [m] and kn of a law between particles a and b (a particle and a wall: pass it twice).
+struct PairLaw {
+  real contact_radius = 0;
+  real normal_stiffness = 0;
+};
+
+/// The finer of two particles (smaller h; on a tie, the smaller horizon), so laws are symmetric.
+inline const ContactSide& finer(const ContactSide& a, const ContactSide& b) {
+  if (a.mesh_size != b.mesh_size) return a.mesh_size < b.mesh_size ? a : b;
+  return a.horizon <= b.horizon ? a : b;
+}
+
+/// Rc of a law between particles a and b: absolute, or factor x the finer mesh size.
+inline real resolve_contact_radius(const Law& law, const ContactSide& a, const ContactSide& b) {
+  return law.contact_radius > 0 ? law.contact_radius : law.contact_radius_factor * finer(a, b).mesh_size;
+}
+
+/// Rc and kn of a law between particles a and b (a particle and a wall: pass it twice). The
+/// default kn is the stiffness of a peridynamic bond one horizon long (PMB micromodulus,
+/// constant influence) for the harmonic mean of the moduli: 18 K_eff / (pi delta^5) in 3D,
+/// 12 kappa_eff / (pi delta^4) in 2D, K_eff = 2 K_a K_b / (K_a + K_b), delta the finer
+/// particle's horizon.
+inline PairLaw resolve(const Law& law, const ContactSide& a, const ContactSide& b, int dimension) {
+  PairLaw out;
+  out.contact_radius = resolve_contact_radius(law, a, b);
+  if (law.normal_stiffness > 0) {
+    out.normal_stiffness = law.normal_stiffness;
+  } else {
+    const real effective = 2 * a.modulus * b.modulus / (a.modulus + b.modulus);
+    const real delta = finer(a, b).horizon;
+    const real delta4 = delta * delta * delta * delta;
+    out.normal_stiffness =
+        law.stiffness_factor * (dimension == 3 ? 18 * effective / (std::numbers::pi * delta4 * delta)
+                                               : 12 * effective / (std::numbers::pi * delta4));
+  }
+  return out;
+}
 
 /// zeta of a linear spring-dashpot with restitution e (0 < e <= 1).
 inline real damping_ratio_from_restitution(real e) {

@@ -39,9 +39,10 @@ class ContactModel {
 
   bool active() const { return any_law_ || !walls_.empty(); }
 
-  /// Stable time step of the contact springs alone [s]: per material, sqrt(2 rho / S) with the
-  /// Gershgorin bound S = 2 n kn V_max of a node touching n partners (n = 4 in 2D, 6 in 3D; a
-  /// node meets at most that many lattice neighbours within Rc < h). Infinity without contact.
+  /// Stable time step of the contact springs alone [s]: per particle, sqrt(2 rho / S) with the
+  /// Gershgorin bound S = 2 n max(kn V_j) of a node touching n partners (n = 4 in 2D, 6 in 3D;
+  /// a node meets at most that many lattice neighbours within Rc < h), the maximum taken over
+  /// every particle and wall it has a law with. Infinity without contact.
   real stable_time_step(const Model& model) const;
   const std::vector<Wall>& walls() const { return walls_; }
 
@@ -60,7 +61,14 @@ class ContactModel {
   /// bonds) once bonds break; labelled at every list build (a break forces a build).
   void label_bodies(const Model& model, const State& state, std::uint64_t broken_bonds);
 
+  /// Rc and kn of the pair of particles p, q (resolve() of their materials' law).
+  contact::PairLaw pair_law(index_t p, index_t q) const;
+  contact::PairLaw wall_law(index_t wall, index_t p) const;
+
   index_t material_count_ = 0;
+  std::vector<contact::ContactSide> particle_side_;  // h, delta, kappa_d of each particle
+  std::vector<index_t> particle_material_;
+  std::vector<real> material_max_mesh_size_;
   std::vector<contact::Law> laws_;  // material x material
   std::vector<std::uint8_t> law_set_;
   bool any_law_ = false;
@@ -72,6 +80,7 @@ class ContactModel {
   std::vector<index_t> node_body_;  // body of each node
   std::vector<real> body_mass_;
   std::vector<index_t> body_material_;
+  std::vector<index_t> body_particle_;
   std::vector<index_t> body_node_offsets_, body_nodes_;  // CSR: nodes of each body
   int dimension_ = 3;
 
@@ -88,7 +97,8 @@ class ContactModel {
   std::vector<std::array<index_t, 2>> slots_;  // particle pairs (p <= q), then (p, wall)
   std::size_t particle_slot_count_ = 0;
   std::vector<real> slot_reduced_mass_;
-  std::vector<real> slot_stiffness_;  // K: sum of the contact springs, last evaluation
+  std::vector<contact::PairLaw> slot_law_;  // Rc and kn of each slot's pair of bodies
+  std::vector<real> slot_stiffness_;        // K: sum of the contact springs, last evaluation
   // Collision history per pair of bodies, kept across list rebuilds: the approach x of the two
   // bodies since they touched (for the secant stiffness F / x of the dashpot).
   std::vector<real> slot_approach_;
