@@ -1,9 +1,19 @@
-"""Shapes: bodies to discretize and regions to select nodes with.
+"""Shapes: bodies to discretize, containers to pack, regions to select nodes with.
 
-Every shape answers ``contains(points)`` for an (n, 3) array of points (2D shapes ignore z),
-knows its bounding box (``bounds()``) and its exact ``measure`` (area in 2D, volume in 3D).
+Every shape answers ``contains(points)`` and ``signed_distance(points)`` (negative inside,
+positive outside, zero on the surface [m]) for an (n, 3) array of points (2D shapes ignore z),
+knows its bounding box (``bounds()``), its ``bounding_radius`` about its origin point and its
+exact ``measure`` (area in 2D, volume in 3D).
+
+2D: Rectangle, Disc, Ellipse, Polygon (any simple polygon, concave allowed), RegularPolygon,
+Star, Drum2D (PeriDEM's drum). 3D: Box, Sphere, Ellipsoid, Cylinder, and closed triangle
+surfaces (``granulate.meshes.SurfaceMesh``, from STL/OBJ/PLY). Union and Difference combine
+shapes of one dimension.
+
 ``lattice(shape, h)`` fills a shape with nodes of a uniform lattice of spacing h, each carrying
-the volume h^d of its cell.
+the volume h^d of its cell; ``conforming(shape, h)`` puts nodes on rings (shells) that follow a
+disc's, sphere's, ellipse's or ellipsoid's surface, so its boundary is smooth rather than a
+staircase.
 """
 
 from __future__ import annotations
@@ -49,6 +59,28 @@ class Shape(ABC):
     def measure(self) -> float:
         """Exact area (2D) or volume (3D) [m^2 or m^3]."""
 
+    @abstractmethod
+    def signed_distance(self, points: ArrayLike) -> NDArray[np.float64]:
+        """Distance of each of the (n, 3) points to the surface [m]: negative inside.
+
+        Exact for every primitive; for Union and Difference it is the usual min/max
+        combination (exact outside a union, a bound elsewhere; the sign is always right).
+        """
+
+    @property
+    def origin(self) -> NDArray[np.float64]:
+        """The shape's reference point (its centre; for polygons the centroid) [m], 3 numbers.
+        A reference shape is discretised about it, and rotated and scaled about it."""
+        lower, upper = self.bounds()
+        return 0.5 * (lower + upper)
+
+    @property
+    def bounding_radius(self) -> float:
+        """Radius of a sphere (circle) about ``origin`` that holds the shape [m]."""
+        lower, upper = self.bounds()
+        d = self.dimension
+        return float(0.5 * np.linalg.norm((upper - lower)[:d]))
+
 
 @dataclass(frozen=True)
 class Rectangle(Shape):
@@ -80,6 +112,19 @@ class Rectangle(Shape):
     def measure(self) -> float:
         return float(np.prod(np.subtract(self.upper, self.lower)))
 
+    def signed_distance(self, points: ArrayLike) -> NDArray[np.float64]:
+        return _box_distance(_points(points)[:, :2], self.lower, self.upper)
+
+
+def _box_distance(
+    p: NDArray[np.float64], lower: ArrayLike, upper: ArrayLike
+) -> NDArray[np.float64]:
+    """Signed distance to an axis-aligned box (any dimension)."""
+    lo, hi = np.asarray(lower, dtype=float), np.asarray(upper, dtype=float)
+    q = np.abs(p - 0.5 * (lo + hi)) - 0.5 * (hi - lo)
+    outside = np.linalg.norm(np.maximum(q, 0.0), axis=1)
+    return outside + np.minimum(q.max(axis=1), 0.0)
+
 
 @dataclass(frozen=True)
 class Disc(Shape):
@@ -105,6 +150,18 @@ class Disc(Shape):
     @property
     def measure(self) -> float:
         return float(np.pi * self.radius**2)
+
+    def signed_distance(self, points: ArrayLike) -> NDArray[np.float64]:
+        p = _points(points)
+        return np.linalg.norm(p[:, :2] - np.asarray(self.center), axis=1) - self.radius
+
+    @property
+    def origin(self) -> NDArray[np.float64]:
+        return np.array([*self.center, 0.0])
+
+    @property
+    def bounding_radius(self) -> float:
+        return float(self.radius)
 
 
 @dataclass(frozen=True)
@@ -142,6 +199,242 @@ class Polygon(Shape):
         x, y = v[:, 0], v[:, 1]
         return float(abs(0.5 * np.sum(x * np.roll(y, -1) - np.roll(x, -1) * y)))
 
+    def signed_distance(self, points: ArrayLike) -> NDArray[np.float64]:
+        p = _points(points)
+        distance = _distance_to_segments(p[:, :2], np.asarray(self.vertices, dtype=float))
+        return np.where(self.contains(p), -distance, distance)
+
+    @property
+    def origin(self) -> NDArray[np.float64]:
+        """The centroid of the polygon's area."""
+        v = np.asarray(self.vertices, dtype=float)
+        x, y = v[:, 0], v[:, 1]
+        cross = x * np.roll(y, -1) - np.roll(x, -1) * y
+        area = 0.5 * np.sum(cross)
+        cx = np.sum((x + np.roll(x, -1)) * cross) / (6 * area)
+        cy = np.sum((y + np.roll(y, -1)) * cross) / (6 * area)
+        return np.array([cx, cy, 0.0])
+
+    @property
+    def bounding_radius(self) -> float:
+        v = np.asarray(self.vertices, dtype=float)
+        return float(np.max(np.linalg.norm(v - self.origin[:2], axis=1)))
+
+
+def _distance_to_segments(
+    p: NDArray[np.float64], vertices: NDArray[np.float64]
+) -> NDArray[np.float64]:
+    """Distance of 2D points (n, 2) to the closed polyline through ``vertices`` (m, 2)."""
+    a = vertices
+    b = np.roll(vertices, -1, axis=0)
+    best = np.full(len(p), np.inf)
+    for start, end in zip(a, b, strict=True):
+        edge = end - start
+        t = np.clip(((p - start) @ edge) / (edge @ edge), 0.0, 1.0)
+        best = np.minimum(best, np.linalg.norm(p - (start + t[:, None] * edge), axis=1))
+    return best
+
+
+def _regular_vertices(
+    center: ArrayLike, radius: float, sides: int, angle: float
+) -> tuple[tuple[float, float], ...]:
+    c = np.asarray(center, dtype=float)
+    phi = angle + 2 * np.pi * np.arange(sides) / sides
+    return tuple((float(c[0] + radius * np.cos(f)), float(c[1] + radius * np.sin(f))) for f in phi)
+
+
+class RegularPolygon(Polygon):
+    """Regular polygon with ``sides`` vertices on a circle of ``radius`` (circumradius) about
+    ``center`` [m], the first vertex at ``angle`` [rad] from the x axis (PeriDEM's triangle,
+    square and hexagon are 3, 4 and 6 sides with the first vertex on the axis)."""
+
+    def __init__(
+        self, center: tuple[float, float], radius: float, sides: int, angle: float = 0.0
+    ) -> None:
+        _vector(center, 2, "RegularPolygon center")
+        if not (isinstance(sides, int | np.integer) and sides >= 3):
+            raise InputError(f"RegularPolygon needs an integer number of sides >= 3, got {sides!r}")
+        if not (radius > 0 and np.isfinite(radius)):
+            raise InputError(f"RegularPolygon radius must be positive, got {radius}")
+        super().__init__(_regular_vertices(center, radius, int(sides), angle))
+        object.__setattr__(self, "center", tuple(float(c) for c in center))
+        object.__setattr__(self, "radius", float(radius))
+        object.__setattr__(self, "sides", int(sides))
+        object.__setattr__(self, "angle", float(angle))
+
+    def __repr__(self) -> str:
+        return (
+            f"RegularPolygon(center={self.center}, radius={self.radius}, sides={self.sides}, "
+            f"angle={self.angle})"
+        )
+
+    @property
+    def origin(self) -> NDArray[np.float64]:
+        return np.array([*self.center, 0.0])
+
+    @property
+    def bounding_radius(self) -> float:
+        return self.radius
+
+
+class Star(Polygon):
+    """Star with ``points`` tips on a circle of ``outer_radius`` and the notches between them on
+    ``inner_radius`` about ``center`` [m]; the first tip at ``angle`` [rad]."""
+
+    def __init__(
+        self,
+        center: tuple[float, float],
+        outer_radius: float,
+        inner_radius: float,
+        points: int = 5,
+        angle: float = 0.0,
+    ) -> None:
+        _vector(center, 2, "Star center")
+        if not (isinstance(points, int | np.integer) and points >= 3):
+            raise InputError(f"Star needs an integer number of points >= 3, got {points!r}")
+        if not (0 < inner_radius < outer_radius and np.isfinite(outer_radius)):
+            raise InputError(
+                f"Star needs 0 < inner_radius < outer_radius, got {inner_radius}, {outer_radius}"
+            )
+        tips = _regular_vertices(center, outer_radius, int(points), angle)
+        notches = _regular_vertices(center, inner_radius, int(points), angle + np.pi / points)
+        super().__init__(tuple(v for pair in zip(tips, notches, strict=True) for v in pair))
+        object.__setattr__(self, "center", tuple(float(c) for c in center))
+        object.__setattr__(self, "outer_radius", float(outer_radius))
+        object.__setattr__(self, "inner_radius", float(inner_radius))
+        object.__setattr__(self, "points", int(points))
+        object.__setattr__(self, "angle", float(angle))
+
+    def __repr__(self) -> str:
+        return (
+            f"Star(center={self.center}, outer_radius={self.outer_radius}, "
+            f"inner_radius={self.inner_radius}, points={self.points}, angle={self.angle})"
+        )
+
+    @property
+    def origin(self) -> NDArray[np.float64]:
+        return np.array([*self.center, 0.0])
+
+    @property
+    def bounding_radius(self) -> float:
+        return self.outer_radius
+
+
+class Drum2D(Polygon):
+    """PeriDEM's drum: a hexagon of circumradius ``radius`` about ``center`` [m] whose two
+    vertices on the axis (at ``angle`` [rad] from x) are pulled in to ``neck_half_width``. The
+    vertices are c + w a, c + r R(60 deg) a, then that point - r a, c - w a, and their mirror
+    images (Jha et al. 2021, PeriDEM's drum2d)."""
+
+    def __init__(
+        self, center: tuple[float, float], radius: float, neck_half_width: float, angle: float = 0.0
+    ) -> None:
+        c = _vector(center, 2, "Drum2D center")
+        if not (0 < neck_half_width < radius and np.isfinite(radius)):
+            raise InputError(
+                f"Drum2D needs 0 < neck_half_width < radius, got {neck_half_width}, {radius}"
+            )
+        a = np.array([np.cos(angle), np.sin(angle)])
+        up = np.array([-a[1], a[0]])
+        half = np.sqrt(3.0) / 2
+        vertices = [
+            c + neck_half_width * a,
+            c + radius * (0.5 * a + half * up),
+            c + radius * (-0.5 * a + half * up),
+            c - neck_half_width * a,
+            c + radius * (-0.5 * a - half * up),
+            c + radius * (0.5 * a - half * up),
+        ]
+        super().__init__(tuple((float(v[0]), float(v[1])) for v in vertices))
+        object.__setattr__(self, "center", (float(c[0]), float(c[1])))
+        object.__setattr__(self, "radius", float(radius))
+        object.__setattr__(self, "neck_half_width", float(neck_half_width))
+        object.__setattr__(self, "angle", float(angle))
+
+    def __repr__(self) -> str:
+        return (
+            f"Drum2D(center={self.center}, radius={self.radius}, "
+            f"neck_half_width={self.neck_half_width}, angle={self.angle})"
+        )
+
+    @property
+    def origin(self) -> NDArray[np.float64]:
+        return np.array([*self.center, 0.0])
+
+    @property
+    def bounding_radius(self) -> float:
+        return self.radius
+
+
+def _ellipsoid_distance(q: NDArray[np.float64], axes: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Signed distance of points q (n, d), in the frame of the ellipsoid's axes, to the
+    ellipsoid sum (x_k / a_k)^2 = 1. The closest point is x_k = a_k^2 q_k / (a_k^2 + t) with t
+    the root of sum (a_k q_k / (a_k^2 + t))^2 = 1 in (-min a_k^2, inf), found by bisection (the
+    function decreases there). Coordinates are nudged off zero by 1e-12 a_k, which keeps the
+    root in that interval and moves the distance by at most as much."""
+    p = np.maximum(np.abs(q), 1e-12 * axes)
+    a2 = axes**2
+    low = np.full(len(p), -np.min(a2) * (1 - 1e-15))
+    high = np.full(len(p), float(np.max(axes) * np.max(np.linalg.norm(p, axis=1)) + np.max(a2)))
+    for _ in range(200):
+        middle = 0.5 * (low + high)
+        value = np.sum((axes * p / (a2 + middle[:, None])) ** 2, axis=1) - 1
+        positive = value > 0
+        low = np.where(positive, middle, low)
+        high = np.where(positive, high, middle)
+    t = 0.5 * (low + high)
+    closest = a2 * p / (a2 + t[:, None])
+    distance = np.linalg.norm(p - closest, axis=1)
+    inside = np.sum((q / axes) ** 2, axis=1) <= 1
+    return np.where(inside, -distance, distance)
+
+
+@dataclass(frozen=True)
+class Ellipse(Shape):
+    """Ellipse of a centre (x, y), semi-axes (a, b) [m] and the angle [rad] of its a axis."""
+
+    center: tuple[float, float]
+    semi_axes: tuple[float, float]
+    angle: float = 0.0
+    dimension: int = field(default=2, init=False)
+
+    def __post_init__(self) -> None:
+        _vector(self.center, 2, "Ellipse center")
+        axes = _vector(self.semi_axes, 2, "Ellipse semi_axes")
+        if np.any(axes <= 0):
+            raise InputError(f"Ellipse semi_axes must be positive, got {self.semi_axes}")
+
+    def _local(self, points: ArrayLike) -> NDArray[np.float64]:
+        p = _points(points)[:, :2] - np.asarray(self.center)
+        c, s = np.cos(self.angle), np.sin(self.angle)
+        return np.column_stack([c * p[:, 0] + s * p[:, 1], -s * p[:, 0] + c * p[:, 1]])
+
+    def contains(self, points: ArrayLike) -> NDArray[np.bool_]:
+        q = self._local(points)
+        return np.sum((q / np.asarray(self.semi_axes)) ** 2, axis=1) <= 1
+
+    def signed_distance(self, points: ArrayLike) -> NDArray[np.float64]:
+        return _ellipsoid_distance(self._local(points), np.asarray(self.semi_axes, dtype=float))
+
+    def bounds(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        a, b = self.semi_axes
+        c, s = np.cos(self.angle), np.sin(self.angle)
+        half = np.array([np.hypot(a * c, b * s), np.hypot(a * s, b * c)])
+        center = np.asarray(self.center, dtype=float)
+        return np.array([*(center - half), 0.0]), np.array([*(center + half), 0.0])
+
+    @property
+    def measure(self) -> float:
+        return float(np.pi * self.semi_axes[0] * self.semi_axes[1])
+
+    @property
+    def origin(self) -> NDArray[np.float64]:
+        return np.array([*self.center, 0.0])
+
+    @property
+    def bounding_radius(self) -> float:
+        return float(max(self.semi_axes))
+
 
 @dataclass(frozen=True)
 class Box(Shape):
@@ -166,6 +459,9 @@ class Box(Shape):
     @property
     def measure(self) -> float:
         return float(np.prod(np.subtract(self.upper, self.lower)))
+
+    def signed_distance(self, points: ArrayLike) -> NDArray[np.float64]:
+        return _box_distance(_points(points), self.lower, self.upper)
 
 
 @dataclass(frozen=True)
@@ -192,6 +488,124 @@ class Sphere(Shape):
     @property
     def measure(self) -> float:
         return float(4.0 / 3.0 * np.pi * self.radius**3)
+
+    def signed_distance(self, points: ArrayLike) -> NDArray[np.float64]:
+        return np.linalg.norm(_points(points) - np.asarray(self.center), axis=1) - self.radius
+
+    @property
+    def origin(self) -> NDArray[np.float64]:
+        return np.asarray(self.center, dtype=float)
+
+    @property
+    def bounding_radius(self) -> float:
+        return float(self.radius)
+
+
+@dataclass(frozen=True)
+class Ellipsoid(Shape):
+    """Ellipsoid of a centre, semi-axes (a, b, c) [m] and a rotation of its axes (a rotation
+    vector [rad] or a 3 x 3 matrix; see ``rotation_matrix``)."""
+
+    center: tuple[float, float, float]
+    semi_axes: tuple[float, float, float]
+    rotation: ArrayLike | None = None
+    dimension: int = field(default=3, init=False)
+
+    def __post_init__(self) -> None:
+        _vector(self.center, 3, "Ellipsoid center")
+        axes = _vector(self.semi_axes, 3, "Ellipsoid semi_axes")
+        if np.any(axes <= 0):
+            raise InputError(f"Ellipsoid semi_axes must be positive, got {self.semi_axes}")
+        if self.rotation is not None and np.ndim(self.rotation) == 0:
+            raise InputError("Ellipsoid rotation is a rotation vector or a 3x3 matrix")
+        rotation_matrix(self.rotation, 3)
+
+    def _local(self, points: ArrayLike) -> NDArray[np.float64]:
+        return (_points(points) - np.asarray(self.center)) @ rotation_matrix(self.rotation, 3)
+
+    def contains(self, points: ArrayLike) -> NDArray[np.bool_]:
+        return np.sum((self._local(points) / np.asarray(self.semi_axes)) ** 2, axis=1) <= 1
+
+    def signed_distance(self, points: ArrayLike) -> NDArray[np.float64]:
+        return _ellipsoid_distance(self._local(points), np.asarray(self.semi_axes, dtype=float))
+
+    def bounds(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        matrix = rotation_matrix(self.rotation, 3)
+        half = np.sqrt((matrix**2) @ np.asarray(self.semi_axes, dtype=float) ** 2)
+        center = np.asarray(self.center, dtype=float)
+        return center - half, center + half
+
+    @property
+    def measure(self) -> float:
+        return float(4.0 / 3.0 * np.pi * np.prod(self.semi_axes))
+
+    @property
+    def origin(self) -> NDArray[np.float64]:
+        return np.asarray(self.center, dtype=float)
+
+    @property
+    def bounding_radius(self) -> float:
+        return float(max(self.semi_axes))
+
+
+@dataclass(frozen=True)
+class Cylinder(Shape):
+    """Solid cylinder of a centre (mid-point of its axis), unit ``axis`` direction, radius and
+    length [m]."""
+
+    center: tuple[float, float, float]
+    radius: float
+    length: float
+    axis: tuple[float, float, float] = (0.0, 0.0, 1.0)
+    dimension: int = field(default=3, init=False)
+
+    def __post_init__(self) -> None:
+        _vector(self.center, 3, "Cylinder center")
+        axis = _vector(self.axis, 3, "Cylinder axis")
+        if not np.linalg.norm(axis) > 0:
+            raise InputError("Cylinder axis must be a non-zero vector")
+        if not (self.radius > 0 and self.length > 0):
+            raise InputError(
+                f"Cylinder radius and length must be positive, got {self.radius}, {self.length}"
+            )
+
+    def _axial_radial(self, points: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        axis = np.asarray(self.axis, dtype=float)
+        axis = axis / np.linalg.norm(axis)
+        p = _points(points) - np.asarray(self.center)
+        axial = p @ axis
+        radial = np.linalg.norm(p - axial[:, None] * axis, axis=1)
+        return axial, radial
+
+    def contains(self, points: ArrayLike) -> NDArray[np.bool_]:
+        axial, radial = self._axial_radial(points)
+        return (np.abs(axial) <= 0.5 * self.length) & (radial <= self.radius)
+
+    def signed_distance(self, points: ArrayLike) -> NDArray[np.float64]:
+        axial, radial = self._axial_radial(points)
+        q = np.column_stack([radial - self.radius, np.abs(axial) - 0.5 * self.length])
+        return np.linalg.norm(np.maximum(q, 0.0), axis=1) + np.minimum(q.max(axis=1), 0.0)
+
+    def bounds(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        axis = np.asarray(self.axis, dtype=float)
+        axis = axis / np.linalg.norm(axis)
+        half = 0.5 * self.length * np.abs(axis) + self.radius * np.sqrt(
+            np.clip(1 - axis**2, 0.0, 1.0)
+        )
+        center = np.asarray(self.center, dtype=float)
+        return center - half, center + half
+
+    @property
+    def measure(self) -> float:
+        return float(np.pi * self.radius**2 * self.length)
+
+    @property
+    def origin(self) -> NDArray[np.float64]:
+        return np.asarray(self.center, dtype=float)
+
+    @property
+    def bounding_radius(self) -> float:
+        return float(np.hypot(self.radius, 0.5 * self.length))
 
 
 def lattice(
@@ -241,6 +655,82 @@ def lattice(
     return np.ascontiguousarray(points), volumes
 
 
+def conforming(shape: Shape, mesh_size: float) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Nodes on rings (2D) or shells (3D) that follow the surface of a Disc, Ellipse, Sphere or
+    Ellipsoid, so the particle's surface is smooth instead of a lattice staircase (this matters
+    for oblique contacts: a staircase passes tangential impulse even without friction).
+
+    m = round(R / h) rings of radius (k + 1/2) R / m, k = 0 .. m-1, each with
+    round(2 pi r / h) nodes at equal angles (shells: round(4 pi r^2 / h^2) nodes on a Fibonacci
+    lattice); each node carries an equal share of its ring's (shell's) exact area (volume), so
+    the volumes sum to the exact measure. Ellipses and ellipsoids are the unit disc or sphere
+    stretched by their semi-axes (an affine map keeps the shares equal). The outermost nodes lie
+    h/2 inside the surface, as a lattice's do.
+
+    Returns (positions (n, 3) [m], volumes (n,) [m^d]).
+    """
+    if not (mesh_size > 0 and np.isfinite(mesh_size)):
+        raise InputError(f"mesh size must be positive, got {mesh_size}")
+    if isinstance(shape, Disc | Ellipse):
+        axes = (
+            np.array([shape.radius, shape.radius])
+            if isinstance(shape, Disc)
+            else np.asarray(shape.semi_axes, dtype=float)
+        )
+        angle = shape.angle if isinstance(shape, Ellipse) else 0.0
+        rings = _rings(float(axes.max()) / mesh_size, 2)
+        local = np.array([[x * axes[0], y * axes[1], 0.0] for x, y, _ in rings[0]])
+        c, s = np.cos(angle), np.sin(angle)
+        turn = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+        positions = local @ turn.T + shape.origin
+        volumes = rings[1] * float(np.prod(axes))
+    elif isinstance(shape, Sphere | Ellipsoid):
+        axes = (
+            np.full(3, shape.radius)
+            if isinstance(shape, Sphere)
+            else np.asarray(shape.semi_axes, dtype=float)
+        )
+        rotation = rotation_matrix(shape.rotation if isinstance(shape, Ellipsoid) else None, 3)
+        rings = _rings(float(axes.max()) / mesh_size, 3)
+        positions = (rings[0] * axes) @ rotation.T + shape.origin
+        volumes = rings[1] * float(np.prod(axes))
+    else:
+        raise InputError(
+            f"conforming discretization is available for Disc, Ellipse, Sphere and Ellipsoid, "
+            f"not {type(shape).__name__}; use the lattice, or import a mesh"
+        )
+    return np.ascontiguousarray(positions), volumes
+
+
+def _rings(resolution: float, dimension: int) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Nodes of the unit disc (sphere) on m = round(resolution) rings (shells) and their
+    volumes (summing to pi, or 4 pi / 3)."""
+    m = max(1, round(resolution))
+    spacing = 1.0 / m
+    points: list[NDArray[np.float64]] = []
+    volumes: list[NDArray[np.float64]] = []
+    for k in range(m):
+        radius = (k + 0.5) * spacing
+        inner, outer = k * spacing, (k + 1) * spacing
+        if dimension == 2:
+            count = max(3, round(2 * np.pi * radius / spacing))
+            phi = 0.5 * k + 2 * np.pi * np.arange(count) / count
+            ring = np.column_stack([np.cos(phi), np.sin(phi), np.zeros(count)])
+            share = np.pi * (outer**2 - inner**2) / count
+        else:
+            count = max(4, round(4 * np.pi * radius**2 / spacing**2))
+            # Fibonacci lattice: nearly equal areas, no poles; turned per shell to stagger.
+            index = np.arange(count) + 0.5
+            z = 1 - 2 * index / count
+            phi = np.pi * (3 - np.sqrt(5)) * index + 0.5 * k
+            rho = np.sqrt(1 - z * z)
+            ring = np.column_stack([rho * np.cos(phi), rho * np.sin(phi), z])
+            share = 4.0 / 3.0 * np.pi * (outer**3 - inner**3) / count
+        points.append(radius * ring)
+        volumes.append(np.full(count, share))
+    return np.concatenate(points), np.concatenate(volumes)
+
+
 @dataclass(frozen=True)
 class Union(Shape):
     """Points in any of the shapes (all of one dimension)."""
@@ -271,6 +761,10 @@ class Union(Shape):
             "the measure of a Union is not known exactly; discretize it and sum volumes"
         )
 
+    def signed_distance(self, points: ArrayLike) -> NDArray[np.float64]:
+        p = _points(points)
+        return np.min([shape.signed_distance(p) for shape in self.shapes], axis=0)
+
 
 @dataclass(frozen=True)
 class Difference(Shape):
@@ -299,6 +793,10 @@ class Difference(Shape):
             "the measure of a Difference is not known exactly; discretize it and sum volumes"
         )
 
+    def signed_distance(self, points: ArrayLike) -> NDArray[np.float64]:
+        p = _points(points)
+        return np.maximum(self.base.signed_distance(p), -self.removed.signed_distance(p))
+
 
 def _same_dimension(shapes: tuple[Shape, ...], name: str) -> None:
     if not shapes:
@@ -313,8 +811,9 @@ class ReferenceShape:
     """A particle shape discretised once, to be placed as many particles (translated, rotated,
     scaled); all of them share one set of bonds in memory.
 
-    Positions are in the shape's local frame: rotation and scale act about its origin.
-    Use ``ReferenceShape.from_shape(shape, mesh_size)`` (lattice) or ``from_nodes``.
+    Positions are in the shape's local frame: rotation and scale act about its origin (0, 0, 0).
+    Use ``ReferenceShape.from_shape(shape, mesh_size)`` (lattice or conforming rings),
+    ``from_mesh(path)`` (gmsh, VTU, CSV) or ``from_nodes``.
     """
 
     positions: NDArray[np.float64]  # (n, 3) [m]
@@ -324,10 +823,58 @@ class ReferenceShape:
 
     @staticmethod
     def from_shape(
-        shape: Shape, mesh_size: float, *, jitter: float = 0.0, seed: int = 0
+        shape: Shape,
+        mesh_size: float,
+        *,
+        discretization: str = "lattice",
+        jitter: float = 0.0,
+        seed: int = 0,
+        centered: bool = False,
     ) -> ReferenceShape:
-        positions, volumes = lattice(shape, mesh_size, jitter=jitter, seed=seed)
+        """Discretize a shape: ``discretization`` "lattice" (any shape; optional jitter) or
+        "conforming" (rings or shells following the surface: Disc, Ellipse, Sphere, Ellipsoid).
+        ``centered``: move the shape's ``origin`` (centre or centroid) to (0, 0, 0), so that
+        rotations and scales act about it."""
+        if discretization == "lattice":
+            positions, volumes = lattice(shape, mesh_size, jitter=jitter, seed=seed)
+        elif discretization == "conforming":
+            if jitter:
+                raise InputError("jitter applies to the lattice discretization only")
+            positions, volumes = conforming(shape, mesh_size)
+        else:
+            raise InputError(
+                f"unknown discretization {discretization!r}; choose 'lattice' or 'conforming'"
+            )
+        if centered:
+            positions = positions - shape.origin
         return ReferenceShape(positions, volumes, float(mesh_size), shape.dimension)
+
+    @staticmethod
+    def from_mesh(
+        path: str,
+        *,
+        dimension: int | None = None,
+        mesh_size: float | None = None,
+        center: ArrayLike | None = None,
+    ) -> ReferenceShape:
+        """Nodes of a mesh made elsewhere: gmsh .msh (v2 or v4; triangles, quads, tetrahedra,
+        hexahedra), .vtu (with a point field 'volume' or elements) or a CSV of points with
+        volumes. Nodal volume = equal share of each element's measure (see granulate.meshes).
+        ``mesh_size`` defaults to the median edge length; ``center`` [m] is moved to the origin
+        of the local frame (e.g. the centre of a particle meshed off the origin)."""
+        from granulate.meshes import read_mesh
+
+        mesh = read_mesh(path, dimension=dimension)
+        positions = mesh.positions
+        if center is not None:
+            c = np.zeros(3)
+            given = np.asarray(center, dtype=float).reshape(-1)
+            c[: len(given)] = given
+            positions = positions - c
+        h = mesh.mesh_size if mesh_size is None else float(mesh_size)
+        if not (h > 0 and np.isfinite(h)):
+            raise InputError(f"mesh size must be positive, got {mesh_size}")
+        return ReferenceShape(np.ascontiguousarray(positions), mesh.volumes, h, mesh.dimension)
 
     @staticmethod
     def from_nodes(

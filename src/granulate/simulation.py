@@ -29,7 +29,7 @@ from granulate.errors import GranulateWarning, InputError
 from granulate.functions import Constant, Linear, TimeFunction, VelocityRamp
 from granulate.io import HistoryWriter, PvdSeries, atomic_write, write_vtu
 from granulate.materials import Material
-from granulate.shapes import ReferenceShape, Shape, lattice, rotation_matrix
+from granulate.shapes import ReferenceShape, Shape, rotation_matrix
 from granulate.walls import Surface, Wall
 
 Components = str  # any of "x", "y", "z", e.g. "xy"
@@ -178,23 +178,30 @@ class Simulation:
         material: Material,
         mesh_size: float,
         *,
+        discretization: str = "lattice",
         jitter: float = 0.0,
         seed: int = 0,
         velocity: ArrayLike | None = None,
         angular_velocity: float | ArrayLike | None = None,
         name: str | None = None,
     ) -> Body:
-        """Discretize a shape on a uniform lattice of spacing ``mesh_size`` [m] and add it.
+        """Discretize a shape with nodes of spacing ``mesh_size`` [m] and add it.
 
-        ``velocity`` [m/s] and ``angular_velocity`` [rad/s; a scalar about z in 2D, a vector in
-        3D, about the body's centroid] set the initial motion.
+        ``discretization``: "lattice" (uniform lattice clipped to the shape; optional
+        ``jitter``) or "conforming" (rings or shells following the surface of a Disc, Ellipse,
+        Sphere or Ellipsoid; see granulate.shapes.conforming). ``velocity`` [m/s] and
+        ``angular_velocity`` [rad/s; a scalar about z in 2D, a vector in 3D, about the body's
+        centroid] set the initial motion.
         """
         if shape.dimension != self.dimension:
             raise InputError(
                 f"{type(shape).__name__} is a {shape.dimension}D shape but the simulation is "
                 f"{self.dimension}D"
             )
-        positions, volumes = lattice(shape, mesh_size, jitter=jitter, seed=seed)
+        reference = ReferenceShape.from_shape(
+            shape, mesh_size, discretization=discretization, jitter=jitter, seed=seed
+        )
+        positions, volumes = reference.positions, reference.volumes
         return self.add_body_from_nodes(
             positions,
             volumes,

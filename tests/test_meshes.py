@@ -1,0 +1,205 @@
+"""Meshes made elsewhere: gmsh v2/v4, VTU and CSV particle meshes, closed triangle surfaces;
+nodal volumes from elements; clear errors for bad files."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import meshio
+import numpy as np
+import pytest
+
+import granulate as gr
+
+DECKS = Path(__file__).resolve().parents[2] / "shared" / "peridem" / "decks"
+
+
+def structured(dimension: int, kind: str, n: int = 4, size: float = 2e-3) -> meshio.Mesh:
+    """A square (cube) of side `size` meshed with n cells per side: quads or triangles
+    (hexahedra or tetrahedra, six per cube), slightly distorted so elements differ."""
+    axes = [np.linspace(0, size, n + 1)] * dimension
+    grid = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, dimension)
+    rng = np.random.default_rng(3)
+    interior = np.all((grid > 0) & (grid < size), axis=1)
+    grid[interior] += rng.uniform(-0.15, 0.15, size=(interior.sum(), dimension)) * size / n
+    points = np.zeros((len(grid), 3))
+    points[:, :dimension] = grid
+
+    def node(*index: int) -> int:
+        flat = 0
+        for i in index:
+            flat = flat * (n + 1) + i
+        return flat
+
+    cells = []
+    if dimension == 2:
+        for i in range(n):
+            for j in range(n):
+                quad = [node(i, j), node(i + 1, j), node(i + 1, j + 1), node(i, j + 1)]
+                if kind == "quad":
+                    cells.append(quad)
+                else:
+                    cells += [[quad[0], quad[1], quad[2]], [quad[0], quad[2], quad[3]]]
+    else:
+        for i in range(n):
+            for j in range(n):
+                for k in range(n):
+                    c = [
+                        node(i + a, j + b, k + z)
+                        for z in (0, 1)
+                        for a, b in ((0, 0), (1, 0), (1, 1), (0, 1))
+                    ]
+                    if kind == "hexahedron":
+                        cells.append(c)
+                    else:  # six tetrahedra around the 0-6 diagonal
+                        for a, b in ((1, 2), (2, 3), (3, 7), (7, 4), (4, 5), (5, 1)):
+                            cells.append([c[0], c[a], c[b], c[6]])
+    return meshio.Mesh(points, [(kind, np.asarray(cells))])
+
+
+def exact_measure(mesh: meshio.Mesh, kind: str) -> float:
+    """Independent reference: 2D shoelace over the boundary polygon is the square's area only
+    without distortion of the boundary, which holds (boundary nodes are not moved)."""
+    dimension = 2 if kind in ("triangle", "quad") else 3
+    return float(np.prod(np.ptp(mesh.points[:, :dimension], axis=0)))
+
+
+@pytest.mark.parametrize("kind", ["triangle", "quad", "tetra", "hexahedron"])
+@pytest.mark.parametrize("file_format", ["gmsh22", "gmsh", "vtu"])
+def test_imported_mesh_volumes_sum_to_the_mesh_measure(
+    tmp_path: Path, kind: str, file_format: str
+) -> None:
+    mesh = structured(2 if kind in ("triangle", "quad") else 3, kind)
+    path = tmp_path / ("mesh.vtu" if file_format == "vtu" else "mesh.msh")
+    extra = {"binary": False} if file_format.startswith("gmsh") else {}
+    meshio.write(path, mesh, file_format=file_format, **extra)
+    reference = gr.ReferenceShape.from_mesh(str(path))
+    assert reference.dimension == (2 if kind in ("triangle", "quad") else 3)
+    assert reference.node_count == len(mesh.points)
+    assert reference.volumes.sum() == pytest.approx(exact_measure(mesh, kind), rel=1e-12)
+    assert reference.mesh_size == pytest.approx(0.5e-3, rel=0.2)
+
+
+def test_gmsh_binary_v4_and_a_vtu_volume_field(tmp_path: Path) -> None:
+    mesh = structured(2, "triangle")
+    meshio.write(tmp_path / "b.msh", mesh, file_format="gmsh", binary=True)
+    assert gr.read_mesh(tmp_path / "b.msh").volumes.sum() == pytest.approx(4e-6, rel=1e-12)
+    given = np.full(len(mesh.points), 1e-7)
+    vertices = [("vertex", np.arange(len(mesh.points)).reshape(-1, 1))]
+    meshio.write(
+        tmp_path / "v.vtu", meshio.Mesh(mesh.points, vertices, point_data={"volume": given})
+    )
+    np.testing.assert_array_equal(gr.read_mesh(tmp_path / "v.vtu", dimension=2).volumes, given)
+
+
+def test_peridem_deck_meshes_read_with_their_element_areas() -> None:
+    """PeriDEM's gmsh v2 disc mesh: volumes sum to the area of its polygonal boundary (the
+    inscribed 64-gon of radius 1 mm here), within round-off."""
+    path = DECKS / "twop_circ" / "mesh_cir_1_0.msh"
+    if not path.exists():
+        pytest.fail(f"the PeriDEM decks are missing: {path}")
+    reference = gr.ReferenceShape.from_mesh(str(path))
+    boundary = np.linalg.norm(reference.positions[:, :2], axis=1)
+    sides = int(np.sum(np.isclose(boundary, 1e-3, rtol=1e-6)))
+    polygon = 0.5 * sides * 1e-6 * np.sin(2 * np.pi / sides)
+    assert reference.volumes.sum() == pytest.approx(polygon, rel=1e-6)
+    assert reference.node_count == 123
+
+
+def test_csv_points_with_volumes(tmp_path: Path) -> None:
+    path = tmp_path / "points.csv"
+    path.write_text("x,y,volume\n0,0,1e-8\n1e-4,0,1e-8\n# comment\n0,1e-4,2e-8\n")
+    reference = gr.ReferenceShape.from_mesh(str(path), dimension=2)
+    assert reference.node_count == 3
+    assert reference.volumes.sum() == pytest.approx(4e-8)
+    assert reference.mesh_size == pytest.approx(1e-4)
+
+
+@pytest.mark.parametrize(
+    ("content", "message"),
+    [
+        ("x,y,volume\n0,0,1e-8\n1,0,0\n", "positive volume"),
+        ("x,y,volume\n0,0,-1e-8\n", "positive volume"),
+        ("0,0\n", "expected 3 columns"),
+        ("0,0,1e-8\n1,zero,1e-8\n", "line 2: expected numbers"),
+        ("x,y,volume\n", "holds no points"),
+    ],
+)
+def test_bad_csv_points_give_clear_errors(tmp_path: Path, content: str, message: str) -> None:
+    path = tmp_path / "bad.csv"
+    path.write_text(content)
+    with pytest.raises(gr.InputError, match=message):
+        gr.read_mesh(path, dimension=2)
+
+
+def test_bad_mesh_files_give_clear_errors(tmp_path: Path) -> None:
+    with pytest.raises(gr.InputError, match="does not exist"):
+        gr.read_mesh(tmp_path / "missing.msh")
+    garbage = tmp_path / "garbage.msh"
+    garbage.write_text("$MeshFormat\nthis is not a mesh\n")
+    with pytest.raises(gr.InputError, match=r"garbage\.msh"):
+        gr.read_mesh(garbage)
+    points = np.array([[0, 0, 0], [1, 0, 0], [2, 0, 0], [0, 1, 0]], float) * 1e-3
+    degenerate = meshio.Mesh(points, [("triangle", np.array([[0, 1, 2], [0, 1, 3]]))])
+    meshio.write(tmp_path / "flat.vtu", degenerate)
+    with pytest.raises(gr.InputError, match="zero area"):
+        gr.read_mesh(tmp_path / "flat.vtu")
+    lines = meshio.Mesh(points, [("line", np.array([[0, 1], [1, 3]]))])
+    meshio.write(tmp_path / "lines.vtu", lines)
+    with pytest.raises(gr.InputError, match="no triangles or quads"):
+        gr.read_mesh(tmp_path / "lines.vtu")
+    quadratic = meshio.Mesh(
+        np.vstack([points, [[0.5e-3, 0, 0], [0.5e-3, 0.5e-3, 0]]]),
+        [("triangle6", np.array([[0, 1, 3, 4, 5, 5]]))],
+    )
+    meshio.write(tmp_path / "quadratic.vtu", quadratic)
+    with pytest.raises(gr.InputError, match="second-order"):
+        gr.read_mesh(tmp_path / "quadratic.vtu")
+
+
+def cube_surface(size: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
+    v = np.array([[x, y, z] for x in (0, size) for y in (0, size) for z in (0, size)], float)
+    quads = [(0, 1, 3, 2), (4, 6, 7, 5), (0, 4, 5, 1), (2, 3, 7, 6), (0, 2, 6, 4), (1, 5, 7, 3)]
+    triangles = [t for a, b, c, d in quads for t in ((a, b, c), (a, c, d))]
+    return v, np.asarray(triangles)
+
+
+def test_surface_mesh_from_stl_matches_the_box_it_describes(tmp_path: Path) -> None:
+    vertices, triangles = cube_surface(2e-3)
+    meshio.write(tmp_path / "cube.stl", meshio.Mesh(vertices, [("triangle", triangles)]))
+    surface = gr.SurfaceMesh.from_file(tmp_path / "cube.stl")
+    box = gr.Box((0, 0, 0), (2e-3, 2e-3, 2e-3))
+    assert surface.measure == pytest.approx(8e-9, rel=1e-12)
+    np.testing.assert_allclose(surface.origin, [1e-3] * 3, atol=1e-15)
+    rng = np.random.default_rng(4)
+    p = rng.uniform(-1e-3, 3e-3, size=(3000, 3))
+    np.testing.assert_array_equal(surface.contains(p), box.contains(p))
+    np.testing.assert_allclose(surface.signed_distance(p), box.signed_distance(p), atol=1e-15)
+    # Filled with a lattice, it holds the box's nodes.
+    positions, _ = gr.lattice(surface, 0.25e-3)
+    assert len(positions) == 8**3
+
+
+def test_surface_mesh_orientation_is_fixed_and_holes_are_refused() -> None:
+    vertices, triangles = cube_surface()
+    inverted = gr.SurfaceMesh(vertices, triangles[:, ::-1])
+    assert inverted.measure == pytest.approx(1.0)
+    assert inverted.contains([[0.5, 0.5, 0.5]])[0]
+    with pytest.raises(gr.InputError, match="not closed"):
+        gr.SurfaceMesh(vertices, triangles[:-1])
+
+
+def test_a_meshed_particle_runs(tmp_path: Path) -> None:
+    """A PeriDEM disc mesh placed twice: the particles collide and separate."""
+    path = DECKS / "twop_circ" / "mesh_cir_1_0.msh"
+    reference = gr.ReferenceShape.from_mesh(str(path))
+    material = gr.Material(density=1200, bulk_modulus=2.16e7, shear_modulus=1.296e7, fracture=False)
+    sim = gr.Simulation(2)
+    sim.contact = gr.Contact(restitution=0.8)
+    a = sim.add_particle(reference, material, position=(0, 0), velocity=(0.5, 0))
+    b = sim.add_particle(reference, material, position=(2.3e-3, 0), velocity=(-0.5, 0))
+    sim.run(until=3e-3)
+    va = np.average(sim.velocities[a.nodes, 0], weights=sim.volumes[a.nodes])
+    vb = np.average(sim.velocities[b.nodes, 0], weights=sim.volumes[b.nodes])
+    assert va < 0 < vb
+    assert (vb - va) / 1.0 == pytest.approx(0.8, abs=0.05)
