@@ -24,6 +24,18 @@ from granulate.functions import (
 )
 from granulate.materials import Material
 from granulate.meshes import SurfaceMesh, read_mesh
+from granulate.packing import (
+    Fixed,
+    Grain,
+    LogNormal,
+    Normal,
+    Packing,
+    Placements,
+    Sieve,
+    Uniform,
+    pack,
+    read_placements,
+)
 from granulate.shapes import (
     Box,
     Cylinder,
@@ -87,11 +99,17 @@ __all__ = [
     "Drum2D",
     "Ellipse",
     "Ellipsoid",
+    "Fixed",
+    "Grain",
     "GranulateWarning",
     "InputError",
     "InstabilityError",
     "Linear",
+    "LogNormal",
     "Material",
+    "Normal",
+    "Packing",
+    "Placements",
     "Plane",
     "Polygon",
     "PolygonContainer",
@@ -102,6 +120,7 @@ __all__ = [
     "RegularPolygon",
     "Rotation",
     "Shape",
+    "Sieve",
     "Simulation",
     "Sine",
     "SmoothRamp",
@@ -111,6 +130,7 @@ __all__ = [
     "TimeFunction",
     "Translation",
     "TriangleMesh",
+    "Uniform",
     "Union",
     "VelocityRamp",
     "Wall",
@@ -118,7 +138,9 @@ __all__ = [
     "conforming",
     "get_num_threads",
     "lattice",
+    "pack",
     "read_mesh",
+    "read_placements",
     "set_num_threads",
     "walls",
 ]

@@ -43,7 +43,8 @@ class NodalMesh:
     source: str = field(default="")
 
 
-def _read(path: str | Path):  # -> meshio.Mesh
+def read_file(path: str | Path):  # -> meshio.Mesh
+    """meshio.read with one clear InputError for a missing, unreadable or malformed file."""
     import meshio
 
     file = Path(path)
@@ -188,7 +189,7 @@ def read_mesh(path: str | Path, *, dimension: int | None = None) -> NodalMesh:
     CSV of points with volumes (``read_points_csv``)."""
     if Path(path).suffix.lower() == ".csv":
         return read_points_csv(path, dimension=dimension or 3)
-    return nodal_mesh(_read(path), dimension=dimension, source=str(path))
+    return nodal_mesh(read_file(path), dimension=dimension, source=str(path))
 
 
 def read_points_csv(path: str | Path, *, dimension: int) -> NodalMesh:
@@ -318,7 +319,7 @@ class SurfaceMesh(Shape):
     @staticmethod
     def from_file(path: str | Path, *, scale: float = 1.0) -> SurfaceMesh:
         """Read a closed triangle surface (STL, OBJ, PLY, OFF, ...), coordinates times scale."""
-        mesh = _read(path)
+        mesh = read_file(path)
         triangles = [np.asarray(b.data) for b in mesh.cells if b.type == "triangle"]
         if not triangles:
             raise InputError(f"{path} holds no triangles")

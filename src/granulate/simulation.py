@@ -16,6 +16,7 @@ from __future__ import annotations
 import json
 import time as wallclock
 import warnings
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Literal
@@ -29,6 +30,7 @@ from granulate.errors import GranulateWarning, InputError
 from granulate.functions import Constant, Linear, TimeFunction, VelocityRamp
 from granulate.io import HistoryWriter, PvdSeries, atomic_write, write_vtu
 from granulate.materials import Material
+from granulate.packing import Grain, Packing, Placements, grains_by_kind
 from granulate.shapes import ReferenceShape, Shape, rotation_matrix
 from granulate.walls import Surface, Wall
 
@@ -259,6 +261,34 @@ class Simulation:
             reference,
             float(scale),
         )
+
+    def add_placements(
+        self,
+        placements: Placements,
+        grains: Sequence[Grain] | Mapping[int, Grain],
+        *,
+        velocity: ArrayLike | None = None,
+    ) -> list[Body]:
+        """Add one particle per placement (see granulate.packing): the grain of its kind
+        (zone), scaled by r / r_ref, rotated and moved into place; all share the grain's
+        discretization. ``grains``: a list indexed by kind, or a {zone: Grain} mapping (PeriDEM
+        CSV zones). ``velocity`` [m/s]: initial velocity of every particle."""
+        chosen = grains_by_kind(grains, placements.kinds)
+        return [
+            self.add_particle(
+                grain.reference,
+                grain.material,
+                position=placements.positions[k],
+                rotation=placements.rotations[k],
+                scale=float(placements.radii[k] / grain.radius),
+                velocity=velocity,
+            )
+            for k, grain in enumerate(chosen)
+        ]
+
+    def add_packing(self, packing: Packing, *, velocity: ArrayLike | None = None) -> list[Body]:
+        """Add the particles of a generated packing (``granulate.pack``)."""
+        return self.add_placements(packing, packing.grains, velocity=velocity)
 
     def add_body_from_nodes(
         self,

@@ -15,6 +15,10 @@ A wall is one or more surfaces moving together (``Wall(surfaces, motion=...)``).
                              outside it
 ===========================  ===================================================================
 
+``container(shape)`` and ``obstacle(shape)`` make the surface of a shape from granulate.shapes:
+Rectangle and Box become boxes, Disc a circle, every polygon (RegularPolygon, Star, Drum2D, ...)
+a polygon, an Ellipse a polygon of ``segments`` sides, a SurfaceMesh a triangle mesh.
+
 Motions: ``Translation(direction, function)`` moves the wall by function(t) metres along the
 direction; ``Rotation(angle, center, axis)`` turns it by angle(t) radians about the axis
 through ``center`` (``Rotation.steady(omega, center)`` for a constant angular velocity). The
@@ -24,11 +28,9 @@ recorded in history.csv.
 
 from __future__ import annotations
 
-import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 
-import meshio
 import numpy as np
 from numpy.typing import ArrayLike
 
@@ -36,6 +38,8 @@ from granulate import _core
 from granulate.contact import Contact
 from granulate.errors import InputError
 from granulate.functions import Constant, Linear, TimeFunction
+from granulate.meshes import SurfaceMesh, read_file
+from granulate.shapes import Box, Disc, Ellipse, Polygon, Rectangle, Shape
 
 
 def _vec3(value: ArrayLike, name: str) -> tuple[float, float, float]:
@@ -166,19 +170,10 @@ class TriangleMesh(Surface):
     def from_file(path: str | Path, *, inside: bool = True, scale: float = 1.0) -> TriangleMesh:
         """Read the triangles of an STL, OBJ, PLY (or any meshio-readable) file; coordinates are
         multiplied by ``scale`` (e.g. 1e-3 for a file in millimetres)."""
-        source = Path(path)
-        if not source.is_file():
-            raise InputError(f"wall mesh file {source} does not exist")
-        try:
-            with warnings.catch_warnings():
-                # meshio's binary-STL size probe overflows harmlessly on ASCII files.
-                warnings.simplefilter("ignore", RuntimeWarning)
-                mesh = meshio.read(source)
-        except Exception as error:  # meshio raises many types for unreadable files
-            raise InputError(f"cannot read wall mesh {source}: {error}") from None
+        mesh = read_file(path)
         triangles = [block.data for block in mesh.cells if block.type == "triangle"]
         if not triangles:
-            raise InputError(f"wall mesh {source} has no triangles")
+            raise InputError(f"wall mesh {path} has no triangles")
         return TriangleMesh(
             np.asarray(mesh.points, dtype=float) * scale, np.concatenate(triangles), inside
         )
@@ -265,3 +260,45 @@ class Wall:
                 f"wall motion must be a Translation or a Rotation, got {self.motion!r}"
             )
         return wall
+
+
+def _shape_surface(shape: Shape, inside: bool, segments: int) -> Surface:
+    if isinstance(shape, Rectangle):
+        lower, upper = (*shape.lower, 0.0), (*shape.upper, 0.0)
+        return BoxContainer(lower, upper) if inside else BoxObstacle(lower, upper)
+    if isinstance(shape, Box):
+        return (
+            BoxContainer(shape.lower, shape.upper)
+            if inside
+            else BoxObstacle(shape.lower, shape.upper)
+        )
+    if isinstance(shape, Disc):
+        return (CircleContainer if inside else CircleObstacle)(shape.center, shape.radius)
+    if isinstance(shape, Polygon):
+        return (PolygonContainer if inside else PolygonObstacle)(shape.vertices)
+    if isinstance(shape, Ellipse):
+        if segments < 8:
+            raise InputError(f"an ellipse wall needs at least 8 segments, got {segments}")
+        t = 2 * np.pi * np.arange(segments) / segments
+        a, b = shape.semi_axes
+        c, s = np.cos(shape.angle), np.sin(shape.angle)
+        x, y = a * np.cos(t), b * np.sin(t)
+        vertices = np.column_stack([c * x - s * y, s * x + c * y]) + np.asarray(shape.center)
+        return (PolygonContainer if inside else PolygonObstacle)(vertices)
+    if isinstance(shape, SurfaceMesh):
+        return TriangleMesh(shape.vertices, shape.triangles, inside)
+    raise InputError(
+        f"a {type(shape).__name__} cannot be a wall; use a Rectangle, Box, Disc, polygon, "
+        "Ellipse or SurfaceMesh (a sphere or cylinder: a triangle surface, or CircleContainer "
+        "with an axis for an infinite cylinder)"
+    )
+
+
+def container(shape: Shape, *, segments: int = 128) -> Surface:
+    """A wall surface keeping particles inside ``shape`` (see the module docstring)."""
+    return _shape_surface(shape, True, segments)
+
+
+def obstacle(shape: Shape, *, segments: int = 128) -> Surface:
+    """A wall surface keeping particles outside ``shape`` (posts, lifters, blades)."""
+    return _shape_surface(shape, False, segments)

@@ -1,0 +1,540 @@
+"""Assemblies of particles: placements read from PeriDEM's CSV files, and a packing generator.
+
+A placement puts a *grain* (a reference shape with a material) at a position, with a size and an
+orientation. The size of a particle is its bounding radius r (the circumradius of a polygon, the
+radius of a disc, PeriDEM's ``r``): the grain's reference shape, discretized once, is scaled by
+r / r_ref (mesh size and horizon scale with it), rotated and moved into place.
+
+``pack(container, grains, count)`` fills a container shape (any shape with a signed distance:
+Rectangle, Disc, Polygon, Box, Cylinder, ...) with particles whose bounding circles (spheres)
+neither overlap each other nor leave the container, so no two particles touch at the start.
+Two methods:
+
+- ``"random"``: random sequential addition, largest first, with a cell grid (so 10,000
+  particles take seconds). Bounding discs reach about 50 % of the area (RSA jams at 54.7 % for
+  equal discs; 38 % for spheres).
+- ``"lattice"``: sites of a hexagonal (2D) or face-centred cubic (3D) lattice spaced by the
+  largest bounding diameter, filled in random order, each particle shifted at random within the
+  slack of its site: denser (up to 90.7 % / 74 % of bounding discs/spheres of one size) and
+  regular at the scale of the largest grain.
+
+The packing fraction reported is the grains' exact area (volume) over the container's.
+"""
+
+from __future__ import annotations
+
+import csv
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from granulate.errors import InputError
+from granulate.materials import Material
+from granulate.shapes import ReferenceShape, Shape
+
+
+# ----------------------------------------------------------------------- size distributions
+class SizeDistribution:
+    """Distribution of particle sizes (bounding radii [m])."""
+
+    def sample(self, rng: np.random.Generator, count: int) -> NDArray[np.float64]:
+        raise NotImplementedError
+
+    def _bounded(self, draw, low: float, high: float, rng, count: int) -> NDArray[np.float64]:
+        """Draws kept within [low, high] by redrawing the rest (a truncated distribution)."""
+        out = np.empty(0)
+        for _ in range(1000):
+            values = draw(rng, 2 * (count - len(out)) + 16)
+            out = np.concatenate([out, values[(values >= low) & (values <= high)]])
+            if len(out) >= count:
+                return out[:count]
+        raise InputError(f"{self!r}: almost no sizes fall within [{low}, {high}]; widen the bounds")
+
+
+@dataclass(frozen=True)
+class Fixed(SizeDistribution):
+    """Every particle has bounding radius ``radius`` [m]."""
+
+    radius: float
+
+    def __post_init__(self) -> None:
+        if not (self.radius > 0 and np.isfinite(self.radius)):
+            raise InputError(f"Fixed radius must be positive, got {self.radius}")
+
+    def sample(self, rng: np.random.Generator, count: int) -> NDArray[np.float64]:
+        return np.full(count, float(self.radius))
+
+
+@dataclass(frozen=True)
+class Uniform(SizeDistribution):
+    """Radius uniform in [low, high] [m]."""
+
+    low: float
+    high: float
+
+    def __post_init__(self) -> None:
+        if not (0 < self.low <= self.high and np.isfinite(self.high)):
+            raise InputError(f"Uniform sizes need 0 < low <= high, got {self.low}, {self.high}")
+
+    def sample(self, rng: np.random.Generator, count: int) -> NDArray[np.float64]:
+        return rng.uniform(self.low, self.high, count)
+
+
+@dataclass(frozen=True)
+class Normal(SizeDistribution):
+    """Radius normal with ``mean`` and ``std`` [m], truncated to [low, high] (default: mean -/+
+    3 std, and above zero)."""
+
+    mean: float
+    std: float
+    low: float | None = None
+    high: float | None = None
+
+    def __post_init__(self) -> None:
+        if not (self.mean > 0 and self.std >= 0):
+            raise InputError(
+                f"Normal sizes need mean > 0 and std >= 0, got {self.mean}, {self.std}"
+            )
+
+    def sample(self, rng: np.random.Generator, count: int) -> NDArray[np.float64]:
+        low = self.low if self.low is not None else max(self.mean - 3 * self.std, 1e-3 * self.mean)
+        high = self.high if self.high is not None else self.mean + 3 * self.std
+        if self.std == 0:
+            return np.full(count, float(self.mean))
+        return self._bounded(lambda r, n: r.normal(self.mean, self.std, n), low, high, rng, count)
+
+
+@dataclass(frozen=True)
+class LogNormal(SizeDistribution):
+    """Radius log-normal: ln r normal about ln ``median`` with ``sigma``, truncated to [low,
+    high] [m] (default: median e^-/+3 sigma)."""
+
+    median: float
+    sigma: float
+    low: float | None = None
+    high: float | None = None
+
+    def __post_init__(self) -> None:
+        if not (self.median > 0 and self.sigma >= 0):
+            raise InputError(
+                f"LogNormal sizes need median > 0 and sigma >= 0, got {self.median}, {self.sigma}"
+            )
+
+    def sample(self, rng: np.random.Generator, count: int) -> NDArray[np.float64]:
+        low = self.low if self.low is not None else self.median * np.exp(-3 * self.sigma)
+        high = self.high if self.high is not None else self.median * np.exp(3 * self.sigma)
+        draw = lambda r, n: self.median * np.exp(r.normal(0.0, self.sigma, n))  # noqa: E731
+        return self._bounded(draw, low, high, rng, count)
+
+
+@dataclass(frozen=True)
+class Sieve(SizeDistribution):
+    """A grading curve: ``passing[k]`` is the mass fraction of grains finer than sieve opening
+    ``diameters[k]`` [m] (increasing, from 0 to 1). Within a sieve interval the mass is spread
+    uniformly in log size; radii are half the diameters. Grains of one shape have mass ~ r^d,
+    so the number of grains per interval is the mass fraction / r^d (``dimension``)."""
+
+    diameters: tuple[float, ...]
+    passing: tuple[float, ...]
+    dimension: int = 3
+
+    def __post_init__(self) -> None:
+        d = np.asarray(self.diameters, dtype=float)
+        p = np.asarray(self.passing, dtype=float)
+        if len(d) < 2 or d.shape != p.shape:
+            raise InputError("Sieve needs at least two (diameter, passing) pairs of equal length")
+        if np.any(d <= 0) or np.any(np.diff(d) <= 0):
+            raise InputError("Sieve diameters must be positive and increasing")
+        if np.any(np.diff(p) < 0) or not (np.isclose(p[0], 0) and np.isclose(p[-1], 1)):
+            raise InputError("Sieve passing fractions must rise from 0 to 1")
+        if self.dimension not in (2, 3):
+            raise InputError(f"Sieve dimension must be 2 or 3, got {self.dimension}")
+
+    def sample(self, rng: np.random.Generator, count: int) -> NDArray[np.float64]:
+        d = np.log(np.asarray(self.diameters, dtype=float))
+        mass = np.diff(np.asarray(self.passing, dtype=float))
+        # Number per interval: mass / mean of r^d over the interval (log-uniform).
+        k = self.dimension
+        mean_power = (np.exp(k * d[1:]) - np.exp(k * d[:-1])) / (k * (d[1:] - d[:-1]))
+        number = mass / mean_power
+        interval = rng.choice(len(mass), size=count, p=number / number.sum())
+        # Within an interval, number density ~ r^-d on a log-uniform mass: inverse CDF of r^-k.
+        u = rng.uniform(0, 1, count)
+        low, high = np.exp(-k * d[interval]), np.exp(-k * d[interval + 1])
+        return 0.5 * (low + u * (high - low)) ** (-1.0 / k)
+
+
+# ----------------------------------------------------------------------- grains, placements
+@dataclass(frozen=True, eq=False)
+class Grain:
+    """A kind of particle: a shape (discretized once, about its ``origin``) or a ready
+    ReferenceShape (e.g. from a mesh), its material, and for packings its sizes and fraction.
+
+    ``mesh_size`` [m] is for the reference size (a Shape needs it); ``reference_radius`` [m]
+    defaults to the shape's bounding radius (for a ReferenceShape: the farthest node plus half
+    a mesh size). ``fraction`` is this grain's share of the particles (by number or by volume,
+    see ``pack``).
+    """
+
+    shape: Shape | ReferenceShape
+    material: Material
+    mesh_size: float | None = None
+    sizes: SizeDistribution | None = None
+    fraction: float = 1.0
+    discretization: str = "lattice"
+    reference_radius: float | None = None
+    _cache: dict = field(default_factory=dict, repr=False)
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.material, Material):
+            raise InputError(f"Grain material must be a granulate.Material, got {self.material!r}")
+        if isinstance(self.shape, Shape) and not (
+            self.mesh_size is not None and self.mesh_size > 0 and np.isfinite(self.mesh_size)
+        ):
+            raise InputError("a Grain made from a Shape needs a positive mesh_size [m]")
+        if not (self.fraction >= 0 and np.isfinite(self.fraction)):
+            raise InputError(f"Grain fraction must be non-negative, got {self.fraction}")
+
+    @property
+    def dimension(self) -> int:
+        return self.shape.dimension
+
+    @property
+    def reference(self) -> ReferenceShape:
+        """The shape discretized once, centred on its origin."""
+        if "reference" not in self._cache:
+            if isinstance(self.shape, ReferenceShape):
+                self._cache["reference"] = self.shape
+            else:
+                assert self.mesh_size is not None
+                self._cache["reference"] = ReferenceShape.from_shape(
+                    self.shape, self.mesh_size, discretization=self.discretization, centered=True
+                )
+        return self._cache["reference"]
+
+    @property
+    def radius(self) -> float:
+        """Reference (bounding) radius r_ref [m]; a particle of size r is scaled by r / r_ref."""
+        if self.reference_radius is not None:
+            return float(self.reference_radius)
+        if isinstance(self.shape, Shape):
+            return self.shape.bounding_radius
+        reference = self.reference
+        return float(np.linalg.norm(reference.positions, axis=1).max() + 0.5 * reference.mesh_size)
+
+    @property
+    def measure_at_unit_radius(self) -> float:
+        """Area (volume) of a particle of bounding radius 1: |S| / r_ref^d."""
+        if isinstance(self.shape, Shape):
+            return self.shape.measure / self.radius**self.dimension
+        return float(self.reference.volumes.sum()) / self.radius**self.dimension
+
+
+@dataclass(frozen=True)
+class Placements:
+    """Where particles go: ``kinds`` (n,) grain (zone) index, ``positions`` (n, 3) [m],
+    ``radii`` (n,) bounding radii [m], ``rotations`` (n,) angles [rad] in 2D or (n, 3) rotation
+    vectors [rad] in 3D."""
+
+    kinds: NDArray[np.int64]
+    positions: NDArray[np.float64]
+    radii: NDArray[np.float64]
+    rotations: NDArray[np.float64]
+    dimension: int
+
+    def __len__(self) -> int:
+        return len(self.radii)
+
+    def write_csv(self, path: str | Path) -> None:
+        """PeriDEM's format: ``i, x, y, z, r, o`` (2D) or ``i, x, y, z, r`` (3D)."""
+        from granulate.io.atomic import atomic_write
+
+        lines = ["i, x, y, z, r, o" if self.dimension == 2 else "i, x, y, z, r"]
+        for k in range(len(self)):
+            x, y, z = self.positions[k]
+            row = f"{self.kinds[k]}, {x:.9g}, {y:.9g}, {z:.9g}, {self.radii[k]:.9g}"
+            lines.append(row + (f", {self.rotations[k]:.9g}" if self.dimension == 2 else ""))
+        atomic_write(Path(path), ("\n".join(lines) + "\n").encode())
+
+
+def random_rotations(rng: np.random.Generator, count: int, dimension: int) -> NDArray[np.float64]:
+    """Uniform random orientations: angles in [0, 2 pi) (2D) or rotation vectors of uniformly
+    distributed rotations (3D, from uniform unit quaternions; Shoemake 1992)."""
+    if dimension == 2:
+        return rng.uniform(0, 2 * np.pi, count)
+    q = rng.normal(size=(count, 4))
+    q /= np.linalg.norm(q, axis=1)[:, None]
+    q[q[:, 0] < 0] *= -1
+    angle = 2 * np.arccos(np.clip(q[:, 0], -1, 1))
+    sin_half = np.sqrt(np.clip(1 - q[:, 0] ** 2, 0, None))
+    axis = np.where(
+        sin_half[:, None] > 1e-12, q[:, 1:] / np.maximum(sin_half, 1e-300)[:, None], 0.0
+    )
+    return axis * angle[:, None]
+
+
+def read_placements(path: str | Path, *, dimension: int = 2, seed: int = 0) -> Placements:
+    """Read PeriDEM's particle-location CSV: ``i, x, y, z, r`` (random orientations, seeded)
+    or ``i, x, y, z, r, o`` (o: rotation about z [rad]); i is the zone (0-based), r the radius.
+    A header line is optional."""
+    file = Path(path)
+    if not file.is_file():
+        raise InputError(f"particle-location file {file} does not exist")
+    rows: list[list[float]] = []
+    with file.open(newline="") as handle:
+        for number, row in enumerate(csv.reader(handle), start=1):
+            cells = [c.strip() for c in row]
+            if not any(cells) or cells[0].startswith("#"):
+                continue
+            try:
+                values = [float(c) for c in cells]
+            except ValueError:
+                if not rows and number == 1:
+                    continue
+                raise InputError(f"{file}, line {number}: expected numbers, got {row}") from None
+            if len(values) not in (5, 6) or (rows and len(values) != len(rows[0])):
+                raise InputError(
+                    f"{file}, line {number}: expected the columns i, x, y, z, r[, o] on every "
+                    f"line, got {len(values)} values"
+                )
+            rows.append(values)
+    if not rows:
+        raise InputError(f"{file} lists no particles")
+    data = np.asarray(rows)
+    zones = data[:, 0]
+    if np.any(zones < 0) or np.any(zones != np.round(zones)):
+        raise InputError(f"{file}: zone ids (column i) must be non-negative integers")
+    radii = data[:, 4]
+    bad = np.flatnonzero(~(radii > 0) | ~np.all(np.isfinite(data), axis=1))
+    if len(bad):
+        raise InputError(
+            f"{file}: particle {bad[0]} (line {bad[0] + 2}) has a non-positive radius or a "
+            "non-finite value"
+        )
+    positions = data[:, 1:4].copy()
+    if dimension == 2:
+        positions[:, 2] = 0.0
+    if data.shape[1] == 6:
+        if dimension == 3:
+            raise InputError(
+                f"{file}: an orientation column o is a 2D rotation; 3D takes i,x,y,z,r"
+            )
+        rotations = data[:, 5].copy()
+    else:
+        rotations = random_rotations(np.random.default_rng(seed), len(data), dimension)
+    return Placements(zones.astype(np.int64), positions, radii.copy(), rotations, dimension)
+
+
+# ----------------------------------------------------------------------------- packings
+@dataclass(frozen=True)
+class Packing(Placements):
+    """A generated assembly: placements plus the grains (``kinds`` index them) and the
+    container."""
+
+    grains: tuple[Grain, ...] = ()
+    container: Shape | None = None
+
+    @property
+    def packing_fraction(self) -> float:
+        """Exact area (volume) of the grains over the container's."""
+        assert self.container is not None
+        unit = np.array([g.measure_at_unit_radius for g in self.grains])
+        return float(np.sum(unit[self.kinds] * self.radii**self.dimension) / self.container.measure)
+
+    def summary(self) -> str:
+        counts = np.bincount(self.kinds, minlength=len(self.grains))
+        parts = ", ".join(
+            f"{c} x {type(g.shape).__name__}" for c, g in zip(counts, self.grains, strict=True)
+        )
+        return (
+            f"{len(self)} particles ({parts}); radius {self.radii.min():.4g} .. "
+            f"{self.radii.max():.4g} m (mean {self.radii.mean():.4g}); packing fraction "
+            f"{self.packing_fraction:.3f}"
+        )
+
+
+def _grain_counts(
+    grains: Sequence[Grain], count: int, by: str, rng: np.random.Generator
+) -> NDArray[np.int64]:
+    fractions = np.array([g.fraction for g in grains], dtype=float)
+    if not fractions.sum() > 0:
+        raise InputError("the grains' fractions sum to zero")
+    fractions /= fractions.sum()
+    if by == "volume":  # numbers ~ volume fraction / mean particle volume
+        d = grains[0].dimension
+        mean_volume = np.array(
+            [g.measure_at_unit_radius * np.mean(g.sizes.sample(rng, 2000) ** d) for g in grains]  # type: ignore[union-attr]
+        )
+        fractions = fractions / mean_volume
+        fractions /= fractions.sum()
+    elif by != "number":
+        raise InputError(f"fractions are 'number' or 'volume', got {by!r}")
+    exact = fractions * count
+    counts = np.floor(exact).astype(np.int64)
+    remainder = count - counts.sum()
+    counts[np.argsort(-(exact - counts), kind="stable")[:remainder]] += 1
+    return counts
+
+
+def pack(
+    container: Shape,
+    grains: Sequence[Grain],
+    count: int,
+    *,
+    by: str = "number",
+    method: str = "random",
+    gap: float = 0.0,
+    seed: int = 0,
+    attempts: int = 2000,
+) -> Packing:
+    """Fill ``container`` with ``count`` particles of the given grains (see the module
+    docstring). ``by``: the grains' fractions count particles ("number") or their volume
+    ("volume"). ``gap`` [m]: extra clearance between bounding circles (spheres) and from the
+    container walls. ``seed`` makes the packing reproducible. ``attempts``: random positions
+    tried per particle before giving up ("random" method).
+
+    Raises InputError, naming how many particles fitted, when the container cannot hold them.
+    """
+    if not grains:
+        raise InputError("pack needs at least one Grain")
+    d = container.dimension
+    for g in grains:
+        if g.dimension != d:
+            raise InputError(f"a {g.dimension}D grain cannot fill a {d}D container")
+        if g.sizes is None:
+            raise InputError("every Grain of a packing needs sizes (e.g. Uniform(0.9e-3, 1.1e-3))")
+    if not (isinstance(count, int | np.integer) and count > 0):
+        raise InputError(f"count must be a positive number of particles, got {count!r}")
+    if not (gap >= 0 and np.isfinite(gap)):
+        raise InputError(f"gap must be a non-negative distance, got {gap}")
+    rng = np.random.default_rng(seed)
+    counts = _grain_counts(grains, int(count), by, rng)
+    kinds = np.repeat(np.arange(len(grains)), counts)
+    radii = np.concatenate(
+        [g.sizes.sample(rng, int(c)) for g, c in zip(grains, counts, strict=True)]
+    )  # type: ignore[union-attr]
+    order = np.argsort(-radii, kind="stable")  # largest first
+    kinds, radii = kinds[order], radii[order]
+    if method == "random":
+        positions = _random_sequential(container, radii, gap, rng, attempts)
+    elif method == "lattice":
+        positions = _lattice_sites(container, radii, gap, rng)
+    else:
+        raise InputError(f"unknown packing method {method!r}; choose 'random' or 'lattice'")
+    rotations = random_rotations(rng, len(radii), d)
+    return Packing(kinds, positions, radii, rotations, d, tuple(grains), container)
+
+
+def _candidates(
+    container: Shape, radius: float, gap: float, rng, count: int
+) -> NDArray[np.float64]:
+    lower, upper = container.bounds()
+    d = container.dimension
+    p = np.zeros((count, 3))
+    p[:, :d] = rng.uniform(lower[:d] + radius, upper[:d] - radius, size=(count, d))
+    return p[container.signed_distance(p) <= -(radius + gap)]
+
+
+def _random_sequential(
+    container: Shape, radii: NDArray[np.float64], gap: float, rng, attempts: int
+) -> NDArray[np.float64]:
+    """Random sequential addition of bounding spheres, with a grid of cells of the largest
+    diameter holding at most `slots` particle indices each (grown when full)."""
+    d = container.dimension
+    lower, upper = container.bounds()
+    cell = 2 * radii.max() + gap
+    shape = np.maximum(1, np.ceil((upper[:d] - lower[:d]) / cell).astype(np.int64)) + 2
+    slots = 4
+    members = np.full((int(np.prod(shape)), slots), -1, dtype=np.int64)
+    fill = np.zeros(len(members), dtype=np.int64)
+    strides = np.cumprod(np.concatenate([[1], shape[:0:-1]]))[::-1]
+    offsets = np.array(np.meshgrid(*[[-1, 0, 1]] * d, indexing="ij")).reshape(d, -1).T @ strides
+    positions = np.zeros((len(radii), 3))
+    batch = 64
+    for k, radius in enumerate(radii):
+        placed = False
+        tried = 0
+        while tried < attempts and not placed:
+            tried += batch
+            p = _candidates(container, radius, gap, rng, batch)
+            if len(p) == 0:
+                continue
+            index = np.floor((p[:, :d] - lower[:d]) / cell).astype(np.int64) + 1
+            flat = index @ strides
+            near = members[flat[:, None] + offsets[None, :]].reshape(len(p), -1)
+            valid = near >= 0
+            centres = positions[np.where(valid, near, 0)]
+            reach = radii[np.where(valid, near, 0)] + radius + gap
+            distance = np.linalg.norm(centres - p[:, None, :], axis=2)
+            free = np.all(~valid | (distance >= reach), axis=1)
+            if free.any():
+                first = int(np.argmax(free))
+                positions[k] = p[first]
+                target = flat[first]
+                if fill[target] == members.shape[1]:
+                    members = np.concatenate([members, np.full_like(members, -1)], axis=1)
+                members[target, fill[target]] = k
+                fill[target] += 1
+                placed = True
+        if not placed:
+            raise InputError(
+                f"the container holds only {k} of the {len(radii)} particles with the 'random' "
+                f"method (no free spot in {attempts} tries for particle {k + 1}, radius "
+                f"{radius:.4g} m); ask for fewer particles, a larger container, or "
+                "method='lattice' (denser)"
+            )
+    return positions
+
+
+def _lattice_sites(
+    container: Shape, radii: NDArray[np.float64], gap: float, rng
+) -> NDArray[np.float64]:
+    """Hexagonal (2D) or FCC (3D) sites spaced by the largest bounding diameter plus gap, kept
+    where a sphere of half the spacing fits in the container; particles take random sites and a
+    random shift within their slack."""
+    d = container.dimension
+    spacing = 2 * radii.max() + gap
+    lower, upper = container.bounds()
+    if d == 2:
+        rows = np.arange(lower[1], upper[1] + spacing, spacing * np.sqrt(3) / 2)
+        columns = np.arange(lower[0], upper[0] + spacing, spacing)
+        sites = np.array(
+            [
+                (x + (0.5 * spacing if r % 2 else 0.0), y, 0.0)
+                for r, y in enumerate(rows)
+                for x in columns
+            ]
+        )
+    else:
+        a = spacing * np.sqrt(2)  # FCC cube edge; nearest neighbours at a / sqrt(2)
+        basis = np.array([[0, 0, 0], [0.5, 0.5, 0], [0.5, 0, 0.5], [0, 0.5, 0.5]]) * a
+        axes = [np.arange(lower[k], upper[k] + a, a) for k in range(3)]
+        corners = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
+        sites = (corners[:, None, :] + basis[None]).reshape(-1, 3)
+    sites = sites[container.signed_distance(sites) <= -(0.5 * spacing + gap)]
+    if len(sites) < len(radii):
+        raise InputError(
+            f"the container holds only {len(sites)} lattice sites of spacing {spacing:.4g} m "
+            f"for {len(radii)} particles; ask for fewer or smaller particles, or a larger container"
+        )
+    chosen = sites[rng.permutation(len(sites))[: len(radii)]]
+    slack = 0.5 * (spacing - gap) - radii  # moves that keep a gap to every other site
+    direction = rng.normal(size=(len(radii), d))
+    direction /= np.linalg.norm(direction, axis=1)[:, None]
+    shift = direction * (slack * rng.uniform(0, 1, len(radii)) ** (1 / d))[:, None]
+    chosen[:, :d] += shift
+    return chosen
+
+
+def grains_by_kind(grains: Sequence[Grain] | Mapping[int, Grain], kinds: ArrayLike) -> list[Grain]:
+    """The grain of each placement; every kind must have one."""
+    lookup = dict(enumerate(grains)) if isinstance(grains, Sequence) else dict(grains)
+    missing = sorted(set(np.unique(np.asarray(kinds)).tolist()) - set(lookup))
+    if missing:
+        raise InputError(
+            f"placements use zone(s) {missing} with no grain given; give a Grain for each zone"
+        )
+    return [lookup[int(k)] for k in np.asarray(kinds)]
