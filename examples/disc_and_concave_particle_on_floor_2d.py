@@ -1,10 +1,10 @@
-"""Example 4: a concave particle (a drum: two lobes joined by a neck, PeriDEM's drum2d shape)
-and a disc fall onto a floor and bounce, as in PeriDEM's two-particle-with-wall case.
+"""Example 4: a concave particle (PeriDEM's drum2d: a hexagon pinched to a neck) and a disc fall
+onto a floor and bounce, as in PeriDEM's two-particle-with-wall case.
 
     python examples/disc_and_concave_particle_on_floor_2d.py           # ~20 s
     python examples/disc_and_concave_particle_on_floor_2d.py --smoke   # seconds
 
-Steps: (1) material; (2) a drum-shaped polygon and a disc above a floor, the disc thrown
+Steps: (1) material; (2) a Drum2D and a disc above a floor, the disc thrown
 sideways; (3) gravity, contact with restitution 0.7 and friction 0.3; (4) run 60 ms with
 output (history.csv has the floor's force); (5) report the highest rebound of each particle.
 """
@@ -13,22 +13,7 @@ from __future__ import annotations
 
 import argparse
 
-import numpy as np
-
 import granulate as gr
-
-
-def drum(center: tuple[float, float], radius: float, neck: float, points: int = 40) -> gr.Polygon:
-    """Two lobes of a circle of the given radius, cut by a neck of half-width `neck`."""
-    cx, cy = center
-    angles = np.linspace(0, 2 * np.pi, points, endpoint=False)
-    vertices = []
-    for a in angles:
-        x, y = radius * np.cos(a), radius * np.sin(a)
-        if abs(x) < neck:  # pinch the waist: the concave neck
-            y *= 0.35
-        vertices.append((cx + x, cy + y))
-    return gr.Polygon(tuple(vertices))
 
 
 def main(argv: list[str] | None = None) -> dict[str, float]:
@@ -42,7 +27,7 @@ def main(argv: list[str] | None = None) -> dict[str, float]:
     h = 0.25e-3 if args.smoke else 0.1e-3
     sim = gr.Simulation(dimension=2, gravity=(0, -9.81))
     sim.contact = gr.Contact(restitution=0.7, friction=0.3)
-    concave = sim.add_body(drum((0.0, 3e-3), 2e-3, 0.8e-3), rubber, h, name="drum")
+    concave = sim.add_body(gr.Drum2D((0.0, 3e-3), 2e-3, 0.8e-3), rubber, h, name="drum")
     disc = sim.add_body(gr.Disc((4e-3, 6e-3), 1e-3), rubber, h, velocity=(-0.1, 0), name="disc")
     sim.add_wall(gr.Plane((0, 0), (0, 1)), name="floor")
     end = 5e-3 if args.smoke else 60e-3

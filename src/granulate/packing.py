@@ -347,13 +347,21 @@ class Packing(Placements):
     def summary(self) -> str:
         counts = np.bincount(self.kinds, minlength=len(self.grains))
         parts = ", ".join(
-            f"{c} x {type(g.shape).__name__}" for c, g in zip(counts, self.grains, strict=True)
+            f"{c} x {_label(g.shape)}" for c, g in zip(counts, self.grains, strict=True)
         )
         return (
             f"{len(self)} particles ({parts}); radius {self.radii.min():.4g} .. "
             f"{self.radii.max():.4g} m (mean {self.radii.mean():.4g}); packing fraction "
             f"{self.packing_fraction:.3f}"
         )
+
+
+def _label(shape: Shape | ReferenceShape) -> str:
+    sides = getattr(shape, "sides", None)
+    names = {3: "triangle", 4: "square", 6: "hexagon"}
+    if sides is not None:
+        return names.get(sides, f"{sides}-gon")
+    return type(shape).__name__
 
 
 def _grain_counts(
@@ -499,8 +507,10 @@ def _lattice_sites(
     spacing = 2 * radii.max() + gap
     lower, upper = container.bounds()
     if d == 2:
-        rows = np.arange(lower[1], upper[1] + spacing, spacing * np.sqrt(3) / 2)
-        columns = np.arange(lower[0], upper[0] + spacing, spacing)
+        # The first row and column (just over) half a spacing in, so that they fit in a box.
+        inset = 0.5 * spacing * (1 + 1e-6)
+        rows = np.arange(lower[1] + inset, upper[1], spacing * np.sqrt(3) / 2)
+        columns = np.arange(lower[0] + inset, upper[0], spacing)
         sites = np.array(
             [
                 (x + (0.5 * spacing if r % 2 else 0.0), y, 0.0)
@@ -511,7 +521,7 @@ def _lattice_sites(
     else:
         a = spacing * np.sqrt(2)  # FCC cube edge; nearest neighbours at a / sqrt(2)
         basis = np.array([[0, 0, 0], [0.5, 0.5, 0], [0.5, 0, 0.5], [0, 0.5, 0.5]]) * a
-        axes = [np.arange(lower[k], upper[k] + a, a) for k in range(3)]
+        axes = [np.arange(lower[k] + 0.5 * spacing * (1 + 1e-6), upper[k], a) for k in range(3)]
         corners = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
         sites = (corners[:, None, :] + basis[None]).reshape(-1, 3)
     sites = sites[container.signed_distance(sites) <= -(0.5 * spacing + gap)]
