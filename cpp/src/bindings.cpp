@@ -38,6 +38,95 @@ std::vector<index_t> to_vector(const Indices& nodes) {
   return std::vector<index_t>(nodes.data(), nodes.data() + nodes.shape(0));
 }
 
+/// A flat array of T from a dict entry (a checkpoint), copied; a missing or mistyped entry is an
+/// InputError naming it.
+template <class T>
+std::vector<T> entry(const nb::dict& data, const char* key) {
+  if (!data.contains(key)) throw InputError(std::string("the checkpoint has no '") + key + "' entry");
+  try {
+    auto array = nb::cast<nb::ndarray<const T, nb::ndim<1>, nb::c_contig, nb::device::cpu>>(data[key]);
+    return std::vector<T>(array.data(), array.data() + array.shape(0));
+  } catch (const nb::cast_error&) {
+    throw InputError(std::string("the checkpoint's '") + key + "' entry has the wrong type or shape");
+  }
+}
+
+template <class T>
+T scalar(const nb::dict& data, const char* key) {
+  if (!data.contains(key)) throw InputError(std::string("the checkpoint has no '") + key + "' entry");
+  try {
+    return nb::cast<T>(data[key]);
+  } catch (const nb::cast_error&) {
+    throw InputError(std::string("the checkpoint's '") + key + "' entry has the wrong type");
+  }
+}
+
+nb::dict checkpoint_dict(const Simulation& self) {
+  const State& s = self.state();
+  const ContactCheckpoint c = self.contact().checkpoint();
+  nb::dict d;
+  d["positions"] = copy_out(s.positions);
+  d["velocities"] = copy_out(s.velocities);
+  d["forces"] = copy_out(s.forces);
+  d["bond_intact"] = copy_out(s.bond_intact);
+  d["dilatation"] = copy_out(s.dilatation);
+  d["time"] = s.time;
+  d["step"] = s.step;
+  d["contact_built"] = c.built;
+  d["contact_positions_at_build"] = copy_out(c.positions_at_build);
+  d["contact_time_at_build"] = c.time_at_build;
+  d["contact_broken_at_build"] = c.broken_at_build;
+  d["contact_skin"] = c.skin;
+  std::vector<index_t> slots;
+  for (const auto& slot : c.slots) slots.insert(slots.end(), slot.begin(), slot.end());
+  d["contact_slots"] = copy_out(slots);
+  d["contact_particle_slot_count"] = c.particle_slot_count;
+  d["contact_slot_approach"] = copy_out(c.slot_approach);
+  d["contact_last_time"] = c.last_time;
+  d["contact_has_last_time"] = c.has_last_time;
+  d["contact_statistics"] =
+      copy_out(std::vector<std::uint64_t>{c.statistics.rebuilds, c.statistics.list_entries,
+                                          c.statistics.node_contacts, c.statistics.wall_contacts});
+  std::vector<real> reactions;
+  for (const auto& r : c.wall_reactions) reactions.insert(reactions.end(), r.begin(), r.end());
+  d["contact_wall_reactions"] = copy_out(reactions);
+  return d;
+}
+
+void restore_dict(Simulation& self, const nb::dict& d) {
+  State s;
+  s.positions = entry<real>(d, "positions");
+  s.velocities = entry<real>(d, "velocities");
+  s.forces = entry<real>(d, "forces");
+  s.bond_intact = entry<std::uint8_t>(d, "bond_intact");
+  s.dilatation = entry<real>(d, "dilatation");
+  s.time = scalar<real>(d, "time");
+  s.step = scalar<std::uint64_t>(d, "step");
+  ContactCheckpoint c;
+  c.built = scalar<bool>(d, "contact_built");
+  c.positions_at_build = entry<real>(d, "contact_positions_at_build");
+  c.time_at_build = scalar<real>(d, "contact_time_at_build");
+  c.broken_at_build = scalar<std::uint64_t>(d, "contact_broken_at_build");
+  c.skin = scalar<real>(d, "contact_skin");
+  const auto slots = entry<index_t>(d, "contact_slots");
+  if (slots.size() % 2) throw InputError("the checkpoint's contact slots are malformed");
+  for (std::size_t k = 0; k < slots.size(); k += 2) c.slots.push_back({slots[k], slots[k + 1]});
+  c.particle_slot_count = scalar<std::uint64_t>(d, "contact_particle_slot_count");
+  c.slot_approach = entry<real>(d, "contact_slot_approach");
+  c.last_time = scalar<real>(d, "contact_last_time");
+  c.has_last_time = scalar<bool>(d, "contact_has_last_time");
+  const auto statistics = entry<std::uint64_t>(d, "contact_statistics");
+  if (statistics.size() != 4) throw InputError("the checkpoint's contact statistics are malformed");
+  c.statistics = {statistics[0], statistics[1], statistics[2], statistics[3]};
+  const auto reactions = entry<real>(d, "contact_wall_reactions");
+  if (reactions.size() % 6) throw InputError("the checkpoint's wall reactions are malformed");
+  for (std::size_t k = 0; k < reactions.size(); k += 6) {
+    c.wall_reactions.push_back({reactions[k], reactions[k + 1], reactions[k + 2], reactions[k + 3],
+                                reactions[k + 4], reactions[k + 5]});
+  }
+  self.restore(s, c);
+}
+
 TimeFunction make_function(TimeFunction::Kind kind, real a, real b) {
   TimeFunction f;
   f.kind = kind;
@@ -172,6 +261,11 @@ NB_MODULE(_core, m) {
                      return view(const_cast<real*>(self.volumes().data()), self.node_count(), 0,
                                  nb::find(self));
                    })
+      .def_prop_ro("node_density",
+                   [](Model& self) {
+                     return view(const_cast<real*>(self.node_density().data()), self.node_count(), 0,
+                                 nb::find(self));
+                   })
       .def_prop_ro("node_particle",
                    [](Model& self) {
                      return view(const_cast<index_t*>(self.node_particle().data()), self.node_count(), 0,
@@ -270,6 +364,9 @@ NB_MODULE(_core, m) {
       .def_prop_rw(
           "step", [](const Simulation& self) { return self.state().step; },
           [](Simulation& self, std::uint64_t s) { self.state().step = s; })
+      .def("checkpoint", &checkpoint_dict,
+           "Everything a run needs to continue bit for bit: a dict of arrays (copies) and numbers.")
+      .def("restore", &restore_dict, "data"_a, "Continue from a dict made by checkpoint().")
       .def("set_body_acceleration", &Simulation::set_body_acceleration, "acceleration"_a)
       .def_prop_rw("viscous_damping", &Simulation::viscous_damping, &Simulation::set_viscous_damping)
       .def(

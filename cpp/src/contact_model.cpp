@@ -520,6 +520,48 @@ void ContactModel::rebuild(const Model& model, const State& state, std::uint64_t
   statistics_.list_entries = pair_partner_.size();
 }
 
+ContactCheckpoint ContactModel::checkpoint() const {
+  ContactCheckpoint c;
+  c.built = built_;
+  c.positions_at_build = positions_at_build_;
+  c.time_at_build = time_at_build_;
+  c.broken_at_build = broken_at_build_;
+  c.skin = skin_;
+  c.slots = slots_;
+  c.particle_slot_count = particle_slot_count_;
+  c.slot_approach = slot_approach_;
+  c.last_time = last_time_;
+  c.has_last_time = has_last_time_;
+  c.statistics = statistics_;
+  c.wall_reactions = wall_reactions_;
+  return c;
+}
+
+void ContactModel::restore(const Model& model, const State& state, const ContactCheckpoint& saved) {
+  if (saved.slot_approach.size() != saved.slots.size() || saved.particle_slot_count > saved.slots.size() ||
+      (saved.built && saved.positions_at_build.size() != 3 * static_cast<std::size_t>(model.node_count())) ||
+      saved.wall_reactions.size() != walls_.size()) {
+    throw InputError("the checkpoint's contact data do not match this model (nodes or walls differ)");
+  }
+  skin_ = saved.skin;
+  slots_ = saved.slots;
+  particle_slot_count_ = saved.particle_slot_count;
+  slot_approach_ = saved.slot_approach;
+  built_ = false;
+  if (saved.built) {
+    // Rebuild the lists from the positions and time they were built at: the same lists,
+    // and rebuild() carries each pair's collision history over from the restored slots.
+    State at_build = state;
+    at_build.positions = saved.positions_at_build;
+    at_build.time = saved.time_at_build;
+    rebuild(model, at_build, saved.broken_at_build);
+  }
+  last_time_ = saved.last_time;
+  has_last_time_ = saved.has_last_time;
+  statistics_ = saved.statistics;
+  wall_reactions_ = saved.wall_reactions;
+}
+
 void ContactModel::add_forces(const Model& model, State& state, std::uint64_t broken_bonds) {
   if (!active()) return;
   if (needs_rebuild(model, state, broken_bonds)) rebuild(model, state, broken_bonds);

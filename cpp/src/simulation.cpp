@@ -288,6 +288,19 @@ void Simulation::run(std::uint64_t steps) {
   }
 }
 
+void Simulation::restore(const State& state, const ContactCheckpoint& contact) {
+  const std::size_t n = 3 * static_cast<std::size_t>(model_->node_count());
+  if (state.positions.size() != n || state.velocities.size() != n || state.forces.size() != n ||
+      state.bond_intact.size() != model_->bond_count() || state.dilatation.size() != model_->node_count()) {
+    throw InputError("the checkpoint's state does not match this model (nodes or bonds differ)");
+  }
+  state_ = state;
+  broken_bond_copies_ = static_cast<std::uint64_t>(
+      std::count(state_.bond_intact.begin(), state_.bond_intact.end(), std::uint8_t{0}));
+  contact_.restore(*model_, state_, contact);
+  forces_current_ = true;
+}
+
 void Simulation::check_stability() const {
   const auto& v = state_.velocities;
   const auto& x = state_.positions;

@@ -10,7 +10,8 @@ a C++ core (OpenMP), set-up and output from Python.
     >>> body = sim.add_body(gr.Rectangle((0, 0), (0.05, 0.01)), rock, mesh_size=1e-3)
 """
 
-from granulate import _core, walls
+from granulate import _core, stopping, walls
+from granulate._version import __version__
 from granulate.contact import Contact
 from granulate.errors import GranulateWarning, InputError, InstabilityError
 from granulate.functions import (
@@ -55,7 +56,7 @@ from granulate.shapes import (
     conforming,
     lattice,
 )
-from granulate.simulation import FIELDS, Body, Simulation
+from granulate.simulation import FIELDS, Body, Progress, Simulation
 from granulate.walls import (
     BoxContainer,
     BoxObstacle,
@@ -69,8 +70,6 @@ from granulate.walls import (
     TriangleMesh,
     Wall,
 )
-
-__version__ = "0.1.0"
 
 
 def set_num_threads(threads: int) -> None:
@@ -114,6 +113,7 @@ __all__ = [
     "Polygon",
     "PolygonContainer",
     "PolygonObstacle",
+    "Progress",
     "Quadratic",
     "Rectangle",
     "ReferenceShape",
@@ -142,5 +142,6 @@ __all__ = [
     "read_mesh",
     "read_placements",
     "set_num_threads",
+    "stopping",
     "walls",
 ]

@@ -13,10 +13,13 @@ energies J per metre.
 
 from __future__ import annotations
 
+import io
 import json
+import signal
+import threading
 import time as wallclock
 import warnings
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Literal
@@ -25,13 +28,16 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from granulate import _core
+from granulate._version import __version__
 from granulate.contact import Contact
 from granulate.errors import GranulateWarning, InputError
 from granulate.functions import Constant, Linear, TimeFunction, VelocityRamp
 from granulate.io import HistoryWriter, PvdSeries, atomic_write, write_vtu
+from granulate.io import checkpoint as checkpoint_file
 from granulate.materials import Material
 from granulate.packing import Grain, Packing, Placements, grains_by_kind
 from granulate.shapes import ReferenceShape, Shape, rotation_matrix
+from granulate.stopping import StopCriterion
 from granulate.walls import Surface, Wall
 
 Components = str  # any of "x", "y", "z", e.g. "xy"
@@ -81,6 +87,26 @@ class Body:
 
 
 @dataclass
+class _Checkpointing:
+    path: Path
+    every_steps: int | None
+    every_seconds: float | None
+    last_wall_time: float = 0.0
+
+
+@dataclass(frozen=True)
+class Progress:
+    """What ``run(progress=...)`` reports after each chunk of steps."""
+
+    step: int
+    target_step: int
+    time: float
+    broken_bonds: int
+    steps_per_second: float
+    wall_seconds: float
+
+
+@dataclass
 class _Output:
     directory: Path
     every: int
@@ -88,6 +114,31 @@ class _Output:
     pvd: PvdSeries
     history: HistoryWriter | None = None
     frames: int = 0
+
+
+class _SignalCatcher:
+    """During a run, Ctrl-C (SIGINT) and SIGTERM only set ``caught``: the run finishes its
+    chunk of steps and stops cleanly. A second signal interrupts at once. Outside the main
+    thread (where handlers cannot be installed) nothing changes."""
+
+    def __init__(self) -> None:
+        self.caught = False
+        self._previous: dict[int, object] = {}
+
+    def _handle(self, number: int, frame: object) -> None:
+        if self.caught:
+            raise KeyboardInterrupt
+        self.caught = True
+
+    def __enter__(self) -> _SignalCatcher:
+        if threading.current_thread() is threading.main_thread():
+            for number in (signal.SIGINT, signal.SIGTERM):
+                self._previous[number] = signal.signal(number, self._handle)
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        for number, handler in self._previous.items():
+            signal.signal(number, handler)  # type: ignore[arg-type]
 
 
 def _component_mask(components: Components, dimension: int) -> int:
@@ -153,6 +204,9 @@ class Simulation:
         self._model: _core.Model | None = None
         self._reference: NDArray[np.float64] | None = None
         self._wall_seconds = 0.0
+        self._checkpoint: _Checkpointing | None = None
+        #: Extra text identifying the set-up (a case file's hash), checked by load_checkpoint.
+        self.case_fingerprint = ""
         if not (np.isfinite(viscous_damping) and viscous_damping >= 0):
             raise InputError(
                 f"viscous_damping must be a non-negative rate in 1/s, got {viscous_damping}"
@@ -574,10 +628,14 @@ class Simulation:
         *,
         fields: tuple[str, ...] = FIELDS,
         overwrite: bool = False,
+        resume: bool = False,
     ) -> None:
-        """Write VTU frames (``frames/``), ``simulation.pvd`` and ``history.csv`` every N steps.
+        """Write VTU frames (``frames/``), ``simulation.pvd``, ``history.csv`` and particle
+        snapshots (``frames/particles_*.csv``) every N steps.
 
-        A directory that already holds a run is refused unless ``overwrite`` is true.
+        A directory that already holds a run is refused unless ``overwrite`` is true (its
+        frames are then deleted) or ``resume`` is true (it is kept for ``load_checkpoint``,
+        which must follow).
         """
         if not (isinstance(every, int) and every > 0):
             raise InputError(f"output interval must be a positive number of steps, got {every!r}")
@@ -585,15 +643,18 @@ class Simulation:
         if unknown:
             raise InputError(f"unknown output fields {unknown}; choose from {', '.join(FIELDS)}")
         path = Path(directory)
-        if (path / "simulation.pvd").exists() and not overwrite:
+        if overwrite and resume:
+            raise InputError("overwrite and resume exclude each other")
+        if (path / "simulation.pvd").exists() and not (overwrite or resume):
             raise InputError(
                 f"{path} already holds a run (simulation.pvd); choose another directory or pass "
                 "overwrite=True"
             )
         (path / "frames").mkdir(parents=True, exist_ok=True)
         if overwrite:
-            for old in (path / "frames").glob("frame_*.vtu"):
-                old.unlink()
+            for pattern in ("frame_*.vtu", "particles_*.csv"):
+                for old in (path / "frames").glob(pattern):
+                    old.unlink()
         self._output = _Output(path, every, tuple(fields), PvdSeries(path / "simulation.pvd"))
 
     # ------------------------------------------------------------------ the core
@@ -731,11 +792,25 @@ class Simulation:
         """Stable time-step estimate [s] (Silling & Askari's bound, see Model::stable_time_step)."""
         return self._build().stable_time_step
 
-    def run(self, steps: int | None = None, *, until: float | None = None) -> None:
+    def run(
+        self,
+        steps: int | None = None,
+        *,
+        until: float | None = None,
+        stop: Sequence[StopCriterion] = (),
+        check_every: int = 100,
+        progress: Callable[[Progress], None] | None = None,
+    ) -> str | None:
         """Advance ``steps`` time steps, or until simulated time ``until`` [s].
 
-        Writes outputs at step 0 and every ``output(every=...)`` steps. Raises InstabilityError
-        if the integration blows up.
+        Writes outputs at step 0 and every ``output(every=...)`` steps, and checkpoints as set
+        by ``checkpoint_every``. ``stop`` criteria (granulate.stopping) are checked every
+        ``check_every`` steps; the run ends at the first one met and its reason is returned
+        (None when the run reached its last step). ``progress`` is called after each chunk of
+        steps (about every half second). Raises InstabilityError if the integration blows up.
+
+        Ctrl-C or SIGTERM during a run finishes the current chunk, writes a checkpoint (when
+        checkpoints or outputs are set) and raises KeyboardInterrupt; outputs stay intact.
         """
         core = self._build()
         if (steps is None) == (until is None):
@@ -747,22 +822,177 @@ class Simulation:
         assert steps is not None
         if steps < 0:
             raise InputError(f"steps must be non-negative, got {steps}")
+        if not (isinstance(check_every, int) and check_every > 0):
+            raise InputError(f"check_every must be a positive number of steps, got {check_every}")
         out = self._output
         if out is not None and out.frames == 0:
             self._write_output()
         target = core.step + steps
         start = wallclock.perf_counter()
+        chunk_limit = 10
+        signals = _SignalCatcher()
+        reason = None
         try:
-            while core.step < target:
-                chunk = min(target - core.step, 1000)
-                if out is not None:
-                    chunk = min(chunk, out.every - core.step % out.every)
-                core.run(chunk)
-                if out is not None and core.step % out.every == 0:
-                    self._write_output()
+            with signals:
+                while core.step < target and reason is None:
+                    boundaries = [target - core.step, chunk_limit]
+                    if out is not None:
+                        boundaries.append(out.every - core.step % out.every)
+                    if stop:
+                        boundaries.append(check_every - core.step % check_every)
+                    if self._checkpoint is not None and self._checkpoint.every_steps:
+                        every = self._checkpoint.every_steps
+                        boundaries.append(every - core.step % every)
+                    chunk = min(boundaries)
+                    began = wallclock.perf_counter()
+                    core.run(chunk)
+                    elapsed = wallclock.perf_counter() - began
+                    # Aim at chunks of about half a second: responsive to Ctrl-C and progress.
+                    rate = chunk / max(elapsed, 1e-9)
+                    chunk_limit = int(min(10_000, max(1, 0.5 * rate)))
+                    if out is not None and core.step % out.every == 0:
+                        self._write_output()
+                    if stop and core.step % check_every == 0:
+                        reason = next((r for c in stop if (r := c.check(self)) is not None), None)
+                    self._checkpoint_if_due()
+                    if progress is not None:
+                        progress(
+                            Progress(
+                                int(core.step),
+                                int(target),
+                                float(core.time),
+                                self.broken_bonds(),
+                                rate,
+                                self._wall_seconds + wallclock.perf_counter() - start,
+                            )
+                        )
+                    if signals.caught:
+                        saved = self._save_on_interrupt()
+                        where = f"; checkpoint written to {saved}" if saved else ""
+                        raise KeyboardInterrupt(f"interrupted at step {core.step}{where}")
         finally:
             self._wall_seconds += wallclock.perf_counter() - start
+        return reason
 
+    # ------------------------------------------------------------------ checkpoints
+    def checkpoint_every(
+        self,
+        steps: int | None = None,
+        *,
+        minutes: float | None = None,
+        path: str | Path | None = None,
+    ) -> None:
+        """Write a checkpoint every ``steps`` steps and/or every ``minutes`` of wall time, and on
+        Ctrl-C/SIGTERM, to ``path`` (default: ``checkpoint.npz`` in the output directory). Each
+        checkpoint replaces the last one atomically."""
+        if steps is not None and not (isinstance(steps, int) and steps > 0):
+            raise InputError(f"checkpoint interval must be a positive number of steps, got {steps}")
+        if minutes is not None and not (np.isfinite(minutes) and minutes > 0):
+            raise InputError(
+                f"checkpoint interval must be a positive number of minutes, got {minutes}"
+            )
+        if path is None:
+            if self._output is None:
+                raise InputError("give a checkpoint path, or set output(...) first")
+            path = self._output.directory / "checkpoint.npz"
+        self._checkpoint = _Checkpointing(
+            Path(path), steps, None if minutes is None else 60.0 * minutes, wallclock.perf_counter()
+        )
+
+    def _checkpoint_if_due(self) -> None:
+        plan = self._checkpoint
+        if plan is None:
+            return
+        step = self._build().step
+        due = bool(plan.every_steps) and step % plan.every_steps == 0  # type: ignore[operator]
+        now = wallclock.perf_counter()
+        due = due or (
+            plan.every_seconds is not None and now - plan.last_wall_time >= plan.every_seconds
+        )
+        if due:
+            self.save_checkpoint(plan.path)
+            plan.last_wall_time = now
+
+    def _save_on_interrupt(self) -> Path | None:
+        if self._checkpoint is not None:
+            path = self._checkpoint.path
+        elif self._output is not None:
+            path = self._output.directory / "checkpoint.npz"
+        else:
+            return None
+        self.save_checkpoint(path)
+        return path
+
+    def fingerprint(self) -> str:
+        """Identifies the set-up a checkpoint belongs to: nodes, volumes, bonds, time step,
+        body force, damping, loading, walls, contact, and ``case_fingerprint``."""
+        core = self._build()
+        model = self.model
+        loads = []
+        for kind, args in self._loads:
+            loads.append(kind)
+            for a in args:
+                loads.append(np.asarray(a).tobytes() if isinstance(a, np.ndarray) else repr(a))
+        return checkpoint_file.fingerprint(
+            np.ascontiguousarray(model.reference_positions).tobytes(),
+            np.ascontiguousarray(model.volumes).tobytes(),
+            np.ascontiguousarray(model.bond_offsets).tobytes(),
+            float(core.time_step),
+            repr(self.gravity.tolist()),
+            self._viscous_damping,
+            *loads,
+            repr(self._walls),
+            repr(self._contact),
+            repr(sorted((k, repr(v)) for k, v in self._pair_contacts.items())),
+            self.case_fingerprint,
+        )
+
+    def save_checkpoint(self, path: str | Path) -> Path:
+        """Write the state (positions, velocities, forces, bond states, contact history, time,
+        step) and the output bookkeeping to ``path`` atomically."""
+        core = self._build()
+        out = self._output
+        header = {
+            "granulate": __version__,
+            "fingerprint": self.fingerprint(),
+            "step": int(core.step),
+            "time": float(core.time),
+            "output": None
+            if out is None
+            else {"frames": out.frames, "every": out.every, "pvd": out.pvd.entries},
+        }
+        target = Path(path)
+        target.parent.mkdir(parents=True, exist_ok=True)
+        checkpoint_file.save(target, core.checkpoint(), header)
+        return target
+
+    def load_checkpoint(self, path: str | Path) -> None:
+        """Continue from a checkpoint of this same set-up (else InputError): restores the state
+        and, when outputs are set, the frame count, the PVD series and history.csv up to the
+        checkpoint's step, so that the outputs that follow are those of an uninterrupted run."""
+        core = self._build()
+        state, header = checkpoint_file.load(path)
+        if header.get("fingerprint") != self.fingerprint():
+            raise InputError(
+                f"checkpoint {path} belongs to a different set-up (other nodes, loading, walls, "
+                "time step or case file); run without --resume, or restore the original case"
+            )
+        core.restore(state)
+        out = self._output
+        saved = header.get("output")
+        if out is not None:
+            if saved is None or saved["every"] != out.every:
+                raise InputError(
+                    f"checkpoint {path} was written with other output settings; keep the "
+                    "output interval of the original run"
+                )
+            out.frames = int(saved["frames"])
+            out.pvd.entries = [(float(t), str(f)) for t, f in saved["pvd"]]
+            history = out.directory / "history.csv"
+            if history.exists():
+                out.history = HistoryWriter.resume(history, int(core.step))
+
+    # ------------------------------------------------------------------ results
     # ------------------------------------------------------------------ results
     @property
     def positions(self) -> NDArray[np.float64]:
@@ -821,6 +1051,27 @@ class Simulation:
     def broken_bonds(self) -> int:
         """Number of broken bonds, each counted once."""
         return self._build().broken_bonds()
+
+    def wall_displacement(self, name: str) -> float:
+        """Distance the named wall has moved (translation) or angle it has turned [m or rad]."""
+        core = self._build()
+        for (label, _), wall in zip(self._walls, core.walls, strict=True):
+            if label == name:
+                return float(wall.displacement(core.time))
+        names = ", ".join(label for label, _ in self._walls) or "none"
+        raise InputError(f"no wall named {name!r}; walls: {names}")
+
+    def fully_broken_particles(self) -> int:
+        """Number of particles none of whose bonds is intact (with at least one bond)."""
+        model = self.model
+        intact = np.asarray(self._build().bond_intact)
+        offsets = np.asarray(model.bond_offsets)
+        count = 0
+        for body in self.bodies:
+            begin, end = offsets[body.first_node], offsets[body.first_node + body.node_count]
+            if end > begin and not intact[begin:end].any():
+                count += 1
+        return count
 
     def precrack(self, point: ArrayLike, normal: ArrayLike, *, region: Shape | None = None) -> int:
         """Break the bonds that cross the plane through ``point`` with ``normal`` (in the reference
@@ -892,6 +1143,29 @@ class Simulation:
             "neighbor_list_rebuilds": core.contact_statistics.rebuilds,
         }
 
+    def _write_particles(self, path: Path, damage: NDArray[np.float64]) -> None:
+        """One row per particle: centre of mass [m], its velocity [m/s], mass [kg; kg/m in
+        2D], volume-weighted mean damage."""
+        model = self.model
+        core = self._build()
+        owner = np.asarray(model.node_particle)
+        count = len(self.bodies)
+        mass = np.asarray(model.node_density) * np.asarray(model.volumes)
+        total = np.bincount(owner, mass, count)
+        columns = [np.arange(count)]
+        for array in (core.positions, core.velocities):
+            for k in range(3):
+                columns.append(np.bincount(owner, mass * array[:, k], count) / total)
+        columns.append(total)
+        volumes = np.asarray(model.volumes)
+        columns.append(
+            np.bincount(owner, volumes * damage, count) / np.bincount(owner, volumes, count)
+        )
+        buffer = io.StringIO()
+        buffer.write("particle,x,y,z,vx,vy,vz,mass,damage\n")
+        np.savetxt(buffer, np.column_stack(columns), delimiter=",", fmt=["%d"] + ["%.17g"] * 8)
+        atomic_write(path, buffer.getvalue().encode())
+
     def _write_output(self) -> None:
         out = self._output
         assert out is not None and self._model is not None
@@ -917,6 +1191,7 @@ class Simulation:
             {field: available[field]() for field in out.fields},
         )
         out.pvd.add(core.time, Path("frames") / name)
+        self._write_particles(out.directory / "frames" / f"particles_{out.frames:06d}.csv", phi)
         kinetic, strain = core.kinetic_energy(), core.strain_energy()
         statistics = core.contact_statistics
         row: dict[str, float | int] = {

@@ -74,6 +74,11 @@ class Simulation {
   std::vector<std::uint8_t> fixity() const;
   const PhaseTimes& phase_times() const { return phase_times_; }
 
+  /// Continues a run bit for bit from a checkpoint: the state (with the forces of its last
+  /// step) and the contact model's history. The model, loading and walls must be the ones the
+  /// checkpoint was taken with (the caller checks; sizes are checked here).
+  void restore(const State& state, const ContactCheckpoint& contact);
+
  private:
   void apply_prescribed_motion(bool positions_too);
   void check_stability() const;

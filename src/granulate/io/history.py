@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import csv
+import io
 import os
 from collections.abc import Mapping, Sequence
 from pathlib import Path
@@ -18,6 +19,31 @@ class HistoryWriter:
         self._writer = csv.writer(self._handle)
         self._writer.writerow(self.columns)
         self._handle.flush()
+
+    @classmethod
+    def resume(cls, path: str | os.PathLike[str], last_step: int) -> HistoryWriter:
+        """Reopen a history for appending, keeping its rows up to ``last_step`` (a run resumed
+        from a checkpoint rewrites the rows after it)."""
+        from granulate.io.atomic import atomic_write
+
+        target = Path(path)
+        with target.open(newline="") as handle:
+            rows = list(csv.reader(handle))
+        if not rows or "step" not in rows[0]:
+            raise ValueError(f"{target} is not a history file")
+        column = rows[0].index("step")
+        kept = [rows[0]] + [
+            r for r in rows[1:] if len(r) == len(rows[0]) and int(r[column]) <= last_step
+        ]
+        buffer = io.StringIO()
+        csv.writer(buffer).writerows(kept)
+        atomic_write(target, buffer.getvalue().encode())
+        writer = cls.__new__(cls)
+        writer.path = target
+        writer.columns = list(rows[0])
+        writer._handle = target.open("a", newline="")
+        writer._writer = csv.writer(writer._handle)
+        return writer
 
     def write(self, row: Mapping[str, float | int]) -> None:
         self._writer.writerow(

@@ -21,6 +21,24 @@ struct ContactStatistics {
   std::uint64_t wall_contacts = 0;  ///< node-wall contacts at the last evaluation
 };
 
+/// What a checkpoint needs of the contact model to continue bit for bit: the state the lists
+/// were built from (they are rebuilt from it on restore) and the collision history of each
+/// pair of bodies.
+struct ContactCheckpoint {
+  bool built = false;
+  std::vector<real> positions_at_build;
+  real time_at_build = 0;
+  std::uint64_t broken_at_build = 0;
+  real skin = -1;
+  std::vector<std::array<index_t, 2>> slots;
+  std::uint64_t particle_slot_count = 0;
+  std::vector<real> slot_approach;
+  real last_time = 0;
+  bool has_last_time = false;
+  ContactStatistics statistics;
+  std::vector<std::array<real, 6>> wall_reactions;
+};
+
 class ContactModel {
  public:
   /// Sizes the law tables for the model's materials (no contact until laws are set).
@@ -53,6 +71,11 @@ class ContactModel {
   /// [N, N m; per unit thickness in 2D], from the last evaluation.
   const std::vector<std::array<real, 6>>& wall_reactions() const { return wall_reactions_; }
   const ContactStatistics& statistics() const { return statistics_; }
+
+  ContactCheckpoint checkpoint() const;
+  /// Restores a checkpoint taken with the same model, laws and walls; `state` is the restored
+  /// state (its bond states are those the lists were built with).
+  void restore(const Model& model, const State& state, const ContactCheckpoint& saved);
 
  private:
   bool needs_rebuild(const Model& model, const State& state, std::uint64_t broken_bonds) const;

@@ -1,0 +1,79 @@
+"""Checkpoint files: everything a run needs to continue bit for bit.
+
+A checkpoint is a NumPy .npz archive (zip, CRC-checked members) written atomically, holding
+the core's state and contact history (``_core.Simulation.checkpoint()``) and a JSON header:
+format version, granulate version, the model fingerprint, step, time, and the state of the
+outputs (frames written, PVD entries). A checkpoint is only loaded into a simulation with the
+same fingerprint (same nodes, volumes, bonds, time step, loading and walls).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import io
+import json
+import zipfile
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from granulate.errors import InputError
+from granulate.io.atomic import atomic_write
+
+FORMAT = 1
+HEADER = "__header__"
+
+
+def save(path: str | Path, state: dict[str, Any], header: dict[str, Any]) -> None:
+    """Write the core's checkpoint dict and a JSON header to ``path`` atomically."""
+    arrays = {k: np.asarray(v) for k, v in state.items()}
+    arrays[HEADER] = np.frombuffer(json.dumps({"format": FORMAT, **header}).encode(), np.uint8)
+    buffer = io.BytesIO()
+    np.savez(buffer, **arrays)
+    atomic_write(Path(path), buffer.getvalue())
+
+
+def load(path: str | Path) -> tuple[dict[str, Any], dict[str, Any]]:
+    """Read a checkpoint: (state dict for the core, header). Refuses missing, corrupted or
+    foreign files with one clear InputError."""
+    file = Path(path)
+    if not file.is_file():
+        raise InputError(f"checkpoint {file} does not exist; run without --resume to start over")
+    try:
+        with np.load(file, allow_pickle=False) as archive:
+            data = {name: archive[name] for name in archive.files}
+        header = json.loads(bytes(data.pop(HEADER)).decode())
+    except (
+        zipfile.BadZipFile,
+        ValueError,
+        KeyError,
+        OSError,
+        EOFError,
+        UnicodeDecodeError,
+    ) as error:
+        raise InputError(
+            f"checkpoint {file} is corrupted or not a granulate checkpoint ({error}); remove it "
+            "and run without --resume"
+        ) from None
+    if header.get("format") != FORMAT:
+        raise InputError(
+            f"checkpoint {file} has format {header.get('format')!r}; this granulate reads "
+            f"format {FORMAT}"
+        )
+    state: dict[str, Any] = {}
+    for name, value in data.items():
+        state[name] = value.item() if value.ndim == 0 else np.ascontiguousarray(value).reshape(-1)
+    return state, header
+
+
+def fingerprint(*parts: bytes | str | float | int) -> str:
+    """SHA-256 of the parts, in order."""
+    digest = hashlib.sha256()
+    for part in parts:
+        if isinstance(part, bytes):
+            digest.update(part)
+        else:
+            digest.update(repr(part).encode())
+        digest.update(b"\0")
+    return digest.hexdigest()

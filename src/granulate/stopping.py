@@ -1,0 +1,92 @@
+"""Stop criteria: conditions that end a run cleanly before its last step.
+
+Pass them to ``Simulation.run(..., stop=[...])``; they are checked every ``check_every`` steps
+(a fixed step interval, so a resumed run stops at the same step). ``run`` returns the reason
+of the first one met, or None when it ran to the end.
+
+- ``KineticEnergyBelow(energy, after=0)``: total kinetic energy below ``energy`` [J; J/m in
+  2D], once the simulated time is past ``after`` [s] (a settled pile).
+- ``WallDisplacement(wall, distance)``: the wall has moved at least ``distance`` [m].
+- ``ParticlesBroken(count)``: at least ``count`` particles have lost every bond.
+- ``BrokenBonds(count)``: at least ``count`` bonds are broken.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from granulate.errors import InputError
+
+if TYPE_CHECKING:
+    from granulate.simulation import Simulation
+
+
+class StopCriterion:
+    def check(self, sim: Simulation) -> str | None:
+        """The reason to stop, or None."""
+        raise NotImplementedError
+
+
+@dataclass(frozen=True)
+class KineticEnergyBelow(StopCriterion):
+    energy: float
+    after: float = 0.0
+
+    def __post_init__(self) -> None:
+        if not (self.energy > 0 and np.isfinite(self.energy)):
+            raise InputError(f"KineticEnergyBelow needs a positive energy, got {self.energy}")
+
+    def check(self, sim: Simulation) -> str | None:
+        if sim.time < self.after:
+            return None
+        energy = sim.kinetic_energy()
+        return (
+            f"kinetic energy {energy:.4g} below {self.energy:.4g}" if energy < self.energy else None
+        )
+
+
+@dataclass(frozen=True)
+class WallDisplacement(StopCriterion):
+    wall: str
+    distance: float
+
+    def __post_init__(self) -> None:
+        if not (self.distance > 0 and np.isfinite(self.distance)):
+            raise InputError(f"WallDisplacement needs a positive distance, got {self.distance}")
+
+    def check(self, sim: Simulation) -> str | None:
+        moved = sim.wall_displacement(self.wall)
+        if moved >= self.distance:
+            return f"wall {self.wall!r} moved {moved:.4g} m (limit {self.distance:.4g} m)"
+        return None
+
+
+@dataclass(frozen=True)
+class ParticlesBroken(StopCriterion):
+    count: int
+
+    def __post_init__(self) -> None:
+        if not (isinstance(self.count, int) and self.count > 0):
+            raise InputError(f"ParticlesBroken needs a positive count, got {self.count!r}")
+
+    def check(self, sim: Simulation) -> str | None:
+        broken = sim.fully_broken_particles()
+        if broken >= self.count:
+            return f"{broken} particles have lost every bond (limit {self.count})"
+        return None
+
+
+@dataclass(frozen=True)
+class BrokenBonds(StopCriterion):
+    count: int
+
+    def __post_init__(self) -> None:
+        if not (isinstance(self.count, int) and self.count > 0):
+            raise InputError(f"BrokenBonds needs a positive count, got {self.count!r}")
+
+    def check(self, sim: Simulation) -> str | None:
+        broken = sim.broken_bonds()
+        return f"{broken} bonds broken (limit {self.count})" if broken >= self.count else None

@@ -1,0 +1,151 @@
+"""Checkpoints and resume: a resumed run writes the same bits as an uninterrupted one; an
+interrupt leaves a usable checkpoint and intact outputs; bad checkpoints are refused; stop
+criteria end runs cleanly."""
+
+from __future__ import annotations
+
+import filecmp
+import os
+import signal
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import granulate as gr
+
+
+def tumbling_drum(out: Path, *, resume: bool = False) -> gr.Simulation:
+    """Grains breaking in a rotating drum: contact, friction, damping, walls and fracture."""
+    rock = gr.Material(density=2000, youngs_modulus=1e8, poisson_ratio=0.25, fracture_energy=0.5)
+    sim = gr.Simulation(2, gravity=(0, -9.81))
+    sim.contact = gr.Contact(restitution=0.5, friction=0.4)
+    for k, (x, y) in enumerate([(-3e-3, -2e-3), (0, -4e-3), (3e-3, -2e-3), (0, 0)]):
+        shape = (
+            gr.Disc((x, y), 1.2e-3)
+            if k < 3
+            else gr.Polygon(((-1e-3, -1e-3), (1.2e-3, -1e-3), (0, 1.3e-3)))
+        )
+        sim.add_body(shape, rock, 0.3e-3, velocity=(0.2 * k - 0.3, -4.0))
+    lifter = gr.PolygonObstacle(((-1e-3, -7.5e-3), (1e-3, -7.5e-3), (0, -5.5e-3)))
+    drum = gr.Wall((gr.CircleContainer((0, 0), 7e-3), lifter), motion=gr.Rotation.steady(30.0))
+    sim.add_wall(drum, name="drum")
+    sim.output(out, every=250, overwrite=not resume, resume=resume)
+    sim.checkpoint_every(1000)
+    return sim
+
+
+def output_files(directory: Path) -> list[str]:
+    return sorted(
+        str(p.relative_to(directory))
+        for p in directory.rglob("*")
+        if p.is_file() and p.name not in ("run.json", "checkpoint.npz")
+    )
+
+
+def assert_same_outputs(a: Path, b: Path) -> None:
+    files = output_files(a)
+    assert files == output_files(b)
+    assert len(files) > 20
+    different = [f for f in files if not filecmp.cmp(a / f, b / f, shallow=False)]
+    assert not different, f"files differ after resuming: {different}"
+
+
+def test_resumed_run_writes_the_same_bits_as_an_uninterrupted_one(tmp_path: Path) -> None:
+    whole = tumbling_drum(tmp_path / "whole")
+    whole.run(3000)
+    assert whole.broken_bonds() > 0  # the run exercises fracture and fragments
+    first = tumbling_drum(tmp_path / "split")
+    first.run(2300)  # the last checkpoint is at step 2000; later outputs get rewritten
+    second = tumbling_drum(tmp_path / "split", resume=True)
+    second.load_checkpoint(tmp_path / "split" / "checkpoint.npz")
+    assert second.step == 2000
+    second.run(1000)
+    assert_same_outputs(tmp_path / "whole", tmp_path / "split")
+    for name in ("positions", "velocities", "forces"):
+        np.testing.assert_array_equal(getattr(whole, name), getattr(second, name))
+    np.testing.assert_array_equal(whole.core.bond_intact, second.core.bond_intact)
+    assert whole.core.contact_statistics.rebuilds == second.core.contact_statistics.rebuilds
+
+
+def test_an_interrupt_leaves_a_checkpoint_and_intact_outputs(tmp_path: Path) -> None:
+    whole = tumbling_drum(tmp_path / "whole")
+    whole.run(3000)
+    sim = tumbling_drum(tmp_path / "cut")
+
+    def interrupt(progress: gr.Progress) -> None:
+        if progress.step >= 1300:
+            os.kill(os.getpid(), signal.SIGINT)
+
+    with pytest.raises(KeyboardInterrupt, match="checkpoint written"):
+        sim.run(3000, progress=interrupt)
+    stopped = sim.step
+    assert 1300 <= stopped < 3000
+    history = (tmp_path / "cut" / "history.csv").read_text().splitlines()
+    assert int(history[-1].split(",")[0]) <= stopped  # every row whole, none past the stop
+    resumed = tumbling_drum(tmp_path / "cut", resume=True)
+    resumed.load_checkpoint(tmp_path / "cut" / "checkpoint.npz")
+    assert resumed.step == stopped
+    resumed.run(3000 - stopped)
+    assert_same_outputs(tmp_path / "whole", tmp_path / "cut")
+
+
+def test_mismatched_and_corrupted_checkpoints_are_refused(tmp_path: Path) -> None:
+    sim = tumbling_drum(tmp_path / "a")
+    sim.run(1000)
+    checkpoint = tmp_path / "a" / "checkpoint.npz"
+    other = gr.Simulation(2)
+    other.add_body(
+        gr.Disc((0, 0), 1e-3),
+        gr.Material(density=1, bulk_modulus=1, shear_modulus=1, fracture=False),
+        0.25e-3,
+    )
+    with pytest.raises(gr.InputError, match="different set-up"):
+        other.load_checkpoint(checkpoint)
+    changed = tumbling_drum(tmp_path / "b")
+    changed.gravity = (0, -5.0)
+    with pytest.raises(gr.InputError, match="different set-up"):
+        changed.load_checkpoint(checkpoint)
+    broken = tmp_path / "broken.npz"
+    data = bytearray(checkpoint.read_bytes())
+    data[len(data) // 2 : len(data) // 2 + 64] = bytes(64)
+    broken.write_bytes(bytes(data))
+    with pytest.raises(gr.InputError, match="corrupted"):
+        tumbling_drum(tmp_path / "c").load_checkpoint(broken)
+    (tmp_path / "text.npz").write_text("not a checkpoint")
+    with pytest.raises(gr.InputError, match="corrupted"):
+        tumbling_drum(tmp_path / "d").load_checkpoint(tmp_path / "text.npz")
+    with pytest.raises(gr.InputError, match="does not exist"):
+        tumbling_drum(tmp_path / "e").load_checkpoint(tmp_path / "missing.npz")
+
+
+def test_stop_criteria_end_the_run_at_a_fixed_step(tmp_path: Path) -> None:
+    sim = tumbling_drum(tmp_path / "a")
+    reason = sim.run(3000, stop=[gr.stopping.BrokenBonds(20)], check_every=50)
+    assert reason is not None and "bonds broken" in reason
+    assert sim.step % 50 == 0 and sim.step < 3000
+    again = tumbling_drum(tmp_path / "b")
+    again.run(3000, stop=[gr.stopping.BrokenBonds(20)], check_every=50)
+    assert again.step == sim.step
+
+    piston = gr.Simulation(2)
+    piston.add_body(
+        gr.Disc((0, 0), 1e-3),
+        gr.Material(density=1000, youngs_modulus=1e7, poisson_ratio=0.25, fracture=False),
+        0.25e-3,
+    )
+    piston.add_wall(
+        gr.Wall((gr.Plane((0, 3e-3), (0, -1)),), motion=gr.Translation((0, -1), gr.Linear(1.0))),
+        name="top",
+    )
+    reason = piston.run(100_000, stop=[gr.stopping.WallDisplacement("top", 1e-3)], check_every=10)
+    assert reason is not None and "top" in reason
+    assert piston.wall_displacement("top") == pytest.approx(1e-3, rel=0.05)
+    settled = gr.Simulation(2)
+    settled.add_body(
+        gr.Disc((0, 0), 1e-3),
+        gr.Material(density=1000, youngs_modulus=1e7, poisson_ratio=0.25, fracture=False),
+        0.25e-3,
+    )
+    assert settled.run(500, stop=[gr.stopping.KineticEnergyBelow(1e-12)]) is not None
+    assert settled.step == 100
