@@ -184,3 +184,22 @@ def test_contact_time_step_bound_matches_brute_force_over_particle_pairs(dimensi
         s = max(s, kn(a, a, p, p) * vmax[p])  # the floor (default law)
         dt = min(dt, np.sqrt(2 * a.material.density / (2 * partners * s)))
     assert core.contact_stable_time_step == pytest.approx(dt, rel=1e-12)
+
+
+def test_particles_outside_their_container_or_overlapping_are_refused() -> None:
+    sim = gr.Simulation(2)
+    sim.add_body(gr.Disc((0, 0), 1e-3), SOFT, 0.25e-3, name="pebble")
+    sim.add_wall(gr.BoxContainer((0.5e-3, -5e-3), (5e-3, 5e-3)), name="box")
+    with pytest.raises(gr.InputError, match="pebble starts on the wrong side of wall 'box'"):
+        sim.run(1)
+    overlapping = gr.Simulation(2)
+    overlapping.add_body(gr.Disc((0, 0), 1e-3), SOFT, 0.25e-3, name="a")
+    overlapping.add_body(gr.Disc((1.5e-3, 0), 1e-3), SOFT, 0.25e-3, name="b")
+    with pytest.raises(gr.InputError, match="a and b overlap at the start"):
+        overlapping.run(1)
+    overlapping.contact = None  # bodies that do not interact may overlap
+    overlapping.run(1)
+    touching = gr.Simulation(2)  # a gap of one mesh size is fine
+    touching.add_body(gr.Disc((0, 0), 1e-3), SOFT, 0.25e-3)
+    touching.add_body(gr.Disc((2.25e-3, 0), 1e-3), SOFT, 0.25e-3)
+    touching.run(1)

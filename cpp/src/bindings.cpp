@@ -364,6 +364,16 @@ NB_MODULE(_core, m) {
       .def_prop_rw(
           "step", [](const Simulation& self) { return self.state().step; },
           [](Simulation& self, std::uint64_t s) { self.state().step = s; })
+      .def("first_wall_penetration",
+           [](const Simulation& self) {
+             return self.contact().first_wall_penetration(self.model(), self.state());
+           })
+      .def(
+          "first_overlap",
+          [](const Simulation& self, real fraction) {
+            return self.contact().first_overlap(self.model(), self.state(), fraction);
+          },
+          "fraction"_a)
       .def("checkpoint", &checkpoint_dict,
            "Everything a run needs to continue bit for bit: a dict of arrays (copies) and numbers.")
       .def("restore", &restore_dict, "data"_a, "Continue from a dict made by checkpoint().")

@@ -520,6 +520,48 @@ void ContactModel::rebuild(const Model& model, const State& state, std::uint64_t
   statistics_.list_entries = pair_partner_.size();
 }
 
+std::array<index_t, 2> ContactModel::first_wall_penetration(const Model& model, const State& state) const {
+  std::vector<WallContact> found;
+  for (index_t i = 0; i < model.node_count(); ++i) {
+    for (std::size_t w = 0; w < walls_.size(); ++w) {
+      if (!wall_law_set_[w * material_count_ + model.node_material()[i]]) continue;
+      const auto p = walls_[w].to_reference(&state.positions[3 * i], state.time);
+      for (std::size_t s = 0; s < walls_[w].surfaces.size(); ++s) {
+        found.clear();
+        walls_[w].contacts(s, p, 0.0, dimension_, found);
+        for (const WallContact& c : found) {
+          if (c.distance < 0) return {i, static_cast<index_t>(w)};
+        }
+      }
+    }
+  }
+  return {model.node_count(), 0};
+}
+
+std::array<index_t, 2> ContactModel::first_overlap(const Model& model, const State& state,
+                                                   real fraction) const {
+  const index_t n = model.node_count();
+  if (!any_law_ || n == 0) return {n, n};
+  real finest = std::numeric_limits<real>::infinity();
+  for (const Particle& p : model.particles()) finest = std::min(finest, p.mesh_size);
+  const real radius = fraction * finest;
+  const CellGrid grid = CellGrid::build(state.positions, 0, n, radius);
+  const auto& owner = model.node_particle();
+  for (index_t i = 0; i < n; ++i) {
+    index_t hit = n;
+    grid.for_each_within(state.positions, i, radius, dimension_, [&](index_t j, real r2) {
+      if (hit != n || owner[j] == owner[i]) return;
+      const index_t a = model.node_material()[i], b = model.node_material()[j];
+      if (!law_set_[a * material_count_ + b]) return;
+      const real limit =
+          fraction * std::min(model.particles()[owner[i]].mesh_size, model.particles()[owner[j]].mesh_size);
+      if (r2 < limit * limit) hit = j;
+    });
+    if (hit != n) return {i, hit};
+  }
+  return {n, n};
+}
+
 ContactCheckpoint ContactModel::checkpoint() const {
   ContactCheckpoint c;
   c.built = built_;

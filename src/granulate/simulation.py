@@ -205,6 +205,8 @@ class Simulation:
         self._reference: NDArray[np.float64] | None = None
         self._wall_seconds = 0.0
         self._checkpoint: _Checkpointing | None = None
+        #: Packings added with add_packing (for summaries).
+        self.packings: list[Packing] = []
         #: Extra text identifying the set-up (a case file's hash), checked by load_checkpoint.
         self.case_fingerprint = ""
         if not (np.isfinite(viscous_damping) and viscous_damping >= 0):
@@ -342,7 +344,9 @@ class Simulation:
 
     def add_packing(self, packing: Packing, *, velocity: ArrayLike | None = None) -> list[Body]:
         """Add the particles of a generated packing (``granulate.pack``)."""
-        return self.add_placements(packing, packing.grains, velocity=velocity)
+        bodies = self.add_placements(packing, packing.grains, velocity=velocity)
+        self.packings.append(packing)
+        return bodies
 
     def add_body_from_nodes(
         self,
@@ -691,6 +695,7 @@ class Simulation:
         model.finalize()
         core = _core.Simulation(model)
         self._set_contact_laws(core, core_materials)
+        self._check_start(model, core)
         if self._dt is None:
             core.time_step = self._dt_safety * core.stable_time_step
         else:
@@ -727,6 +732,28 @@ class Simulation:
         self._core = core
         self._reference = model.reference_positions
         return core
+
+    def _check_start(self, model: _core.Model, core: _core.Simulation) -> None:
+        """Refuse particles that start outside their container (inside an obstacle) or
+        overlapping each other by more than half a mesh size."""
+        owner = model.node_particle
+        node, wall = core.first_wall_penetration()
+        if node < model.node_count:
+            body = self.bodies[owner[node]]
+            where = ", ".join(f"{c:.4g}" for c in model.reference_positions[node][: self.dimension])
+            raise InputError(
+                f"{body.name} starts on the wrong side of wall {self._walls[wall][0]!r} (its "
+                f"node {node} at ({where})); place it inside the container, or outside the "
+                "obstacle"
+            )
+        i, j = core.first_overlap(0.5)
+        if i < model.node_count:
+            a, b = self.bodies[owner[i]], self.bodies[owner[j]]
+            raise InputError(
+                f"{a.name} and {b.name} overlap at the start (nodes {i} and {j} are closer than "
+                "half a mesh size); move them apart, or generate the assembly with "
+                "granulate.pack, which never overlaps"
+            )
 
     @staticmethod
     def _law(contact: Contact) -> _core.ContactLaw:

@@ -72,6 +72,13 @@ class ContactModel {
   const std::vector<std::array<real, 6>>& wall_reactions() const { return wall_reactions_; }
   const ContactStatistics& statistics() const { return statistics_; }
 
+  /// Set-up checks. The first node (and wall) with a node on the wrong side of a wall surface
+  /// (a particle placed outside its container, or inside an obstacle); {node count, 0} if none.
+  std::array<index_t, 2> first_wall_penetration(const Model& model, const State& state) const;
+  /// The first pair of nodes of different particles (with a contact law between them) closer
+  /// than `fraction` times the finer mesh size: overlapping particles; {n, n} if none.
+  std::array<index_t, 2> first_overlap(const Model& model, const State& state, real fraction) const;
+
   ContactCheckpoint checkpoint() const;
   /// Restores a checkpoint taken with the same model, laws and walls; `state` is the restored
   /// state (its bond states are those the lists were built with).

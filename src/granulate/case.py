@@ -1,0 +1,1180 @@
+"""YAML case files: a whole simulation described as data, mapping one-to-one onto the Python API.
+
+    granulate check case.yaml          # validate and summarise
+    granulate run case.yaml            # run it
+    granulate schema                   # the reference of every key (units included)
+
+A case is validated up front (pydantic): an error names the key path, what was expected, what
+was found, and for a misspelt key the closest valid one. File paths (meshes, STL surfaces,
+placement CSVs) are relative to the case file's folder. SI units throughout. Example::
+
+    dimension: 2
+    materials:
+      rock: {density: 2600, youngs_modulus: 5.0e+9, poisson_ratio: 0.25, fracture_energy: 20}
+    grains:
+      pebble: {shape: {type: disc, radius: 1.0e-3}, material: rock, mesh_size: 2.0e-4,
+               sizes: {distribution: uniform, low: 0.8e-3, high: 1.2e-3}}
+    packings:
+      - {container: {type: rectangle, lower: [0, 0], upper: [0.02, 0.02]}, grains: [pebble],
+         count: 40, seed: 1}
+    walls:
+      - {name: box, surfaces: [{type: container, shape: {type: rectangle, lower: [0, 0],
+                                                         upper: [0.02, 0.02]}}]}
+    gravity: [0, -9.81]
+    contact: {restitution: 0.5, friction: 0.4}
+    time: {end: 0.01}
+    output: {directory: out/pile, every: 500}
+"""
+
+from __future__ import annotations
+
+import difflib
+import hashlib
+import json
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Annotated, Any, Literal
+
+import numpy as np
+import yaml
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+
+from granulate import functions, meshes, packing, shapes, stopping, walls
+from granulate.contact import Contact
+from granulate.errors import InputError
+from granulate.materials import Material
+from granulate.simulation import FIELDS, Body, Simulation
+
+Vector = list[float]
+Positive = Annotated[float, Field(gt=0, allow_inf_nan=False)]
+NonNegative = Annotated[float, Field(ge=0, allow_inf_nan=False)]
+Finite = Annotated[float, Field(allow_inf_nan=False)]
+
+
+class Spec(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+# ----------------------------------------------------------------------------- shapes
+class RectangleSpec(Spec):
+    """Axis-aligned rectangle (2D)."""
+
+    type: Literal["rectangle"]
+    lower: Annotated[list[Finite], Field(min_length=2, max_length=2, description="corner [m]")]
+    upper: Annotated[list[Finite], Field(min_length=2, max_length=2, description="corner [m]")]
+
+    def make(self, case: CaseContext) -> shapes.Shape:
+        return shapes.Rectangle(tuple(self.lower), tuple(self.upper))  # type: ignore[arg-type]
+
+
+class DiscSpec(Spec):
+    """Disc (2D)."""
+
+    type: Literal["disc"]
+    center: Annotated[list[Finite], Field(min_length=2, max_length=2, description="[m]")] = [0, 0]
+    radius: Positive = Field(description="[m]")
+
+    def make(self, case: CaseContext) -> shapes.Shape:
+        return shapes.Disc(tuple(self.center), self.radius)  # type: ignore[arg-type]
+
+
+class EllipseSpec(Spec):
+    """Ellipse (2D)."""
+
+    type: Literal["ellipse"]
+    center: Annotated[list[Finite], Field(min_length=2, max_length=2, description="[m]")] = [0, 0]
+    semi_axes: Annotated[list[Positive], Field(min_length=2, max_length=2, description="[m]")]
+    angle: Finite = Field(0.0, description="of the first semi-axis from x [rad]")
+
+    def make(self, case: CaseContext) -> shapes.Shape:
+        return shapes.Ellipse(tuple(self.center), tuple(self.semi_axes), self.angle)  # type: ignore[arg-type]
+
+
+class PolygonSpec(Spec):
+    """Simple polygon from its vertices in order, concave allowed (2D)."""
+
+    type: Literal["polygon"]
+    vertices: Annotated[
+        list[Annotated[list[Finite], Field(min_length=2, max_length=2)]],
+        Field(min_length=3, description="[m]"),
+    ]
+
+    def make(self, case: CaseContext) -> shapes.Shape:
+        return shapes.Polygon(tuple(tuple(v) for v in self.vertices))  # type: ignore[arg-type]
+
+
+class RegularPolygonSpec(Spec):
+    """Regular polygon: sides 3 (triangle), 4, 6 (hexagon), ... (2D)."""
+
+    type: Literal["regular_polygon"]
+    center: Annotated[list[Finite], Field(min_length=2, max_length=2, description="[m]")] = [0, 0]
+    radius: Positive = Field(description="circumradius [m]")
+    sides: Annotated[int, Field(ge=3)]
+    angle: Finite = Field(0.0, description="of the first vertex from x [rad]")
+
+    def make(self, case: CaseContext) -> shapes.Shape:
+        return shapes.RegularPolygon(tuple(self.center), self.radius, self.sides, self.angle)  # type: ignore[arg-type]
+
+
+class StarSpec(Spec):
+    """Star polygon (2D)."""
+
+    type: Literal["star"]
+    center: Annotated[list[Finite], Field(min_length=2, max_length=2, description="[m]")] = [0, 0]
+    outer_radius: Positive = Field(description="tips [m]")
+    inner_radius: Positive = Field(description="notches [m]")
+    points: Annotated[int, Field(ge=3)] = 5
+    angle: Finite = Field(0.0, description="[rad]")
+
+    def make(self, case: CaseContext) -> shapes.Shape:
+        return shapes.Star(
+            tuple(self.center), self.outer_radius, self.inner_radius, self.points, self.angle
+        )  # type: ignore[arg-type]
+
+
+class Drum2DSpec(Spec):
+    """PeriDEM's drum: a hexagon pinched to a neck (2D)."""
+
+    type: Literal["drum2d"]
+    center: Annotated[list[Finite], Field(min_length=2, max_length=2, description="[m]")] = [0, 0]
+    radius: Positive = Field(description="circumradius [m]")
+    neck_half_width: Positive = Field(description="[m]")
+    angle: Finite = Field(0.0, description="of the axis [rad]")
+
+    def make(self, case: CaseContext) -> shapes.Shape:
+        return shapes.Drum2D(tuple(self.center), self.radius, self.neck_half_width, self.angle)  # type: ignore[arg-type]
+
+
+class BoxSpec(Spec):
+    """Axis-aligned box (3D)."""
+
+    type: Literal["box"]
+    lower: Annotated[list[Finite], Field(min_length=3, max_length=3, description="corner [m]")]
+    upper: Annotated[list[Finite], Field(min_length=3, max_length=3, description="corner [m]")]
+
+    def make(self, case: CaseContext) -> shapes.Shape:
+        return shapes.Box(tuple(self.lower), tuple(self.upper))  # type: ignore[arg-type]
+
+
+class SphereSpec(Spec):
+    """Sphere (3D)."""
+
+    type: Literal["sphere"]
+    center: Annotated[list[Finite], Field(min_length=3, max_length=3, description="[m]")] = [
+        0,
+        0,
+        0,
+    ]
+    radius: Positive = Field(description="[m]")
+
+    def make(self, case: CaseContext) -> shapes.Shape:
+        return shapes.Sphere(tuple(self.center), self.radius)  # type: ignore[arg-type]
+
+
+class EllipsoidSpec(Spec):
+    """Ellipsoid (3D)."""
+
+    type: Literal["ellipsoid"]
+    center: Annotated[list[Finite], Field(min_length=3, max_length=3, description="[m]")] = [
+        0,
+        0,
+        0,
+    ]
+    semi_axes: Annotated[list[Positive], Field(min_length=3, max_length=3, description="[m]")]
+    rotation: (
+        Annotated[
+            list[Finite], Field(min_length=3, max_length=3, description="rotation vector [rad]")
+        ]
+        | None
+    ) = None
+
+    def make(self, case: CaseContext) -> shapes.Shape:
+        return shapes.Ellipsoid(tuple(self.center), tuple(self.semi_axes), self.rotation)  # type: ignore[arg-type]
+
+
+class CylinderSpec(Spec):
+    """Solid cylinder (3D)."""
+
+    type: Literal["cylinder"]
+    center: Annotated[
+        list[Finite], Field(min_length=3, max_length=3, description="mid-axis [m]")
+    ] = [0, 0, 0]
+    radius: Positive = Field(description="[m]")
+    length: Positive = Field(description="[m]")
+    axis: Annotated[list[Finite], Field(min_length=3, max_length=3)] = [0, 0, 1]
+
+    def make(self, case: CaseContext) -> shapes.Shape:
+        return shapes.Cylinder(tuple(self.center), self.radius, self.length, tuple(self.axis))  # type: ignore[arg-type]
+
+
+class SurfaceSpec(Spec):
+    """A solid bounded by a closed triangle surface file: STL, OBJ, PLY (3D)."""
+
+    type: Literal["surface"]
+    file: str = Field(description="path, relative to the case file")
+    scale: Positive = Field(1.0, description="multiplies the coordinates (1e-3 for millimetres)")
+
+    def make(self, case: CaseContext) -> shapes.Shape:
+        return meshes.SurfaceMesh.from_file(case.path(self.file), scale=self.scale)
+
+
+class UnionSpec(Spec):
+    """Points in any of the shapes."""
+
+    type: Literal["union"]
+    shapes: Annotated[list[ShapeRef], Field(min_length=1)]
+
+    def make(self, case: CaseContext) -> shapes.Shape:
+        return shapes.Union(tuple(case.shape(s) for s in self.shapes))
+
+
+class DifferenceSpec(Spec):
+    """Points of `base` not in `removed` (notches, holes)."""
+
+    type: Literal["difference"]
+    base: ShapeRef
+    removed: ShapeRef
+
+    def make(self, case: CaseContext) -> shapes.Shape:
+        return shapes.Difference(case.shape(self.base), case.shape(self.removed))
+
+
+ShapeSpec = Annotated[
+    RectangleSpec
+    | DiscSpec
+    | EllipseSpec
+    | PolygonSpec
+    | RegularPolygonSpec
+    | StarSpec
+    | Drum2DSpec
+    | BoxSpec
+    | SphereSpec
+    | EllipsoidSpec
+    | CylinderSpec
+    | SurfaceSpec
+    | UnionSpec
+    | DifferenceSpec,
+    Field(discriminator="type"),
+]
+#: A shape, or the name of one in the case's `shapes` section.
+ShapeRef = ShapeSpec | str
+
+
+# ------------------------------------------------------------------------ time functions
+class ConstantSpec(Spec):
+    type: Literal["constant"]
+    value: Finite = 1.0
+
+
+class LinearSpec(Spec):
+    type: Literal["linear"]
+    rate: Finite = Field(description="per second")
+
+
+class QuadraticSpec(Spec):
+    type: Literal["quadratic"]
+    a: Finite = Field(description="f = a t + b t^2")
+    b: Finite
+
+
+class SineSpec(Spec):
+    type: Literal["sine"]
+    amplitude: Finite
+    frequency: Positive = Field(description="[Hz]")
+
+
+class SmoothRampSpec(Spec):
+    type: Literal["smooth_ramp"]
+    target: Finite
+    duration: Positive = Field(description="[s]")
+
+
+class VelocityRampSpec(Spec):
+    type: Literal["velocity_ramp"]
+    rate: Finite = Field(description="final rate, per second")
+    duration: Positive = Field(description="[s]")
+
+
+FunctionSpec = Annotated[
+    ConstantSpec | LinearSpec | QuadraticSpec | SineSpec | SmoothRampSpec | VelocityRampSpec,
+    Field(discriminator="type"),
+]
+_FUNCTIONS = {
+    "constant": functions.Constant,
+    "linear": functions.Linear,
+    "quadratic": functions.Quadratic,
+    "sine": functions.Sine,
+    "smooth_ramp": functions.SmoothRamp,
+    "velocity_ramp": functions.VelocityRamp,
+}
+
+
+def make_function(spec: BaseModel) -> functions.TimeFunction:
+    values = spec.model_dump()
+    return _FUNCTIONS[values.pop("type")](**values)
+
+
+# ------------------------------------------------------------------------ sizes, grains
+class FixedSizeSpec(Spec):
+    distribution: Literal["fixed"]
+    radius: Positive = Field(description="bounding radius [m]")
+
+
+class UniformSizeSpec(Spec):
+    distribution: Literal["uniform"]
+    low: Positive = Field(description="[m]")
+    high: Positive = Field(description="[m]")
+
+
+class NormalSizeSpec(Spec):
+    distribution: Literal["normal"]
+    mean: Positive = Field(description="[m]")
+    std: NonNegative = Field(description="[m]")
+    low: Positive | None = None
+    high: Positive | None = None
+
+
+class LogNormalSizeSpec(Spec):
+    distribution: Literal["lognormal"]
+    median: Positive = Field(description="[m]")
+    sigma: NonNegative = Field(description="of ln r")
+    low: Positive | None = None
+    high: Positive | None = None
+
+
+class SieveSizeSpec(Spec):
+    distribution: Literal["sieve"]
+    diameters: list[Positive] = Field(description="sieve openings, increasing [m]")
+    passing: list[NonNegative] = Field(description="mass fraction passing, 0 ... 1")
+    dimension: Literal[2, 3] = 3
+
+
+SizeSpec = Annotated[
+    FixedSizeSpec | UniformSizeSpec | NormalSizeSpec | LogNormalSizeSpec | SieveSizeSpec,
+    Field(discriminator="distribution"),
+]
+_SIZES = {
+    "fixed": packing.Fixed,
+    "uniform": packing.Uniform,
+    "normal": packing.Normal,
+    "lognormal": packing.LogNormal,
+    "sieve": packing.Sieve,
+}
+
+
+class MeshSpec(Spec):
+    """A particle mesh made elsewhere: gmsh .msh (v2/v4), .vtu or a CSV of points with volumes."""
+
+    file: str = Field(description="path, relative to the case file")
+    dimension: Literal[2, 3] | None = None
+    mesh_size: Positive | None = Field(None, description="default: median element size [m]")
+    center: list[Finite] | None = Field(None, description="moved to the local origin [m]")
+
+
+class GrainSpec(Spec):
+    """A kind of particle: a shape (discretized once) or a mesh, and its material."""
+
+    shape: ShapeRef | None = None
+    mesh: MeshSpec | None = None
+    material: str = Field(description="name in `materials`")
+    mesh_size: Positive | None = Field(None, description="at the reference size [m]")
+    discretization: Literal["lattice", "conforming"] = "lattice"
+    sizes: SizeSpec | None = Field(None, description="bounding radii, for packings")
+    fraction: NonNegative = Field(1.0, description="share in packings (by number or volume)")
+    reference_radius: Positive | None = Field(None, description="default: bounding radius [m]")
+
+    @model_validator(mode="after")
+    def _one_source(self) -> GrainSpec:
+        if (self.shape is None) == (self.mesh is None):
+            raise ValueError("give either shape or mesh")
+        if self.shape is not None and self.mesh_size is None:
+            raise ValueError("a grain made from a shape needs mesh_size [m]")
+        return self
+
+
+# ------------------------------------------------------------------ bodies and particles
+class BodySpec(Spec):
+    """One body: a shape filled with nodes (Simulation.add_body)."""
+
+    name: str | None = None
+    shape: ShapeRef
+    material: str
+    mesh_size: Positive = Field(description="[m]")
+    discretization: Literal["lattice", "conforming"] = "lattice"
+    jitter: Annotated[float, Field(ge=0, lt=0.5)] = 0.0
+    seed: int = 0
+    velocity: list[Finite] | None = Field(None, description="[m/s]")
+    angular_velocity: Finite | list[Finite] | None = Field(None, description="[rad/s]")
+
+
+class ParticleSpec(Spec):
+    """One placed grain (Simulation.add_particle)."""
+
+    name: str | None = None
+    grain: str = Field(description="name in `grains`")
+    position: list[Finite] = Field(description="[m]")
+    rotation: Finite | list[Finite] | None = Field(
+        None, description="angle or rotation vector [rad]"
+    )
+    scale: Positive | None = None
+    radius: Positive | None = Field(None, description="bounding radius [m] (instead of scale)")
+    velocity: list[Finite] | None = Field(None, description="[m/s]")
+    angular_velocity: Finite | list[Finite] | None = Field(None, description="[rad/s]")
+
+
+class PackingSpec(Spec):
+    """A generated packing (granulate.pack)."""
+
+    container: ShapeRef
+    grains: Annotated[list[str], Field(min_length=1)]
+    count: Annotated[int, Field(gt=0)]
+    by: Literal["number", "volume"] = "number"
+    method: Literal["random", "lattice"] = "random"
+    gap: NonNegative = Field(0.0, description="[m]")
+    seed: int = 0
+    attempts: Annotated[int, Field(gt=0)] = 2000
+    velocity: list[Finite] | None = Field(None, description="[m/s]")
+
+
+class PlacementSpec(Spec):
+    """Particles from a PeriDEM placement CSV (i, x, y, z, r[, o])."""
+
+    file: str = Field(description="path, relative to the case file")
+    zones: dict[int, str] = Field(description="zone id -> grain name")
+    seed: int = 0
+    velocity: list[Finite] | None = Field(None, description="[m/s]")
+
+
+class PrecrackSpec(Spec):
+    point: list[Finite] = Field(description="[m]")
+    normal: list[Finite]
+    region: ShapeRef | None = None
+
+
+# ----------------------------------------------------------------------- contact, walls
+class ContactSpec(Spec):
+    """Contact parameters (see granulate.Contact)."""
+
+    restitution: Annotated[float, Field(gt=0, le=1)] = 1.0
+    friction: NonNegative = 0.0
+    contact_radius_factor: Positive = Field(0.95, description="Rc / h of the finer particle")
+    contact_radius: Positive | None = Field(None, description="absolute Rc [m]")
+    normal_stiffness: Positive | None = Field(None, description="absolute kn")
+    stiffness_factor: Positive = 1.0
+    slip_velocity: Positive = Field(1e-4, description="[m/s]")
+
+    def make(self) -> Contact:
+        return Contact(**self.model_dump())
+
+
+class PairContactSpec(Spec):
+    materials: Annotated[list[str], Field(min_length=2, max_length=2)]
+    contact: ContactSpec | None = Field(description="null: the materials pass through each other")
+
+
+class PlaneSurfaceSpec(Spec):
+    type: Literal["plane"]
+    point: list[Finite] = Field(description="[m]")
+    normal: list[Finite] = Field(description="towards the particles")
+
+
+class BoxSurfaceSpec(Spec):
+    type: Literal["box_container", "box_obstacle"]
+    lower: list[Finite] = Field(description="[m]")
+    upper: list[Finite] = Field(description="[m]")
+
+
+class CircleSurfaceSpec(Spec):
+    type: Literal["circle_container", "circle_obstacle"]
+    center: list[Finite] = Field(description="[m]")
+    radius: Positive = Field(description="[m]")
+    axis: list[Finite] = Field([0, 0, 1], description="cylinder axis (3D)")
+
+
+class PolygonSurfaceSpec(Spec):
+    type: Literal["polygon_container", "polygon_obstacle"]
+    vertices: Annotated[list[list[Finite]], Field(min_length=3, description="[m]")]
+
+
+class MeshSurfaceSpec(Spec):
+    type: Literal["triangle_mesh"]
+    file: str = Field(description="STL/OBJ/PLY, relative to the case file")
+    inside: bool = True
+    scale: Positive = 1.0
+
+
+class ShapeSurfaceSpec(Spec):
+    type: Literal["container", "obstacle"]
+    shape: ShapeRef
+
+
+SurfaceSpecs = Annotated[
+    PlaneSurfaceSpec
+    | BoxSurfaceSpec
+    | CircleSurfaceSpec
+    | PolygonSurfaceSpec
+    | MeshSurfaceSpec
+    | ShapeSurfaceSpec,
+    Field(discriminator="type"),
+]
+
+
+class TranslationSpec(Spec):
+    type: Literal["translation"]
+    direction: list[Finite]
+    function: FunctionSpec = Field(description="distance [m] along direction")
+
+
+class RotationSpec(Spec):
+    type: Literal["rotation"]
+    angle: FunctionSpec = Field(description="[rad]")
+    center: list[Finite] = Field([0, 0, 0], description="[m]")
+    axis: list[Finite] = [0, 0, 1]
+
+
+class SteadyRotationSpec(Spec):
+    type: Literal["steady_rotation"]
+    angular_velocity: Finite = Field(description="[rad/s]")
+    center: list[Finite] = Field([0, 0, 0], description="[m]")
+    axis: list[Finite] = [0, 0, 1]
+
+
+MotionSpec = Annotated[
+    TranslationSpec | RotationSpec | SteadyRotationSpec,
+    Field(discriminator="type"),
+]
+
+
+class WallSpec(Spec):
+    """A rigid wall: surfaces moving together."""
+
+    name: str
+    surfaces: Annotated[list[SurfaceSpecs], Field(min_length=1)]
+    motion: MotionSpec | None = None
+    contact: ContactSpec | None = None
+    center: list[Finite] = Field([0, 0, 0], description="torque reference [m]")
+
+
+# ----------------------------------------------------------------------------- loading
+class SelectSpec(Spec):
+    """Nodes by region (reference positions), body name and/or node ids; all must hold."""
+
+    region: ShapeRef | None = None
+    body: str | None = None
+    ids: list[Annotated[int, Field(ge=0)]] | None = None
+
+
+class FixSpec(Spec):
+    type: Literal["fix"]
+    nodes: SelectSpec
+    components: str = "xyz"
+
+
+class DisplacementSpec(Spec):
+    type: Literal["displacement"]
+    nodes: SelectSpec
+    direction: list[Finite]
+    function: FunctionSpec = Field(description="displacement [m] along direction")
+    components: str | None = None
+
+
+class VelocitySpec(Spec):
+    type: Literal["velocity"]
+    nodes: SelectSpec
+    velocity: list[Finite] = Field(description="[m/s]")
+    ramp_time: NonNegative = Field(0.0, description="[s]")
+    components: str | None = None
+
+
+class RotationLoadSpec(Spec):
+    type: Literal["rotation"]
+    nodes: SelectSpec
+    center: list[Finite] = Field(description="[m]")
+    angle: FunctionSpec = Field(description="[rad]")
+    axis: list[Finite] = [0, 0, 1]
+
+
+class ForceDensitySpec(Spec):
+    type: Literal["force_density"]
+    nodes: SelectSpec
+    vector: list[Finite] = Field(description="[N/m^3]")
+    function: FunctionSpec | None = None
+
+
+LoadSpec = Annotated[
+    FixSpec | DisplacementSpec | VelocitySpec | RotationLoadSpec | ForceDensitySpec,
+    Field(discriminator="type"),
+]
+
+
+# ------------------------------------------------------------------- time, output, stop
+class TimeSpec(Spec):
+    """Time stepping: dt (default: dt_safety x the stable estimate) and the run length."""
+
+    dt: Positive | None = Field(None, description="[s]")
+    dt_safety: Annotated[float, Field(gt=0, le=1)] = 0.8
+    end: Positive | None = Field(None, description="simulated time to reach [s]")
+    steps: Annotated[int, Field(gt=0)] | None = None
+
+    @model_validator(mode="after")
+    def _length(self) -> TimeSpec:
+        if (self.end is None) == (self.steps is None):
+            raise ValueError("give the run length as either end [s] or steps")
+        return self
+
+
+class OutputSpec(Spec):
+    directory: str = Field("out", description="relative to the working directory")
+    every: Annotated[int, Field(gt=0)] = Field(1000, description="steps between frames")
+    fields: list[Literal[FIELDS]] = list(FIELDS)  # type: ignore[valid-type]
+
+
+class CheckpointSpec(Spec):
+    every_steps: Annotated[int, Field(gt=0)] | None = None
+    every_minutes: Positive | None = None
+
+
+class KineticEnergyStopSpec(Spec):
+    energy: Positive = Field(description="[J; J/m in 2D]")
+    after: NonNegative = Field(0.0, description="not before this time [s]")
+
+
+class WallDisplacementStopSpec(Spec):
+    wall: str
+    distance: Positive = Field(description="[m]")
+
+
+class StopSpec(Spec):
+    """Criteria that end the run early (checked every check_every steps)."""
+
+    kinetic_energy_below: KineticEnergyStopSpec | None = None
+    wall_displacement: WallDisplacementStopSpec | None = None
+    particles_broken: Annotated[int, Field(gt=0)] | None = Field(
+        None, description="particles with every bond broken"
+    )
+    broken_bonds: Annotated[int, Field(gt=0)] | None = None
+    check_every: Annotated[int, Field(gt=0)] = 100
+
+
+class CaseSpec(Spec):
+    """A granulate case."""
+
+    dimension: Literal[2, 3]
+    plane: Literal["strain", "stress"] = "strain"
+    materials: Annotated[dict[str, Material], Field(min_length=1)]
+    shapes: dict[str, ShapeSpec] = {}
+    grains: dict[str, GrainSpec] = {}
+    bodies: list[BodySpec] = []
+    particles: list[ParticleSpec] = []
+    packings: list[PackingSpec] = []
+    placements: list[PlacementSpec] = []
+    precracks: list[PrecrackSpec] = []
+    contact: ContactSpec | None = ContactSpec()
+    contact_pairs: list[PairContactSpec] = []
+    walls: list[WallSpec] = []
+    loading: list[LoadSpec] = []
+    gravity: list[Finite] | None = Field(None, description="[m/s^2]")
+    viscous_damping: NonNegative = Field(0.0, description="[1/s]")
+    neighbor_skin: Positive | None = Field(None, description="[m]")
+    time: TimeSpec
+    output: OutputSpec | None = None
+    checkpoint: CheckpointSpec | None = None
+    stop: StopSpec | None = None
+
+    @model_validator(mode="after")
+    def _something(self) -> CaseSpec:
+        if not (self.bodies or self.particles or self.packings or self.placements):
+            raise ValueError(
+                "the case has no particles: add bodies, particles, packings or placements"
+            )
+        return self
+
+
+for _model in list(globals().values()):
+    if isinstance(_model, type) and issubclass(_model, Spec) and _model is not Spec:
+        _model.model_rebuild()
+
+
+# --------------------------------------------------------------------------- building
+@dataclass
+class CaseContext:
+    """Resolves names and paths while a case is built."""
+
+    spec: CaseSpec
+    folder: Path
+    _shapes: dict[str, shapes.Shape] = field(default_factory=dict)
+    _grains: dict[str, packing.Grain] = field(default_factory=dict)
+
+    def path(self, name: str) -> Path:
+        return (self.folder / name).resolve()
+
+    def shape(self, ref: ShapeRef) -> shapes.Shape:  # type: ignore[valid-type]
+        if isinstance(ref, str):
+            if ref not in self.spec.shapes:
+                raise InputError(f"unknown shape {ref!r}{_closest(ref, self.spec.shapes)}")
+            if ref not in self._shapes:
+                self._shapes[ref] = self.spec.shapes[ref].make(self)  # type: ignore[union-attr]
+            return self._shapes[ref]
+        return ref.make(self)  # type: ignore[union-attr]
+
+    def material(self, name: str) -> Material:
+        if name not in self.spec.materials:
+            raise InputError(f"unknown material {name!r}{_closest(name, self.spec.materials)}")
+        return self.spec.materials[name]
+
+    def grain(self, name: str) -> packing.Grain:
+        if name not in self.spec.grains:
+            raise InputError(f"unknown grain {name!r}{_closest(name, self.spec.grains)}")
+        if name not in self._grains:
+            g = self.spec.grains[name]
+            sizes = None
+            if g.sizes is not None:
+                values = g.sizes.model_dump()
+                sizes = _SIZES[values.pop("distribution")](**values)
+            if g.mesh is not None:
+                source: shapes.Shape | shapes.ReferenceShape = shapes.ReferenceShape.from_mesh(
+                    str(self.path(g.mesh.file)),
+                    dimension=g.mesh.dimension,
+                    mesh_size=g.mesh.mesh_size,
+                    center=g.mesh.center,
+                )
+            else:
+                source = self.shape(g.shape)
+            self._grains[name] = packing.Grain(
+                source,
+                self.material(g.material),
+                g.mesh_size,
+                sizes,
+                g.fraction,
+                g.discretization,
+                g.reference_radius,
+            )
+        return self._grains[name]
+
+
+def _closest(name: str, choices: Any) -> str:
+    options = sorted(choices)
+    match = difflib.get_close_matches(name, options, n=1)
+    if match:
+        return f"; did you mean {match[0]!r}?"
+    return f"; defined: {', '.join(map(repr, options)) or 'none'}"
+
+
+@dataclass
+class Case:
+    """A validated case, built into a Simulation with its run plan."""
+
+    spec: CaseSpec
+    source: Path
+    text: str
+
+    @property
+    def fingerprint(self) -> str:
+        return hashlib.sha256(
+            json.dumps(self.spec.model_dump(mode="json"), sort_keys=True).encode()
+        ).hexdigest()
+
+    def build(
+        self, *, output: str | Path | None = None, resume: bool = False, overwrite: bool = False
+    ) -> Simulation:
+        """The Simulation the case describes (not yet run). ``output`` overrides the output
+        directory; ``resume`` keeps an existing run there for load_checkpoint."""
+        spec = self.spec
+        case = CaseContext(spec, self.source.parent)
+        sim = Simulation(
+            spec.dimension,
+            spec.plane,
+            dt=spec.time.dt,
+            dt_safety=spec.time.dt_safety,
+            gravity=None
+            if spec.gravity is None
+            else _vector(spec.gravity, spec.dimension, "gravity"),
+            viscous_damping=spec.viscous_damping,
+        )
+        sim.case_fingerprint = self.fingerprint
+        named: dict[str, Body] = {}
+        for k, b in enumerate(spec.bodies):
+            shape = case.shape(b.shape)
+            body = sim.add_body(
+                shape,
+                case.material(b.material),
+                b.mesh_size,
+                discretization=b.discretization,
+                jitter=b.jitter,
+                seed=b.seed,
+                velocity=b.velocity,
+                angular_velocity=_angular(b.angular_velocity),
+                name=b.name or f"body{k}",
+            )
+            named[body.name] = body
+        for p in spec.particles:
+            g = case.grain(p.grain)
+            if p.scale is not None and p.radius is not None:
+                raise InputError(f"particle of grain {p.grain!r}: give scale or radius, not both")
+            scale = p.radius / g.radius if p.radius is not None else (p.scale or 1.0)
+            body = sim.add_particle(
+                g.reference,
+                g.material,
+                position=p.position,
+                rotation=_angular(p.rotation),
+                scale=scale,
+                velocity=p.velocity,
+                angular_velocity=_angular(p.angular_velocity),
+                name=p.name,
+            )
+            if p.name:
+                named[p.name] = body
+        for pk in spec.packings:
+            result = packing.pack(
+                case.shape(pk.container),
+                [case.grain(g) for g in pk.grains],
+                pk.count,
+                by=pk.by,
+                method=pk.method,
+                gap=pk.gap,
+                seed=pk.seed,
+                attempts=pk.attempts,
+            )
+            sim.add_packing(result, velocity=pk.velocity)
+        for pl in spec.placements:
+            placements = packing.read_placements(
+                case.path(pl.file), dimension=spec.dimension, seed=pl.seed
+            )
+            sim.add_placements(
+                placements, {z: case.grain(g) for z, g in pl.zones.items()}, velocity=pl.velocity
+            )
+        for c in spec.precracks:
+            region = None if c.region is None else case.shape(c.region)
+            sim.precrack(c.point, c.normal, region=region)
+        sim.contact = None if spec.contact is None else spec.contact.make()
+        for pair in spec.contact_pairs:
+            sim.set_contact(
+                case.material(pair.materials[0]),
+                case.material(pair.materials[1]),
+                None if pair.contact is None else pair.contact.make(),
+            )
+        if spec.neighbor_skin is not None:
+            sim.set_neighbor_skin(spec.neighbor_skin)
+        for w in spec.walls:
+            sim.add_wall(_wall(w, case), name=w.name)
+        for load in spec.loading:
+            _load(sim, load, case, named)
+        if spec.output is not None or output is not None:
+            o = spec.output or OutputSpec()
+            sim.output(
+                output if output is not None else o.directory,
+                o.every,
+                fields=tuple(o.fields),
+                overwrite=overwrite,
+                resume=resume,
+            )
+        if spec.checkpoint is not None:
+            sim.checkpoint_every(spec.checkpoint.every_steps, minutes=spec.checkpoint.every_minutes)
+        return sim
+
+    def stop_criteria(self) -> list[stopping.StopCriterion]:
+        s = self.spec.stop
+        if s is None:
+            return []
+        criteria: list[stopping.StopCriterion] = []
+        if s.kinetic_energy_below is not None:
+            criteria.append(
+                stopping.KineticEnergyBelow(
+                    s.kinetic_energy_below.energy, s.kinetic_energy_below.after
+                )
+            )
+        if s.wall_displacement is not None:
+            if s.wall_displacement.wall not in {w.name for w in self.spec.walls}:
+                raise InputError(
+                    f"stop.wall_displacement names wall {s.wall_displacement.wall!r}"
+                    f"{_closest(s.wall_displacement.wall, [w.name for w in self.spec.walls])}"
+                )
+            criteria.append(
+                stopping.WallDisplacement(s.wall_displacement.wall, s.wall_displacement.distance)
+            )
+        if s.particles_broken is not None:
+            criteria.append(stopping.ParticlesBroken(s.particles_broken))
+        if s.broken_bonds is not None:
+            criteria.append(stopping.BrokenBonds(s.broken_bonds))
+        return criteria
+
+    def steps(self, sim: Simulation) -> int:
+        """Steps from the current state to the end of the case."""
+        if self.spec.time.steps is not None:
+            return max(0, self.spec.time.steps - sim.step)
+        return max(0, int(np.ceil((self.spec.time.end - sim.time) / sim.dt - 1e-9)))  # type: ignore[operator]
+
+
+def _vector(values: list[float], dimension: int, name: str) -> list[float]:
+    if len(values) not in (dimension, 3):
+        raise InputError(f"{name} needs {dimension} components, got {len(values)}")
+    return list(values)
+
+
+def _angular(value: float | list[float] | None) -> float | list[float] | None:
+    return value
+
+
+def _surface(s: BaseModel, case: CaseContext) -> walls.Surface:
+    kind = s.type  # type: ignore[attr-defined]
+    if kind == "plane":
+        return walls.Plane(s.point, s.normal)  # type: ignore[attr-defined]
+    if kind in ("box_container", "box_obstacle"):
+        cls = walls.BoxContainer if kind == "box_container" else walls.BoxObstacle
+        return cls(s.lower, s.upper)  # type: ignore[attr-defined]
+    if kind in ("circle_container", "circle_obstacle"):
+        cls2 = walls.CircleContainer if kind == "circle_container" else walls.CircleObstacle
+        return cls2(s.center, s.radius, s.axis)  # type: ignore[attr-defined]
+    if kind in ("polygon_container", "polygon_obstacle"):
+        cls3 = walls.PolygonContainer if kind == "polygon_container" else walls.PolygonObstacle
+        return cls3(s.vertices)  # type: ignore[attr-defined]
+    if kind == "triangle_mesh":
+        return walls.TriangleMesh.from_file(case.path(s.file), inside=s.inside, scale=s.scale)  # type: ignore[attr-defined]
+    shape = case.shape(s.shape)  # type: ignore[attr-defined]
+    return walls.container(shape) if kind == "container" else walls.obstacle(shape)
+
+
+def _wall(w: WallSpec, case: CaseContext) -> walls.Wall:
+    motion: walls.Translation | walls.Rotation | None = None
+    if isinstance(w.motion, TranslationSpec):
+        motion = walls.Translation(w.motion.direction, make_function(w.motion.function))
+    elif isinstance(w.motion, RotationSpec):
+        motion = walls.Rotation(make_function(w.motion.angle), w.motion.center, w.motion.axis)
+    elif isinstance(w.motion, SteadyRotationSpec):
+        motion = walls.Rotation.steady(w.motion.angular_velocity, w.motion.center, w.motion.axis)
+    return walls.Wall(
+        tuple(_surface(s, case) for s in w.surfaces),
+        motion,
+        w.name,
+        None if w.contact is None else w.contact.make(),
+        w.center,
+    )
+
+
+def _load(sim: Simulation, load: BaseModel, case: CaseContext, named: dict[str, Body]) -> None:
+    select: SelectSpec = load.nodes  # type: ignore[attr-defined]
+    body = None
+    if select.body is not None:
+        if select.body not in named:
+            raise InputError(f"loading selects body {select.body!r}{_closest(select.body, named)}")
+        body = named[select.body]
+    region = None if select.region is None else case.shape(select.region)
+    nodes = sim.select(region, body=body, ids=select.ids)
+    if isinstance(load, FixSpec):
+        sim.fix(nodes, load.components)
+    elif isinstance(load, DisplacementSpec):
+        sim.prescribe_displacement(
+            nodes, load.direction, make_function(load.function), components=load.components
+        )
+    elif isinstance(load, VelocitySpec):
+        sim.prescribe_velocity(
+            nodes, load.velocity, ramp_time=load.ramp_time, components=load.components
+        )
+    elif isinstance(load, RotationLoadSpec):
+        sim.prescribe_rotation(nodes, load.center, make_function(load.angle), axis=load.axis)
+    elif isinstance(load, ForceDensitySpec):
+        sim.add_force_density(
+            nodes, load.vector, None if load.function is None else make_function(load.function)
+        )
+
+
+# ----------------------------------------------------------------------------- loading
+def load_case(path: str | Path) -> Case:
+    """Read and validate a YAML case file (InputError with every problem found)."""
+    source = Path(path)
+    if not source.is_file():
+        raise InputError(f"case file {source} does not exist")
+    try:
+        text = source.read_text()
+    except (OSError, UnicodeDecodeError) as error:
+        raise InputError(f"cannot read case file {source}: {error}") from None
+    return parse_case(text, source)
+
+
+def parse_case(text: str, source: Path = Path("case.yaml")) -> Case:
+    try:
+        data = yaml.safe_load(text)
+    except yaml.YAMLError as error:
+        where = ""
+        mark = getattr(error, "problem_mark", None)
+        if mark is not None:
+            where = f" at line {mark.line + 1}, column {mark.column + 1}"
+        problem = getattr(error, "problem", None) or str(error).splitlines()[0]
+        raise InputError(f"{source}: not valid YAML{where}: {problem}") from None
+    if not isinstance(data, dict):
+        raise InputError(
+            f"{source}: a case file is a mapping of keys (dimension, materials, ...), got "
+            f"{type(data).__name__}"
+        )
+    try:
+        spec = CaseSpec.model_validate(data)
+    except ValidationError as error:
+        raise InputError(f"{source}: " + describe(error, data)) from None
+    return Case(spec, source.resolve(), text)
+
+
+def _location(loc: tuple[Any, ...]) -> str:
+    out = ""
+    for part in loc:
+        if isinstance(part, int):
+            out += f"[{part}]"
+        else:
+            out += ("." if out else "") + str(part)
+    return out or "(top level)"
+
+
+_ALL_SPECS: list[type[BaseModel]] = [
+    m
+    for m in list(globals().values())
+    if isinstance(m, type) and issubclass(m, Spec) and m is not Spec
+] + [Material]
+
+
+def _fields_for(parent: Any) -> list[str]:
+    """Field names of the spec models that best match a mapping (for typo suggestions)."""
+    if not isinstance(parent, dict):
+        return []
+    kind = parent.get("type", parent.get("distribution"))
+    scores: list[tuple[int, list[str]]] = []
+    for model in _ALL_SPECS:
+        names = list(model.model_fields)
+        score = sum(1 for key in parent if key in names)
+        tag = model.model_fields.get("type") or model.model_fields.get("distribution")
+        if kind is not None and tag is not None and kind in getattr(tag.annotation, "__args__", ()):
+            score += 10
+        scores.append((score, names))
+    best = max(score for score, _ in scores)
+    return sorted({name for score, names in scores if score == best for name in names})
+
+
+#: Names other codes (PeriDEM) use for our shapes.
+_SYNONYMS = {
+    "circle": "disc",
+    "hexagon": "regular_polygon",
+    "triangle": "regular_polygon",
+    "square": "regular_polygon",
+    "cube": "box",
+    "cuboid": "box",
+    "rect": "rectangle",
+    "stl": "surface",
+}
+
+
+def _clean(loc: tuple[Any, ...], data: Any) -> tuple[tuple[Any, ...], Any]:
+    """The key path as the user wrote it (without pydantic's union tags), and the mapping that
+    holds its last key."""
+    path: list[Any] = []
+    current, parent = data, None
+    for part in loc:
+        if isinstance(current, list) and isinstance(part, int) and part < len(current):
+            path.append(part)
+            parent, current = current, current[part]
+        elif isinstance(current, dict) and part in current:
+            path.append(part)
+            parent, current = current, current[part]
+        elif isinstance(current, dict) and part in (
+            current.get("type"),
+            current.get("distribution"),
+        ):
+            continue  # the tag of a discriminated union
+        elif isinstance(part, str) and ("[" in part or part in ("str", "int", "float", "list")):
+            continue  # a union member's name
+        else:
+            path.append(part)
+            parent, current = current, None
+    return tuple(path), parent
+
+
+def describe(error: ValidationError, data: Any) -> str:
+    """One line per problem: key path, what was expected, what was found; a suggestion for
+    misspelt keys and kinds."""
+    problems = [(p, *_clean(p["loc"], data)) for p in error.errors()]
+    lines: list[str] = []
+    for problem, loc, parent in problems:
+        kind = problem["type"]
+        # A shape given inline that fails also fails as a shape name: keep the real reason.
+        if kind == "string_type" and isinstance(problem.get("input"), dict):
+            if any(other[1][: len(loc)] == loc and other[0] is not problem for other in problems):
+                continue
+        where = _location(loc)
+        if kind == "extra_forbidden":
+            bad = str(loc[-1])
+            suggestion = difflib.get_close_matches(bad, _fields_for(parent), n=1)
+            hint = f"; did you mean {suggestion[0]!r}?" if suggestion else ""
+            message = f"{where}: unknown key {bad!r}{hint}"
+        elif kind == "missing":
+            message = f"{where}: required key is missing"
+        elif kind in ("union_tag_invalid", "union_tag_not_found"):
+            ctx = problem.get("ctx", {})
+            expected = str(ctx.get("expected_tags", ""))
+            found = str(ctx.get("tag", problem.get("input")))
+            options = [t.strip().strip("'") for t in expected.split(",")]
+            message = f"{where}: unknown kind {found!r}; expected one of {expected}"
+            match = difflib.get_close_matches(found, options, n=1)
+            if _SYNONYMS.get(found) in options:
+                message += f"; a {found} is {_SYNONYMS[found]!r} here"
+            elif match:
+                message += f"; did you mean {match[0]!r}?"
+        else:
+            found = problem.get("input")
+            shown = "a mapping" if isinstance(found, dict) else repr(found)
+            if len(shown) > 60:
+                shown = shown[:57] + "..."
+            text = problem["msg"].removeprefix("Value error, ")
+            message = f"{where}: {text} (found {shown})"
+        if message not in lines:
+            lines.append(message)
+    if len(lines) == 1:
+        return lines[0]
+    return f"{len(lines)} problems:\n  " + "\n  ".join(lines)
+
+
+def schema() -> dict[str, Any]:
+    """The JSON Schema of case files (for editors)."""
+    return CaseSpec.model_json_schema()
+
+
+def reference() -> str:
+    """A readable reference of every key, with types, defaults and units."""
+    out = ["granulate case file reference (SI units)", ""]
+    document = schema()
+    definitions = document.get("$defs", {})
+
+    def describe_type(prop: dict[str, Any]) -> str:
+        if "$ref" in prop:
+            return prop["$ref"].split("/")[-1].removesuffix("Spec")
+        if "anyOf" in prop:
+            return " | ".join(describe_type(p) for p in prop["anyOf"])
+        if "oneOf" in prop:
+            return " | ".join(describe_type(p) for p in prop["oneOf"])
+        if "enum" in prop:
+            return " | ".join(map(repr, prop["enum"]))
+        if "const" in prop:
+            return repr(prop["const"])
+        if prop.get("type") == "array":
+            return f"list of {describe_type(prop.get('items', {}))}"
+        if prop.get("type") == "object" and "additionalProperties" in prop:
+            return f"mapping of name -> {describe_type(prop['additionalProperties'])}"
+        return str(prop.get("type", "any"))
+
+    def section(name: str, body: dict[str, Any]) -> None:
+        out.append(
+            f"{name}:"
+            + (f"  {body['description'].splitlines()[0]}" if body.get("description") else "")
+        )
+        required = set(body.get("required", []))
+        for key, prop in body.get("properties", {}).items():
+            line = f"  {key}: {describe_type(prop)}"
+            if key in required:
+                line += " (required)"
+            elif "default" in prop:
+                line += f" = {json.dumps(prop['default'])}"
+            if prop.get("description"):
+                line += f"  -- {prop['description']}"
+            out.append(line)
+        out.append("")
+
+    section("case", document)
+    for name, body in definitions.items():
+        section(name.removesuffix("Spec"), body)
+    return "\n".join(out)
