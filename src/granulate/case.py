@@ -31,6 +31,7 @@ from __future__ import annotations
 import difflib
 import hashlib
 import json
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Annotated, Any, Literal
@@ -402,7 +403,7 @@ class BodySpec(Spec):
     mesh_size: Positive = Field(description="[m]")
     discretization: Literal["lattice", "conforming"] = "lattice"
     jitter: Annotated[float, Field(ge=0, lt=0.5)] = 0.0
-    seed: int = 0
+    seed: Annotated[int, Field(ge=0)] = 0
     velocity: list[Finite] | None = Field(None, description="[m/s]")
     angular_velocity: Finite | list[Finite] | None = Field(None, description="[rad/s]")
 
@@ -431,7 +432,7 @@ class PackingSpec(Spec):
     by: Literal["number", "volume"] = "number"
     method: Literal["random", "lattice"] = "random"
     gap: NonNegative = Field(0.0, description="[m]")
-    seed: int = 0
+    seed: Annotated[int, Field(ge=0)] = 0
     attempts: Annotated[int, Field(gt=0)] = 2000
     velocity: list[Finite] | None = Field(None, description="[m/s]")
 
@@ -441,7 +442,7 @@ class PlacementSpec(Spec):
 
     file: str = Field(description="path, relative to the case file")
     zones: dict[int, str] = Field(description="zone id -> grain name")
-    seed: int = 0
+    seed: Annotated[int, Field(ge=0)] = 0
     velocity: list[Finite] | None = Field(None, description="[m/s]")
 
 
@@ -775,10 +776,16 @@ class Case:
         ).hexdigest()
 
     def build(
-        self, *, output: str | Path | None = None, resume: bool = False, overwrite: bool = False
+        self,
+        *,
+        output: str | Path | None = None,
+        resume: bool = False,
+        overwrite: bool = False,
+        outputs: bool = True,
     ) -> Simulation:
         """The Simulation the case describes (not yet run). ``output`` overrides the output
-        directory; ``resume`` keeps an existing run there for load_checkpoint."""
+        directory; ``resume`` keeps an existing run there for load_checkpoint; ``outputs=False``
+        sets up no output or checkpoints (``granulate check``)."""
         spec = self.spec
         case = CaseContext(spec, self.source.parent)
         sim = Simulation(
@@ -859,6 +866,13 @@ class Case:
             sim.add_wall(_wall(w, case), name=w.name)
         for load in spec.loading:
             _load(sim, load, case, named)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            sim.validate_time_step()  # an error here makes the warning about dt moot
+        for warning in caught:
+            warnings.warn(warning.message, warning.category, stacklevel=2)
+        if not outputs:
+            return sim
         if spec.output is not None or output is not None:
             o = spec.output or OutputSpec()
             sim.output(

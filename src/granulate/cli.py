@@ -1,18 +1,33 @@
-"""Command line: ``granulate info`` (version, build, threads) and ``granulate run SCRIPT.py``.
+"""Command line: ``granulate`` (also ``python -m granulate``).
 
-User errors (InputError, InstabilityError) print one line and exit with 2 (bad input) or 1
-(failed run); ``--debug`` shows the traceback.
+    granulate check CASE.yaml                  validate, build and summarise without running
+    granulate run CASE.yaml [--out DIR] [--resume] [--overwrite]
+    granulate run SCRIPT.py [ARGS...]          run a Python set-up script
+    granulate plot DIR                         PNG plots from DIR/history.csv
+    granulate render DIR [--frame N] [--gif]   PNG images (and a GIF) of the particles
+    granulate schema [--json]                  the case-file reference (or its JSON Schema)
+    granulate info                             version, build options, threads
+
+Exit codes: 0 success, 2 invalid input, 1 failed run, 130 interrupted. User errors print one
+line (``--debug`` shows the traceback).
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import runpy
 import sys
+import time
 from pathlib import Path
 
-from granulate import __version__, _core
+from granulate import _core
+from granulate._version import __version__
 from granulate.errors import InputError, InstabilityError
+
+#: Bytes per node of state and model arrays besides bonds (positions, velocities, forces,
+#: reference positions, volumes, per-node constants, contact lists).
+BYTES_PER_NODE = 300
 
 
 def _info() -> int:
@@ -23,6 +38,162 @@ def _info() -> int:
     return 0
 
 
+def _schema(as_json: bool) -> int:
+    from granulate import case
+
+    if as_json:
+        print(json.dumps(case.schema(), indent=2))
+    else:
+        print(case.reference())
+    return 0
+
+
+def _check(path: Path) -> int:
+    from granulate.case import load_case
+
+    case = load_case(path)
+    sim = case.build(outputs=False)
+    case.stop_criteria()  # names of walls in stop criteria
+    steps = case.steps(sim)
+    model = sim.model
+    memory = model.shared_bond_bytes() + sim.bond_count + BYTES_PER_NODE * sim.node_count
+    probe = max(1, min(20, steps))
+    start = time.perf_counter()
+    sim.run(probe)
+    rate = probe / max(time.perf_counter() - start, 1e-9)
+    print(f"{path}: valid")
+    print(
+        f"  dimension {sim.dimension}, {len(sim.bodies)} particles, {sim.node_count} nodes, "
+        f"{sim.bond_count} bonds"
+    )
+    for packing in sim.packings:
+        print(f"  packing: {packing.summary()}")
+    print(f"  walls: {', '.join(name for name, _ in sim._walls) or 'none'}")
+    print(f"  dt {sim.dt:.4g} s (stable estimate {sim.stable_dt:.4g} s); {steps} steps to the end")
+    print(
+        f"  estimated memory {memory / 1e6:.1f} MB; estimated time {_duration(steps / rate)} "
+        f"with {_core.get_max_threads()} threads"
+    )
+    return 0
+
+
+def _duration(seconds: float) -> str:
+    if seconds < 120:
+        return f"{seconds:.0f} s"
+    if seconds < 7200:
+        return f"{seconds / 60:.0f} min"
+    return f"{seconds / 3600:.1f} h"
+
+
+class _Reporter:
+    """A progress bar on a terminal, plain lines (every 10 % or 30 s) otherwise."""
+
+    def __init__(self, total: int, quiet: bool) -> None:
+        self.total = max(total, 1)
+        self.quiet = quiet
+        self.bar = None
+        self.last_line = time.perf_counter()
+        self.last_tenth = -1
+        if not quiet and sys.stdout.isatty():
+            from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
+
+            self.bar = Progress(
+                TextColumn("[bold]step {task.completed:>9}/{task.total}"),
+                BarColumn(),
+                TextColumn(
+                    "{task.fields[rate]} steps/s  t = {task.fields[time]} s  "
+                    "broken {task.fields[broken]}"
+                ),
+                TimeRemainingColumn(),
+            )
+            self.task = self.bar.add_task("run", total=self.total, rate="-", time="0", broken=0)
+            self.bar.start()
+        self.start_step: int | None = None
+
+    def __call__(self, p) -> None:
+        if self.quiet:
+            return
+        if self.start_step is None:
+            self.start_step = p.step
+        done = p.step - (p.target_step - self.total)
+        if self.bar is not None:
+            self.bar.update(
+                self.task,
+                completed=done,
+                rate=f"{p.steps_per_second:,.0f}",
+                time=f"{p.time:.4g}",
+                broken=p.broken_bonds,
+            )
+            return
+        tenth = int(10 * done / self.total)
+        now = time.perf_counter()
+        if tenth > self.last_tenth or now - self.last_line > 30:
+            self.last_tenth, self.last_line = tenth, now
+            remaining = (p.target_step - p.step) / max(p.steps_per_second, 1e-9)
+            print(
+                f"step {p.step} ({100 * done / self.total:.0f} %), t = {p.time:.4g} s, "
+                f"{p.steps_per_second:,.0f} steps/s, broken bonds {p.broken_bonds}, "
+                f"ETA {_duration(remaining)}",
+                flush=True,
+            )
+
+    def close(self) -> None:
+        if self.bar is not None:
+            self.bar.stop()
+
+
+def _run_case(
+    path: Path, out: Path | None, resume: bool, overwrite: bool, quiet: bool, limit: int | None
+) -> int:
+    from granulate.case import load_case
+
+    case = load_case(path)
+    if out is None and case.spec.output is None:
+        out = Path("out") / path.stem
+    sim = case.build(output=out, resume=resume, overwrite=overwrite)
+    directory = sim.output_directory
+    assert directory is not None
+    if sim.checkpoint_path is None:  # a checkpoint on interrupt, at least
+        sim.checkpoint_every(path=directory / "checkpoint.npz")
+    if resume:
+        sim.load_checkpoint(sim.checkpoint_path)
+        print(f"resuming from step {sim.step} (t = {sim.time:.6g} s)")
+    steps = case.steps(sim)
+    if limit is not None:
+        if limit <= 0:
+            raise InputError(f"--steps must be positive, got {limit}")
+        steps = min(steps, limit)
+    stop = case.stop_criteria()
+    check_every = case.spec.stop.check_every if case.spec.stop is not None else 100
+    if not quiet:
+        print(
+            f"{sim.node_count} nodes, {sim.bond_count} bonds, dt {sim.dt:.4g} s, {steps} steps; "
+            f"output in {directory}"
+        )
+    reporter = _Reporter(steps, quiet)
+    try:
+        reason = sim.run(steps, stop=stop, check_every=check_every, progress=reporter)
+    finally:
+        reporter.close()
+    sim.save_checkpoint(sim.checkpoint_path)
+    summary = sim.summary()
+    rate = summary["nodes"] * summary["steps"] / max(summary["wall_seconds"], 1e-9)
+    ended = f"stopped: {reason}" if reason else "finished"
+    print(
+        f"{ended} at step {sim.step} (t = {sim.time:.6g} s) in {summary['wall_seconds']:.1f} s, "
+        f"{rate / 1e6:.2f} M node-steps/s, {sim.broken_bonds()} broken bonds"
+    )
+    return 0
+
+
+def _run_script(script: Path, args: list[str]) -> int:
+    if not script.is_file():
+        raise InputError(f"script {script} does not exist")
+    sys.argv = [str(script), *args]
+    runpy.run_path(str(script), run_name="__main__")
+    return 0
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="granulate", description=__doc__.splitlines()[0])
     parser.add_argument("--version", action="version", version=f"granulate {__version__}")
@@ -30,19 +201,61 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--threads", type=int, help="number of OpenMP threads")
     commands = parser.add_subparsers(dest="command", required=True)
     commands.add_parser("info", help="print version, build options and thread count")
-    run = commands.add_parser("run", help="run a Python set-up script")
-    run.add_argument("script", type=Path)
-    run.add_argument("args", nargs=argparse.REMAINDER, help="arguments passed to the script")
-    options = parser.parse_args(argv)
+    schema = commands.add_parser("schema", help="print the case-file reference")
+    schema.add_argument("--json", action="store_true", help="the JSON Schema, for editors")
+    check = commands.add_parser("check", help="validate a case and print a summary")
+    check.add_argument("case", type=Path)
+    run = commands.add_parser("run", help="run a case (.yaml) or a Python script (.py)")
+    run.add_argument("case", type=Path)
+    run.add_argument("--out", type=Path, help="output directory (default: the case's)")
+    run.add_argument("--resume", action="store_true", help="continue from the last checkpoint")
+    run.add_argument(
+        "--overwrite", action="store_true", help="replace an earlier run in the output directory"
+    )
+    run.add_argument("--quiet", action="store_true", help="no progress lines")
+    run.add_argument("--steps", type=int, help="run at most this many steps (a trial run)")
+    run.add_argument("args", nargs="*", help="arguments passed to a script (after --)")
+    plot = commands.add_parser("plot", help="PNG plots of a run's history.csv")
+    plot.add_argument("directory", type=Path)
+    render = commands.add_parser("render", help="PNG images of the particles coloured by damage")
+    render.add_argument("directory", type=Path)
+    render.add_argument("--frame", type=int, help="only this frame (default: all)")
+    render.add_argument("--gif", action="store_true", help="also an animated GIF of the run")
+    options, extra = parser.parse_known_args(argv)
+    if extra and not (options.command == "run" and options.case.suffix == ".py"):
+        parser.error(f"unrecognized arguments: {' '.join(extra)}")
+    if extra:
+        options.args = [*options.args, *extra]
     try:
         if options.threads is not None:
             _core.set_num_threads(options.threads)
         if options.command == "info":
             return _info()
-        if not options.script.is_file():
-            raise InputError(f"script {options.script} does not exist")
-        sys.argv = [str(options.script), *options.args]
-        runpy.run_path(str(options.script), run_name="__main__")
+        if options.command == "schema":
+            return _schema(options.json)
+        if options.command == "check":
+            return _check(options.case)
+        if options.command == "run":
+            if options.case.suffix == ".py":
+                return _run_script(options.case, options.args)
+            if options.args:
+                raise InputError(f"unexpected arguments {options.args} after the case file")
+            return _run_case(
+                options.case,
+                options.out,
+                options.resume,
+                options.overwrite,
+                options.quiet,
+                options.steps,
+            )
+        from granulate import plots
+
+        if options.command == "plot":
+            for written in plots.plot_history(options.directory):
+                print(written)
+            return 0
+        for written in plots.render(options.directory, frame=options.frame, gif=options.gif):
+            print(written)
         return 0
     except InputError as error:
         if options.debug:
@@ -54,6 +267,6 @@ def main(argv: list[str] | None = None) -> int:
             raise
         print(f"granulate: run failed: {error}", file=sys.stderr)
         return 1
-    except KeyboardInterrupt:
-        print("granulate: interrupted", file=sys.stderr)
+    except KeyboardInterrupt as error:
+        print(f"granulate: {error or 'interrupted'}", file=sys.stderr)
         return 130

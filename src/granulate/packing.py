@@ -260,6 +260,12 @@ class Placements:
         atomic_write(Path(path), ("\n".join(lines) + "\n").encode())
 
 
+def _generator(seed: int) -> np.random.Generator:
+    if not (isinstance(seed, int | np.integer) and seed >= 0):
+        raise InputError(f"seed must be a non-negative integer, got {seed!r}")
+    return np.random.default_rng(seed)
+
+
 def random_rotations(rng: np.random.Generator, count: int, dimension: int) -> NDArray[np.float64]:
     """Uniform random orientations: angles in [0, 2 pi) (2D) or rotation vectors of uniformly
     distributed rotations (3D, from uniform unit quaternions; Shoemake 1992)."""
@@ -324,7 +330,7 @@ def read_placements(path: str | Path, *, dimension: int = 2, seed: int = 0) -> P
             )
         rotations = data[:, 5].copy()
     else:
-        rotations = random_rotations(np.random.default_rng(seed), len(data), dimension)
+        rotations = random_rotations(_generator(seed), len(data), dimension)
     return Placements(zones.astype(np.int64), positions, radii.copy(), rotations, dimension)
 
 
@@ -418,12 +424,19 @@ def pack(
         raise InputError(f"count must be a positive number of particles, got {count!r}")
     if not (gap >= 0 and np.isfinite(gap)):
         raise InputError(f"gap must be a non-negative distance, got {gap}")
-    rng = np.random.default_rng(seed)
+    rng = _generator(seed)
     counts = _grain_counts(grains, int(count), by, rng)
     kinds = np.repeat(np.arange(len(grains)), counts)
     radii = np.concatenate(
         [g.sizes.sample(rng, int(c)) for g, c in zip(grains, counts, strict=True)]
     )  # type: ignore[union-attr]
+    lower, upper = container.bounds()
+    if 2 * (radii.max() + gap) > float(np.min((upper - lower)[:d])):
+        raise InputError(
+            f"the largest particle (bounding radius {radii.max():.4g} m) does not fit in the "
+            f"container (smallest extent {float(np.min((upper - lower)[:d])):.4g} m); check the "
+            "sizes and the container"
+        )
     order = np.argsort(-radii, kind="stable")  # largest first
     kinds, radii = kinds[order], radii[order]
     if method == "random":
@@ -453,7 +466,11 @@ def _random_sequential(
     diameter holding at most `slots` particle indices each (grown when full)."""
     d = container.dimension
     lower, upper = container.bounds()
+    # Cells of at least one bounding diameter (the 3^d neighbourhood then holds every possible
+    # overlap), and not many more cells than particles.
     cell = 2 * radii.max() + gap
+    while np.prod(np.ceil((upper[:d] - lower[:d]) / cell) + 2) > max(4 * len(radii), 4096):
+        cell *= 2
     shape = np.maximum(1, np.ceil((upper[:d] - lower[:d]) / cell).astype(np.int64)) + 2
     slots = 4
     members = np.full((int(np.prod(shape)), slots), -1, dtype=np.int64)
@@ -504,8 +521,11 @@ def _lattice_sites(
     where a sphere of half the spacing fits in the container; particles take random sites and a
     random shift within their slack."""
     d = container.dimension
-    spacing = 2 * radii.max() + gap
     lower, upper = container.bounds()
+    # One bounding diameter apart, or wider when few particles go in a large container.
+    spacing = 2 * radii.max() + gap
+    while np.prod(np.ceil((upper[:d] - lower[:d]) / spacing) + 1) > max(64 * len(radii), 4096):
+        spacing *= 1.5
     if d == 2:
         # The first row and column (just over) half a spacing in, so that they fit in a box.
         inset = 0.5 * spacing * (1 + 1e-6)

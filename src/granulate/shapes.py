@@ -671,6 +671,11 @@ def conforming(shape: Shape, mesh_size: float) -> tuple[NDArray[np.float64], NDA
     """
     if not (mesh_size > 0 and np.isfinite(mesh_size)):
         raise InputError(f"mesh size must be positive, got {mesh_size}")
+    rings = shape.bounding_radius / mesh_size if hasattr(shape, "bounding_radius") else 0.0
+    if rings**shape.dimension > 2e8:
+        raise InputError(
+            f"mesh size {mesh_size} gives over 200 million nodes; use a larger mesh size"
+        )
     if isinstance(shape, Disc | Ellipse):
         axes = (
             np.array([shape.radius, shape.radius])

@@ -651,8 +651,9 @@ class Simulation:
             raise InputError("overwrite and resume exclude each other")
         if (path / "simulation.pvd").exists() and not (overwrite or resume):
             raise InputError(
-                f"{path} already holds a run (simulation.pvd); choose another directory or pass "
-                "overwrite=True"
+                f"{path} already holds a run (simulation.pvd); choose another directory, replace "
+                "it (overwrite=True; granulate run --overwrite) or continue it (granulate run "
+                "--resume)"
             )
         (path / "frames").mkdir(parents=True, exist_ok=True)
         if overwrite:
@@ -900,6 +901,27 @@ class Simulation:
         finally:
             self._wall_seconds += wallclock.perf_counter() - start
         return reason
+
+    @property
+    def output_directory(self) -> Path | None:
+        """Where output(...) writes, or None."""
+        return None if self._output is None else self._output.directory
+
+    @property
+    def checkpoint_path(self) -> Path | None:
+        """Where checkpoint_every(...) writes, or None."""
+        return None if self._checkpoint is None else self._checkpoint.path
+
+    def validate_time_step(self, tolerance: float = 2.0) -> None:
+        """InputError if the time step exceeds ``tolerance`` times the stable estimate (a run
+        would blow up); the case runner calls it before running."""
+        core = self._build()
+        if core.time_step > tolerance * core.stable_time_step:
+            raise InputError(
+                f"time step {core.time_step:.4g} s is {core.time_step / core.stable_time_step:.1f} "
+                f"times the stable estimate {core.stable_time_step:.4g} s; use at most the "
+                "estimate (or leave dt out: the default is 0.8 times it)"
+            )
 
     # ------------------------------------------------------------------ checkpoints
     def checkpoint_every(

@@ -1,0 +1,173 @@
+"""Plots and renders of a run directory, without ParaView (matplotlib, Agg backend).
+
+``plot_history(directory)`` writes from history.csv:
+- ``energies.png``: kinetic, strain and total energy against time;
+- ``broken_bonds.png``: broken bonds against time;
+- ``wall_<name>.png`` for every wall: the force components against the wall's displacement
+  (a compression test's load curve).
+
+``render(directory, frame=None, gif=False)`` writes ``renders/frame_NNNNNN.png``: the nodes of
+each VTU frame coloured by damage (2D: in the plane; 3D: projected on x-z), and with ``gif`` an
+animated ``renders/run.gif``.
+"""
+
+from __future__ import annotations
+
+import csv
+from pathlib import Path
+
+import numpy as np
+
+from granulate.errors import InputError
+
+
+def _pyplot():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def read_history(directory: str | Path) -> dict[str, np.ndarray]:
+    """history.csv as columns of floats."""
+    path = Path(directory) / "history.csv"
+    if not path.is_file():
+        raise InputError(f"{path} does not exist; give the output directory of a run")
+    with path.open(newline="") as handle:
+        rows = list(csv.reader(handle))
+    if len(rows) < 2:
+        raise InputError(f"{path} has no rows yet")
+    header = rows[0]
+    try:
+        data = np.array([[float(v) for v in row] for row in rows[1:] if len(row) == len(header)])
+    except ValueError as error:
+        raise InputError(f"{path} is not a granulate history ({error})") from None
+    return {name: data[:, k] for k, name in enumerate(header)}
+
+
+def plot_history(directory: str | Path) -> list[Path]:
+    """Write the history plots (see the module docstring); returns their paths."""
+    history = read_history(directory)
+    plt = _pyplot()
+    folder = Path(directory)
+    written = []
+    t = history["time"]
+
+    figure, axes = plt.subplots(figsize=(6, 4))
+    for name in ("kinetic_energy", "strain_energy", "total_energy"):
+        axes.plot(t, history[name], label=name.replace("_", " "))
+    axes.set_xlabel("time [s]")
+    axes.set_ylabel("energy [J, J/m in 2D]")
+    axes.legend()
+    figure.tight_layout()
+    written.append(folder / "energies.png")
+    figure.savefig(written[-1], dpi=120)
+    plt.close(figure)
+
+    figure, axes = plt.subplots(figsize=(6, 4))
+    axes.plot(t, history["broken_bonds"])
+    axes.set_xlabel("time [s]")
+    axes.set_ylabel("broken bonds")
+    figure.tight_layout()
+    written.append(folder / "broken_bonds.png")
+    figure.savefig(written[-1], dpi=120)
+    plt.close(figure)
+
+    walls = sorted(
+        {name[: -len("_displacement")] for name in history if name.endswith("_displacement")}
+    )
+    for wall in walls:
+        figure, axes = plt.subplots(figsize=(6, 4))
+        moved = history[f"{wall}_displacement"]
+        for component in ("fx", "fy", "fz"):
+            if f"{wall}_{component}" in history:
+                axes.plot(moved, history[f"{wall}_{component}"], label=component)
+        axes.set_xlabel(f"{wall} displacement [m or rad]")
+        axes.set_ylabel("force on the wall [N, N/m in 2D]")
+        axes.legend()
+        figure.tight_layout()
+        written.append(folder / f"wall_{wall}.png")
+        figure.savefig(written[-1], dpi=120)
+        plt.close(figure)
+    return written
+
+
+def _frames(directory: Path) -> list[Path]:
+    frames = sorted((directory / "frames").glob("frame_*.vtu"))
+    if not frames:
+        raise InputError(
+            f"{directory / 'frames'} holds no frame_*.vtu; give the output directory of a run"
+        )
+    return frames
+
+
+def render(directory: str | Path, *, frame: int | None = None, gif: bool = False) -> list[Path]:
+    """Write PNG images of the frames (one, or all) and optionally an animated GIF."""
+    import meshio
+
+    folder = Path(directory)
+    frames = _frames(folder)
+    if frame is not None:
+        if not 0 <= frame < len(frames):
+            raise InputError(
+                f"frame {frame} does not exist; the run has frames 0 to {len(frames) - 1}"
+            )
+        frames = [frames[frame]]
+    plt = _pyplot()
+    out = folder / "renders"
+    out.mkdir(exist_ok=True)
+    meshes = [meshio.read(f) for f in frames]
+    points = np.concatenate([m.points for m in meshes])
+    is_3d = bool(np.ptp(points[:, 2]) > 0)
+    columns = (0, 2) if is_3d else (0, 1)
+    lower, upper = points[:, columns].min(axis=0), points[:, columns].max(axis=0)
+    margin = 0.05 * float(np.max(upper - lower) or 1.0)
+    written = []
+    images = []
+    for path, mesh in zip(frames, meshes, strict=True):
+        damage = mesh.point_data.get("Damage", np.zeros(len(mesh.points)))
+        volume = mesh.point_data.get("Nodal_Volume")
+        figure, axes = plt.subplots(
+            figsize=(
+                6,
+                6 * (upper[1] - lower[1] + 2 * margin) / (upper[0] - lower[0] + 2 * margin)
+                if upper[0] > lower[0]
+                else 6,
+            )
+        )
+        size = (
+            4.0 if volume is None else np.clip(2e4 * (np.asarray(volume) / np.max(volume)), 1, 20)
+        )
+        dots = axes.scatter(
+            mesh.points[:, columns[0]],
+            mesh.points[:, columns[1]],
+            c=damage,
+            s=size,
+            cmap="inferno_r",
+            vmin=0,
+            vmax=1,
+            linewidths=0,
+        )
+        figure.colorbar(dots, ax=axes, label="damage", shrink=0.8)
+        axes.set_xlim(lower[0] - margin, upper[0] + margin)
+        axes.set_ylim(lower[1] - margin, upper[1] + margin)
+        axes.set_aspect("equal")
+        axes.set_title(f"{path.stem}: damage")
+        axes.set_xlabel("x [m]")
+        axes.set_ylabel("z [m]" if is_3d else "y [m]")
+        figure.tight_layout()
+        target = out / f"{path.stem}.png"
+        figure.savefig(target, dpi=100)
+        plt.close(figure)
+        written.append(target)
+        images.append(target)
+    if gif:
+        from PIL import Image
+
+        pictures = [Image.open(p).convert("P", palette=Image.ADAPTIVE) for p in images]
+        target = out / "run.gif"
+        pictures[0].save(target, save_all=True, append_images=pictures[1:], duration=150, loop=0)
+        written.append(target)
+    return written
