@@ -1176,6 +1176,8 @@ class Simulation:
         core = self._build()
         phases = core.phase_times
         return {
+            "granulate": __version__,
+            "case_fingerprint": self.case_fingerprint,
             "bodies": len(self.bodies),
             "nodes": self.node_count,
             "bonds": self.bond_count,
