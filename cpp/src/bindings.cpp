@@ -231,7 +231,7 @@ NB_MODULE(_core, m) {
            [](const Model& self) {
              std::size_t bytes = 0;
              for (const BondFamilies& f : self.families()) {
-               bytes += f.neighbors.size() * (sizeof(index_t) + 2 * sizeof(real)) +
+               bytes += f.neighbors.size() * (sizeof(index_t) + sizeof(float) + sizeof(real)) +
                         f.offsets.size() * sizeof(index_t);
              }
              return bytes;

@@ -211,7 +211,8 @@ BondFamilies Model::build_family(index_t shape_index, real horizon, InfluenceKin
       // Partial volume: a neighbour cell cut by the horizon counts for its share inside.
       const real partial = r > horizon - 0.5 * h ? std::min(1.0, (horizon + 0.5 * h - r) / h) : 1.0;
       family.lengths[b] = r;
-      family.weights[b] = influence(influence_kind, std::min(r / horizon, 1.0)) * shape.volumes[j] * partial;
+      family.weights[b] = static_cast<float>(influence(influence_kind, std::min(r / horizon, 1.0)) *
+                                             shape.volumes[j] * partial);
     }
   }
   if (!coincident.empty()) {

@@ -66,12 +66,13 @@ TEST_CASE("bond families: interior counts, symmetry, partial volumes") {
       CHECK(found);
     }
   }
-  // a bond of length exactly delta keeps half its volume; one of length 2h all of it
+  // a bond of length exactly delta keeps half its volume; one of length 2h all of it (weights
+  // are stored in single precision: 6e-8 relative)
   const NodeBonds bc = model2->node_bonds(centre);
   for (index_t k = 0; k < bc.count; ++k) {
     const double r = bc.length(k) / 1e-3;
-    if (std::abs(r - 3.0) < 1e-9) CHECK_CLOSE(bc.weight(k), 0.5e-6, 1e-9);
-    if (std::abs(r - 2.0) < 1e-9) CHECK_CLOSE(bc.weight(k), 1e-6, 1e-12);
+    if (std::abs(r - 3.0) < 1e-9) CHECK_CLOSE(bc.weight(k), 0.5e-6, 1e-7);
+    if (std::abs(r - 2.0) < 1e-9) CHECK_CLOSE(bc.weight(k), 1e-6, 1e-7);
   }
 }
 
