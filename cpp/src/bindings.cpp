@@ -349,6 +349,7 @@ NB_MODULE(_core, m) {
   nb::class_<PhaseTimes>(m, "PhaseTimes")
       .def_ro("peridynamics", &PhaseTimes::peridynamics)
       .def_ro("contact", &PhaseTimes::contact)
+      .def_ro("contact_search", &PhaseTimes::contact_search)
       .def_ro("integration", &PhaseTimes::integration)
       .def_ro("loading", &PhaseTimes::loading);
 
@@ -463,6 +464,7 @@ NB_MODULE(_core, m) {
              return copy_out(labels);
            })
       .def_prop_ro("phase_times", &Simulation::phase_times)
+      .def("memory_bytes", &Simulation::memory_bytes)
       .def_prop_ro("positions",
                    [](Simulation& self) {
                      return view(self.state().positions.data(), self.model().node_count(), 3, nb::find(self));

@@ -1,6 +1,7 @@
 #include "granulate/contact/contact_model.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
 
@@ -562,6 +563,16 @@ std::array<index_t, 2> ContactModel::first_overlap(const Model& model, const Sta
   return {n, n};
 }
 
+std::size_t ContactModel::memory_bytes() const {
+  auto bytes = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
+  return bytes(laws_) + bytes(wall_laws_) + bytes(node_body_) + bytes(body_mass_) +
+         bytes(body_node_offsets_) + bytes(body_nodes_) + bytes(positions_at_build_) + bytes(pair_offsets_) +
+         bytes(pair_partner_) + bytes(pair_slot_) + bytes(wall_offsets_) + bytes(wall_entry_) +
+         bytes(wall_slot_) + bytes(slots_) + bytes(slot_reduced_mass_) + bytes(slot_law_) +
+         bytes(slot_stiffness_) + bytes(slot_approach_) + bytes(pair_stiffness_) + bytes(pair_distance_) +
+         bytes(wall_points_) + bytes(wall_entry_stiffness_) + bytes(wall_entry_reaction_);
+}
+
 ContactCheckpoint ContactModel::checkpoint() const {
   ContactCheckpoint c;
   c.built = built_;
@@ -606,7 +617,9 @@ void ContactModel::restore(const Model& model, const State& state, const Contact
 
 void ContactModel::add_forces(const Model& model, State& state, std::uint64_t broken_bonds) {
   if (!active()) return;
+  const auto search_start = std::chrono::steady_clock::now();
   if (needs_rebuild(model, state, broken_bonds)) rebuild(model, state, broken_bonds);
+  search_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - search_start).count();
   const auto& x = state.positions;
   const auto& v = state.velocities;
   auto& f = state.forces;

@@ -236,6 +236,7 @@ void Simulation::compute_forces() {
   const auto contact_start = clock_type::now();
   contact_.add_forces(m, state_, broken_bond_copies_);
   phase_times_.contact += seconds_since(contact_start);
+  phase_times_.contact_search = contact_.search_seconds();
 
   const real t = state_.time;
   for (const NodalForce& load : nodal_forces_) {
@@ -286,6 +287,23 @@ void Simulation::run(std::uint64_t steps) {
     if (state_.step % stability_check_interval == 0) check_stability();
     phase_times_.integration += seconds_since(start);
   }
+}
+
+std::array<std::size_t, 2> Simulation::memory_bytes() const {
+  auto bytes = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
+  const Model& m = *model_;
+  std::size_t bonds = bytes(state_.bond_intact);
+  for (const BondFamilies& f : m.families())
+    bonds += bytes(f.neighbors) + bytes(f.weights) + bytes(f.lengths);
+  std::size_t other = bytes(state_.positions) + bytes(state_.velocities) + bytes(state_.forces) +
+                      bytes(state_.dilatation) + bytes(pressure_) + bytes(mesh_size_) +
+                      bytes(m.reference_positions()) + bytes(m.volumes()) + bytes(m.node_particle()) +
+                      bytes(m.node_material()) + bytes(m.node_density()) + bytes(m.bond_offsets()) +
+                      bytes(m.weighted_volume()) + bytes(m.lps_coefficients()) + bytes(m.pmb_stiffness()) +
+                      contact_.memory_bytes();
+  for (const BondFamilies& f : m.families()) other += bytes(f.offsets);
+  for (const Shape& s : m.shapes()) other += bytes(s.positions) + bytes(s.volumes);
+  return {bonds, other};
 }
 
 void Simulation::restore(const State& state, const ContactCheckpoint& contact) {

@@ -749,6 +749,7 @@ class CaseContext:
                 g.fraction,
                 g.discretization,
                 g.reference_radius,
+                name,
             )
         return self._grains[name]
 

@@ -186,6 +186,7 @@ class Grain:
     fraction: float = 1.0
     discretization: str = "lattice"
     reference_radius: float | None = None
+    name: str | None = None
     _cache: dict = field(default_factory=dict, repr=False)
 
     def __post_init__(self) -> None:
@@ -220,6 +221,16 @@ class Grain:
         """Reference (bounding) radius r_ref [m]; a particle of size r is scaled by r / r_ref."""
         if self.reference_radius is not None:
             return float(self.reference_radius)
+        if isinstance(self.shape, Shape):
+            return self.shape.bounding_radius
+        reference = self.reference
+        return float(np.linalg.norm(reference.positions, axis=1).max() + 0.5 * reference.mesh_size)
+
+    @property
+    def extent(self) -> float:
+        """Radius about the origin that holds the particle at its reference size [m] (for a
+        mesh: the farthest node plus half a mesh size, which may exceed ``radius`` when the
+        reference radius is given, as PeriDEM's Parameters[0])."""
         if isinstance(self.shape, Shape):
             return self.shape.bounding_radius
         reference = self.reference
@@ -353,7 +364,7 @@ class Packing(Placements):
     def summary(self) -> str:
         counts = np.bincount(self.kinds, minlength=len(self.grains))
         parts = ", ".join(
-            f"{c} x {_label(g.shape)}" for c, g in zip(counts, self.grains, strict=True)
+            f"{c} x {g.name or _label(g.shape)}" for c, g in zip(counts, self.grains, strict=True)
         )
         return (
             f"{len(self)} particles ({parts}); radius {self.radii.min():.4g} .. "
@@ -431,18 +442,26 @@ def pack(
         [g.sizes.sample(rng, int(c)) for g, c in zip(grains, counts, strict=True)]
     )  # type: ignore[union-attr]
     lower, upper = container.bounds()
-    if 2 * (radii.max() + gap) > float(np.min((upper - lower)[:d])):
+    largest = float(np.max(radii * np.array([g.extent / g.radius for g in grains])[kinds]))
+    if 2 * (largest + gap) > float(np.min((upper - lower)[:d])):
         raise InputError(
-            f"the largest particle (bounding radius {radii.max():.4g} m) does not fit in the "
+            f"the largest particle (bounding radius {largest:.4g} m) does not fit in the "
             f"container (smallest extent {float(np.min((upper - lower)[:d])):.4g} m); check the "
             "sizes and the container"
         )
-    order = np.argsort(-radii, kind="stable")  # largest first
+    order = np.argsort(
+        -radii * np.array([g.extent / g.radius for g in grains])[kinds], kind="stable"
+    )
     kinds, radii = kinds[order], radii[order]
+    # Overlaps are checked on the extent of each particle (its bounding radius at its size).
+    extents = radii * np.array([g.extent / g.radius for g in grains])[kinds]
+    # Nodes stay a mesh size from the container (a contact radius, 0.95 h by default), so no
+    # particle presses on a wall at the start: half a mesh size beyond the extent.
+    margins = radii * np.array([0.5 * g.reference.mesh_size / g.radius for g in grains])[kinds]
     if method == "random":
-        positions = _random_sequential(container, radii, gap, rng, attempts)
+        positions = _random_sequential(container, extents, margins, gap, rng, attempts)
     elif method == "lattice":
-        positions = _lattice_sites(container, radii, gap, rng)
+        positions = _lattice_sites(container, extents, float(margins.max()), gap, rng)
     else:
         raise InputError(f"unknown packing method {method!r}; choose 'random' or 'lattice'")
     rotations = random_rotations(rng, len(radii), d)
@@ -450,17 +469,22 @@ def pack(
 
 
 def _candidates(
-    container: Shape, radius: float, gap: float, rng, count: int
+    container: Shape, radius: float, margin: float, gap: float, rng, count: int
 ) -> NDArray[np.float64]:
     lower, upper = container.bounds()
     d = container.dimension
     p = np.zeros((count, 3))
     p[:, :d] = rng.uniform(lower[:d] + radius, upper[:d] - radius, size=(count, d))
-    return p[container.signed_distance(p) <= -(radius + gap)]
+    return p[container.signed_distance(p) <= -(radius + margin + gap)]
 
 
 def _random_sequential(
-    container: Shape, radii: NDArray[np.float64], gap: float, rng, attempts: int
+    container: Shape,
+    radii: NDArray[np.float64],
+    margins: NDArray[np.float64],
+    gap: float,
+    rng,
+    attempts: int,
 ) -> NDArray[np.float64]:
     """Random sequential addition of bounding spheres, with a grid of cells of the largest
     diameter holding at most `slots` particle indices each (grown when full)."""
@@ -484,7 +508,7 @@ def _random_sequential(
         tried = 0
         while tried < attempts and not placed:
             tried += batch
-            p = _candidates(container, radius, gap, rng, batch)
+            p = _candidates(container, radius, margins[k], gap, rng, batch)
             if len(p) == 0:
                 continue
             index = np.floor((p[:, :d] - lower[:d]) / cell).astype(np.int64) + 1
@@ -515,7 +539,7 @@ def _random_sequential(
 
 
 def _lattice_sites(
-    container: Shape, radii: NDArray[np.float64], gap: float, rng
+    container: Shape, radii: NDArray[np.float64], margin: float, gap: float, rng
 ) -> NDArray[np.float64]:
     """Hexagonal (2D) or FCC (3D) sites spaced by the largest bounding diameter plus gap, kept
     where a sphere of half the spacing fits in the container; particles take random sites and a
@@ -528,7 +552,7 @@ def _lattice_sites(
         spacing *= 1.5
     if d == 2:
         # The first row and column (just over) half a spacing in, so that they fit in a box.
-        inset = 0.5 * spacing * (1 + 1e-6)
+        inset = (0.5 * spacing + margin + gap) * (1 + 1e-6)
         rows = np.arange(lower[1] + inset, upper[1], spacing * np.sqrt(3) / 2)
         columns = np.arange(lower[0] + inset, upper[0], spacing)
         sites = np.array(
@@ -541,10 +565,11 @@ def _lattice_sites(
     else:
         a = spacing * np.sqrt(2)  # FCC cube edge; nearest neighbours at a / sqrt(2)
         basis = np.array([[0, 0, 0], [0.5, 0.5, 0], [0.5, 0, 0.5], [0, 0.5, 0.5]]) * a
-        axes = [np.arange(lower[k] + 0.5 * spacing * (1 + 1e-6), upper[k], a) for k in range(3)]
+        inset = (0.5 * spacing + margin + gap) * (1 + 1e-6)
+        axes = [np.arange(lower[k] + inset, upper[k], a) for k in range(3)]
         corners = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
         sites = (corners[:, None, :] + basis[None]).reshape(-1, 3)
-    sites = sites[container.signed_distance(sites) <= -(0.5 * spacing + gap)]
+    sites = sites[container.signed_distance(sites) <= -(0.5 * spacing + margin + gap)]
     if len(sites) < len(radii):
         raise InputError(
             f"the container holds only {len(sites)} lattice sites of spacing {spacing:.4g} m "

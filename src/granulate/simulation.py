@@ -912,7 +912,7 @@ class Simulation:
         """Where checkpoint_every(...) writes, or None."""
         return None if self._checkpoint is None else self._checkpoint.path
 
-    def validate_time_step(self, tolerance: float = 2.0) -> None:
+    def validate_time_step(self, tolerance: float = 5.0) -> None:
         """InputError if the time step exceeds ``tolerance`` times the stable estimate (a run
         would blow up); the case runner calls it before running."""
         core = self._build()

@@ -15,7 +15,8 @@ namespace granulate {
 /// Wall-clock seconds spent in each phase of the step loop.
 struct PhaseTimes {
   double peridynamics = 0;
-  double contact = 0;
+  double contact = 0;         ///< all contact work, including the search
+  double contact_search = 0;  ///< neighbour-list checks and rebuilds (part of contact)
   double integration = 0;
   double loading = 0;
 };
@@ -73,6 +74,9 @@ class Simulation {
   /// Bit k set: component k of the node is prescribed.
   std::vector<std::uint8_t> fixity() const;
   const PhaseTimes& phase_times() const { return phase_times_; }
+  /// Bytes held by the core: {bond data (shared families + per-bond state), everything else
+  /// (per-node model and state arrays, contact lists)}, from the arrays' capacities.
+  std::array<std::size_t, 2> memory_bytes() const;
 
   /// Continues a run bit for bit from a checkpoint: the state (with the forces of its last
   /// step) and the contact model's history. The model, loading and walls must be the ones the

@@ -71,6 +71,10 @@ class ContactModel {
   /// [N, N m; per unit thickness in 2D], from the last evaluation.
   const std::vector<std::array<real, 6>>& wall_reactions() const { return wall_reactions_; }
   const ContactStatistics& statistics() const { return statistics_; }
+  /// Wall-clock seconds spent checking and rebuilding the neighbour lists.
+  double search_seconds() const { return search_seconds_; }
+  /// Bytes of the lists and per-entry scratch.
+  std::size_t memory_bytes() const;
 
   /// Set-up checks. The first node (and wall) with a node on the wrong side of a wall surface
   /// (a particle placed outside its container, or inside an obstacle); {node count, 0} if none.
@@ -148,6 +152,7 @@ class ContactModel {
   std::vector<std::array<real, 6>> wall_entry_reaction_;
   std::vector<std::array<real, 6>> wall_reactions_;
   ContactStatistics statistics_;
+  double search_seconds_ = 0;
 };
 
 }  // namespace granulate
