@@ -6,6 +6,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 
 def granulate(*args: str, cwd: Path | None = None) -> subprocess.CompletedProcess[str]:
     return subprocess.run(
@@ -71,3 +73,53 @@ def test_blow_up_exits_1(tmp_path: Path) -> None:
 def test_missing_script_is_a_user_error() -> None:
     result = granulate("run", "does_not_exist.py")
     assert result.returncode == 2 and "does not exist" in result.stderr
+
+
+def test_bench_quick_prints_the_documented_keys(tmp_path: Path) -> None:
+    result = granulate(
+        "--threads",
+        "1",
+        "bench",
+        "--quick",
+        "--json",
+        "--case",
+        "lps3d_lattice",
+        "--case",
+        "compression_small",
+        "--case",
+        "vtu_1m",
+        "--out",
+        str(tmp_path),
+        cwd=Path(__file__).parents[1],
+    )
+    assert result.returncode == 0, result.stderr
+    import json
+
+    rows = [json.loads(line) for line in result.stdout.splitlines()]
+    assert [r["case"] for r in rows] == ["lps3d_lattice", "compression_small", "vtu_1m"]
+    keys = {
+        "case",
+        "nodes",
+        "bonds",
+        "particles",
+        "steps",
+        "threads",
+        "seconds",
+        "node_steps_per_s",
+        "bond_evals_per_s",
+        "peak_rss_mb",
+        "phases",
+    }
+    for r in rows:
+        assert keys <= set(r)
+        assert r["threads"] == 1 and r["seconds"] > 0
+    assert set(rows[0]["phases"]) == {
+        "peridynamics",
+        "contact_search",
+        "contact_forces",
+        "walls",
+        "integration",
+        "output",
+    }
+    assert rows[0]["memory"]["bytes_per_bond"] == pytest.approx(17.0, abs=0.5)
+    assert granulate("bench", "--case", "nonsense").returncode == 2

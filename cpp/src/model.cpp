@@ -163,6 +163,9 @@ void Model::finalize() {
   if (finalized_) return;
   if (particles_.empty()) throw InputError("the model has no particles; add at least one body");
   build_bonds();
+  // The shapes' node positions were only needed to build the bond families (a body used once
+  // would otherwise hold its nodes twice).
+  for (Shape& shape : shapes_) std::vector<real>().swap(shape.positions);
   finalized_ = true;
 }
 

@@ -6,6 +6,7 @@
     granulate plot DIR                         PNG plots from DIR/history.csv
     granulate render DIR [--frame N] [--gif]   PNG images (and a GIF) of the particles
     granulate schema [--json]                  the case-file reference (or its JSON Schema)
+    granulate bench [--quick] [--case NAME ...] [--threads N] [--json]
     granulate info                             version, build options, threads
 
 Exit codes: 0 success, 2 invalid input, 1 failed run, 130 interrupted. User errors print one
@@ -215,6 +216,11 @@ def main(argv: list[str] | None = None) -> int:
     run.add_argument("--quiet", action="store_true", help="no progress lines")
     run.add_argument("--steps", type=int, help="run at most this many steps (a trial run)")
     run.add_argument("args", nargs="*", help="arguments passed to a script (after --)")
+    bench = commands.add_parser("bench", help="run the benchmark cases (benchmarks/cases)")
+    bench.add_argument("--quick", action="store_true", help="small sizes, a smoke check")
+    bench.add_argument("--case", action="append", help="a case (repeatable; default: all)")
+    bench.add_argument("--json", action="store_true", help="one JSON object per case")
+    bench.add_argument("--out", type=Path, default=Path("out") / "bench", help="scratch output")
     plot = commands.add_parser("plot", help="PNG plots of a run's history.csv")
     plot.add_argument("directory", type=Path)
     render = commands.add_parser("render", help="PNG images of the particles coloured by damage")
@@ -248,6 +254,10 @@ def main(argv: list[str] | None = None) -> int:
                 options.quiet,
                 options.steps,
             )
+        if options.command == "bench":
+            from granulate import bench as benchmarks
+
+            return benchmarks.main(options.case, options.quick, None, options.json, options.out)
         from granulate import plots
 
         if options.command == "plot":

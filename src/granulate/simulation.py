@@ -204,6 +204,7 @@ class Simulation:
         self._model: _core.Model | None = None
         self._reference: NDArray[np.float64] | None = None
         self._wall_seconds = 0.0
+        self._output_seconds = 0.0
         self._checkpoint: _Checkpointing | None = None
         #: Packings added with add_packing (for summaries).
         self.packings: list[Packing] = []
@@ -1217,7 +1218,19 @@ class Simulation:
         np.savetxt(buffer, np.column_stack(columns), delimiter=",", fmt=["%d"] + ["%.17g"] * 8)
         atomic_write(path, buffer.getvalue().encode())
 
+    @property
+    def output_seconds(self) -> float:
+        """Wall-clock seconds spent writing outputs so far."""
+        return self._output_seconds
+
     def _write_output(self) -> None:
+        start = wallclock.perf_counter()
+        try:
+            self._write_frame()
+        finally:
+            self._output_seconds += wallclock.perf_counter() - start
+
+    def _write_frame(self) -> None:
         out = self._output
         assert out is not None and self._model is not None
         core = self._build()

@@ -16,7 +16,7 @@ namespace granulate {
 /// A reference shape: nodes (local coordinates) and volumes, discretised once and placed as
 /// many particles as wanted (translated, rotated, scaled); its bond families are shared.
 struct Shape {
-  std::vector<real> positions;  ///< n x 3 [m], local frame
+  std::vector<real> positions;  ///< n x 3 [m], local frame (released by Model::finalize)
   std::vector<real> volumes;    ///< n [m^d]
   real mesh_size = 0;           ///< h [m] of the reference discretisation
   index_t node_count() const { return static_cast<index_t>(volumes.size()); }

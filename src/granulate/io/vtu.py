@@ -54,11 +54,11 @@ def _blocks(array: NDArray[np.generic]) -> list[memoryview]:
 
 def _level(blocks: list[memoryview]) -> int:
     """zlib level for an array: 1, or 0 (stored, no compression work) when its first block does
-    not shrink by 10 % (the low bits of doubles are noise; IDs, flags and cells compress)."""
+    shrink to half (the low bits of doubles are noise; IDs, flags and cells compress)."""
     sample = blocks[0]
     if len(sample) == 0:
         return _LEVEL
-    return _LEVEL if len(zlib.compress(sample, _LEVEL)) < 0.9 * len(sample) else 0
+    return _LEVEL if len(zlib.compress(sample, _LEVEL)) < 0.5 * len(sample) else 0
 
 
 def _compress_all(arrays: list[NDArray[np.generic]]) -> list[bytes]:
