@@ -138,10 +138,10 @@ def test_peridem_placement_files_are_read_and_written(tmp_path: Path) -> None:
     ("content", "message"),
     [
         ("i, x, y, z, r\n0, 0, 0, 0, -1e-3\n", "non-positive radius"),
-        ("i, x, y, z, r\n0, 0, 0, 0\n", "columns i, x, y, z, r"),
+        ("i, x, y, z, r\n0, 0, 0, 0\n", r"5 or 6 columns \(i, x, y, z, r"),
         ("i, x, y, z, r\n-1, 0, 0, 0, 1e-3\n", "zone ids"),
         ("i, x, y, z, r\n0, 0, zero, 0, 1e-3\n", "line 2: expected numbers"),
-        ("i, x, y, z, r\n", "lists no particles"),
+        ("i, x, y, z, r\n", "holds no particles"),
     ],
 )
 def test_bad_placement_files_give_clear_errors(tmp_path: Path, content: str, message: str) -> None:

@@ -12,7 +12,6 @@ spacing as h); without elements, the median of V^(1/d).
 from __future__ import annotations
 
 import contextlib
-import csv
 import io
 import warnings
 from dataclasses import dataclass, field
@@ -22,6 +21,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from granulate.errors import InputError
+from granulate.io.table import read_table
 from granulate.shapes import Shape, _points
 
 #: Element kinds we take volumes from, per dimension, with their node count.
@@ -196,29 +196,8 @@ def read_points_csv(path: str | Path, *, dimension: int) -> NodalMesh:
     """A CSV of nodes: columns x, y, volume (2D) or x, y, z, volume (3D) [m, m^d]; a header
     line is optional; lines starting with # are comments."""
     file = Path(path)
-    if not file.is_file():
-        raise InputError(f"points file {file} does not exist")
-    rows: list[list[float]] = []
-    with file.open(newline="") as handle:
-        for number, row in enumerate(csv.reader(handle), start=1):
-            cells = [c.strip() for c in row]
-            if not cells or not any(cells) or cells[0].startswith("#"):
-                continue
-            try:
-                values = [float(c) for c in cells]
-            except ValueError:
-                if not rows and number == 1:
-                    continue  # header
-                raise InputError(f"{file}, line {number}: expected numbers, got {row}") from None
-            if len(values) != dimension + 1:
-                raise InputError(
-                    f"{file}, line {number}: expected {dimension + 1} columns "
-                    f"({'x, y, ' if dimension == 2 else 'x, y, z, '}volume), got {len(values)}"
-                )
-            rows.append(values)
-    if not rows:
-        raise InputError(f"{file} holds no points")
-    data = np.asarray(rows)
+    columns = "x, y, volume" if dimension == 2 else "x, y, z, volume"
+    data = read_table(file, what="points", widths=(dimension + 1,), columns=columns)
     positions = np.zeros((len(data), 3))
     positions[:, :dimension] = data[:, :dimension]
     volumes = data[:, dimension]

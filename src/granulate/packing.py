@@ -23,7 +23,6 @@ The packing fraction reported is the grains' exact area (volume) over the contai
 
 from __future__ import annotations
 
-import csv
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -32,6 +31,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from granulate.errors import InputError
+from granulate.io.table import read_table
 from granulate.materials import Material
 from granulate.shapes import ReferenceShape, Shape
 
@@ -298,29 +298,7 @@ def read_placements(path: str | Path, *, dimension: int = 2, seed: int = 0) -> P
     or ``i, x, y, z, r, o`` (o: rotation about z [rad]); i is the zone (0-based), r the radius.
     A header line is optional."""
     file = Path(path)
-    if not file.is_file():
-        raise InputError(f"particle-location file {file} does not exist")
-    rows: list[list[float]] = []
-    with file.open(newline="") as handle:
-        for number, row in enumerate(csv.reader(handle), start=1):
-            cells = [c.strip() for c in row]
-            if not any(cells) or cells[0].startswith("#"):
-                continue
-            try:
-                values = [float(c) for c in cells]
-            except ValueError:
-                if not rows and number == 1:
-                    continue
-                raise InputError(f"{file}, line {number}: expected numbers, got {row}") from None
-            if len(values) not in (5, 6) or (rows and len(values) != len(rows[0])):
-                raise InputError(
-                    f"{file}, line {number}: expected the columns i, x, y, z, r[, o] on every "
-                    f"line, got {len(values)} values"
-                )
-            rows.append(values)
-    if not rows:
-        raise InputError(f"{file} lists no particles")
-    data = np.asarray(rows)
+    data = read_table(file, what="particles", widths=(5, 6), columns="i, x, y, z, r[, o]")
     zones = data[:, 0]
     if np.any(zones < 0) or np.any(zones != np.round(zones)):
         raise InputError(f"{file}: zone ids (column i) must be non-negative integers")
