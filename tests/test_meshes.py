@@ -11,7 +11,8 @@ import pytest
 
 import granulate as gr
 
-DECKS = Path(__file__).resolve().parents[2] / "shared" / "peridem" / "decks"
+# Copies of a PeriDEM deck's files (made by PeriDEM's set-up scripts), kept with the benchmarks.
+DECK = Path(__file__).resolve().parents[1] / "benchmarks" / "cases" / "compression_small"
 
 
 def structured(dimension: int, kind: str, n: int = 4, size: float = 2e-3) -> meshio.Mesh:
@@ -95,9 +96,7 @@ def test_gmsh_binary_v4_and_a_vtu_volume_field(tmp_path: Path) -> None:
 def test_peridem_deck_meshes_read_with_their_element_areas() -> None:
     """PeriDEM's gmsh v2 disc mesh: volumes sum to the area of its polygonal boundary (the
     inscribed 64-gon of radius 1 mm here), within round-off."""
-    path = DECKS / "twop_circ" / "mesh_cir_1_0.msh"
-    if not path.exists():
-        pytest.fail(f"the PeriDEM decks are missing: {path}")
+    path = DECK / "mesh_cir_small_0.msh"
     reference = gr.ReferenceShape.from_mesh(str(path))
     boundary = np.linalg.norm(reference.positions[:, :2], axis=1)
     sides = int(np.sum(np.isclose(boundary, 1e-3, rtol=1e-6)))
@@ -191,7 +190,7 @@ def test_surface_mesh_orientation_is_fixed_and_holes_are_refused() -> None:
 
 def test_a_meshed_particle_runs(tmp_path: Path) -> None:
     """A PeriDEM disc mesh placed twice: the particles collide and separate."""
-    path = DECKS / "twop_circ" / "mesh_cir_1_0.msh"
+    path = DECK / "mesh_cir_small_0.msh"
     reference = gr.ReferenceShape.from_mesh(str(path))
     material = gr.Material(density=1200, bulk_modulus=2.16e7, shear_modulus=1.296e7, fracture=False)
     sim = gr.Simulation(2)

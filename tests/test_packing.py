@@ -11,7 +11,8 @@ import pytest
 import granulate as gr
 
 ROCK = gr.Material(density=2600, bulk_modulus=2.16e7, shear_modulus=1.296e7, fracture_energy=50)
-DECKS = Path(__file__).resolve().parents[2] / "shared" / "peridem" / "decks"
+# Copies of a PeriDEM deck's files (made by PeriDEM's set-up scripts), kept with the benchmarks.
+DECK = Path(__file__).resolve().parents[1] / "benchmarks" / "cases" / "compression_small"
 
 
 def grain(shape: gr.Shape, sizes: gr.SizeDistribution, fraction: float = 1.0) -> gr.Grain:
@@ -116,7 +117,7 @@ def test_a_full_container_is_reported_with_the_count_that_fits() -> None:
 
 
 def test_peridem_placement_files_are_read_and_written(tmp_path: Path) -> None:
-    path = DECKS / "compression_small_set" / "particle_locations_0.csv"
+    path = DECK / "particle_locations_0.csv"
     placements = gr.read_placements(path)
     assert len(placements) == 15
     assert placements.kinds.min() == 0
