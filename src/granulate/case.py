@@ -811,7 +811,7 @@ class Case:
                 jitter=b.jitter,
                 seed=b.seed,
                 velocity=b.velocity,
-                angular_velocity=_angular(b.angular_velocity),
+                angular_velocity=b.angular_velocity,
                 name=b.name or f"body{k}",
             )
             named[body.name] = body
@@ -824,10 +824,10 @@ class Case:
                 g.reference,
                 g.material,
                 position=p.position,
-                rotation=_angular(p.rotation),
+                rotation=p.rotation,
                 scale=scale,
                 velocity=p.velocity,
-                angular_velocity=_angular(p.angular_velocity),
+                angular_velocity=p.angular_velocity,
                 name=p.name,
             )
             if p.name:
@@ -924,10 +924,6 @@ def _vector(values: list[float], dimension: int, name: str) -> list[float]:
     if len(values) not in (dimension, 3):
         raise InputError(f"{name} needs {dimension} components, got {len(values)}")
     return list(values)
-
-
-def _angular(value: float | list[float] | None) -> float | list[float] | None:
-    return value
 
 
 def _surface(s: BaseModel, case: CaseContext) -> walls.Surface:
