@@ -148,11 +148,6 @@ void Simulation::apply_prescribed_motion(bool positions_too) {
   }
 }
 
-real Simulation::bond_extension(index_t i, index_t j, real length, const std::vector<real>& x) const {
-  const real dx = x[3 * j] - x[3 * i], dy = x[3 * j + 1] - x[3 * i + 1], dz = x[3 * j + 2] - x[3 * i + 2];
-  return std::sqrt(dx * dx + dy * dy + dz * dz) - length;
-}
-
 void Simulation::compute_forces() {
   const Model& m = *model_;
   const auto& materials = m.materials();

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <array>
+#include <cmath>
 #include <memory>
 #include <vector>
 
@@ -86,8 +87,11 @@ class Simulation {
  private:
   void apply_prescribed_motion(bool positions_too);
   void check_stability() const;
-  /// |x_j - x_i| - length.
-  real bond_extension(index_t i, index_t j, real length, const std::vector<real>& x) const;
+  /// |x_j - x_i| - length (inline: it is the inner step of the bond loops).
+  static real bond_extension(index_t i, index_t j, real length, const std::vector<real>& x) {
+    const real dx = x[3 * j] - x[3 * i], dy = x[3 * j + 1] - x[3 * i + 1], dz = x[3 * j + 2] - x[3 * i + 2];
+    return std::sqrt(dx * dx + dy * dy + dz * dz) - length;
+  }
 
   std::shared_ptr<Model> model_;
   State state_;
