@@ -53,9 +53,9 @@ def _blocks(array: NDArray[np.generic]) -> list[memoryview]:
 
 
 def _level(blocks: list[memoryview]) -> int:
-    """zlib level for an array: 1, or 0 (stored, no compression work) when its first block does
+    """zlib level for an array: 1, or 0 (stored, no compression work) when its middle block does
     shrink to half (the low bits of doubles are noise; IDs, flags and cells compress)."""
-    sample = blocks[0]
+    sample = blocks[len(blocks) // 2]  # the middle: edges of a field are often special
     if len(sample) == 0:
         return _LEVEL
     return _LEVEL if len(zlib.compress(sample, _LEVEL)) < 0.5 * len(sample) else 0
