@@ -23,6 +23,7 @@ The packing fraction reported is the grains' exact area (volume) over the contai
 
 from __future__ import annotations
 
+from abc import ABC, abstractmethod
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -37,11 +38,12 @@ from granulate.shapes import ReferenceShape, Shape
 
 
 # ----------------------------------------------------------------------- size distributions
-class SizeDistribution:
+class SizeDistribution(ABC):
     """Distribution of particle sizes (bounding radii [m])."""
 
+    @abstractmethod
     def sample(self, rng: np.random.Generator, count: int) -> NDArray[np.float64]:
-        raise NotImplementedError
+        """``count`` sizes drawn with ``rng`` [m]."""
 
     def _bounded(self, draw, low: float, high: float, rng, count: int) -> NDArray[np.float64]:
         """Draws kept within [low, high] by redrawing the rest (a truncated distribution)."""
@@ -219,12 +221,7 @@ class Grain:
     @property
     def radius(self) -> float:
         """Reference (bounding) radius r_ref [m]; a particle of size r is scaled by r / r_ref."""
-        if self.reference_radius is not None:
-            return float(self.reference_radius)
-        if isinstance(self.shape, Shape):
-            return self.shape.bounding_radius
-        reference = self.reference
-        return float(np.linalg.norm(reference.positions, axis=1).max() + 0.5 * reference.mesh_size)
+        return float(self.reference_radius) if self.reference_radius is not None else self.extent
 
     @property
     def extent(self) -> float:
@@ -233,8 +230,11 @@ class Grain:
         reference radius is given, as PeriDEM's Parameters[0])."""
         if isinstance(self.shape, Shape):
             return self.shape.bounding_radius
-        reference = self.reference
-        return float(np.linalg.norm(reference.positions, axis=1).max() + 0.5 * reference.mesh_size)
+        if "extent" not in self._cache:
+            reference = self.reference
+            farthest = np.linalg.norm(reference.positions, axis=1).max()
+            self._cache["extent"] = float(farthest + 0.5 * reference.mesh_size)
+        return self._cache["extent"]
 
     @property
     def measure_at_unit_radius(self) -> float:
@@ -420,19 +420,17 @@ def pack(
         [g.sizes.sample(rng, int(c)) for g, c in zip(grains, counts, strict=True)]
     )  # type: ignore[union-attr]
     lower, upper = container.bounds()
-    largest = float(np.max(radii * np.array([g.extent / g.radius for g in grains])[kinds]))
+    # Overlaps are checked on the extent of each particle (its bounding radius at its size).
+    extents = radii * np.array([g.extent / g.radius for g in grains])[kinds]
+    largest = float(extents.max())
     if 2 * (largest + gap) > float(np.min((upper - lower)[:d])):
         raise InputError(
             f"the largest particle (bounding radius {largest:.4g} m) does not fit in the "
             f"container (smallest extent {float(np.min((upper - lower)[:d])):.4g} m); check the "
             "sizes and the container"
         )
-    order = np.argsort(
-        -radii * np.array([g.extent / g.radius for g in grains])[kinds], kind="stable"
-    )
-    kinds, radii = kinds[order], radii[order]
-    # Overlaps are checked on the extent of each particle (its bounding radius at its size).
-    extents = radii * np.array([g.extent / g.radius for g in grains])[kinds]
+    order = np.argsort(-extents, kind="stable")  # largest first
+    kinds, radii, extents = kinds[order], radii[order], extents[order]
     # Nodes stay a mesh size from the container (a contact radius, 0.95 h by default), so no
     # particle presses on a wall at the start: half a mesh size beyond the extent.
     margins = radii * np.array([0.5 * g.reference.mesh_size / g.radius for g in grains])[kinds]

@@ -13,6 +13,7 @@ of the first one met, or None when it ran to the end.
 
 from __future__ import annotations
 
+from abc import ABC, abstractmethod
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -24,10 +25,12 @@ if TYPE_CHECKING:
     from granulate.simulation import Simulation
 
 
-class StopCriterion:
+class StopCriterion(ABC):
+    """A condition checked during a run (see the module docstring)."""
+
+    @abstractmethod
     def check(self, sim: Simulation) -> str | None:
         """The reason to stop, or None."""
-        raise NotImplementedError
 
 
 @dataclass(frozen=True)
