@@ -91,6 +91,22 @@ def test_resume_through_the_cli_continues_bit_for_bit(tmp_path: Path) -> None:
         assert filecmp.cmp(whole / name, split / name, shallow=False), name
 
 
+def test_resume_works_with_per_pair_contact(tmp_path: Path) -> None:
+    """The fingerprint names materials by order, not identity: a case reloaded for --resume
+    (new Material objects) with a per-pair contact law still matches its checkpoint."""
+    case = tmp_path / "pairs.yaml"
+    text = BASE.read_text().replace(
+        "walls:",
+        "contact_pairs:\n  - {materials: [rock, rock], contact: {restitution: 0.5}}\nwalls:",
+    )
+    case.write_text(text)
+    whole, split = tmp_path / "whole", tmp_path / "split"
+    assert main(["run", str(case), "--out", str(whole), "--quiet"]) == 0
+    assert main(["run", str(case), "--out", str(split), "--quiet", "--steps", "70"]) == 0
+    assert main(["run", str(case), "--out", str(split), "--quiet", "--resume"]) == 0
+    assert filecmp.cmp(whole / "history.csv", split / "history.csv", shallow=False)
+
+
 def test_resume_refuses_another_case(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     out = tmp_path / "run"
     assert main(["run", str(BASE), "--out", str(out), "--quiet", "--steps", "40"]) == 0

@@ -205,6 +205,8 @@ class Simulation:
         self._reference: NDArray[np.float64] | None = None
         self._wall_seconds = 0.0
         self._output_seconds = 0.0
+        self._core_materials: list[Material] = []
+        self._setup_digest: str | None = None
         self._checkpoint: _Checkpointing | None = None
         #: Packings added with add_packing (for summaries).
         self.packings: list[Packing] = []
@@ -697,6 +699,7 @@ class Simulation:
         model.finalize()
         core = _core.Simulation(model)
         self._set_contact_laws(core, core_materials)
+        self._core_materials = core_materials
         self._check_start(model, core)
         if self._dt is None:
             core.time_step = self._dt_safety * core.stable_time_step
@@ -974,26 +977,38 @@ class Simulation:
         return path
 
     def fingerprint(self) -> str:
-        """Identifies the set-up a checkpoint belongs to: nodes, volumes, bonds, time step,
-        body force, damping, loading, walls, contact, and ``case_fingerprint``."""
+        """Identifies the set-up a checkpoint belongs to: nodes, volumes, bonds, loading,
+        walls, contact (frozen once built: hashed once), time step, body force, damping and
+        ``case_fingerprint``. Materials are named by their order, not by object identity, so
+        the fingerprint is the same in every process."""
         core = self._build()
-        model = self.model
-        loads = []
-        for kind, args in self._loads:
-            loads.append(kind)
-            for a in args:
-                loads.append(np.asarray(a).tobytes() if isinstance(a, np.ndarray) else repr(a))
+        if self._setup_digest is None:
+            model = self.model
+            loads = []
+            for kind, args in self._loads:
+                loads.append(kind)
+                for a in args:
+                    loads.append(np.asarray(a).tobytes() if isinstance(a, np.ndarray) else repr(a))
+            order = {id(m): k for k, m in enumerate(self._core_materials)}
+            pairs = sorted(
+                (order[a], order[b], repr(contact))
+                for (a, b), contact in self._pair_contacts.items()
+                if a in order and b in order
+            )
+            self._setup_digest = checkpoint_file.fingerprint(
+                np.ascontiguousarray(model.reference_positions).tobytes(),
+                np.ascontiguousarray(model.volumes).tobytes(),
+                np.ascontiguousarray(model.bond_offsets).tobytes(),
+                *loads,
+                repr(self._walls),
+                repr(self._contact),
+                repr(pairs),
+            )
         return checkpoint_file.fingerprint(
-            np.ascontiguousarray(model.reference_positions).tobytes(),
-            np.ascontiguousarray(model.volumes).tobytes(),
-            np.ascontiguousarray(model.bond_offsets).tobytes(),
+            self._setup_digest,
             float(core.time_step),
             repr(self.gravity.tolist()),
             self._viscous_damping,
-            *loads,
-            repr(self._walls),
-            repr(self._contact),
-            repr(sorted((k, repr(v)) for k, v in self._pair_contacts.items())),
             self.case_fingerprint,
         )
 
