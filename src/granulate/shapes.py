@@ -243,7 +243,32 @@ def _regular_vertices(
     return tuple((float(c[0] + radius * np.cos(f)), float(c[1] + radius * np.sin(f))) for f in phi)
 
 
-class RegularPolygon(Polygon):
+class _CentredPolygon(Polygon):
+    """A polygon generated from a few parameters about a centre: it keeps them (for repr and
+    YAML round trips), and its origin is the centre; ``_extent`` names the parameter that is
+    its bounding radius."""
+
+    _extent = "radius"
+
+    def _keep(self, **parameters: object) -> None:
+        for name, value in parameters.items():
+            object.__setattr__(self, name, value)
+        object.__setattr__(self, "_parameters", tuple(parameters))
+
+    def __repr__(self) -> str:
+        values = ", ".join(f"{name}={getattr(self, name)!r}" for name in self._parameters)  # type: ignore[attr-defined]
+        return f"{type(self).__name__}({values})"
+
+    @property
+    def origin(self) -> NDArray[np.float64]:
+        return np.array([*self.center, 0.0])  # type: ignore[attr-defined]
+
+    @property
+    def bounding_radius(self) -> float:
+        return float(getattr(self, self._extent))
+
+
+class RegularPolygon(_CentredPolygon):
     """Regular polygon with ``sides`` vertices on a circle of ``radius`` (circumradius) about
     ``center`` [m], the first vertex at ``angle`` [rad] from the x axis (PeriDEM's triangle,
     square and hexagon are 3, 4 and 6 sides with the first vertex on the axis)."""
@@ -257,29 +282,19 @@ class RegularPolygon(Polygon):
         if not (radius > 0 and np.isfinite(radius)):
             raise InputError(f"RegularPolygon radius must be positive, got {radius}")
         super().__init__(_regular_vertices(center, radius, int(sides), angle))
-        object.__setattr__(self, "center", tuple(float(c) for c in center))
-        object.__setattr__(self, "radius", float(radius))
-        object.__setattr__(self, "sides", int(sides))
-        object.__setattr__(self, "angle", float(angle))
-
-    def __repr__(self) -> str:
-        return (
-            f"RegularPolygon(center={self.center}, radius={self.radius}, sides={self.sides}, "
-            f"angle={self.angle})"
+        self._keep(
+            center=tuple(float(c) for c in center),
+            radius=float(radius),
+            sides=int(sides),
+            angle=float(angle),
         )
 
-    @property
-    def origin(self) -> NDArray[np.float64]:
-        return np.array([*self.center, 0.0])
 
-    @property
-    def bounding_radius(self) -> float:
-        return self.radius
-
-
-class Star(Polygon):
+class Star(_CentredPolygon):
     """Star with ``points`` tips on a circle of ``outer_radius`` and the notches between them on
     ``inner_radius`` about ``center`` [m]; the first tip at ``angle`` [rad]."""
+
+    _extent = "outer_radius"
 
     def __init__(
         self,
@@ -299,28 +314,16 @@ class Star(Polygon):
         tips = _regular_vertices(center, outer_radius, int(points), angle)
         notches = _regular_vertices(center, inner_radius, int(points), angle + np.pi / points)
         super().__init__(tuple(v for pair in zip(tips, notches, strict=True) for v in pair))
-        object.__setattr__(self, "center", tuple(float(c) for c in center))
-        object.__setattr__(self, "outer_radius", float(outer_radius))
-        object.__setattr__(self, "inner_radius", float(inner_radius))
-        object.__setattr__(self, "points", int(points))
-        object.__setattr__(self, "angle", float(angle))
-
-    def __repr__(self) -> str:
-        return (
-            f"Star(center={self.center}, outer_radius={self.outer_radius}, "
-            f"inner_radius={self.inner_radius}, points={self.points}, angle={self.angle})"
+        self._keep(
+            center=tuple(float(c) for c in center),
+            outer_radius=float(outer_radius),
+            inner_radius=float(inner_radius),
+            points=int(points),
+            angle=float(angle),
         )
 
-    @property
-    def origin(self) -> NDArray[np.float64]:
-        return np.array([*self.center, 0.0])
 
-    @property
-    def bounding_radius(self) -> float:
-        return self.outer_radius
-
-
-class Drum2D(Polygon):
+class Drum2D(_CentredPolygon):
     """PeriDEM's drum: a hexagon of circumradius ``radius`` about ``center`` [m] whose two
     vertices on the axis (at ``angle`` [rad] from x) are pulled in to ``neck_half_width``. The
     vertices are c + w a, c + r R(60 deg) a, then that point - r a, c - w a, and their mirror
@@ -346,24 +349,12 @@ class Drum2D(Polygon):
             c + radius * (0.5 * a - half * up),
         ]
         super().__init__(tuple((float(v[0]), float(v[1])) for v in vertices))
-        object.__setattr__(self, "center", (float(c[0]), float(c[1])))
-        object.__setattr__(self, "radius", float(radius))
-        object.__setattr__(self, "neck_half_width", float(neck_half_width))
-        object.__setattr__(self, "angle", float(angle))
-
-    def __repr__(self) -> str:
-        return (
-            f"Drum2D(center={self.center}, radius={self.radius}, "
-            f"neck_half_width={self.neck_half_width}, angle={self.angle})"
+        self._keep(
+            center=(float(c[0]), float(c[1])),
+            radius=float(radius),
+            neck_half_width=float(neck_half_width),
+            angle=float(angle),
         )
-
-    @property
-    def origin(self) -> NDArray[np.float64]:
-        return np.array([*self.center, 0.0])
-
-    @property
-    def bounding_radius(self) -> float:
-        return self.radius
 
 
 def _ellipsoid_distance(q: NDArray[np.float64], axes: NDArray[np.float64]) -> NDArray[np.float64]:
