@@ -148,7 +148,10 @@ NB_MODULE(_core, m) {
   });
   m.def("get_max_threads", [] { return omp_get_max_threads(); });
 
-  nb::enum_<PlaneMode>(m, "PlaneMode").value("strain", PlaneMode::strain).value("stress", PlaneMode::stress);
+  nb::enum_<PlaneMode>(m, "PlaneMode")
+      .value("strain", PlaneMode::strain)
+      .value("stress", PlaneMode::stress)
+      .value("peridem", PlaneMode::peridem);
   nb::enum_<ForceModel>(m, "ForceModel").value("lps", ForceModel::lps).value("pmb", ForceModel::pmb);
   nb::enum_<InfluenceKind>(m, "InfluenceKind")
       .value("constant", InfluenceKind::constant)
@@ -297,7 +300,8 @@ NB_MODULE(_core, m) {
       .def_rw("stiffness_factor", &contact::Law::stiffness_factor)
       .def_rw("damping_ratio", &contact::Law::damping_ratio)
       .def_rw("friction", &contact::Law::friction)
-      .def_rw("slip_velocity", &contact::Law::slip_velocity);
+      .def_rw("slip_velocity", &contact::Law::slip_velocity)
+      .def_rw("peridem_friction", &contact::Law::peridem_friction);
   m.def("damping_ratio_from_restitution", &contact::damping_ratio_from_restitution, "restitution"_a);
 
   nb::enum_<WallSurface::Kind>(m, "WallSurfaceKind")

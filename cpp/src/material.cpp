@@ -130,7 +130,11 @@ Material Material::make(const MaterialParams& params, int dimension, PlaneMode p
   m.plane = plane;
   const real K = params.bulk_modulus;
   const real G = params.shear_modulus;
-  if (dimension == 3) {
+  const bool peridem = dimension == 2 && plane == PlaneMode::peridem;
+  if (peridem && params.model != ForceModel::lps) {
+    throw InputError("PeriDEM's 2D constants (plane 'peridem') are reproduced for the LPS model only");
+  }
+  if (dimension == 3 || peridem) {
     m.dilatation_modulus = K;
     m.deviatoric_factor = 15.0;
   } else {
@@ -152,7 +156,13 @@ Material Material::make(const MaterialParams& params, int dimension, PlaneMode p
   }
 
   m.critical_stretch = std::numeric_limits<real>::infinity();
-  if (params.fracture) {
+  if (params.fracture && peridem) {
+    const real energy_per_stretch2 = (3.0 * G + std::pow(0.75, 4) * (K - 5.0 * G / 3.0)) * delta;
+    if (!(energy_per_stretch2 > 0)) {
+      throw InputError("material constants give a non-positive fracture energy per stretch; check K and G");
+    }
+    m.critical_stretch = std::sqrt(params.fracture_energy / energy_per_stretch2);
+  } else if (params.fracture) {
     const FractureCoefficients coefficients =
         known ? *known : fracture_coefficients(params.model, params.influence, dimension);
     real energy_per_stretch2;  // Gc / s0^2

@@ -275,7 +275,7 @@ void Model::build_bonds() {
       pmb_stiffness_[i] = dimension_ * dimension_ * material.dilatation_modulus / first_moment;
     }
     if (m > 0) {
-      const real d = dimension_;
+      const real d = lps_dimension();
       const real a = material.deviatoric_factor;
       const real G = material.params.shear_modulus;
       lps_coefficients_[i].dilatation_scale = d / m;

@@ -349,7 +349,7 @@ real Simulation::kinetic_energy() const {
 
 void Simulation::strain_energy_density(real* out) const {
   const Model& m = *model_;
-  const real inverse_dimension = 1.0 / m.dimension();
+  const real inverse_dimension = 1.0 / m.lps_dimension();
 #pragma omp parallel for schedule(static)
   for (std::int64_t ii = 0; ii < static_cast<std::int64_t>(m.node_count()); ++ii) {
     const index_t i = static_cast<index_t>(ii);

@@ -379,7 +379,7 @@ class GrainSpec(Spec):
     mesh: MeshSpec | None = None
     material: str = Field(description="name in `materials`")
     mesh_size: Positive | None = Field(None, description="at the reference size [m]")
-    discretization: Literal["lattice", "conforming"] = "lattice"
+    discretization: Literal["lattice", "conforming", "grid"] = "lattice"
     sizes: SizeSpec | None = Field(None, description="bounding radii, for packings")
     fraction: NonNegative = Field(1.0, description="share in packings (by number or volume)")
     reference_radius: Positive | None = Field(None, description="default: bounding radius [m]")
@@ -401,7 +401,7 @@ class BodySpec(Spec):
     shape: ShapeRef
     material: str
     mesh_size: Positive = Field(description="[m]")
-    discretization: Literal["lattice", "conforming"] = "lattice"
+    discretization: Literal["lattice", "conforming", "grid"] = "lattice"
     jitter: Annotated[float, Field(ge=0, lt=0.5)] = 0.0
     seed: Annotated[int, Field(ge=0)] = 0
     velocity: list[Finite] | None = Field(None, description="[m/s]")
@@ -463,6 +463,9 @@ class ContactSpec(Spec):
     normal_stiffness: Positive | None = Field(None, description="absolute kn")
     stiffness_factor: Positive = 1.0
     slip_velocity: Positive = Field(1e-4, description="[m/s]")
+    friction_law: Literal["coulomb", "peridem"] = Field(
+        "coulomb", description="'peridem': PeriDEM's friction (speeds sliding up), comparisons only"
+    )
 
     def make(self) -> Contact:
         return Contact(**self.model_dump())
@@ -558,10 +561,11 @@ class WallSpec(Spec):
 
 # ----------------------------------------------------------------------------- loading
 class SelectSpec(Spec):
-    """Nodes by region (reference positions), body name and/or node ids; all must hold."""
+    """Nodes by region (reference positions), body name(s) and/or node ids; all must hold."""
 
     region: ShapeRef | None = None
-    body: str | None = None
+    body: str | list[str] | None = Field(None, description="a body name, or a list (any of them)")
+    exclude: list[str] = Field([], description="bodies whose nodes are left out")
     ids: list[Annotated[int, Field(ge=0)]] | None = None
 
 
@@ -628,6 +632,12 @@ class OutputSpec(Spec):
     directory: str = Field("out", description="relative to the working directory")
     every: Annotated[int, Field(gt=0)] = Field(1000, description="steps between frames")
     fields: list[Literal[FIELDS]] = list(FIELDS)  # type: ignore[valid-type]
+    history_every: Annotated[int, Field(gt=0)] | None = Field(
+        None, description="steps between history.csv rows (default: every)"
+    )
+    track: list[str] = Field(
+        [], description="bodies whose force resultant and mean displacement history.csv records"
+    )
 
 
 class CheckpointSpec(Spec):
@@ -654,6 +664,9 @@ class StopSpec(Spec):
         None, description="particles with every bond broken"
     )
     broken_bonds: Annotated[int, Field(gt=0)] | None = None
+    node_distance: Positive | None = Field(
+        None, description="a node farther than this from the origin [m]"
+    )
     check_every: Annotated[int, Field(gt=0)] = 100
 
 
@@ -661,7 +674,9 @@ class CaseSpec(Spec):
     """A granulate case."""
 
     dimension: Literal[2, 3]
-    plane: Literal["strain", "stress"] = "strain"
+    plane: Literal["strain", "stress", "peridem"] = Field(
+        "strain", description="2D: 'peridem' = PeriDEM's 3D constants in 2D, comparisons only"
+    )
     materials: Annotated[dict[str, Material], Field(min_length=1)]
     shapes: dict[str, ShapeSpec] = {}
     grains: dict[str, GrainSpec] = {}
@@ -769,6 +784,8 @@ class Case:
     spec: CaseSpec
     source: Path
     text: str
+    #: What a translated PeriDEM deck runs differently (printed once by the CLI).
+    notes: list[str] = field(default_factory=list)
 
     @property
     def fingerprint(self) -> str:
@@ -882,6 +899,8 @@ class Case:
                 fields=tuple(o.fields),
                 overwrite=overwrite,
                 resume=resume,
+                history_every=o.history_every,
+                track=[_named(t, named, "output.track") for t in o.track],
             )
         if spec.checkpoint is not None:
             sim.checkpoint_every(spec.checkpoint.every_steps, minutes=spec.checkpoint.every_minutes)
@@ -911,6 +930,8 @@ class Case:
             criteria.append(stopping.ParticlesBroken(s.particles_broken))
         if s.broken_bonds is not None:
             criteria.append(stopping.BrokenBonds(s.broken_bonds))
+        if s.node_distance is not None:
+            criteria.append(stopping.NodeDistance(s.node_distance))
         return criteria
 
     def steps(self, sim: Simulation) -> int:
@@ -962,15 +983,37 @@ def _wall(w: WallSpec, case: CaseContext) -> walls.Wall:
     )
 
 
+def _named(name: str, named: dict[str, Body], what: str) -> Body:
+    if name not in named:
+        raise InputError(f"{what} {name!r}{_closest(name, named)}")
+    return named[name]
+
+
 def _load(sim: Simulation, load: BaseModel, case: CaseContext, named: dict[str, Body]) -> None:
     select: SelectSpec = load.nodes  # type: ignore[attr-defined]
-    body = None
-    if select.body is not None:
-        if select.body not in named:
-            raise InputError(f"loading selects body {select.body!r}{_closest(select.body, named)}")
-        body = named[select.body]
     region = None if select.region is None else case.shape(select.region)
-    nodes = sim.select(region, body=body, ids=select.ids)
+    if select.body is None:
+        nodes = sim.select(region, ids=select.ids)
+    else:
+        chosen = [select.body] if isinstance(select.body, str) else select.body
+        bodies = [_named(b, named, "loading selects body") for b in chosen]
+        parts = []
+        for body in bodies:
+            try:
+                parts.append(sim.select(region, body=body, ids=select.ids))
+            except InputError:
+                if len(bodies) == 1:
+                    raise
+        if not parts:
+            raise InputError(f"loading selects no node of bodies {chosen}")
+        nodes = np.unique(np.concatenate(parts)).astype(np.uint32)
+    if select.exclude:
+        left_out = np.concatenate(
+            [_named(b, named, "loading excludes body").nodes for b in select.exclude]
+        )
+        nodes = np.setdiff1d(nodes, left_out).astype(np.uint32)
+        if len(nodes) == 0:
+            raise InputError("loading selects no node once the excluded bodies are left out")
     if isinstance(load, FixSpec):
         sim.fix(nodes, load.components)
     elif isinstance(load, DisplacementSpec):
@@ -990,8 +1033,10 @@ def _load(sim: Simulation, load: BaseModel, case: CaseContext, named: dict[str, 
 
 
 # ----------------------------------------------------------------------------- loading
-def load_case(path: str | Path) -> Case:
-    """Read and validate a YAML case file (InputError with every problem found)."""
+def load_case(path: str | Path, *, peridem_compat: bool = False) -> Case:
+    """Read and validate a YAML case file (InputError with every problem found). A PeriDEM
+    input deck is recognised and translated (granulate.peridem); ``peridem_compat`` selects
+    PeriDEM's formulas where granulate has them. It is refused for a native case."""
     source = Path(path)
     if not source.is_file():
         raise InputError(f"case file {source} does not exist")
@@ -999,6 +1044,23 @@ def load_case(path: str | Path) -> Case:
         text = source.read_text()
     except (OSError, UnicodeDecodeError) as error:
         raise InputError(f"cannot read case file {source}: {error}") from None
+    try:
+        data = yaml.safe_load(text)
+    except yaml.YAMLError:
+        data = None  # parse_case reports it
+    from granulate import peridem
+
+    if peridem.is_deck(data):
+        translation = peridem.translate(source, compat=peridem_compat)
+        case = parse_case(peridem.to_yaml(translation, peridem_compat), source)
+        case.text = text + "\n---\n" + case.text
+        case.notes = translation.notes
+        return case
+    if peridem_compat:
+        raise InputError(
+            f"{source} is a granulate case, not a PeriDEM deck: --peridem-compat applies to "
+            "decks (a case sets plane: peridem and friction_law: peridem itself)"
+        )
     return parse_case(text, source)
 
 

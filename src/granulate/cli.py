@@ -2,6 +2,8 @@
 
     granulate check CASE.yaml                  validate, build and summarise without running
     granulate run CASE.yaml [--out DIR] [--resume] [--overwrite]
+    granulate run input_0.yaml [--peridem-compat]   a PeriDEM deck, translated
+    granulate convert input_0.yaml -o case.yaml     write a PeriDEM deck as a granulate case
     granulate run SCRIPT.py [ARGS...]          run a Python set-up script
     granulate plot DIR                         PNG plots from DIR/history.csv
     granulate render DIR [--frame N] [--gif]   PNG images (and a GIF) of the particles
@@ -49,10 +51,36 @@ def _schema(as_json: bool) -> int:
     return 0
 
 
-def _check(path: Path) -> int:
+def _notes(case) -> None:
+    """Say once what a translated PeriDEM deck runs differently."""
+    if case.notes:
+        print(f"{case.source.name}: PeriDEM deck, translated; differences from PeriDEM:")
+        for note in case.notes:
+            print(f"  - {note}")
+
+
+def _convert(deck: Path, target: Path, compat: bool, overwrite: bool) -> int:
+    from granulate import peridem
+    from granulate.case import parse_case
+    from granulate.io.atomic import atomic_write
+
+    if target.exists() and not overwrite:
+        raise InputError(f"{target} exists; choose another name or pass --overwrite")
+    translation = peridem.translate(deck, compat=compat, output=target.resolve().parent)
+    text = peridem.to_yaml(translation, compat)
+    parse_case(text, target.resolve())  # what is written must load as a case
+    atomic_write(target, text.encode())
+    print(f"wrote {target} ({len(translation.case.get('particles', []))} placed particles)")
+    for note in translation.notes:
+        print(f"  - {note}")
+    return 0
+
+
+def _check(path: Path, compat: bool = False) -> int:
     from granulate.case import load_case
 
-    case = load_case(path)
+    case = load_case(path, peridem_compat=compat)
+    _notes(case)
     sim = case.build(outputs=False)
     case.stop_criteria()  # names of walls in stop criteria
     steps = case.steps(sim)
@@ -145,11 +173,18 @@ class _Reporter:
 
 
 def _run_case(
-    path: Path, out: Path | None, resume: bool, overwrite: bool, quiet: bool, limit: int | None
+    path: Path,
+    out: Path | None,
+    resume: bool,
+    overwrite: bool,
+    quiet: bool,
+    limit: int | None,
+    compat: bool = False,
 ) -> int:
     from granulate.case import load_case
 
-    case = load_case(path)
+    case = load_case(path, peridem_compat=compat)
+    _notes(case)
     if out is None and case.spec.output is None:
         out = Path("out") / path.stem
     sim = case.build(output=out, resume=resume, overwrite=overwrite)
@@ -205,8 +240,15 @@ def main(argv: list[str] | None = None) -> int:
     commands.add_parser("info", help="print version, build options and thread count")
     schema = commands.add_parser("schema", help="print the case-file reference")
     schema.add_argument("--json", action="store_true", help="the JSON Schema, for editors")
+    compat_help = "PeriDEM deck: PeriDEM's formulas where granulate has them (comparisons)"
     check = commands.add_parser("check", help="validate a case and print a summary")
     check.add_argument("case", type=Path)
+    check.add_argument("--peridem-compat", action="store_true", help=compat_help)
+    convert = commands.add_parser("convert", help="write a PeriDEM deck as a granulate case")
+    convert.add_argument("deck", type=Path)
+    convert.add_argument("-o", "--output", type=Path, required=True, help="the case file to write")
+    convert.add_argument("--peridem-compat", action="store_true", help=compat_help)
+    convert.add_argument("--overwrite", action="store_true", help="replace an existing file")
     run = commands.add_parser("run", help="run a case (.yaml) or a Python script (.py)")
     run.add_argument("case", type=Path)
     run.add_argument("--out", type=Path, help="output directory (default: the case's)")
@@ -216,6 +258,7 @@ def main(argv: list[str] | None = None) -> int:
     )
     run.add_argument("--quiet", action="store_true", help="no progress lines")
     run.add_argument("--steps", type=int, help="run at most this many steps (a trial run)")
+    run.add_argument("--peridem-compat", action="store_true", help=compat_help)
     run.add_argument("args", nargs="*", help="arguments passed to a script (after --)")
     bench = commands.add_parser("bench", help="run the benchmark cases (benchmarks/cases)")
     bench.add_argument("--quick", action="store_true", help="small sizes, a smoke check")
@@ -241,7 +284,9 @@ def main(argv: list[str] | None = None) -> int:
         if options.command == "schema":
             return _schema(options.json)
         if options.command == "check":
-            return _check(options.case)
+            return _check(options.case, options.peridem_compat)
+        if options.command == "convert":
+            return _convert(options.deck, options.output, options.peridem_compat, options.overwrite)
         if options.command == "run":
             if options.case.suffix == ".py":
                 return _run_script(options.case, options.args)
@@ -254,6 +299,7 @@ def main(argv: list[str] | None = None) -> int:
                 options.overwrite,
                 options.quiet,
                 options.steps,
+                options.peridem_compat,
             )
         if options.command == "bench":
             from granulate import bench as benchmarks

@@ -35,6 +35,9 @@ class Contact:
         stiffness_factor: multiplies the default kn.
         slip_velocity: friction regularisation: below this slip speed [m/s] friction grows
             linearly from zero (keep it well below the velocities of interest).
+        friction_law: "coulomb" (default), or "peridem": PeriDEM's friction, mu |F_n| along
+            the slip velocity (it speeds sliding up instead of resisting it); for comparisons
+            with PeriDEM only.
     """
 
     restitution: float = 1.0
@@ -44,8 +47,13 @@ class Contact:
     normal_stiffness: float | None = None
     stiffness_factor: float = 1.0
     slip_velocity: float = 1e-4
+    friction_law: str = "coulomb"
 
     def __post_init__(self) -> None:
+        if self.friction_law not in ("coulomb", "peridem"):
+            raise InputError(
+                f"friction_law must be 'coulomb' or 'peridem', got {self.friction_law!r}"
+            )
         if not 0 < self.restitution <= 1:
             raise InputError(f"restitution must be in (0, 1], got {self.restitution}")
         if not (self.friction >= 0 and math.isfinite(self.friction)):

@@ -646,6 +646,45 @@ def lattice(
     return np.ascontiguousarray(points), volumes
 
 
+def grid(shape: Shape, mesh_size: float) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Nodes at the vertices of a uniform grid over a Rectangle or Box, boundary included, with
+    the nodal volumes of bilinear (trilinear) finite elements: each cell gives 1/2^d of its
+    measure to each of its corners (a corner node of the rectangle carries h^2/4, an edge node
+    h^2/2). The grid has n_k = round(L_k / h) cells along axis k, of size L_k / n_k. This is
+    PeriDEM's built-in uniform mesh (``CreateMesh: {Flag: true, Info: uniform}``).
+
+    Returns (positions (n, 3) [m], volumes (n,) [m^d]).
+    """
+    if not isinstance(shape, Rectangle | Box):
+        raise InputError(
+            f"grid discretization is available for Rectangle and Box, not {type(shape).__name__}; "
+            "use the lattice, or import a mesh"
+        )
+    if not (mesh_size > 0 and np.isfinite(mesh_size)):
+        raise InputError(f"mesh size must be positive, got {mesh_size}")
+    d = shape.dimension
+    lower = np.asarray(shape.lower, dtype=float)[:d]
+    upper = np.asarray(shape.upper, dtype=float)[:d]
+    cells = np.maximum(1, np.round((upper - lower) / mesh_size).astype(np.int64))
+    if np.prod((cells + 1).astype(float)) > 2e8:
+        raise InputError(
+            f"mesh size {mesh_size} gives over 200 million grid nodes; use a larger mesh size"
+        )
+    axes = [np.linspace(lower[k], upper[k], cells[k] + 1) for k in range(d)]
+    spacing = (upper - lower) / cells
+    shares = []
+    for k in range(d):
+        w = np.full(cells[k] + 1, spacing[k])
+        w[[0, -1]] *= 0.5
+        shares.append(w)
+    points = np.zeros((int(np.prod(cells + 1)), 3))
+    points[:, :d] = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, d)
+    volumes = np.ones(1)
+    for w in shares:
+        volumes = np.multiply.outer(volumes, w)
+    return points, volumes.reshape(-1)
+
+
 def conforming(shape: Shape, mesh_size: float) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Nodes on rings (2D) or shells (3D) that follow the surface of a Disc, Ellipse, Sphere or
     Ellipsoid, so the particle's surface is smooth instead of a lattice staircase (this matters
@@ -827,19 +866,22 @@ class ReferenceShape:
         seed: int = 0,
         centered: bool = False,
     ) -> ReferenceShape:
-        """Discretize a shape: ``discretization`` "lattice" (any shape; optional jitter) or
-        "conforming" (rings or shells following the surface: Disc, Ellipse, Sphere, Ellipsoid).
+        """Discretize a shape: ``discretization`` "lattice" (any shape; optional jitter),
+        "conforming" (rings or shells following the surface: Disc, Ellipse, Sphere, Ellipsoid)
+        or "grid" (grid vertices with finite-element volumes: Rectangle, Box).
         ``centered``: move the shape's ``origin`` (centre or centroid) to (0, 0, 0), so that
         rotations and scales act about it."""
         if discretization == "lattice":
             positions, volumes = lattice(shape, mesh_size, jitter=jitter, seed=seed)
-        elif discretization == "conforming":
+        elif discretization in ("conforming", "grid"):
             if jitter:
                 raise InputError("jitter applies to the lattice discretization only")
-            positions, volumes = conforming(shape, mesh_size)
+            make = conforming if discretization == "conforming" else grid
+            positions, volumes = make(shape, mesh_size)
         else:
             raise InputError(
-                f"unknown discretization {discretization!r}; choose 'lattice' or 'conforming'"
+                f"unknown discretization {discretization!r}; choose 'lattice', 'conforming' or "
+                "'grid'"
             )
         if centered:
             positions = positions - shape.origin

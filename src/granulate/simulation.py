@@ -14,6 +14,7 @@ energies J per metre.
 from __future__ import annotations
 
 import io
+import difflib
 import json
 import signal
 import threading
@@ -112,6 +113,8 @@ class _Output:
     every: int
     fields: tuple[str, ...]
     pvd: PvdSeries
+    history_every: int
+    tracked: tuple[Body, ...] = ()
     history: HistoryWriter | None = None
     frames: int = 0
 
@@ -160,6 +163,8 @@ class Simulation:
     Args:
         dimension: 2 or 3.
         plane: 2D assumption, ``"strain"`` (default) or ``"stress"``; ignored in 3D.
+            ``"peridem"`` reproduces PeriDEM's 2D LPS (3D coefficients and critical stretch in
+            2D), for comparisons with PeriDEM only: it does not give the material's 2D moduli.
         dt: time step [s]; default ``dt_safety`` times the stable estimate.
         dt_safety: fraction of the stable estimate used when ``dt`` is not given.
         gravity: body acceleration [m/s^2], e.g. (0, -9.81, 0).
@@ -170,7 +175,7 @@ class Simulation:
     def __init__(
         self,
         dimension: int = 2,
-        plane: Literal["strain", "stress"] = "strain",
+        plane: Literal["strain", "stress", "peridem"] = "strain",
         *,
         dt: float | None = None,
         dt_safety: float = 0.8,
@@ -179,8 +184,8 @@ class Simulation:
     ) -> None:
         if dimension not in (2, 3):
             raise InputError(f"dimension must be 2 or 3, got {dimension!r}")
-        if plane not in ("strain", "stress"):
-            raise InputError(f"plane must be 'strain' or 'stress', got {plane!r}")
+        if plane not in ("strain", "stress", "peridem"):
+            raise InputError(f"plane must be 'strain', 'stress' or 'peridem', got {plane!r}")
         if not 0 < dt_safety <= 1:
             raise InputError(f"dt_safety must be in (0, 1], got {dt_safety}")
         self.dimension = dimension
@@ -636,9 +641,19 @@ class Simulation:
         fields: tuple[str, ...] = FIELDS,
         overwrite: bool = False,
         resume: bool = False,
+        history_every: int | None = None,
+        track: Sequence[Body | str] = (),
     ) -> None:
-        """Write VTU frames (``frames/``), ``simulation.pvd``, ``history.csv`` and particle
-        snapshots (``frames/particles_*.csv``) every N steps.
+        """Write VTU frames (``frames/``), ``simulation.pvd`` and particle snapshots
+        (``frames/particles_*.csv``) every ``every`` steps, and a row of ``history.csv`` every
+        ``history_every`` steps (default: with each frame).
+
+        ``track``: bodies (or their names) whose load and motion history.csv records:
+        ``<name>_fx, _fy[, _fz]``, the resultant of the forces on the body other than gravity
+        (contacts, walls, applied force densities; the internal bond forces cancel) [N; N/m in
+        2D], and ``<name>_ux, _uy[, _uz]``, its mean nodal displacement [m]. For a body whose
+        nodes are all prescribed (a meshed wall, a loading platen) the force is the reaction a
+        load cell would measure.
 
         A directory that already holds a run is refused unless ``overwrite`` is true (its
         frames are then deleted) or ``resume`` is true (it is kept for ``load_checkpoint``,
@@ -646,6 +661,12 @@ class Simulation:
         """
         if not (isinstance(every, int) and every > 0):
             raise InputError(f"output interval must be a positive number of steps, got {every!r}")
+        history_every = every if history_every is None else history_every
+        if not (isinstance(history_every, int) and history_every > 0):
+            raise InputError(
+                f"history interval must be a positive number of steps, got {history_every!r}"
+            )
+        tracked = tuple(self._body(b) for b in track)
         unknown = [f for f in fields if f not in FIELDS]
         if unknown:
             raise InputError(f"unknown output fields {unknown}; choose from {', '.join(FIELDS)}")
@@ -663,7 +684,23 @@ class Simulation:
             for pattern in ("frame_*.vtu", "particles_*.csv"):
                 for old in (path / "frames").glob(pattern):
                     old.unlink()
-        self._output = _Output(path, every, tuple(fields), PvdSeries(path / "simulation.pvd"))
+        self._output = _Output(
+            path, every, tuple(fields), PvdSeries(path / "simulation.pvd"), history_every, tracked
+        )
+
+    def _body(self, body: Body | str) -> Body:
+        """A body of this simulation, or the one of that name (InputError otherwise)."""
+        if isinstance(body, Body):
+            if body.index >= len(self.bodies) or self.bodies[body.index] is not body:
+                raise InputError(f"body {body.name!r} belongs to another simulation")
+            return body
+        for b in self.bodies:
+            if b.name == body:
+                return b
+        names = [b.name for b in self.bodies]
+        match = difflib.get_close_matches(str(body), names, n=1)
+        hint = f"; did you mean {match[0]!r}?" if match else ""
+        raise InputError(f"no body named {body!r}{hint}")
 
     # ------------------------------------------------------------------ the core
     def _build(self) -> _core.Simulation:
@@ -772,6 +809,7 @@ class Simulation:
         law.damping_ratio = _core.damping_ratio_from_restitution(contact.restitution)
         law.friction = contact.friction
         law.slip_velocity = contact.slip_velocity
+        law.peridem_friction = contact.friction_law == "peridem"
         return law
 
     def _set_contact_laws(self, core: _core.Simulation, materials: list[Material]) -> None:
@@ -858,6 +896,7 @@ class Simulation:
             raise InputError(f"check_every must be a positive number of steps, got {check_every}")
         out = self._output
         if out is not None and out.frames == 0:
+            core.run(0)  # the forces of step 0 (prescribed motion, contact), for the frame
             self._write_output()
         target = core.step + steps
         start = wallclock.perf_counter()
@@ -870,6 +909,7 @@ class Simulation:
                     boundaries = [target - core.step, chunk_limit]
                     if out is not None:
                         boundaries.append(out.every - core.step % out.every)
+                        boundaries.append(out.history_every - core.step % out.history_every)
                     if stop:
                         boundaries.append(check_every - core.step % check_every)
                     if self._checkpoint is not None and self._checkpoint.every_steps:
@@ -882,7 +922,9 @@ class Simulation:
                     # Aim at chunks of about half a second: responsive to Ctrl-C and progress.
                     rate = chunk / max(elapsed, 1e-9)
                     chunk_limit = int(min(10_000, max(1, 0.5 * rate)))
-                    if out is not None and core.step % out.every == 0:
+                    if out is not None and (
+                        core.step % out.every == 0 or core.step % out.history_every == 0
+                    ):
                         self._write_output()
                     if stop and core.step % check_every == 0:
                         reason = next((r for c in stop if (r := c.check(self)) is not None), None)
@@ -1024,7 +1066,12 @@ class Simulation:
             "time": float(core.time),
             "output": None
             if out is None
-            else {"frames": out.frames, "every": out.every, "pvd": out.pvd.entries},
+            else {
+                "frames": out.frames,
+                "every": out.every,
+                "history_every": out.history_every,
+                "pvd": out.pvd.entries,
+            },
         }
         target = Path(path)
         target.parent.mkdir(parents=True, exist_ok=True)
@@ -1046,7 +1093,11 @@ class Simulation:
         out = self._output
         saved = header.get("output")
         if out is not None:
-            if saved is None or saved["every"] != out.every:
+            if (
+                saved is None
+                or saved["every"] != out.every
+                or saved.get("history_every", saved["every"]) != out.history_every
+            ):
                 raise InputError(
                     f"checkpoint {path} was written with other output settings; keep the "
                     "output interval of the original run"
@@ -1246,10 +1297,22 @@ class Simulation:
             self._output_seconds += wallclock.perf_counter() - start
 
     def _write_frame(self) -> None:
+        """The frame (when the step is a frame step) and the history row (when it is a
+        history step) of the current step."""
         out = self._output
         assert out is not None and self._model is not None
         core = self._build()
         phi, z = core.damage()
+        volumes = self._model.volumes
+        if core.step % out.every == 0 or out.frames == 0:
+            self._write_vtu_frame(phi, z)
+        if core.step % out.history_every == 0 or out.history is None:
+            self._write_history_row()
+
+    def _write_vtu_frame(self, phi: NDArray[np.float64], z: NDArray[np.float64]) -> None:
+        out = self._output
+        assert out is not None and self._model is not None
+        core = self._build()
         volumes = self._model.volumes
         available = {
             "Displacement": lambda: core.positions - self._reference,
@@ -1271,6 +1334,13 @@ class Simulation:
         )
         out.pvd.add(core.time, Path("frames") / name)
         self._write_particles(out.directory / "frames" / f"particles_{out.frames:06d}.csv", phi)
+        out.frames += 1
+        atomic_write(out.directory / "run.json", json.dumps(self.summary(), indent=2).encode())
+
+    def _write_history_row(self) -> None:
+        out = self._output
+        assert out is not None and self._model is not None
+        core = self._build()
         kinetic, strain = core.kinetic_energy(), core.strain_energy()
         statistics = core.contact_statistics
         row: dict[str, float | int] = {
@@ -1294,8 +1364,22 @@ class Simulation:
             for c in components:
                 row[f"{name}_{c}"] = float(reaction[index[c]])
             row[f"{name}_displacement"] = wall.displacement(core.time)
+        if out.tracked:
+            forces = core.forces
+            displacement = core.positions - self._reference
+            volumes = self._model.volumes
+            density = self._model.node_density
+            gravity = self._gravity
+            axes = "xyz"[: self.dimension]
+            for body in out.tracked:
+                nodes = slice(body.first_node, body.first_node + body.node_count)
+                v = volumes[nodes]
+                resultant = v @ forces[nodes] - float(v @ density[nodes]) * gravity
+                mean = displacement[nodes].mean(axis=0)
+                for k, axis in enumerate(axes):
+                    row[f"{body.name}_f{axis}"] = float(resultant[k])
+                for k, axis in enumerate(axes):
+                    row[f"{body.name}_u{axis}"] = float(mean[k])
         if out.history is None:
             out.history = HistoryWriter(out.directory / "history.csv", list(row))
         out.history.write(row)
-        out.frames += 1
-        atomic_write(out.directory / "run.json", json.dumps(self.summary(), indent=2).encode())

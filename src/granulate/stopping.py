@@ -9,6 +9,7 @@ of the first one met, or None when it ran to the end.
 - ``WallDisplacement(wall, distance)``: the wall has moved at least ``distance`` [m].
 - ``ParticlesBroken(count)``: at least ``count`` particles have lost every bond.
 - ``BrokenBonds(count)``: at least ``count`` bonds are broken.
+- ``NodeDistance(distance)``: a node is farther than ``distance`` [m] from the origin.
 """
 
 from __future__ import annotations
@@ -93,3 +94,21 @@ class BrokenBonds(StopCriterion):
     def check(self, sim: Simulation) -> str | None:
         broken = sim.broken_bonds()
         return f"{broken} bonds broken (limit {self.count})" if broken >= self.count else None
+
+
+@dataclass(frozen=True)
+class NodeDistance(StopCriterion):
+    """A node is farther than ``distance`` [m] from the origin (a particle escaped the domain;
+    PeriDEM's ``Output_Criteria: max_node_dist``)."""
+
+    distance: float
+
+    def __post_init__(self) -> None:
+        if not (self.distance > 0 and np.isfinite(self.distance)):
+            raise InputError(f"NodeDistance needs a positive distance, got {self.distance}")
+
+    def check(self, sim: Simulation) -> str | None:
+        farthest = float(np.sqrt(np.max(np.einsum("ij,ij->i", sim.positions, sim.positions))))
+        if farthest > self.distance:
+            return f"a node is {farthest:.4g} m from the origin (limit {self.distance:.4g} m)"
+        return None

@@ -101,6 +101,9 @@ class Model {
   bool finalized() const { return finalized_; }
   int dimension() const { return dimension_; }
   PlaneMode plane() const { return plane_; }
+  /// d in the LPS formulas (theta = d/m sum J r e V, e - theta r / d): the dimension, or 3 in
+  /// PeriDEM's 2D (PlaneMode::peridem).
+  int lps_dimension() const { return plane_ == PlaneMode::peridem ? 3 : dimension_; }
   index_t node_count() const { return static_cast<index_t>(volumes_.size()); }
 
   const std::vector<Material>& materials() const { return materials_; }

@@ -24,7 +24,10 @@ class InstabilityError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-/// Plane assumption of a two-dimensional model; ignored in 3D.
-enum class PlaneMode : std::uint8_t { strain, stress };
+/// Plane assumption of a two-dimensional model; ignored in 3D. `peridem` reproduces PeriDEM's 2D
+/// LPS for comparisons: the 3D coefficients (theta = 3/m sum J r e V, kappa_d = K, a_d = 15) and
+/// the 3D critical stretch s0 = sqrt(Gc / ((3G + (3/4)^4 (K - 5G/3)) delta)), which do not give
+/// the requested 2D moduli or fracture energy (tests/validation prove the strain/stress forms).
+enum class PlaneMode : std::uint8_t { strain, stress, peridem };
 
 }  // namespace granulate

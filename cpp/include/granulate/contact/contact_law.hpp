@@ -17,6 +17,7 @@
 //             (c_ij = 2 zeta k_ij sqrt(M / K), force clipped at zero).
 //   friction: F_t = -mu F_n min(1, |v_t| / v_slip) v_t / |v_t| on each node pair, v_t the
 //             tangential velocity of i relative to j (regularised Coulomb: no chatter near zero slip).
+//             Law::peridem_friction gives PeriDEM's +mu F_n v_t / |v_t| instead (comparisons only).
 // The force density on node i is F / V_i. Every term comes in equal and opposite pairs, so
 // Newton's third law holds to round-off.
 #pragma once
@@ -39,6 +40,9 @@ struct Law {
   real damping_ratio = 0;          ///< zeta, from the restitution coefficient
   real friction = 0;               ///< mu
   real slip_velocity = 1e-4;       ///< v_slip [m/s] of the friction regularisation
+  /// PeriDEM's friction, for comparisons only: mu F_n along +v_t (it speeds sliding up), not
+  /// regularised. See friction_force.
+  bool peridem_friction = false;
 };
 
 /// One particle's side of a contact.
@@ -111,6 +115,10 @@ inline void friction_force(const Law& law, real normal, const real tangential_ve
                                tangential_velocity[2] * tangential_velocity[2]);
   if (!(speed > 0) || law.friction == 0 || normal == 0) {
     force[0] = force[1] = force[2] = 0;
+    return;
+  }
+  if (law.peridem_friction) {  // PeriDEM's sign: along the slip, full mu F_n at any speed
+    for (int k = 0; k < 3; ++k) force[k] = law.friction * normal * tangential_velocity[k] / speed;
     return;
   }
   const real magnitude = law.friction * normal * std::min(1.0, speed / law.slip_velocity);

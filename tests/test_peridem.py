@@ -1,0 +1,309 @@
+"""PeriDEM input decks run unchanged (granulate.peridem), and agree with PeriDEM's own results.
+
+The decks and PeriDEM's outputs are copies kept in tests/data/peridem (see its README). PeriDEM's
+frames_summary.csv gives, per frame and particle, the node count, the centroid (mean of the node
+positions), the mean displacement and velocity, and max/mean Damage_Z.
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+import shutil
+from pathlib import Path
+
+import meshio
+import numpy as np
+import pytest
+
+import granulate as gr
+from granulate import peridem
+from granulate.case import load_case
+from granulate.cli import main
+from granulate.errors import InputError
+
+DECKS = Path(__file__).parent / "data" / "peridem"
+NAMES = [
+    "twop_circ",
+    "single_particle_rectangle_inbuilt_mesh",
+    "compression_small_set",
+    "attrition_mix_particles_small_set",
+]
+
+
+def reference(name: str) -> np.ndarray:
+    """PeriDEM's frames_summary.csv: frame, step, time, particle, zone, nodes, cx, cy, ux, uy,
+    vx, vy, max Z, mean Z, fx, fy."""
+    return np.loadtxt(
+        DECKS / name / "peridem_output" / "frames_summary.csv", delimiter=",", skiprows=1
+    )
+
+
+def summary(name: str) -> dict[str, str]:
+    text = (DECKS / name / "peridem_output" / "run_summary_1thread.txt").read_text()
+    return dict(line.split(" = ") for line in text.splitlines())
+
+
+def run_deck(name: str, out: Path, steps: int | None, *extra: str) -> Path:
+    args = ["run", str(DECKS / name / "input_0.yaml"), "--out", str(out), "--quiet", *extra]
+    if steps is not None:
+        args += ["--steps", str(steps)]
+    assert main(args) == 0
+    return out
+
+
+def frame(out: Path, k: int):
+    return meshio.read(out / "frames" / f"frame_{k:06d}.vtu")
+
+
+def centroids(mesh, count: int) -> np.ndarray:
+    owner = mesh.point_data["Particle_ID"]
+    return np.array([mesh.points[owner == p, :2].mean(axis=0) for p in range(count)])
+
+
+def history(out: Path) -> list[dict[str, float]]:
+    with (out / "history.csv").open() as handle:
+        return [{k: float(v) for k, v in row.items()} for row in csv.DictReader(handle)]
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_deck_runs_with_peridems_particles_and_nodes(name: str, tmp_path: Path) -> None:
+    """Each deck runs (200 steps), with PeriDEM's particle count, node count per particle, and
+    particle placement (centroids of the placed, scaled and turned meshes within 1e-9 m)."""
+    out = run_deck(name, tmp_path / "out", 200)
+    ref = reference(name)
+    first = ref[ref[:, 0] == 0]
+    expected = summary(name)
+    mesh = frame(out, 0)
+    owner = mesh.point_data["Particle_ID"]
+    assert len(mesh.points) == int(expected["nodes"])
+    assert owner.max() + 1 == int(expected["particles_total"]) == len(first)
+    np.testing.assert_array_equal(np.bincount(owner), first[:, 5])
+    np.testing.assert_allclose(centroids(mesh, len(first)), first[:, 6:8], rtol=0, atol=1e-9)
+
+
+def test_two_discs_fall_and_rebound_as_in_peridem(tmp_path: Path) -> None:
+    """twop_circ, the 60,000 steps PeriDEM ran: the top disc's mean displacement every 5,000
+    steps. In free fall (first two frames) the schemes differ by g dt t / 2 (Verlet against
+    semi-implicit Euler): within 1e-8 m. After the impact the rebound differs by the damping:
+    granulate rebounds with the Epsilon = 0.9 asked for, PeriDEM's centre damping with
+    Beta_n_Factor 100 gives another value; measured 4.5 um at most, asserted within 10 um (5 % of
+    the 0.2 mm rebound height)."""
+    out = run_deck("twop_circ", tmp_path / "out", 60_000)
+    ref = reference("twop_circ")
+    top = ref[ref[:, 3] == 1]
+    rows = history(out)
+    ours = np.array([r["p1_uy"] for r in rows])
+    assert len(ours) == len(top) == 13
+    np.testing.assert_allclose(ours[:3], top[:3, 9], rtol=0, atol=1e-8)
+    np.testing.assert_allclose(ours, top[:, 9], rtol=0, atol=1e-5)
+    # It bounced: the apex after the impact is well above the lowest point.
+    assert ours[10:].max() - ours[2:5].min() > 5e-4
+    # Damage onset at the impact (frame 3, step 15,000) in both codes, of the same order.
+    damage = [frame(out, k).point_data["Damage_Z"].max() for k in (2, 3)]
+    assert damage[0] < 1e-9 and top[2, 12] == 0  # round-off before the impact
+    assert 0.3 < damage[1] / top[3, 12] < 3, (damage[1], top[3, 12])
+    # The lower disc is held: its history force is the reaction of the impact, zero before.
+    assert abs(rows[1]["p0_fy"]) < 1e-12 and rows[3]["p0_fy"] < 0
+
+
+def test_pulled_rectangle_compared_with_peridem(tmp_path: Path) -> None:
+    """single_particle_rectangle_inbuilt_mesh: PeriDEM's built-in uniform mesh (441 nodes),
+    corner clamped, opposite corner pulled at 0.01 m/s. With --peridem-compat (PeriDEM's 3D
+    constants in 2D) mean Damage_Z stays within 10 % of PeriDEM's (measured 8 %); the mean
+    displacement is 24 % below PeriDEM's in both modes, a difference not explained yet (see the
+    deck notes: the pulled region is a 5-parameter rectangle), asserted within 30 %."""
+    out = run_deck(
+        "single_particle_rectangle_inbuilt_mesh", tmp_path / "out", None, "--peridem-compat"
+    )
+    ref = reference("single_particle_rectangle_inbuilt_mesh")
+    for k in (4, 10, 20):
+        mesh = frame(out, k)
+        u = mesh.point_data["Displacement"][:, 0].mean()
+        z = mesh.point_data["Damage_Z"].mean()
+        assert abs(u / ref[k, 8] - 1) < 0.30, (k, u, ref[k, 8])
+        assert abs(z / ref[k, 13] - 1) < 0.10, (k, z, ref[k, 13])
+
+
+def test_compression_deck_settles_like_peridem(tmp_path: Path) -> None:
+    """compression_small_set, all 20,000 steps: the grains settle under gravity while the top
+    wall comes down 3 mm, reaching the settled pile only at the end. The mean grain centroid
+    height at the last frame agrees within 0.2 mm (grain radius 1 mm) and no bond breaks. The
+    walls' reactions are those of the grains (PeriDEM's summed force on its walls is their
+    weight alone: it does not report the grains' push, the "one-way walls" of the notes)."""
+    out = run_deck("compression_small_set", tmp_path / "out", None)
+    ref = reference("compression_small_set")
+    last = ref[ref[:, 0] == 10]
+    ours = centroids(frame(out, 10), 17)
+    grains = slice(0, 15)
+    assert abs(ours[grains, 1].mean() - last[grains, 7].mean()) < 2e-4
+    rows = history(out)
+    assert rows[-1]["broken_bonds"] == 0
+    assert rows[-1]["p16_uy"] == pytest.approx(-3e-3, rel=1e-9)
+    # Bouncing grains (no damping) first reach the top wall after step 12,000 and push it up.
+    assert max(abs(r["p16_fy"]) for r in rows if r["step"] < 12_000) < 1e-12
+    assert max(r["p16_fy"] for r in rows) > 0.05
+    assert min(r["p15_fy"] for r in rows) < -0.05  # the grains load the container
+
+
+def test_attrition_drum_turns_as_in_peridem(tmp_path: Path) -> None:
+    """attrition_mix_particles_small_set: the meshed drum turns about (x0, y0) = (-3, 3) mm at
+    -125.66 rad/s; its centroid follows PeriDEM's to 1e-9 m, and no grain leaves the drum."""
+    out = run_deck("attrition_mix_particles_small_set", tmp_path / "out", 4000)
+    ref = reference("attrition_mix_particles_small_set")
+    for k in range(5):
+        wall = ref[(ref[:, 0] == k) & (ref[:, 3] == 12)][0]
+        np.testing.assert_allclose(centroids(frame(out, k), 13)[12], wall[6:8], rtol=0, atol=1e-9)
+        mesh = frame(out, k)
+        grains = mesh.point_data["Particle_ID"] < 12
+        angle = -125.6637 * k * 1000 * 2.5e-6
+        pivot = np.array([-3e-3, 3e-3])
+        turn = np.array([[math.cos(angle), -math.sin(angle)], [math.sin(angle), math.cos(angle)]])
+        centre = pivot + turn @ (np.zeros(2) - pivot)  # the drum's axis, carried round the pivot
+        assert np.hypot(*(mesh.points[grains, :2] - centre).T).max() < 15.0e-3
+
+
+def test_converted_case_runs_the_same_bits(tmp_path: Path) -> None:
+    """`granulate convert` writes a native case that runs exactly as the deck does."""
+    target = tmp_path / "case.yaml"
+    deck = DECKS / "compression_small_set" / "input_0.yaml"
+    assert main(["convert", str(deck), "-o", str(target)]) == 0
+    text = target.read_text()
+    assert "# granulate case converted from the PeriDEM deck" in text
+    assert "p16" in text and "contact_pairs" in text
+    run_deck("compression_small_set", tmp_path / "deck", 300)
+    assert (
+        main(["run", str(target), "--out", str(tmp_path / "case"), "--quiet", "--steps", "300"])
+        == 0
+    )
+    for name in ("history.csv", "frames/particles_000000.csv"):
+        assert (tmp_path / "deck" / name).read_bytes() == (tmp_path / "case" / name).read_bytes()
+    assert main(["convert", str(deck), "-o", str(target)]) == 2  # exists: not replaced
+
+
+def test_notes_say_what_differs(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
+    run_deck("twop_circ", tmp_path / "a", 10)
+    log = capsys.readouterr().out
+    assert "PeriDEM deck, translated" in log
+    for phrase in ("velocity Verlet", "plane-strain constants", "Epsilon", "Neighbor", "Zone_ID"):
+        assert phrase in log
+    run_deck("twop_circ", tmp_path / "b", 10, "--peridem-compat")
+    assert "PeriDEM's 3D constants" in capsys.readouterr().out
+    case = load_case(DECKS / "twop_circ" / "input_0.yaml", peridem_compat=True)
+    assert case.spec.plane == "peridem"
+    assert all(m.break_in_compression for m in case.spec.materials.values())
+
+
+def broken_deck(tmp_path: Path, name: str, edit) -> Path:
+    folder = tmp_path / name
+    shutil.copytree(DECKS / name, folder)
+    deck = folder / "input_0.yaml"
+    deck.write_text(edit(deck.read_text()))
+    return deck
+
+
+@pytest.mark.parametrize(
+    ("edit", "message"),
+    [
+        (
+            lambda t: t.replace("Final_Time", "Final_Tme"),
+            "unknown key 'Final_Tme'; did you mean 'Final_Time'",
+        ),
+        (lambda t: t.replace("mesh_cir_1_0.msh", "missing.msh"), "missing.msh"),
+        (lambda t: t.replace("Type: PDState", "Type: RNPBond", 1), "'RNPBond' is not supported"),
+        (lambda t: t + "Restart:\n  File: a.vtu\n  Step: 10\n", "Restart"),
+        (lambda t: t.replace("Particle_List: [1]", "Particle_List: [7]"), "IC.Constant_Velocity"),
+        (lambda t: t.replace("Particle_List: [0]", "Particle_List: [5]"), "0 .. 1"),
+        (lambda t: t.replace("  Zone_12:\n", "  Zone_21:\n"), "Contact.Zone_12: missing"),
+        (lambda t: t.replace("- Theta", "- Thetta"), "unknown tags ['Thetta']"),
+        (lambda t: t.replace("Time_Steps: 200000", "Time_Steps: -3"), "Time_Steps"),
+        (lambda t: t.replace("Density: 1.200000e+03", "Density: -5", 1), "Density"),
+    ],
+)
+def test_broken_decks_get_one_clear_message(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], edit, message: str
+) -> None:
+    deck = broken_deck(tmp_path, "twop_circ", edit)
+    assert main(["check", str(deck)]) == 2
+    err = capsys.readouterr().err
+    assert message in err, err
+    assert "Traceback" not in err
+
+
+def test_compat_switch_is_for_decks_only(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    case = Path(__file__).parent / "cases" / "base.yaml"
+    assert main(["check", str(case), "--peridem-compat"]) == 2
+    assert "applies to decks" in capsys.readouterr().err
+
+
+def test_peridem_constants_in_2d() -> None:
+    """plane 'peridem': the 3D critical stretch s0 = sqrt(Gc / ((3G + (3/4)^4 (K - 5G/3)) delta))
+    and the 3D LPS state: an isotropic stretch eps of an interior node gives theta = 3 eps and
+    W = K theta^2 / 2 = 4.5 K eps^2 (the 2D plane-strain W is 2 (K + G/3) eps^2)."""
+    K, G, Gc, delta = 2.16e5, 1.296e5, 500.0, 1.5e-3
+    material = gr.Material(
+        density=1200, bulk_modulus=K, shear_modulus=G, fracture_energy=Gc, horizon=delta
+    )
+    s0 = material.critical_stretch(5e-4, 2, "peridem")
+    assert s0 == pytest.approx(
+        math.sqrt(Gc / ((3 * G + 0.75**4 * (K - 5 * G / 3)) * delta)), rel=1e-12
+    )
+    eps = 1e-4
+    energies = {}
+    for plane in ("peridem", "strain"):
+        sim = gr.Simulation(2, plane)
+        body = sim.add_body(gr.Rectangle((0, 0), (10e-3, 10e-3)), material, 5e-4)
+        sim.contact = None
+        sim.positions[:] = sim.positions * (1 + eps)
+        centre = int(np.argmin(np.hypot(*(sim.positions[:, :2] - 5e-3 * (1 + eps)).T)))
+        sim.run(0)
+        energies[plane] = sim.core.strain_energy_density()[centre]
+        assert body.node_count == 400
+    assert energies["peridem"] == pytest.approx(4.5 * K * eps**2, rel=0.03)
+    assert energies["strain"] == pytest.approx(2 * (K + G / 3) * eps**2, rel=0.03)
+
+
+def test_peridem_friction_speeds_sliding_up() -> None:
+    """friction_law 'peridem' reproduces PeriDEM's sign: a block sliding on a floor accelerates
+    at +mu g instead of decelerating (within 10 %)."""
+    rubber = gr.Material(density=1000, youngs_modulus=5e6, poisson_ratio=0.25, fracture=False)
+    mu, g, h = 0.4, 9.81, 1e-3
+    sim = gr.Simulation(2, gravity=(0, -g))
+    sim.contact = gr.Contact(restitution=0.3, friction=mu, friction_law="peridem")
+    block = sim.add_body(gr.Rectangle((0, 0.5 * h), (10 * h, 5.5 * h)), rubber, h)
+    sim.add_wall(gr.Plane((0, 0), (0, 1)), name="floor")
+    sim.run(until=0.02)
+    sim.velocities[:, 0] = 0.3
+    masses = sim.volumes * rubber.density
+    speed = lambda: float(masses @ sim.velocities[:, 0] / masses.sum())  # noqa: E731
+    before, start = speed(), sim.time
+    sim.run(until=start + 0.02)
+    acceleration = (speed() - before) / (sim.time - start)
+    assert acceleration == pytest.approx(mu * g, rel=0.10)
+    with pytest.raises(InputError, match="friction_law"):
+        gr.Contact(friction_law="backwards")
+    assert block.node_count == 50
+
+
+def test_grid_discretization_is_peridems_uniform_mesh() -> None:
+    nodes, volumes = gr.shapes.grid(gr.Rectangle((0, 0), (0.01, 0.01)), 5e-4)
+    assert len(nodes) == 441
+    assert volumes.sum() == pytest.approx(1e-4, rel=1e-12)
+    assert volumes.min() == pytest.approx(0.25 * 5e-4**2) and volumes.max() == pytest.approx(
+        5e-4**2
+    )
+    nodes3, volumes3 = gr.shapes.grid(gr.Box((0, 0, 0), (1, 2, 3)), 0.5)
+    assert len(nodes3) == 3 * 5 * 7 and volumes3.sum() == pytest.approx(6.0, rel=1e-12)
+    with pytest.raises(InputError, match="Rectangle and Box"):
+        gr.shapes.grid(gr.Disc((0, 0), 1), 0.1)
+
+
+def test_smallest_spacing_is_the_closest_pair() -> None:
+    rng = np.random.default_rng(3)
+    points = rng.uniform(size=(300, 3))
+    brute = min(
+        np.linalg.norm(points[i] - points[j]) for i in range(300) for j in range(i + 1, 300)
+    )
+    assert peridem.smallest_spacing(points) == pytest.approx(brute, rel=1e-12)
