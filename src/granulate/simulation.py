@@ -13,8 +13,8 @@ energies J per metre.
 
 from __future__ import annotations
 
-import io
 import difflib
+import io
 import json
 import signal
 import threading
@@ -1303,7 +1303,6 @@ class Simulation:
         assert out is not None and self._model is not None
         core = self._build()
         phi, z = core.damage()
-        volumes = self._model.volumes
         if core.step % out.every == 0 or out.frames == 0:
             self._write_vtu_frame(phi, z)
         if core.step % out.history_every == 0 or out.history is None:
