@@ -15,6 +15,9 @@ from pathlib import Path
 import meshio
 import numpy as np
 import pytest
+import yaml
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 import granulate as gr
 from granulate import peridem
@@ -128,7 +131,8 @@ def test_pulled_rectangle_compared_with_peridem(tmp_path: Path) -> None:
 def test_compression_deck_settles_like_peridem(tmp_path: Path) -> None:
     """compression_small_set, all 20,000 steps: the grains settle under gravity while the top
     wall comes down 3 mm, reaching the settled pile only at the end. The mean grain centroid
-    height at the last frame agrees within 0.2 mm (grain radius 1 mm) and no bond breaks. The
+    height at the last frame agrees within 0.1 mm (grain radius 1 mm; measured 26 um) and no
+    bond breaks. The
     walls' reactions are those of the grains (PeriDEM's summed force on its walls is their
     weight alone: it does not report the grains' push, the "one-way walls" of the notes)."""
     out = run_deck("compression_small_set", tmp_path / "out", None)
@@ -136,7 +140,7 @@ def test_compression_deck_settles_like_peridem(tmp_path: Path) -> None:
     last = ref[ref[:, 0] == 10]
     ours = centroids(frame(out, 10), 17)
     grains = slice(0, 15)
-    assert abs(ours[grains, 1].mean() - last[grains, 7].mean()) < 2e-4
+    assert abs(ours[grains, 1].mean() - last[grains, 7].mean()) < 1e-4  # measured 26 um
     rows = history(out)
     assert rows[-1]["broken_bonds"] == 0
     assert rows[-1]["p16_uy"] == pytest.approx(-3e-3, rel=1e-9)
@@ -307,3 +311,50 @@ def test_smallest_spacing_is_the_closest_pair() -> None:
         np.linalg.norm(points[i] - points[j]) for i in range(300) for j in range(i + 1, 300)
     )
     assert peridem.smallest_spacing(points) == pytest.approx(brute, rel=1e-12)
+
+
+def _leaves(data, path=()):
+    if isinstance(data, dict):
+        for key, value in data.items():
+            yield from _leaves(value, (*path, key))
+    elif isinstance(data, list):
+        for k, value in enumerate(data):
+            yield from _leaves(value, (*path, k))
+    yield path
+
+
+junk = st.one_of(
+    st.none(),
+    st.booleans(),
+    st.integers(-5, 5),
+    st.floats(allow_nan=True, allow_infinity=True),
+    st.text(max_size=5),
+    st.lists(st.integers(-2, 20), max_size=3),
+    st.dictionaries(st.sampled_from(["Type", "Parameters", "File"]), st.integers(), max_size=2),
+)
+
+
+@settings(
+    max_examples=60, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
+)
+@given(data=st.data())
+def test_mutated_decks_give_input_errors_only(tmp_path: Path, data) -> None:
+    """Any value of a deck replaced by junk: the deck loads, or InputError; nothing else."""
+    deck = yaml.safe_load((DECKS / "twop_circ" / "input_0.yaml").read_text())
+    paths = [p for p in _leaves(deck) if p]
+    for _ in range(data.draw(st.integers(1, 3))):
+        where = data.draw(st.sampled_from(paths))
+        target = deck
+        try:
+            for key in where[:-1]:
+                target = target[key]
+            target[where[-1]] = data.draw(junk)
+        except (KeyError, IndexError, TypeError):
+            continue
+    folder = tmp_path / "deck"
+    shutil.copytree(DECKS / "twop_circ", folder, dirs_exist_ok=True)
+    (folder / "input_0.yaml").write_text(yaml.safe_dump(deck))
+    try:
+        load_case(folder / "input_0.yaml")
+    except InputError:
+        pass

@@ -22,6 +22,7 @@ import json
 import runpy
 import sys
 import time
+import warnings
 from pathlib import Path
 
 from granulate import _core
@@ -31,6 +32,11 @@ from granulate.errors import InputError, InstabilityError
 #: Bytes per node of state and model arrays besides bonds (positions, velocities, forces,
 #: reference positions, volumes, per-node constants, contact lists).
 BYTES_PER_NODE = 300
+
+
+def _show_warning(message, category, filename, lineno, file=None, line=None) -> None:
+    """Warnings as one line for the user (not the code location)."""
+    print(f"granulate: warning: {message}", file=sys.stderr)
 
 
 def _info() -> int:
@@ -232,6 +238,16 @@ def _run_script(script: Path, args: list[str]) -> int:
 
 
 def main(argv: list[str] | None = None) -> int:
+    """The command line; warnings are printed as one line each while it runs."""
+    previous = warnings.showwarning
+    warnings.showwarning = _show_warning
+    try:
+        return _main(argv)
+    finally:
+        warnings.showwarning = previous
+
+
+def _main(argv: list[str] | None) -> int:
     parser = argparse.ArgumentParser(prog="granulate", description=__doc__.splitlines()[0])
     parser.add_argument("--version", action="version", version=f"granulate {__version__}")
     parser.add_argument("--debug", action="store_true", help="show tracebacks of errors")

@@ -326,7 +326,18 @@ def translate(path: str | Path, *, compat: bool = False, output: Path | None = N
     """Translate the deck at ``path`` (InputError listing every problem). ``compat``: PeriDEM's
     formulas where granulate has them. ``output``: the folder file paths of the case are made
     relative to (default: the deck's folder)."""
-    source = Path(path).resolve()
+    try:
+        return _translate(Path(path), compat, output)
+    except (AttributeError, TypeError, ValueError, KeyError, IndexError) as error:
+        # A value of a kind no check above expected (a list where a block belongs, ...).
+        raise InputError(
+            f"{path}: a deck value has an unexpected kind ({type(error).__name__}: {error}); "
+            "check the deck against PeriDEM's keys (granulate's docs: PeriDEM input decks)"
+        ) from None
+
+
+def _translate(path: Path, compat: bool, output: Path | None) -> Translation:
+    source = path.resolve()
     deck = read_deck(source)
     folder = source.parent
     relative_to = (output or folder).resolve()
@@ -353,7 +364,9 @@ def translate(path: str | Path, *, compat: bool = False, output: Path | None = N
     if not (isinstance(steps, int) and steps > 0):
         problems.add(f"Model.Time_Steps: expected a positive integer, got {steps!r}")
         steps = 1
-    scheme = (model.get("Discretization_Type") or {}).get("Time", "central_difference")
+    scheme = _block(model, "Discretization_Type", "Model", problems).get(
+        "Time", "central_difference"
+    )
     if scheme not in ("central_difference", "velocity_verlet"):
         problems.add(
             f"Model.Discretization_Type.Time: {scheme!r}; PeriDEM knows central_difference "
@@ -422,7 +435,7 @@ def translate(path: str | Path, *, compat: bool = False, output: Path | None = N
         problems.unknown(f"Mesh.{zk}", minfo, {"File", "CreateMesh", "Mesh_Size"})
         name = f"zone_{z}"
         grain: dict[str, Any] = {"material": name}
-        create = minfo.get("CreateMesh") or {}
+        create = _block(minfo, "CreateMesh", f"Mesh.{zk}", problems)
         if create.get("Flag", False):
             h = _number(minfo.get("Mesh_Size"), f"Mesh.{zk}.Mesh_Size", problems, positive=True)
             if (
@@ -488,10 +501,10 @@ def translate(path: str | Path, *, compat: bool = False, output: Path | None = N
             return {}
         if "Copy_Material_Data" in info:
             other = info["Copy_Material_Data"]
-            if other not in zones or other in seen + (z,):
+            if other not in zones or other in (*seen, z):
                 problems.add(f"Material.{zk}.Copy_Material_Data: no zone {other!r} to copy")
                 return {}
-            return material_of(other, seen + (z,))
+            return material_of(other, (*seen, z))
         return info
 
     for z in zones:
@@ -536,10 +549,10 @@ def translate(path: str | Path, *, compat: bool = False, output: Path | None = N
             ("G", "shear_modulus"),
             ("Poisson_Ratio", "poisson_ratio"),
         ):
-            if key in info and float(info[key]) > 0:
-                spec[ours] = _number(info[key], f"{where}.{key}", problems, positive=True)
+            if key in info and _number(info[key], f"{where}.{key}", problems) > 0:
+                spec[ours] = float(info[key])
         if spec.get("fracture", True):
-            if "Gc" in info and float(info["Gc"]) > 0:
+            if "Gc" in info and _number(info["Gc"], f"{where}.Gc", problems) > 0:
                 spec["fracture_energy"] = _number(info["Gc"], f"{where}.Gc", problems)
             elif "KIc" in info:
                 e = _youngs(spec)
@@ -551,7 +564,7 @@ def translate(path: str | Path, *, compat: bool = False, output: Path | None = N
                     notes.append(f"{where}: Gc = KIc^2 / E = {kic * kic / e:.6g} J/m^2 (PeriDEM's)")
             else:
                 problems.add(f"{where}: give Gc or KIc")
-        influence = (info.get("Influence_Function") or {}).get("Type", 0)
+        influence = _block(info, "Influence_Function", where, problems).get("Type", 0)
         names = {0: "constant", 1: "linear", 2: "gaussian"}
         if influence not in names:
             problems.add(f"{where}.Influence_Function.Type: expected 0, 1 or 2, got {influence!r}")
@@ -689,12 +702,12 @@ def translate(path: str | Path, *, compat: bool = False, output: Path | None = N
                 if (
                     not isinstance(other, list)
                     or len(other) != 2
-                    or tuple(sorted(other)) in seen + ((a, b),)
+                    or tuple(sorted(other)) in (*seen, (a, b))
                     or f"Zone_{min(other)}{max(other)}" not in keys
                 ):
                     problems.add(f"Contact.{key}.Copy_Contact_Data: no zone pair {other!r} to copy")
                     return {}
-                return contact_of(min(other), max(other), seen + ((a, b),))
+                return contact_of(min(other), max(other), (*seen, (a, b)))
             return info
 
         friction_used = False
@@ -815,7 +828,7 @@ def translate(path: str | Path, *, compat: bool = False, output: Path | None = N
             out["exclude"] = [f"p{i}" for i in excluded]
         if "Region" in info:
             region = _region(
-                (info["Region"] or {}).get("Geometry"),
+                _block(info, "Region", where, problems).get("Geometry"),
                 f"{where}.Region.Geometry",
                 dimension,
                 problems,
@@ -856,7 +869,7 @@ def translate(path: str | Path, *, compat: bool = False, output: Path | None = N
             continue
         axes = "".join("xyz"[d - 1] for d in dirs)
         function = info.get("Time_Function")
-        spatial = (info.get("Spatial_Function") or {}).get("Type", "constant")
+        spatial = _block(info, "Spatial_Function", where, problems).get("Type", "constant")
         for body in nodes.get("body", []):
             if "region" not in nodes:
                 moved.setdefault(body, set()).update(dirs)
@@ -927,7 +940,7 @@ def translate(path: str | Path, *, compat: bool = False, output: Path | None = N
         problems.unknown(where, info, _SET_KEYS)
         nodes = select(info, where)
         dirs = directions(info, where)
-        spatial = (info.get("Spatial_Function") or {}).get("Type", "constant")
+        spatial = _block(info, "Spatial_Function", where, problems).get("Type", "constant")
         if spatial != "constant":
             problems.add(
                 f"{where}.Spatial_Function: {spatial!r} force densities are not supported "
@@ -946,7 +959,7 @@ def translate(path: str | Path, *, compat: bool = False, output: Path | None = N
     ic = _block(deck, "IC", "deck", problems)
     problems.unknown("IC", ic, {"Constant_Velocity"})
     if "Constant_Velocity" in ic:
-        info = ic["Constant_Velocity"] or {}
+        info = _block(ic, "Constant_Velocity", "IC", problems)
         problems.unknown("IC.Constant_Velocity", info, {"Velocity_Vector", "Particle_List"})
         v = _numbers(info.get("Velocity_Vector"), "IC.Constant_Velocity.Velocity_Vector", problems)
         for i in info.get("Particle_List", []) or []:
@@ -971,7 +984,7 @@ def translate(path: str | Path, *, compat: bool = False, output: Path | None = N
     strange = [t for t in unwritten if t not in UNWRITTEN_TAGS]
     if strange:
         problems.add(
-            f"Output.Tags: unknown tags {strange}; PeriDEM's are {list(TAGS) + list(UNWRITTEN_TAGS)}"
+            f"Output.Tags: unknown tags {strange}; PeriDEM's are {[*TAGS, *UNWRITTEN_TAGS]}"
         )
     elif unwritten:
         notes.append(f"Output.Tags: {', '.join(unwritten)} are not written by granulate")
@@ -980,7 +993,7 @@ def translate(path: str | Path, *, compat: bool = False, output: Path | None = N
             "Output.Perform_FE_Out: granulate writes the nodes as points, not the mesh cells"
         )
     stop: dict[str, Any] | None = None
-    criteria = out.get("Output_Criteria")
+    criteria = _block(out, "Output_Criteria", "Output", problems)
     if criteria:
         if criteria.get("Type") == "max_node_dist":
             d = _numbers(criteria.get("Parameters"), "Output.Output_Criteria.Parameters", problems)
@@ -988,7 +1001,8 @@ def translate(path: str | Path, *, compat: bool = False, output: Path | None = N
                 stop = {"node_distance": d[0], "check_every": test_every}
         else:
             problems.add(
-                f"Output.Output_Criteria.Type: {criteria.get('Type')!r}; granulate reads max_node_dist"
+                f"Output.Output_Criteria.Type: {criteria.get('Type')!r}; granulate reads "
+                "max_node_dist"
             )
     track = [f"p{k}" for k, z in enumerate(zone_of) if z in walls]
     if "two_particle" in test:
