@@ -682,12 +682,11 @@ def _translate(path: Path, compat: bool, output: Path | None) -> Translation:
     )
     contact_block = _block(deck, "Contact", "deck", problems)
     pairs: list[dict[str, Any]] = []
+    contact = None  # every pair of zones is set below; a deck has no default contact
     if single or not contact_block:
         if not single and len(zone_of) > 1:
             problems.add("Contact: missing; give Contact.Zone_<a><b> for every pair of zones")
-        contact: dict[str, Any] | None = None
     else:
-        contact = None
         keys = {f"Zone_{a}{b}": (a, b) for a in zones for b in zones if a <= b}
         problems.unknown("Contact", contact_block, set(keys))
 
