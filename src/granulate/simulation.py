@@ -651,9 +651,9 @@ class Simulation:
         ``track``: bodies (or their names) whose load and motion history.csv records:
         ``<name>_fx, _fy[, _fz]``, the resultant of the forces on the body other than gravity
         (contacts, walls, applied force densities, viscous damping; the internal bond forces
-        cancel) [N; N/m in 2D], and ``<name>_ux, _uy[, _uz]``, its mean nodal displacement [m]. For a body whose
-        nodes are all prescribed (a meshed wall, a loading platen) the force is the reaction a
-        load cell would measure.
+        cancel) [N; N/m in 2D], and ``<name>_ux, _uy[, _uz]``, its mean nodal displacement
+        [m]. For a body whose nodes are all prescribed (a meshed wall, a loading platen) the
+        force is the reaction a load cell would measure.
 
         A directory that already holds a run is refused unless ``overwrite`` is true (its
         frames are then deleted) or ``resume`` is true (it is kept for ``load_checkpoint``,
