@@ -61,9 +61,10 @@ def _level(blocks: list[memoryview]) -> int:
     return _LEVEL if len(zlib.compress(sample, _LEVEL)) < 0.5 * len(sample) else 0
 
 
-def _compress_all(arrays: list[NDArray[np.generic]]) -> list[bytes]:
-    """Each array as VTK's compressed block stream; all blocks of all arrays compressed in
-    parallel, in order (the output does not depend on the thread count)."""
+def _compress_all(arrays: list[NDArray[np.generic]]) -> list[list[bytes]]:
+    """Each array as VTK's compressed block stream (its header, then its compressed blocks, as
+    separate chunks: a frame's tens of MB are written without being joined); all blocks of all
+    arrays compressed in parallel, in order (the output does not depend on the thread count)."""
     blocks = [_blocks(a) for a in arrays]
     levels = [_level(group) for group in blocks]
     flat = [(b, level) for group, level in zip(blocks, levels, strict=True) for b in group]
@@ -76,7 +77,7 @@ def _compress_all(arrays: list[NDArray[np.generic]]) -> list[bytes]:
         header = np.array(
             [len(group), _BLOCK, len(group[-1]), *(len(p) for p in mine)], dtype="<u8"
         )
-        out.append(header.tobytes() + b"".join(mine))
+        out.append([header.tobytes(), *mine])
     return out
 
 
@@ -114,7 +115,7 @@ def write_vtu(
             f'<DataArray type="{_VTK_TYPES[values.dtype]}"{name_attr}{components} '
             f'format="appended" offset="{offset}"/>'
         )
-        offset += len(payload)
+        offset += sum(len(chunk) for chunk in payload)
     point_count = len(point_data)
 
     xml = [
@@ -136,8 +137,9 @@ def write_vtu(
         "</UnstructuredGrid>",
         '<AppendedData encoding="raw">',
     ]
-    body = "\n".join(xml).encode() + b"\n_" + b"".join(payloads)
-    atomic_write(path, body + b"\n</AppendedData>\n</VTKFile>\n")
+    head = "\n".join(xml).encode() + b"\n_"
+    tail = b"\n</AppendedData>\n</VTKFile>\n"
+    atomic_write(path, [head, *(chunk for payload in payloads for chunk in payload), tail])
 
 
 class PvdSeries:
