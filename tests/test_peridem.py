@@ -358,3 +358,73 @@ def test_mutated_decks_give_input_errors_only(tmp_path: Path, data) -> None:
         load_case(folder / "input_0.yaml")
     except InputError:
         pass
+
+
+def test_keys_the_example_decks_do_not_use(tmp_path: Path) -> None:
+    """loc_rad placements, KIc, Horizon_Mesh_Ratio, PMBBond, force sets, exclusion lists,
+    quadratic and sin displacements, Output_Criteria and Compressive_Test are translated."""
+
+    def edit(text: str) -> str:
+        deck = yaml.safe_load(text)
+        deck["Particle_Generation"]["File_Data_Type"] = "loc_rad"
+        deck["Model"]["Seed"] = 7
+        zone2 = deck["Material"]["Zone_2"]
+        zone2.pop("Gc")
+        zone2.pop("Horizon")
+        zone2.update({"Type": "PMBBond", "KIc": 1.0e5, "Horizon_Mesh_Ratio": 4.0})
+        deck["Force_BC"]["Sets"] = 1
+        deck["Force_BC"]["Set_1"] = {
+            "Particle_List": [0, 1],
+            "Particle_Exclude_List": [0],
+            "Direction": [2],
+            "Time_Function": {"Type": "sin", "Parameters": [5.0, 100.0]},
+            "Spatial_Function": {"Type": "constant"},
+        }
+        deck["Displacement_BC"]["Sets"] = 2
+        deck["Displacement_BC"]["Set_2"] = {
+            "Region": {"Geometry": {"Type": "circle", "Parameters": [2e-4, 1e-3, 1e-3, 0.0]}},
+            "Direction": [1],
+            "Time_Function": {"Type": "quadratic", "Parameters": [1e-3, 2e-2]},
+        }
+        deck["Output"]["Output_Criteria"] = {"Type": "max_node_dist", "Parameters": [0.1]}
+        deck["Particle"]["Compressive_Test"] = {"Particle_Id": 1, "Particle_Force_Direction": 2}
+        return yaml.safe_dump(deck)
+
+    deck = broken_deck(tmp_path, "twop_circ", edit)
+    translation = peridem.translate(deck)
+    case = translation.case
+    # loc_rad: random orientations from the deck's seed; a two-particle test turns disc i by i pi.
+    assert [p["rotation"] for p in case["particles"]] == pytest.approx([0.0, math.pi])
+    zone2 = case["materials"]["zone_2"]
+    assert zone2["model"] == "pmb" and zone2["horizon_factor"] == 4.0
+    e = 9 * 2.16e7 * 1.296e7 / (3 * 2.16e7 + 1.296e7)
+    assert zone2["fracture_energy"] == pytest.approx(1.0e10 / e, rel=1e-12)
+    force = next(load for load in case["loading"] if load["type"] == "force_density")
+    assert force["nodes"] == {"body": ["p0", "p1"], "exclude": ["p0"]}
+    assert force["vector"] == [0.0, 1.0]
+    assert force["function"] == {"type": "sine", "amplitude": 5.0, "frequency": 50.0}
+    quadratic = next(load for load in case["loading"] if load["type"] == "displacement")
+    assert quadratic["nodes"]["region"] == {"type": "disc", "center": [1e-3, 1e-3], "radius": 2e-4}
+    assert quadratic["function"] == {"type": "quadratic", "a": 1e-3, "b": 2e-2}
+    assert quadratic["components"] == "x"
+    assert case["stop"]["node_distance"] == 0.1
+    assert case["output"]["track"] == ["p0", "p1"]
+    assert any("loc_rad" in note for note in translation.notes)
+    assert main(["run", str(deck), "--out", str(tmp_path / "out"), "--quiet", "--steps", "20"]) == 0
+
+
+def test_node_distance_stops_a_run() -> None:
+    sim = gr.Simulation(2)
+    sim.add_body(
+        gr.Disc((0, 0), 1e-3),
+        gr.Material(
+            density=1000, youngs_modulus=1e6, poisson_ratio=0.25, fracture=False, horizon_factor=3
+        ),
+        2.5e-4,
+        velocity=(10.0, 0),
+    )
+    reason = sim.run(10_000, stop=[gr.stopping.NodeDistance(2e-3)], check_every=10)
+    assert reason is not None and "from the origin" in reason
+    assert np.max(np.hypot(sim.positions[:, 0], sim.positions[:, 1])) > 2e-3
+    with pytest.raises(InputError, match="positive distance"):
+        gr.stopping.NodeDistance(-1.0)
