@@ -82,6 +82,7 @@ nb::dict checkpoint_dict(const Simulation& self) {
   d["contact_slots"] = copy_out(slots);
   d["contact_particle_slot_count"] = c.particle_slot_count;
   d["contact_slot_approach"] = copy_out(c.slot_approach);
+  d["contact_slot_normal"] = copy_out(c.slot_normal);
   d["contact_last_time"] = c.last_time;
   d["contact_has_last_time"] = c.has_last_time;
   d["contact_statistics"] =
@@ -113,6 +114,7 @@ void restore_dict(Simulation& self, const nb::dict& d) {
   for (std::size_t k = 0; k < slots.size(); k += 2) c.slots.push_back({slots[k], slots[k + 1]});
   c.particle_slot_count = scalar<std::uint64_t>(d, "contact_particle_slot_count");
   c.slot_approach = entry<real>(d, "contact_slot_approach");
+  c.slot_normal = entry<real>(d, "contact_slot_normal");
   c.last_time = scalar<real>(d, "contact_last_time");
   c.has_last_time = scalar<bool>(d, "contact_has_last_time");
   const auto statistics = entry<std::uint64_t>(d, "contact_statistics");
@@ -363,6 +365,25 @@ NB_MODULE(_core, m) {
       .def_prop_ro("stable_time_step", &Simulation::stable_time_step)
       .def_prop_ro("contact_stable_time_step",
                    [](const Simulation& self) { return self.contact().stable_time_step(self.model()); })
+      .def(
+          "set_peridem_damping",
+          [](Simulation& self, Indices centers, Scalars radii, Indices walls, Scalars betan, Scalars kappa,
+             Scalars contact_radius) {
+            const std::size_t particles = centers.shape(0);
+            const std::size_t pairs = betan.shape(0);
+            if (radii.shape(0) != particles || walls.shape(0) != particles || kappa.shape(0) != pairs ||
+                contact_radius.shape(0) != pairs) {
+              throw InputError("set_peridem_damping: arrays of mismatched lengths");
+            }
+            std::vector<contact::PeridemParticle> p(particles);
+            for (std::size_t k = 0; k < particles; ++k) p[k] = {centers(k), radii(k), walls(k) != 0};
+            std::vector<contact::PeridemPair> q(pairs);
+            for (std::size_t k = 0; k < pairs; ++k) q[k] = {betan(k), kappa(k), contact_radius(k)};
+            self.set_peridem_damping(std::move(p), std::move(q));
+          },
+          "centers"_a, "radii"_a, "walls"_a, "betan"_a, "kappa"_a, "contact_radius"_a,
+          "PeriDEM's centre damping (comparisons only): per particle its centre node, radius and wall "
+          "flag; per material pair (row-major) betan, kappa and Rc")
       .def_prop_rw(
           "time", [](const Simulation& self) { return self.state().time; },
           [](Simulation& self, real t) { self.state().time = t; })

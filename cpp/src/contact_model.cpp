@@ -290,11 +290,13 @@ void ContactModel::label_bodies(const Model& model, const State& state, std::uin
   }
   const index_t count = n == 0 ? 0 : *std::max_element(node_body_.begin(), node_body_.end()) + 1;
   body_mass_.assign(count, 0);
+  body_kinematic_.assign(count, 1);
   body_material_.assign(count, 0);
   body_particle_.assign(count, 0);
   body_node_offsets_.assign(static_cast<std::size_t>(count) + 1, 0);
   for (index_t i = 0; i < n; ++i) {
     body_mass_[node_body_[i]] += model.node_density()[i] * model.volumes()[i];
+    if (node_kinematic_.empty() || !node_kinematic_[i]) body_kinematic_[node_body_[i]] = 0;
     body_material_[node_body_[i]] = model.node_material()[i];
     body_particle_[node_body_[i]] = model.node_particle()[i];
     ++body_node_offsets_[node_body_[i] + 1];
@@ -442,6 +444,7 @@ void ContactModel::rebuild(const Model& model, const State& state, std::uint64_t
   // Slots: one per pair of bodies that appear in the lists, in sorted order.
   const std::vector<std::array<index_t, 2>> old_slots = slots_;
   const std::vector<real> old_approach = slot_approach_;
+  const std::vector<real> old_normal = slot_last_normal_;
   const std::size_t old_particle_slots = particle_slot_count_;
   slots_.clear();
   for (index_t i = 0; i < n; ++i) {
@@ -481,31 +484,38 @@ void ContactModel::rebuild(const Model& model, const State& state, std::uint64_t
   }
   // Reduced masses of the bodies (particles, or fragments once bonds break): two bodies
   // m_p m_q / (m_p + m_q); unbonded nodes of one body (a crack that has not separated it),
-  // about m_p / 4; a body and a rigid wall, m_p.
+  // about m_p / 4; a body and a rigid wall, or a body whose every node is prescribed (a held
+  // particle, a meshed wall), the moving body's mass; two such bodies, 0 (no dashpot).
   slot_reduced_mass_.resize(slots_.size());
   slot_law_.resize(slots_.size());
   for (std::size_t s = 0; s < slots_.size(); ++s) {
     slot_law_[s] = s >= particle_slots ? wall_law(slots_[s][1], body_particle_[slots_[s][0]])
                                        : pair_law(body_particle_[slots_[s][0]], body_particle_[slots_[s][1]]);
-    const real mp = body_mass_[slots_[s][0]];
+    const index_t bp = slots_[s][0];
+    const real mp = body_kinematic_[bp] ? 0.0 : body_mass_[bp];
     if (s >= particle_slots) {
       slot_reduced_mass_[s] = mp;
     } else if (slots_[s][0] == slots_[s][1]) {
       slot_reduced_mass_[s] = 0.25 * mp;
     } else {
-      const real mq = body_mass_[slots_[s][1]];
-      slot_reduced_mass_[s] = mp * mq / (mp + mq);
+      const index_t bq = slots_[s][1];
+      const real mq = body_kinematic_[bq] ? 0.0 : body_mass_[bq];
+      slot_reduced_mass_[s] = mp == 0 || mq == 0 ? mp + mq : mp * mq / (mp + mq);
     }
   }
   slot_stiffness_.assign(slots_.size(), 0);
   slot_approach_.assign(slots_.size(), 0);
+  slot_last_normal_.assign(3 * slots_.size(), 0);
   for (std::size_t slot = 0; slot < slots_.size(); ++slot) {
     const bool wall = slot >= particle_slots;
     const auto begin = old_slots.begin() + (wall ? old_particle_slots : 0);
     const auto end = wall ? old_slots.end() : old_slots.begin() + old_particle_slots;
     const auto previous = std::lower_bound(begin, end, slots_[slot]);
-    if (previous != end && *previous == slots_[slot])
-      slot_approach_[slot] = old_approach[previous - old_slots.begin()];
+    if (previous != end && *previous == slots_[slot]) {
+      const std::size_t old = previous - old_slots.begin();
+      slot_approach_[slot] = old_approach[old];
+      for (int k = 0; k < 3; ++k) slot_last_normal_[3 * slot + k] = old_normal[3 * old + k];
+    }
   }
   pair_stiffness_.assign(pair_partner_.size(), 0);
   wall_entry_stiffness_.assign(wall_entry_.size(), 0);
@@ -569,8 +579,9 @@ std::size_t ContactModel::memory_bytes() const {
          bytes(body_node_offsets_) + bytes(body_nodes_) + bytes(positions_at_build_) + bytes(pair_offsets_) +
          bytes(pair_partner_) + bytes(pair_slot_) + bytes(wall_offsets_) + bytes(wall_entry_) +
          bytes(wall_slot_) + bytes(slots_) + bytes(slot_reduced_mass_) + bytes(slot_law_) +
-         bytes(slot_stiffness_) + bytes(slot_approach_) + bytes(pair_stiffness_) + bytes(pair_distance_) +
-         bytes(wall_points_) + bytes(wall_entry_stiffness_) + bytes(wall_entry_reaction_);
+         bytes(slot_stiffness_) + bytes(slot_approach_) + bytes(slot_last_normal_) + bytes(pair_stiffness_) +
+         bytes(pair_distance_) + bytes(wall_points_) + bytes(wall_entry_stiffness_) +
+         bytes(wall_entry_reaction_);
 }
 
 ContactCheckpoint ContactModel::checkpoint() const {
@@ -583,6 +594,7 @@ ContactCheckpoint ContactModel::checkpoint() const {
   c.slots = slots_;
   c.particle_slot_count = particle_slot_count_;
   c.slot_approach = slot_approach_;
+  c.slot_normal = slot_last_normal_;
   c.last_time = last_time_;
   c.has_last_time = has_last_time_;
   c.statistics = statistics_;
@@ -591,7 +603,8 @@ ContactCheckpoint ContactModel::checkpoint() const {
 }
 
 void ContactModel::restore(const Model& model, const State& state, const ContactCheckpoint& saved) {
-  if (saved.slot_approach.size() != saved.slots.size() || saved.particle_slot_count > saved.slots.size() ||
+  if (saved.slot_approach.size() != saved.slots.size() ||
+      saved.slot_normal.size() != 3 * saved.slots.size() || saved.particle_slot_count > saved.slots.size() ||
       (saved.built && saved.positions_at_build.size() != 3 * static_cast<std::size_t>(model.node_count())) ||
       saved.wall_reactions.size() != walls_.size()) {
     throw InputError("the checkpoint's contact data do not match this model (nodes or walls differ)");
@@ -600,6 +613,7 @@ void ContactModel::restore(const Model& model, const State& state, const Contact
   slots_ = saved.slots;
   particle_slot_count_ = saved.particle_slot_count;
   slot_approach_ = saved.slot_approach;
+  slot_last_normal_ = saved.slot_normal;
   built_ = false;
   if (saved.built) {
     // Rebuild the lists from the positions and time they were built at: the same lists,
@@ -739,11 +753,23 @@ void ContactModel::add_forces(const Model& model, State& state, std::uint64_t br
     const real norm =
         std::sqrt(slot_normal[slot][0] * slot_normal[slot][0] + slot_normal[slot][1] * slot_normal[slot][1] +
                   slot_normal[slot][2] * slot_normal[slot][2]);
-    if (slot_stiffness_[slot] == 0 || (!wall_slot && p == q) || !(norm > 0)) {
-      slot_approach_[slot] = 0;  // not touching (or fragments, damped node by node)
+    if (!wall_slot && p == q) {  // fragments of one body: damped node pair by node pair
+      slot_approach_[slot] = 0;
       continue;
     }
-    const vec normal{slot_normal[slot][0] / norm, slot_normal[slot][1] / norm, slot_normal[slot][2] / norm};
+    // A collision lasts until the bodies are back where they first touched (approach x = 0),
+    // not while springs are in contact: the surface nodes of deformable bodies chatter (touch,
+    // part, touch again) within one collision when the contact is stiffer than the material,
+    // and a dashpot restarted at each touch would damp the collision many times over.
+    const bool touching = slot_stiffness_[slot] > 0 && norm > 0;
+    real* last_normal = &slot_last_normal_[3 * slot];
+    if (touching) {
+      for (int k = 0; k < 3; ++k) last_normal[k] = slot_normal[slot][k] / norm;
+    } else if (!(slot_approach_[slot] > 0)) {
+      slot_approach_[slot] = 0;
+      continue;
+    }
+    const vec normal{last_normal[0], last_normal[1], last_normal[2]};
     real approach;  // closing speed of the two bodies along the normal
     real zeta;
     if (wall_slot) {
@@ -759,6 +785,10 @@ void ContactModel::add_forces(const Model& model, State& state, std::uint64_t br
       zeta = laws_[body_material_[p] * material_count_ + body_material_[q]].damping_ratio;
     }
     slot_approach_[slot] += approach * dt;
+    if (!touching) {  // a gap within the collision: no spring, no dashpot
+      slot_approach_[slot] = std::max(0.0, slot_approach_[slot]);
+      continue;
+    }
     if (zeta == 0) continue;
     const real K = slot_stiffness_[slot];
     const real secant = slot_approach_[slot] > 0 ? std::min(K, slot_force[slot] / slot_approach_[slot]) : K;

@@ -92,6 +92,10 @@ void Simulation::add_prescribed_motion(PrescribedMotion motion) {
     motion.components = 0b111;
   }
   motions_.push_back(std::move(motion));
+  const std::uint8_t all = model_->dimension() == 2 ? 0b011 : 0b111;
+  std::vector<std::uint8_t> kinematic = fixity();
+  for (std::uint8_t& k : kinematic) k = (k & all) == all ? 1 : 0;
+  contact_.set_kinematic_nodes(std::move(kinematic));
   forces_current_ = false;
 }
 
@@ -230,6 +234,7 @@ void Simulation::compute_forces() {
 
   const auto contact_start = clock_type::now();
   contact_.add_forces(m, state_, broken_bond_copies_);
+  peridem_damping_.add_forces(m, state_);
   phase_times_.contact += seconds_since(contact_start);
   phase_times_.contact_search = contact_.search_seconds();
 

@@ -476,6 +476,20 @@ class PairContactSpec(Spec):
     contact: ContactSpec | None = Field(description="null: the materials pass through each other")
 
 
+class PeridemDampingPairSpec(Spec):
+    materials: Annotated[list[str], Field(min_length=2, max_length=2)]
+    epsilon: Annotated[float, Field(gt=0, le=1)] = Field(description="PeriDEM's Epsilon")
+    beta_factor: NonNegative = Field(1.0, description="PeriDEM's Beta_n_Factor")
+
+
+class PeridemDampingSpec(Spec):
+    """PeriDEM's particle-centre contact damping, for comparisons with PeriDEM only (it does
+    not give the restitution epsilon names; Simulation.set_peridem_damping)."""
+
+    pairs: list[PeridemDampingPairSpec]
+    walls: list[str] = Field([], description="bodies PeriDEM treats as walls")
+
+
 class PlaneSurfaceSpec(Spec):
     type: Literal["plane"]
     point: list[Finite] = Field(description="[m]")
@@ -687,6 +701,7 @@ class CaseSpec(Spec):
     precracks: list[PrecrackSpec] = []
     contact: ContactSpec | None = ContactSpec()
     contact_pairs: list[PairContactSpec] = []
+    peridem_damping: PeridemDampingSpec | None = None
     walls: list[WallSpec] = []
     loading: list[LoadSpec] = []
     gravity: list[Finite] | None = Field(None, description="[m/s^2]")
@@ -877,6 +892,20 @@ class Case:
                 case.material(pair.materials[0]),
                 case.material(pair.materials[1]),
                 None if pair.contact is None else pair.contact.make(),
+            )
+        if spec.peridem_damping is not None:
+            for damping in spec.peridem_damping.pairs:
+                sim.set_peridem_damping(
+                    case.material(damping.materials[0]),
+                    case.material(damping.materials[1]),
+                    epsilon=damping.epsilon,
+                    beta_factor=damping.beta_factor,
+                )
+            sim.set_peridem_walls(
+                [
+                    _named(w, named, "peridem_damping.walls names body")
+                    for w in spec.peridem_damping.walls
+                ]
             )
         if spec.neighbor_skin is not None:
             sim.set_neighbor_skin(spec.neighbor_skin)

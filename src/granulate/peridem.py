@@ -683,6 +683,7 @@ def _translate(path: Path, compat: bool, output: Path | None) -> Translation:
     contact_block = _block(deck, "Contact", "deck", problems)
     pairs: list[dict[str, Any]] = []
     contact = None  # every pair of zones is set below; a deck has no default contact
+    peridem_pairs: list[dict[str, Any]] = []
     if single or not contact_block:
         if not single and len(zone_of) > 1:
             problems.add("Contact: missing; give Contact.Zone_<a><b> for every pair of zones")
@@ -748,13 +749,26 @@ def _translate(path: Path, compat: bool, output: Path | None) -> Translation:
                 notes.append(
                     f"{where}: no Kn, granulate's default kn (see granulate.contact) x Kn_Factor"
                 )
-            if info.get("Damping_On", True):
+            beta_factor = _number(
+                info.get("Beta_n_Factor", 1.0), f"{where}.Beta_n_Factor", problems
+            )
+            if info.get("Damping_On", True) and beta_factor > 1e-8:
                 epsilon = _number(info.get("Epsilon", 1.0), f"{where}.Epsilon", problems)
                 if not 0 < epsilon <= 1:
                     problems.add(f"{where}.Epsilon: must be in (0, 1], got {epsilon}")
                     continue
-                spec["restitution"] = epsilon
                 damping_used = damping_used or epsilon < 1
+                if compat:  # PeriDEM's centre damping instead of granulate's dashpot
+                    spec["restitution"] = 1.0
+                    peridem_pairs.append(
+                        {
+                            "materials": [f"zone_{a}", f"zone_{b}"],
+                            "epsilon": epsilon,
+                            "beta_factor": beta_factor,
+                        }
+                    )
+                else:
+                    spec["restitution"] = epsilon
             else:
                 spec["restitution"] = 1.0
             if info.get("Friction_On", True):
@@ -771,9 +785,12 @@ def _translate(path: Path, compat: bool, output: Path | None) -> Translation:
         )
         if damping_used:
             notes.append(
-                "contact damping: granulate's dashpot gives the restitution Epsilon asks for; "
-                "PeriDEM's particle-centre damping (Beta_n_Factor) does not, and is not "
-                "reproduced, not even with --peridem-compat"
+                "contact damping: --peridem-compat: PeriDEM's particle-centre damping "
+                "(Epsilon, Beta_n_Factor), which does not give the restitution Epsilon names"
+                if compat
+                else "contact damping: granulate's dashpot gives the restitution Epsilon asks "
+                "for; PeriDEM's particle-centre damping (Beta_n_Factor) does not "
+                "(--peridem-compat reproduces it)"
             )
         if friction_used:
             notes.append(
@@ -1044,6 +1061,11 @@ def _translate(path: Path, compat: bool, output: Path | None) -> Translation:
     case["contact"] = contact
     if pairs:
         case["contact_pairs"] = pairs
+    if peridem_pairs:
+        case["peridem_damping"] = {
+            "pairs": peridem_pairs,
+            "walls": [f"p{k}" for k, z in enumerate(zone_of) if z in walls],
+        }
     if loading:
         case["loading"] = loading
     if gravity is not None and any(gravity):

@@ -203,6 +203,8 @@ class Simulation:
         self._output: _Output | None = None
         self._contact: Contact | None = Contact()
         self._pair_contacts: dict[tuple[int, int], Contact | None] = {}
+        self._peridem_damping: dict[tuple[int, int], tuple[float, float]] = {}
+        self._peridem_walls: list[Body | str] = []
         self._walls: list[tuple[str, Wall]] = []
         self._skin: float | None = None
         self._core: _core.Simulation | None = None
@@ -600,6 +602,80 @@ class Simulation:
         self._pair_contacts[(id(a), id(b))] = contact
         self._pair_contacts[(id(b), id(a))] = contact
 
+    def set_peridem_damping(
+        self, a: Material, b: Material, *, epsilon: float, beta_factor: float = 1.0
+    ) -> None:
+        """PeriDEM's contact damping between particles of materials a and b, for comparisons
+        with PeriDEM only (``--peridem-compat``): it acts between particle centres and does not
+        give the restitution ``epsilon`` names (formulas: contact/peridem_damping.hpp). The
+        contact law of the pair should then have restitution 1, or both dampings act.
+        ``beta_factor`` is PeriDEM's Beta_n_Factor."""
+        self._require_building("change contact")
+        if not (0 < epsilon <= 1):
+            raise InputError(f"epsilon must be in (0, 1], got {epsilon}")
+        if not (beta_factor >= 0 and np.isfinite(beta_factor)):
+            raise InputError(f"beta_factor must be a non-negative number, got {beta_factor}")
+        self._peridem_damping[(id(a), id(b))] = (float(epsilon), float(beta_factor))
+        self._peridem_damping[(id(b), id(a))] = (float(epsilon), float(beta_factor))
+
+    def set_peridem_walls(self, bodies: Sequence[Body | str]) -> None:
+        """The bodies PeriDEM's damping treats as walls (PeriDEM's Is_Wall zones): they damp
+        particles through their nodes and are not damped themselves."""
+        self._require_building("change contact")
+        self._peridem_walls = list(bodies)
+
+    def _set_peridem_damping(self, core: _core.Simulation, materials: list[Material]) -> None:
+        if not self._peridem_damping:
+            return
+        walls = {self._body(b).index for b in self._peridem_walls}
+        centers, radii = [], []
+        for body in self.bodies:
+            if body.reference is not None:
+                local = body.reference.positions
+                distance = np.linalg.norm(local, axis=1)
+                centers.append(body.first_node + int(np.argmin(distance)))
+                radii.append(float(distance.max()) * body.scale)
+            else:
+                nodes = self._positions[body.index]
+                distance = np.linalg.norm(nodes - nodes.mean(axis=0), axis=1)
+                centers.append(body.first_node + int(np.argmin(distance)))
+                radii.append(float(distance.max()))
+        count = len(materials)
+        betan, kappa, radius = np.zeros((3, count, count))
+        for a, material_a in enumerate(materials):
+            for b, material_b in enumerate(materials):
+                setting = self._peridem_damping.get((id(material_a), id(material_b)))
+                if setting is None:
+                    continue
+                epsilon, factor = setting
+                contact = self._pair_contacts.get((id(material_a), id(material_b)), self._contact)
+                if contact is None:
+                    raise InputError(
+                        "PeriDEM damping is set for a pair of materials without contact"
+                    )
+                if contact.contact_radius is not None:
+                    radius[a, b] = contact.contact_radius
+                else:  # factor x the smallest mesh size among particles of the two materials
+                    sizes = [
+                        bd.mesh_size
+                        for bd in self.bodies
+                        if bd.material is material_a or bd.material is material_b
+                    ]
+                    radius[a, b] = contact.contact_radius_factor * min(sizes, default=0.0)
+                log_e = np.log(epsilon)
+                betan[a, b] = factor * (-2 * log_e / np.sqrt(np.pi**2 + log_e**2))
+                k_a = material_a.core_params(1.0).bulk_modulus
+                k_b = material_b.core_params(1.0).bulk_modulus
+                kappa[a, b] = 2 * k_a * k_b / (k_a + k_b)  # PeriDEM's harmonic mean
+        core.set_peridem_damping(
+            np.asarray(centers, dtype=np.uint32),
+            np.asarray(radii),
+            np.asarray([1 if k in walls else 0 for k in range(len(self.bodies))], dtype=np.uint32),
+            betan.ravel(),
+            kappa.ravel(),
+            radius.ravel(),
+        )
+
     def set_neighbor_skin(self, skin: float) -> None:
         """Verlet skin of the contact neighbour lists [m] (default: half the contact radius)."""
         if not (np.isfinite(skin) and skin > 0):
@@ -736,6 +812,7 @@ class Simulation:
         model.finalize()
         core = _core.Simulation(model)
         self._set_contact_laws(core, core_materials)
+        self._set_peridem_damping(core, core_materials)
         self._core_materials = core_materials
         self._check_start(model, core)
         if self._dt is None:
@@ -1045,6 +1122,14 @@ class Simulation:
                 repr(self._walls),
                 repr(self._contact),
                 repr(pairs),
+                repr(
+                    sorted(
+                        (order[a], order[b], setting)
+                        for (a, b), setting in self._peridem_damping.items()
+                        if a in order and b in order
+                    )
+                ),
+                repr(sorted(self._body(b).index for b in self._peridem_walls)),
             )
         return checkpoint_file.fingerprint(
             self._setup_digest,

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "granulate/contact/contact_model.hpp"
+#include "granulate/contact/peridem_damping.hpp"
 #include "granulate/loading.hpp"
 #include "granulate/model.hpp"
 #include "granulate/state.hpp"
@@ -47,6 +48,12 @@ class Simulation {
   void add_nodal_force(NodalForce force);
   /// Contact laws, walls and neighbour lists (configured for the model's materials).
   ContactModel& contact() { return contact_; }
+  /// PeriDEM's centre damping (comparisons only; see contact/peridem_damping.hpp).
+  void set_peridem_damping(std::vector<contact::PeridemParticle> particles,
+                           std::vector<contact::PeridemPair> pairs) {
+    peridem_damping_.configure(*model_, std::move(particles), std::move(pairs));
+    forces_current_ = false;
+  }
   const ContactModel& contact() const { return contact_; }
 
   /// Advances n steps of velocity Verlet:
@@ -105,6 +112,7 @@ class Simulation {
   std::vector<real> mesh_size_;           // per node, for the stability check
   std::uint64_t broken_bond_copies_ = 0;  // both copies of a broken bond count
   ContactModel contact_;
+  contact::PeridemDamping peridem_damping_;
   bool forces_current_ = false;
   PhaseTimes phase_times_;
 };

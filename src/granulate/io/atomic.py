@@ -8,9 +8,7 @@ from collections.abc import Iterable
 from pathlib import Path
 
 
-def atomic_write(
-    path: str | os.PathLike[str], data: bytes | Iterable[bytes | memoryview]
-) -> None:
+def atomic_write(path: str | os.PathLike[str], data: bytes | Iterable[bytes | memoryview]) -> None:
     """Write bytes (or a sequence of chunks, written in order without joining them) to path so
     that readers see either the old file or the whole new one."""
     target = Path(path)

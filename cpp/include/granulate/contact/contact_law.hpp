@@ -8,7 +8,9 @@
 //             mean contact normal, applied to each body as a uniform acceleration. dx/dt is the
 //             approach speed of the bodies, M their reduced mass (a particle's own mass against a
 //             wall), K_s = F / x the secant stiffness of the collision (total spring force over the
-//             approach since the bodies touched; at most the sum K of the springs). zeta follows
+//             approach x since the bodies touched; at most the sum K of the springs). A collision
+//             lasts until x is back to 0, through the gaps where chattering surface nodes part for
+//             a few steps (contacts much stiffer than the material). zeta follows
 //             from the requested coefficient of restitution of a linear spring-dashpot:
 //             zeta = -ln e / sqrt(pi^2 + ln^2 e). Acting on the bodies rather than on the contact
 //             nodes, the dashpot dissipates c (dx/dt)^2 whatever the bodies' deformation, so a

@@ -33,6 +33,7 @@ struct ContactCheckpoint {
   std::vector<std::array<index_t, 2>> slots;
   std::uint64_t particle_slot_count = 0;
   std::vector<real> slot_approach;
+  std::vector<real> slot_normal;  ///< 3 per slot: the collision's last contact normal
   real last_time = 0;
   bool has_last_time = false;
   ContactStatistics statistics;
@@ -53,6 +54,13 @@ class ContactModel {
   /// Verlet skin [m]; lists are rebuilt when a node moves more than skin/2 relative to its
   /// last build, a wall moves more than skin/2, or a bond breaks.
   void set_skin(real skin);
+  /// Nodes whose every component is prescribed (1) or not (0): a body made of such nodes moves
+  /// as told, so its partner's dashpot uses the partner's own mass. Takes effect at the next
+  /// list build.
+  void set_kinematic_nodes(std::vector<std::uint8_t> kinematic) {
+    node_kinematic_ = std::move(kinematic);
+    built_ = false;
+  }
   real skin() const { return skin_; }
 
   bool active() const { return any_law_ || !walls_.empty(); }
@@ -113,6 +121,8 @@ class ContactModel {
   real skin_ = -1;                  // < 0: 0.5 x the largest contact radius
   std::vector<index_t> node_body_;  // body of each node
   std::vector<real> body_mass_;
+  std::vector<std::uint8_t> node_kinematic_;  // empty: none
+  std::vector<std::uint8_t> body_kinematic_;  // every node of the body kinematic
   std::vector<index_t> body_material_;
   std::vector<index_t> body_particle_;
   std::vector<index_t> body_node_offsets_, body_nodes_;  // CSR: nodes of each body
@@ -136,6 +146,7 @@ class ContactModel {
   // Collision history per pair of bodies, kept across list rebuilds: the approach x of the two
   // bodies since they touched (for the secant stiffness F / x of the dashpot).
   std::vector<real> slot_approach_;
+  std::vector<real> slot_last_normal_;  // 3 per slot: normal of the last evaluation in contact
   real last_time_ = 0;
   bool has_last_time_ = false;
   // Scratch, per entry.
