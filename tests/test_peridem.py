@@ -69,11 +69,14 @@ def history(out: Path) -> list[dict[str, float]]:
         return [{k: float(v) for k, v in row.items()} for row in csv.DictReader(handle)]
 
 
+@pytest.mark.parametrize("compat", [False, True], ids=["granulate", "peridem-compat"])
 @pytest.mark.parametrize("name", NAMES)
-def test_deck_runs_with_peridems_particles_and_nodes(name: str, tmp_path: Path) -> None:
-    """Each deck runs (200 steps), with PeriDEM's particle count, node count per particle, and
-    particle placement (centroids of the placed, scaled and turned meshes within 1e-9 m)."""
-    out = run_deck(name, tmp_path / "out", 200)
+def test_deck_runs_with_peridems_particles_and_nodes(
+    name: str, compat: bool, tmp_path: Path
+) -> None:
+    """Each deck runs (200 steps, both physics), with PeriDEM's particle count, node count per
+    particle, and placement (centroids of the placed, scaled and turned meshes within 1e-9 m)."""
+    out = run_deck(name, tmp_path / "out", 200, *(["--peridem-compat"] if compat else []))
     ref = reference(name)
     first = ref[ref[:, 0] == 0]
     expected = summary(name)
