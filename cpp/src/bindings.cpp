@@ -68,7 +68,7 @@ nb::dict checkpoint_dict(const Simulation& self) {
   d["positions"] = copy_out(s.positions);
   d["velocities"] = copy_out(s.velocities);
   d["forces"] = copy_out(s.forces);
-  d["bond_intact"] = copy_out(s.bond_intact);
+  d["bond_intact"] = copy_out(s.bonds.unpacked(self.model().bond_offsets()));
   d["dilatation"] = copy_out(s.dilatation);
   d["time"] = s.time;
   d["step"] = s.step;
@@ -99,7 +99,9 @@ void restore_dict(Simulation& self, const nb::dict& d) {
   s.positions = entry<real>(d, "positions");
   s.velocities = entry<real>(d, "velocities");
   s.forces = entry<real>(d, "forces");
-  s.bond_intact = entry<std::uint8_t>(d, "bond_intact");
+  if (!s.bonds.assign_unpacked(self.model().bond_offsets(), entry<std::uint8_t>(d, "bond_intact"))) {
+    throw InputError("the checkpoint's state does not match this model (nodes or bonds differ)");
+  }
   s.dilatation = entry<real>(d, "dilatation");
   s.time = scalar<real>(d, "time");
   s.step = scalar<std::uint64_t>(d, "step");
@@ -509,10 +511,12 @@ NB_MODULE(_core, m) {
                                  nb::find(self));
                    })
       .def_prop_ro("bond_intact",
-                   [](Simulation& self) {  // read-only: break bonds with break_bonds()
-                     const std::size_t size[1] = {self.state().bond_intact.size()};
-                     return nb::ndarray<nb::numpy, const std::uint8_t, nb::ndim<1>>(
-                         self.state().bond_intact.data(), 1, size, nb::find(self));
+                   [](Simulation& self) {  // a read-only copy, 1 byte per bond (stored as bits)
+                     nb::object array =
+                         nb::cast(copy_out(self.state().bonds.unpacked(self.model().bond_offsets())),
+                                  nb::rv_policy::move);
+                     array.attr("setflags")("write"_a = false);
+                     return array;
                    })
       .def(
           "break_bonds",

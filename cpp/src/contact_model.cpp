@@ -104,7 +104,7 @@ bool intact_bond(const Model& model, const State& state, index_t i, index_t j) {
   const index_t local = j - bonds.first_node;  // j is in i's particle
   const index_t* found = std::lower_bound(bonds.neighbors, bonds.neighbors + bonds.count, local);
   if (found == bonds.neighbors + bonds.count || *found != local) return false;
-  return state.bond_intact[bonds.first + static_cast<std::size_t>(found - bonds.neighbors)] != 0;
+  return state.bonds.intact(i, static_cast<index_t>(found - bonds.neighbors));
 }
 
 }  // namespace
@@ -280,7 +280,7 @@ void ContactModel::label_bodies(const Model& model, const State& state, std::uin
   if (broken_bonds == 0) {  // every particle is whole: the bodies are the particles
     for (index_t i = 0; i < n; ++i) node_body_[i] = model.node_particle()[i];
   } else {  // fragments, numbered in the order of their smallest node
-    model.fragments(state.bond_intact, node_body_.data());
+    model.fragments(state.bonds, node_body_.data());
     std::vector<index_t> number(n, 0);
     index_t next = 0;
     for (index_t i = 0; i < n; ++i) {
@@ -347,10 +347,9 @@ void ContactModel::rebuild(const Model& model, const State& state, std::uint64_t
                                   });
       if (broken_bonds > 0 && !near_particle[p]) {
         const Particle& particle = particles[p];
-        const auto begin = state.bond_intact.begin() + model.bond_offsets()[particle.first_node];
-        const auto end =
-            state.bond_intact.begin() + model.bond_offsets()[particle.first_node + particle.node_count];
-        if (std::find(begin, end, std::uint8_t{0}) != end) near_particle[p] = 1;
+        if (state.bonds.broken(model.bond_offsets(), particle.first_node,
+                               particle.first_node + particle.node_count) > 0)
+          near_particle[p] = 1;
       }
     }
   }

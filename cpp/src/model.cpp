@@ -292,7 +292,7 @@ void Model::build_bonds() {
   }
 }
 
-index_t Model::fragments(const std::vector<std::uint8_t>& intact, index_t* labels) const {
+index_t Model::fragments(const BondStates& intact, index_t* labels) const {
   // Union-find; the root of a set is always its smallest node, so labels are deterministic.
   const index_t n = node_count();
   std::vector<index_t> parent(n);
@@ -307,7 +307,7 @@ index_t Model::fragments(const std::vector<std::uint8_t>& intact, index_t* label
   for (index_t i = 0; i < n; ++i) {
     const NodeBonds bonds = node_bonds(i);
     for (index_t k = 0; k < bonds.count; ++k) {
-      if (!intact[bonds.first + k]) continue;
+      if (!intact.intact(i, k)) continue;
       const index_t a = root(i), b = root(bonds.neighbor(k));
       if (a < b) parent[b] = a;
       if (b < a) parent[a] = b;

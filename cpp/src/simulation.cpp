@@ -31,7 +31,7 @@ Simulation::Simulation(std::shared_ptr<Model> model) : model_(std::move(model)) 
   state_.positions = m.reference_positions();
   state_.velocities.assign(3 * static_cast<std::size_t>(n), 0);
   state_.forces.assign(3 * static_cast<std::size_t>(n), 0);
-  state_.bond_intact.assign(m.bond_count(), 1);
+  state_.bonds.reset(m.bond_offsets());
   state_.dilatation.assign(n, 0);
   pressure_.assign(n, 0);
   mesh_size_.resize(n);
@@ -160,7 +160,7 @@ void Simulation::compute_forces() {
   const auto& density = m.node_density();
   const auto& x = state_.positions;
   auto& f = state_.forces;
-  auto& intact = state_.bond_intact;
+  auto& intact = state_.bonds;
   auto& theta = state_.dilatation;
   const std::int64_t n = m.node_count();
   const auto g = body_acceleration_;
@@ -176,14 +176,14 @@ void Simulation::compute_forces() {
                                     material.params.break_in_compression};
     const bool can_break = material.params.fracture;
     const NodeBonds bonds = m.node_bonds(i);
-    std::uint8_t* bond_intact = intact.data() + bonds.first;
+    std::uint8_t* bond_bits = intact.node(i);
     real sum = 0;
     for (index_t b = 0; b < bonds.count; ++b) {
-      if (!bond_intact[b]) continue;
+      if (!BondStates::intact(bond_bits, b)) continue;
       const real r = bonds.length(b);
       const real e = bond_extension(i, bonds.neighbor(b), r, x);
       if (can_break && criterion.breaks(e / r)) {
-        bond_intact[b] = 0;
+        BondStates::clear(bond_bits, b);
         ++newly_broken;
         continue;
       }
@@ -205,10 +205,10 @@ void Simulation::compute_forces() {
     const real pressure_i = pressure_[i];
     const real deviatoric_i = lps_coefficients[i].deviatoric_stiffness;
     const NodeBonds bonds = m.node_bonds(i);
-    const std::uint8_t* bond_intact = intact.data() + bonds.first;
+    const std::uint8_t* bond_bits = intact.node(i);
     real fx = 0, fy = 0, fz = 0;
     for (index_t b = 0; b < bonds.count; ++b) {
-      if (!bond_intact[b]) continue;
+      if (!BondStates::intact(bond_bits, b)) continue;
       const index_t j = bonds.neighbor(b);
       const real dx = x[3 * j] - x[3 * i], dy = x[3 * j + 1] - x[3 * i + 1], dz = x[3 * j + 2] - x[3 * i + 2];
       const real length = std::sqrt(dx * dx + dy * dy + dz * dz);
@@ -292,11 +292,11 @@ void Simulation::run(std::uint64_t steps) {
 std::array<std::size_t, 2> Simulation::memory_bytes() const {
   auto bytes = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
   const Model& m = *model_;
-  std::size_t bonds = bytes(state_.bond_intact);
+  std::size_t bonds = state_.bonds.bit_bytes();
   for (const BondFamilies& f : m.families())
     bonds += bytes(f.neighbors) + bytes(f.weights) + bytes(f.lengths);
-  std::size_t other = bytes(state_.positions) + bytes(state_.velocities) + bytes(state_.forces) +
-                      bytes(state_.dilatation) + bytes(pressure_) + bytes(mesh_size_) +
+  std::size_t other = state_.bonds.offset_bytes() + bytes(state_.positions) + bytes(state_.velocities) +
+                      bytes(state_.forces) + bytes(state_.dilatation) + bytes(pressure_) + bytes(mesh_size_) +
                       bytes(m.reference_positions()) + bytes(m.volumes()) + bytes(m.node_particle()) +
                       bytes(m.node_material()) + bytes(m.node_density()) + bytes(m.bond_offsets()) +
                       bytes(m.weighted_volume()) + bytes(m.lps_coefficients()) + bytes(m.pmb_stiffness()) +
@@ -309,12 +309,11 @@ std::array<std::size_t, 2> Simulation::memory_bytes() const {
 void Simulation::restore(const State& state, const ContactCheckpoint& contact) {
   const std::size_t n = 3 * static_cast<std::size_t>(model_->node_count());
   if (state.positions.size() != n || state.velocities.size() != n || state.forces.size() != n ||
-      state.bond_intact.size() != model_->bond_count() || state.dilatation.size() != model_->node_count()) {
+      state.dilatation.size() != model_->node_count()) {
     throw InputError("the checkpoint's state does not match this model (nodes or bonds differ)");
   }
   state_ = state;
-  broken_bond_copies_ = static_cast<std::uint64_t>(
-      std::count(state_.bond_intact.begin(), state_.bond_intact.end(), std::uint8_t{0}));
+  broken_bond_copies_ = state_.bonds.broken(model_->bond_offsets(), 0, model_->node_count());
   contact_.restore(*model_, state_, contact);
   forces_current_ = true;
 }
@@ -364,7 +363,7 @@ void Simulation::strain_energy_density(real* out) const {
     const NodeBonds bonds = m.node_bonds(i);
     real sum = 0;
     for (index_t b = 0; b < bonds.count; ++b) {
-      if (!state_.bond_intact[bonds.first + b]) continue;
+      if (!state_.bonds.intact(i, b)) continue;
       const index_t j = bonds.neighbor(b);
       const real r = bonds.length(b);
       const real e = bond_extension(i, j, r, state_.positions);
@@ -397,7 +396,7 @@ void Simulation::damage(real* phi, real* z) const {
     for (index_t b = 0; b < bonds.count; ++b) {
       const real w = bonds.weight(b), r = bonds.length(b);
       all += w;
-      if (state_.bond_intact[bonds.first + b]) intact += w;
+      if (state_.bonds.intact(i, b)) intact += w;
       max_stretch =
           std::max(max_stretch, std::abs(bond_extension(i, bonds.neighbor(b), r, state_.positions) / r));
     }
@@ -408,7 +407,7 @@ void Simulation::damage(real* phi, real* z) const {
 
 void Simulation::break_bonds(const std::vector<std::array<index_t, 2>>& pairs) {
   const Model& m = *model_;
-  auto copy_of = [&](index_t i, index_t j) -> std::size_t {
+  auto copy_of = [&](index_t i, index_t j) -> std::array<index_t, 2> {  // (node, its bond)
     if (i >= m.node_count() || j >= m.node_count() || m.node_particle()[i] != m.node_particle()[j]) {
       throw InputError("nodes " + std::to_string(i) + " and " + std::to_string(j) + " are not bonded");
     }
@@ -418,12 +417,13 @@ void Simulation::break_bonds(const std::vector<std::array<index_t, 2>>& pairs) {
     if (found == bonds.neighbors + bonds.count || *found != local) {
       throw InputError("nodes " + std::to_string(i) + " and " + std::to_string(j) + " are not bonded");
     }
-    return bonds.first + static_cast<std::size_t>(found - bonds.neighbors);
+    return {i, static_cast<index_t>(found - bonds.neighbors)};
   };
   for (const auto& [i, j] : pairs) {
-    const std::size_t forward = copy_of(i, j), backward = copy_of(j, i);
-    if (state_.bond_intact[forward]) {
-      state_.bond_intact[forward] = state_.bond_intact[backward] = 0;
+    const auto forward = copy_of(i, j), backward = copy_of(j, i);
+    if (state_.bonds.intact(forward[0], forward[1])) {
+      BondStates::clear(state_.bonds.node(forward[0]), forward[1]);
+      BondStates::clear(state_.bonds.node(backward[0]), backward[1]);
       broken_bond_copies_ += 2;
     }
   }
@@ -435,7 +435,7 @@ std::uint64_t Simulation::broken_bonds() const {
 }
 
 index_t Simulation::fragments(index_t* labels) const {
-  return model_->fragments(state_.bond_intact, labels);
+  return model_->fragments(state_.bonds, labels);
 }
 
 std::vector<std::uint8_t> Simulation::fixity() const {

@@ -200,7 +200,7 @@ TEST_CASE("fragments are the connected components of intact bonds") {
     const NodeBonds b = model->node_bonds(i);
     for (index_t k = 0; k < b.count; ++k) {
       const index_t j = b.neighbor(k);
-      if ((X[3 * i] < 6e-3) != (X[3 * j] < 6e-3)) sim.state().bond_intact[b.first + k] = 0;
+      if ((X[3 * i] < 6e-3) != (X[3 * j] < 6e-3)) BondStates::clear(sim.state().bonds.node(i), k);
     }
   }
   CHECK(sim.fragments(labels.data()) == 2);

@@ -9,6 +9,7 @@
 
 #include "granulate/material.hpp"
 #include "granulate/peridynamics/lps.hpp"
+#include "granulate/state.hpp"
 #include "granulate/types.hpp"
 
 namespace granulate {
@@ -54,7 +55,7 @@ struct BondFamilies {
 
 /// The bonds of one node, as seen by the force loops: bond b (0 <= b < count) joins the node to
 /// neighbor(b), has reference length length(b) and weight weight(b); its state (intact or not)
-/// is State::bond_intact[first + b].
+/// is State::bonds.intact(node, b), its global number first + b.
 struct NodeBonds {
   const index_t* neighbors = nullptr;
   const real* lengths = nullptr;
@@ -139,10 +140,10 @@ class Model {
   /// k_i = d^2 kappa_d / sum_j w_ij r_ij of PMB nodes (0 for LPS nodes), see pmb.hpp.
   const std::vector<real>& pmb_stiffness() const { return pmb_stiffness_; }
 
-  /// Fragments: connected components of the graph of intact bonds (`intact` per bond, see
-  /// bond_offsets()). Writes each node's label, the smallest node index of its fragment, and
-  /// returns the number of fragments. Deterministic (sequential union-find).
-  index_t fragments(const std::vector<std::uint8_t>& intact, index_t* labels) const;
+  /// Fragments: connected components of the graph of intact bonds. Writes each node's label,
+  /// the smallest node index of its fragment, and returns the number of fragments.
+  /// Deterministic (sequential union-find).
+  index_t fragments(const BondStates& intact, index_t* labels) const;
 
   /// Per-node stable time step sqrt(2 rho / sum_j C_ij w_ij), minimised (Silling & Askari
   /// 2005, with the LPS dilatation coupling bounded by Gershgorin) [s].
