@@ -149,3 +149,21 @@ def test_stop_criteria_end_the_run_at_a_fixed_step(tmp_path: Path) -> None:
     )
     assert settled.run(500, stop=[gr.stopping.KineticEnergyBelow(1e-12)]) is not None
     assert settled.step == 100
+
+
+def test_checkpoints_without_the_collision_normal_still_restore() -> None:
+    """Checkpoints written before slots kept their last contact normal restore (no normal)."""
+    sim = gr.Simulation(2)
+    sim.add_body(
+        gr.Rectangle((0, 0), (2e-3, 1e-3)),
+        gr.Material(
+            density=1000, youngs_modulus=1e6, poisson_ratio=0.25, fracture=False, horizon_factor=3
+        ),
+        2.5e-4,
+    )
+    sim.run(5)
+    state = dict(sim.core.checkpoint())
+    assert "contact_slot_normal" in state
+    del state["contact_slot_normal"]
+    sim.core.restore(state)
+    assert sim.step == 5

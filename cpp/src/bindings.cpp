@@ -116,7 +116,9 @@ void restore_dict(Simulation& self, const nb::dict& d) {
   for (std::size_t k = 0; k < slots.size(); k += 2) c.slots.push_back({slots[k], slots[k + 1]});
   c.particle_slot_count = scalar<std::uint64_t>(d, "contact_particle_slot_count");
   c.slot_approach = entry<real>(d, "contact_slot_approach");
-  c.slot_normal = entry<real>(d, "contact_slot_normal");
+  // Checkpoints written before the collision normal was kept have no entry: no normal yet.
+  c.slot_normal = d.contains("contact_slot_normal") ? entry<real>(d, "contact_slot_normal")
+                                                    : std::vector<real>(3 * c.slots.size(), 0.0);
   c.last_time = scalar<real>(d, "contact_last_time");
   c.has_last_time = scalar<bool>(d, "contact_has_last_time");
   const auto statistics = entry<std::uint64_t>(d, "contact_statistics");
