@@ -803,8 +803,9 @@ def _translate(path: Path, compat: bool, output: Path | None) -> Translation:
                 )
             )
         notes.append(
-            "fragments of one particle touch each other after it breaks (PeriDEM lets them "
-            "pass through)"
+            "fragments of one particle are bodies in contact after it breaks (PeriDEM repels "
+            "only the node pairs whose bond broke, and lets other nodes of its fragments pass "
+            "through each other)"
         )
         if walls:
             notes.append(
