@@ -810,7 +810,8 @@ def _translate(path: Path, compat: bool, output: Path | None) -> Translation:
         if walls:
             notes.append(
                 "walls are particles with every node constrained; the force on them is the "
-                "reaction of the grains (history.csv <name>_fx, _fy)"
+                "reaction of the grains (history.csv <name>_fx, _fy). PeriDEM computes no "
+                "contact force on wall nodes, so the force it reports on a wall is its weight"
             )
 
     # --------------------------------------------------------------- neighbor
