@@ -227,6 +227,9 @@ def test_particles_at_rest_load_the_floor_with_their_weight(dimension: int) -> N
         sim.add_wall(gr.BoxContainer((-3e-3, 0, -1.5e-3), (3e-3, 20e-3, 1.5e-3)), name="box")
     weight = float(np.sum(sim.volumes) * SOFT.density * g)
     sim.run(until=0.08)
+    # At rest: a late slip of one particle (at about 0.08 s in some runs) must have died out.
+    while sim.kinetic_energy() > 1e-3 * weight * 1e-6 and sim.time < 0.3:
+        sim.run(until=sim.time + 0.01)
     load = mean_vertical_load(sim, "box", 50)
     assert abs(load / weight - 1) < 0.01, f"floor load {load / weight:.4f} x weight"
 
