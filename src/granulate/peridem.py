@@ -1101,7 +1101,8 @@ def to_yaml(translation: Translation, compat: bool) -> str:
     header = [
         f"# granulate case converted from the PeriDEM deck {translation.source}",
         f"# (granulate convert{' --peridem-compat' if compat else ''}). Particles p<i> carry",
-        "# PeriDEM's global particle ids. What differs from PeriDEM:",
+        "# PeriDEM's global particle ids; file paths are relative to this file, output.directory",
+        "# to the working directory convert ran in. What differs from PeriDEM:",
     ]
     header += [f"#   - {n}" for n in translation.notes]
     body = yaml.safe_dump(translation.case, sort_keys=False, default_flow_style=None, width=100)
