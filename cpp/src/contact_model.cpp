@@ -760,9 +760,9 @@ void ContactModel::add_forces(const Model& model, State& state, std::uint64_t br
     // not while springs are in contact: the surface nodes of deformable bodies chatter (touch,
     // part, touch again) within one collision when the contact is stiffer than the material,
     // and a dashpot restarted at each touch would damp the collision many times over.
-    const bool touching = slot_stiffness_[slot] > 0 && norm > 0;
+    const bool in_contact = slot_stiffness_[slot] > 0 && norm > 0;
     real* last_normal = &slot_last_normal_[3 * slot];
-    if (touching) {
+    if (in_contact) {
       for (int k = 0; k < 3; ++k) last_normal[k] = slot_normal[slot][k] / norm;
     } else if (!(slot_approach_[slot] > 0)) {
       slot_approach_[slot] = 0;
@@ -784,7 +784,7 @@ void ContactModel::add_forces(const Model& model, State& state, std::uint64_t br
       zeta = laws_[body_material_[p] * material_count_ + body_material_[q]].damping_ratio;
     }
     slot_approach_[slot] += approach * dt;
-    if (!touching) {  // a gap within the collision: no spring, no dashpot
+    if (!in_contact) {  // a gap within the collision: no spring, no dashpot
       slot_approach_[slot] = std::max(0.0, slot_approach_[slot]);
       continue;
     }
