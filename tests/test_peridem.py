@@ -24,6 +24,7 @@ from granulate import peridem
 from granulate.case import load_case
 from granulate.cli import main
 from granulate.errors import InputError
+from granulate.io.vtu import read_vtu_point_data
 
 DECKS = Path(__file__).parent / "data" / "peridem"
 NAMES = [
@@ -167,22 +168,39 @@ def test_restitution_with_peridems_stiff_contact(
         assert abs(free - epsilon) < 0.05
 
 
-def test_pulled_rectangle_compared_with_peridem(tmp_path: Path) -> None:
-    """single_particle_rectangle_inbuilt_mesh: PeriDEM's built-in uniform mesh (441 nodes),
-    corner clamped, opposite corner pulled at 0.01 m/s. With --peridem-compat (PeriDEM's 3D
-    constants in 2D) mean Damage_Z stays within 10 % of PeriDEM's (measured 8 %); the mean
-    displacement is 24 % below PeriDEM's in both modes, a difference not explained yet (see the
-    deck notes: the pulled region is a 5-parameter rectangle), asserted within 30 %."""
-    out = run_deck(
-        "single_particle_rectangle_inbuilt_mesh", tmp_path / "out", None, "--peridem-compat"
-    )
-    ref = reference("single_particle_rectangle_inbuilt_mesh")
+def test_pulled_rectangle_matches_peridem(tmp_path: Path) -> None:
+    """single_particle_rectangle_inbuilt_mesh: PeriDEM's built-in uniform mesh (441 nodes), a
+    clamped corner, and a pulled 9 x 9 node corner given as PeriDEM's 5-parameter rectangle
+    [Lx, Ly, cx, cy, cz]. With --peridem-compat (PeriDEM's 3D constants in 2D) every node's
+    displacement at the last frame equals PeriDEM's to 1e-9 m (measured 2.7e-12 m), and the mean
+    displacement and max Damage_Z of every frame to 1e-3 (measured 1.0000); mean Damage_Z is
+    3.4 % above PeriDEM's (some nodes of PeriDEM's clamped corner report Z = 0). granulate's
+    plane-strain constants keep the mean displacement within 2 % (measured 0.8 %) and give a 24 %
+    lower Z: the 2D critical stretch and moduli differ from the 3D ones."""
+    name = "single_particle_rectangle_inbuilt_mesh"
+    ref = reference(name)
+    compat = run_deck(name, tmp_path / "compat", None, "--peridem-compat")
+    default = run_deck(name, tmp_path / "default", None)
     for k in (4, 10, 20):
-        mesh = frame(out, k)
+        mesh = frame(compat, k)
         u = mesh.point_data["Displacement"][:, 0].mean()
-        z = mesh.point_data["Damage_Z"].mean()
-        assert abs(u / ref[k, 8] - 1) < 0.30, (k, u, ref[k, 8])
-        assert abs(z / ref[k, 13] - 1) < 0.10, (k, z, ref[k, 13])
+        z = mesh.point_data["Damage_Z"]
+        assert u == pytest.approx(ref[k, 8], rel=1e-3)
+        assert z.max() == pytest.approx(ref[k, 12], rel=1e-3)
+        assert z.mean() == pytest.approx(ref[k, 13], rel=0.05)
+        mesh = frame(default, k)
+        assert mesh.point_data["Displacement"][:, 0].mean() == pytest.approx(ref[k, 8], rel=0.02)
+        assert 0.6 < mesh.point_data["Damage_Z"].max() / ref[k, 12] < 0.9
+    points, data = read_vtu_point_data(DECKS / name / "peridem_output" / "output_0_20.vtu")
+    theirs = {
+        tuple(np.round((p - u)[:2] / 5e-4).astype(int)): u
+        for p, u in zip(points, data["Displacement"], strict=True)
+    }
+    last = frame(compat, 20)
+    ours = last.point_data["Displacement"]
+    origin = np.round((last.points - ours)[:, :2] / 5e-4).astype(int)
+    difference = max(np.abs(ours[k] - theirs[tuple(origin[k])]).max() for k in range(len(ours)))
+    assert difference < 1e-9
 
 
 def test_compression_deck_settles_like_peridem(tmp_path: Path) -> None:

@@ -273,16 +273,20 @@ def _region(geometry: Any, where: str, dimension: int, problems: _Problems, note
     kind = geometry.get("Type")
     p = _numbers(geometry.get("Parameters"), f"{where}.Parameters", problems)
     if kind == "rectangle" and dimension == 2:
-        if len(p) == 6:
+        if len(p) == 6:  # corners [x1, y1, z1, x2, y2, z2]
             lower, upper = p[0:2], p[3:5]
-        elif len(p) in (4, 5):
-            lower, upper = p[0:2], p[2:4]
-            if len(p) == 5:
-                notes.append(
-                    f"{where}: a rectangle with 5 parameters {p} is read as [x1, y1, x2, y2, z]"
-                )
+        elif len(p) == 5:  # PeriDEM's other form: lengths and centre [Lx, Ly, cx, cy, cz]
+            lower = [p[2] - 0.5 * p[0], p[3] - 0.5 * p[1]]
+            upper = [p[2] + 0.5 * p[0], p[3] + 0.5 * p[1]]
+            notes.append(
+                f"{where}: a rectangle of 5 parameters is PeriDEM's [Lx, Ly, cx, cy, cz]: "
+                f"x in [{lower[0]:.6g}, {upper[0]:.6g}], y in [{lower[1]:.6g}, {upper[1]:.6g}]"
+            )
         else:
-            problems.add(f"{where}: a rectangle takes [x1, y1, z1, x2, y2, z2], got {p}")
+            problems.add(
+                f"{where}: a rectangle takes [x1, y1, z1, x2, y2, z2] or [Lx, Ly, cx, cy, cz], "
+                f"got {p}"
+            )
             return None
         return {"type": "rectangle", "lower": lower, "upper": upper}
     if kind in ("cuboid", "cube", "rectangle") and dimension == 3 and len(p) == 6:

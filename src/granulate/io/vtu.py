@@ -165,3 +165,129 @@ class PvdSeries:
             "",
         ]
         atomic_write(self.path, "\n".join(lines).encode())
+
+
+_NUMPY_TYPES = {
+    "Float64": "<f8",
+    "Float32": "<f4",
+    "Int64": "<i8",
+    "Int32": "<i4",
+    "UInt64": "<u8",
+    "UInt32": "<u4",
+    "UInt8": "<u1",
+    "Int8": "<i1",
+}
+
+
+def read_vtu_point_data(
+    path: str | os.PathLike[str],
+) -> tuple[NDArray[np.float64], dict[str, NDArray[np.generic]]]:
+    """Points and point data of a .vtu file: appended data (raw or base64, plain or with VTK's
+    zlib blocks, UInt32 or UInt64 headers) or inline ASCII arrays; this writer's frames and
+    PeriDEM's output files. Raises InputError naming the problem otherwise."""
+    import base64
+    import xml.etree.ElementTree as ElementTree
+
+    from granulate.errors import InputError
+
+    source = Path(path)
+    try:
+        data = source.read_bytes()
+    except OSError as error:
+        raise InputError(f"cannot read {source}: {error}") from None
+    start = data.find(b"<AppendedData")
+    appended = b""
+    encoding = "raw"
+    if start >= 0:
+        tag_end = data.index(b">", start)
+        encoding = "base64" if b'encoding="base64"' in data[start:tag_end] else "raw"
+        body_start = data.index(b"_", tag_end) + 1
+        body_end = data.rfind(b"</AppendedData>")
+        appended = data[body_start:body_end]
+        if encoding == "base64":
+            appended = appended.strip()
+        xml_text = data[:start] + b"</VTKFile>"
+    else:
+        xml_text = data
+    try:
+        root = ElementTree.fromstring(xml_text)
+    except ElementTree.ParseError as error:
+        raise InputError(f"{source} is not a VTU file: {error}") from None
+    header = "<u8" if root.get("header_type") == "UInt64" else "<u4"
+    header_size = np.dtype(header).itemsize
+    compressed = root.get("compressor") == "vtkZLibDataCompressor"
+    if root.get("compressor") not in (None, "vtkZLibDataCompressor"):
+        raise InputError(f"{source}: compressor {root.get('compressor')} is not supported")
+
+    def decode(chunk: bytes) -> bytes:
+        return base64.b64decode(chunk) if encoding == "base64" else chunk
+
+    def appended_bytes(offset: int) -> bytes:
+        if not compressed:
+            if encoding == "base64":  # header and data encoded together
+                size_chars = 4 * -(-header_size // 3)
+                size = int(
+                    np.frombuffer(
+                        decode(appended[offset : offset + size_chars])[:header_size], header
+                    )[0]
+                )
+                chars = 4 * -(-(header_size + size) // 3)
+                return decode(appended[offset : offset + chars])[header_size : header_size + size]
+            size = int(np.frombuffer(appended[offset : offset + header_size], header)[0])
+            return appended[offset + header_size : offset + header_size + size]
+        # zlib blocks: [count, block size, last size, compressed sizes...] then the blocks.
+        head_chars = 3 * header_size
+        if encoding == "base64":
+            first = decode(appended[offset : offset + 4 * -(-head_chars // 3)])
+            count = int(np.frombuffer(first[:header_size], header)[0])
+            table_bytes = (3 + count) * header_size
+            table_chars = 4 * -(-table_bytes // 3)
+            table = np.frombuffer(
+                decode(appended[offset : offset + table_chars])[:table_bytes], header
+            )
+            blocks_chars = 4 * -(-int(table[3:].sum()) // 3)
+            payload = decode(appended[offset + table_chars : offset + table_chars + blocks_chars])
+        else:
+            count = int(np.frombuffer(appended[offset : offset + header_size], header)[0])
+            table = np.frombuffer(appended[offset : offset + (3 + count) * header_size], header)
+            at = offset + (3 + count) * header_size
+            payload = appended[at : at + int(table[3:].sum())]
+        out, position = [], 0
+        for size in table[3:]:
+            out.append(zlib.decompress(payload[position : position + int(size)]))
+            position += int(size)
+        return b"".join(out)
+
+    def array(element: ElementTree.Element) -> NDArray[np.generic]:
+        kind = element.get("type", "")
+        if kind not in _NUMPY_TYPES:
+            raise InputError(
+                f"{source}: array {element.get('Name')!r} of type {kind!r} is not supported"
+            )
+        fmt = element.get("format", "ascii")
+        if fmt == "appended":
+            values = np.frombuffer(
+                appended_bytes(int(element.get("offset", "0"))), _NUMPY_TYPES[kind]
+            )
+        elif fmt == "ascii":
+            values = np.array((element.text or "").split(), dtype=_NUMPY_TYPES[kind])
+        else:
+            raise InputError(f"{source}: {fmt!r} arrays are not supported (use appended or ascii)")
+        components = int(element.get("NumberOfComponents", "1"))
+        return values.reshape(-1, components) if components > 1 else values.copy()
+
+    piece = root.find("UnstructuredGrid/Piece")
+    if piece is None:
+        raise InputError(f"{source} has no UnstructuredGrid piece")
+    points_element = piece.find("Points/DataArray")
+    if points_element is None:
+        raise InputError(f"{source} has no points")
+    try:
+        points = np.asarray(array(points_element), dtype=np.float64).reshape(-1, 3)
+        point_data = {
+            element.get("Name", ""): array(element)
+            for element in piece.findall("PointData/DataArray")
+        }
+    except (ValueError, IndexError, zlib.error) as error:
+        raise InputError(f"{source}: damaged data ({error})") from None
+    return points, point_data
