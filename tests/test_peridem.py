@@ -290,7 +290,8 @@ def broken_deck(tmp_path: Path, name: str, edit) -> Path:
         ),
         (lambda t: t.replace("mesh_cir_1_0.msh", "missing.msh"), "missing.msh"),
         (lambda t: t.replace("Type: PDState", "Type: RNPBond", 1), "'RNPBond' is not supported"),
-        (lambda t: t + "Restart:\n  File: a.vtu\n  Step: 10\n", "Restart"),
+        (lambda t: t + "Restart:\n  File: a.vtu\n  Step: 10\n", "restart file"),
+        (lambda t: t + "Restart:\n  File: a.vtu\n", "Restart: give File"),
         (lambda t: t.replace("Particle_List: [1]", "Particle_List: [7]"), "IC.Constant_Velocity"),
         (lambda t: t.replace("Particle_List: [0]", "Particle_List: [5]"), "0 .. 1"),
         (lambda t: t.replace("  Zone_12:\n", "  Zone_21:\n"), "Contact.Zone_12: missing"),
@@ -503,3 +504,50 @@ def test_node_distance_stops_a_run() -> None:
     assert np.max(np.hypot(sim.positions[:, 0], sim.positions[:, 1])) > 2e-3
     with pytest.raises(InputError, match="positive distance"):
         gr.stopping.NodeDistance(-1.0)
+
+
+def test_restart_from_peridems_output(tmp_path: Path) -> None:
+    """Restart {File, Step}: twop_circ continued from PeriDEM's own frame at step 60,000 starts
+    from its displacements (the top disc's mean uy equals PeriDEM's to 1e-12 m) at t = 0.018 s."""
+    deck = broken_deck(
+        tmp_path,
+        "twop_circ",
+        lambda t: t + "Restart:\n  File: peridem_output/output_0_12.vtu\n  Step: 60000\n",
+    )
+    out = tmp_path / "out"
+    assert main(["run", str(deck), "--out", str(out), "--quiet", "--steps", "5000"]) == 0
+    rows = history(out)
+    top = reference("twop_circ")
+    top = top[(top[:, 3] == 1) & (top[:, 1] == 60_000)][0]
+    assert rows[0]["step"] == 60_000 and rows[0]["time"] == pytest.approx(0.018, rel=1e-12)
+    assert rows[0]["p1_uy"] == pytest.approx(top[9], abs=1e-12)
+    assert rows[-1]["step"] == 65_000
+    with pytest.raises(InputError, match="holds 246 nodes"):
+        broken = broken_deck(
+            tmp_path / "other",
+            "compression_small_set",
+            lambda t: (
+                t + "Restart:\n  File: ../../twop_circ/peridem_output/output_0_12.vtu\n  Step: 5\n"
+            ),
+        )
+        load_case(broken).build(outputs=False)
+
+
+def test_vtu_reader_reads_what_the_writer_writes(tmp_path: Path) -> None:
+    from granulate.io.vtu import write_vtu
+
+    rng = np.random.default_rng(4)
+    points = rng.uniform(size=(70_000, 3))  # several zlib blocks
+    fields = {
+        "Displacement": rng.standard_normal((70_000, 3)),
+        "Particle_ID": np.arange(70_000, dtype=np.uint32) // 7,
+        "Fixity": np.zeros(70_000, np.uint8),
+    }
+    write_vtu(tmp_path / "f.vtu", points, fields)
+    read_points, data = read_vtu_point_data(tmp_path / "f.vtu")
+    np.testing.assert_array_equal(read_points, points)
+    for name, values in fields.items():
+        np.testing.assert_array_equal(data[name], values)
+    (tmp_path / "bad.vtu").write_bytes(b"<VTKFile><Unstructured")
+    with pytest.raises(InputError, match="not a VTU file"):
+        read_vtu_point_data(tmp_path / "bad.vtu")

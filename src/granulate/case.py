@@ -654,6 +654,15 @@ class OutputSpec(Spec):
     )
 
 
+class RestartSpec(Spec):
+    """Start from positions and velocities read from a VTU frame (granulate's or PeriDEM's), at
+    a given step: x = X + Displacement, v = Velocity, t = step dt. Bonds start intact (a VTU frame
+    does not hold their states; granulate's checkpoints do, see --resume)."""
+
+    file: str = Field(description="VTU file with Displacement and Velocity, relative to the case")
+    step: Annotated[int, Field(ge=0)] = Field(description="the step the frame was written at")
+
+
 class CheckpointSpec(Spec):
     every_steps: Annotated[int, Field(gt=0)] | None = None
     every_minutes: Positive | None = None
@@ -710,6 +719,7 @@ class CaseSpec(Spec):
     time: TimeSpec
     output: OutputSpec | None = None
     checkpoint: CheckpointSpec | None = None
+    restart: RestartSpec | None = None
     stop: StopSpec | None = None
 
     @model_validator(mode="after")
@@ -913,6 +923,8 @@ class Case:
             sim.add_wall(_wall(w, case), name=w.name)
         for load in spec.loading:
             _load(sim, load, case, named)
+        if spec.restart is not None and not resume:
+            _restart(sim, case.path(spec.restart.file), spec.restart.step)
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
             sim.validate_time_step()  # an error here makes the warning about dt moot
@@ -1010,6 +1022,30 @@ def _wall(w: WallSpec, case: CaseContext) -> walls.Wall:
         None if w.contact is None else w.contact.make(),
         w.center,
     )
+
+
+def _restart(sim: Simulation, path: Path, step: int) -> None:
+    """Positions and velocities of a VTU frame, at ``step`` (see RestartSpec)."""
+    from granulate.io.vtu import read_vtu_point_data
+
+    if not path.is_file():
+        raise InputError(f"restart file {path} does not exist")
+    _, data = read_vtu_point_data(path)
+    missing = [name for name in ("Displacement", "Velocity") if name not in data]
+    if missing:
+        raise InputError(
+            f"restart file {path} has no {' or '.join(missing)} point data; restart needs both"
+        )
+    displacement, velocity = data["Displacement"], data["Velocity"]
+    if displacement.shape != (sim.node_count, 3) or velocity.shape != (sim.node_count, 3):
+        raise InputError(
+            f"restart file {path} holds {len(displacement)} nodes, the case has "
+            f"{sim.node_count}: it belongs to another set-up"
+        )
+    sim.positions[:] = sim.model.reference_positions + displacement
+    sim.velocities[:] = velocity
+    sim.core.step = step
+    sim.core.time = step * sim.dt
 
 
 def _named(name: str, named: dict[str, Body], what: str) -> Body:

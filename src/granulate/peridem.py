@@ -16,6 +16,7 @@ schema of granulate.case), so a deck runs through exactly the code path of a cas
   node spacing over all particles; kn = Kn x Kn_Factor; e = Epsilon when Damping_On; mu =
   Friction_Coeff when Friction_On; no contact between two walls (PeriDEM skips wall pairs);
 - displacement sets, force sets, gravity and initial velocities become loading entries;
+- Restart {File, Step} starts from a VTU frame's displacements and velocities (bonds intact);
 - Output_Interval sets the frames; the walls (and the particles of a two-particle test) are
   tracked in history.csv every Test_Output_Interval steps (the compressive-test report: the
   force on each wall against its displacement).
@@ -1045,13 +1046,19 @@ def _translate(path: Path, compat: bool, output: Path | None) -> Translation:
         output_spec = None
         notes.append("Output.Perform_Out is false: no output is written")
 
-    restart = deck.get("Restart")
+    restart_spec: dict[str, Any] | None = None
+    restart = _block(deck, "Restart", "deck", problems)
     if restart:
-        problems.add(
-            "Restart: restarting from a PeriDEM VTU is not supported (PeriDEM does not restore "
-            "bond states from it either); run the deck from the start, and use granulate's "
-            "checkpoints (granulate run --resume) to continue runs"
-        )
+        problems.unknown("Restart", restart, {"File", "Step"})
+        step = restart.get("Step")
+        if not isinstance(restart.get("File"), str) or not (isinstance(step, int) and step >= 0):
+            problems.add("Restart: give File (a VTU output of the run) and Step (its step)")
+        else:
+            restart_spec = {"file": file_ref(restart["File"]), "step": step}
+            notes.append(
+                f"Restart: positions and velocities from {restart['File']} at step {step}; bonds "
+                "start intact, as in PeriDEM (granulate's checkpoints keep them: --resume)"
+            )
 
     problems.raise_if_any()
     case: dict[str, Any] = {
@@ -1081,6 +1088,8 @@ def _translate(path: Path, compat: bool, output: Path | None) -> Translation:
         case["output"] = output_spec
     if stop is not None:
         case["stop"] = stop
+    if restart_spec is not None:
+        case["restart"] = restart_spec
     return Translation(case, source, notes)
 
 
