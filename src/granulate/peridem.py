@@ -412,7 +412,6 @@ def _translate(path: Path, compat: bool, output: Path | None) -> Translation:
     test = particle_block.get("Test_Name", "")
 
     materials: dict[str, Any] = {}
-    material_specs: dict[int, dict[str, Any]] = {}
     grains: dict[str, Any] = {}
     walls: set[int] = set()
     geometry_particle: set[int] = set()
@@ -577,7 +576,6 @@ def _translate(path: Path, compat: bool, output: Path | None) -> Translation:
             spec["influence"] = names[influence]
         if compat:
             spec["break_in_compression"] = True
-        material_specs[z] = spec
         materials[f"zone_{z}"] = spec
     if not compat:
         notes.append(
