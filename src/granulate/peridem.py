@@ -23,8 +23,8 @@ schema of granulate.case), so a deck runs through exactly the code path of a cas
 
 Where PeriDEM's physics is a known defect, the translation runs granulate's physics and says so
 in ``Translation.notes``; ``compat=True`` (``--peridem-compat``) reproduces PeriDEM's formulas
-where granulate has them: the 3D LPS constants in 2D, bonds that also break in compression, and
-PeriDEM's friction sign. PeriDEM's particle-centre damping is not reproduced (see the notes).
+where granulate has them: the 3D LPS constants in 2D, bonds that also break in compression,
+PeriDEM's friction sign and PeriDEM's particle-centre damping (contact/peridem_damping.hpp).
 Keys granulate cannot honour stop the translation with one InputError listing them all; keys
 PeriDEM itself ignores are listed in the notes.
 """
