@@ -85,9 +85,11 @@ nb::dict checkpoint_dict(const Simulation& self) {
   d["contact_slot_normal"] = copy_out(c.slot_normal);
   d["contact_last_time"] = c.last_time;
   d["contact_has_last_time"] = c.has_last_time;
-  d["contact_statistics"] =
-      copy_out(std::vector<std::uint64_t>{c.statistics.rebuilds, c.statistics.list_entries,
-                                          c.statistics.node_contacts, c.statistics.wall_contacts});
+  d["contact_statistics"] = copy_out(
+      std::vector<std::uint64_t>{c.statistics.rebuilds, c.statistics.list_entries, c.statistics.node_contacts,
+                                 c.statistics.wall_contacts, c.statistics.list_updates});
+  d["contact_pair_offsets"] = copy_out(c.pair_offsets);
+  d["contact_pair_partners"] = copy_out(c.pair_partners);
   std::vector<real> reactions;
   for (const auto& r : c.wall_reactions) reactions.insert(reactions.end(), r.begin(), r.end());
   d["contact_wall_reactions"] = copy_out(reactions);
@@ -122,8 +124,17 @@ void restore_dict(Simulation& self, const nb::dict& d) {
   c.last_time = scalar<real>(d, "contact_last_time");
   c.has_last_time = scalar<bool>(d, "contact_has_last_time");
   const auto statistics = entry<std::uint64_t>(d, "contact_statistics");
-  if (statistics.size() != 4) throw InputError("the checkpoint's contact statistics are malformed");
-  c.statistics = {statistics[0], statistics[1], statistics[2], statistics[3]};
+  if (statistics.size() != 4 && statistics.size() != 5) {
+    throw InputError("the checkpoint's contact statistics are malformed");
+  }
+  c.statistics = {statistics[0], statistics.size() > 4 ? statistics[4] : 0, statistics[1], statistics[2],
+                  statistics[3]};
+  // Checkpoints written before lists were updated after bond breaks have no lists: a search
+  // at the build positions gives them.
+  if (d.contains("contact_pair_offsets")) {
+    c.pair_offsets = entry<index_t>(d, "contact_pair_offsets");
+    c.pair_partners = entry<index_t>(d, "contact_pair_partners");
+  }
   const auto reactions = entry<real>(d, "contact_wall_reactions");
   if (reactions.size() % 6) throw InputError("the checkpoint's wall reactions are malformed");
   for (std::size_t k = 0; k < reactions.size(); k += 6) {
@@ -352,6 +363,7 @@ NB_MODULE(_core, m) {
 
   nb::class_<ContactStatistics>(m, "ContactStatistics")
       .def_ro("rebuilds", &ContactStatistics::rebuilds)
+      .def_ro("list_updates", &ContactStatistics::list_updates)
       .def_ro("list_entries", &ContactStatistics::list_entries)
       .def_ro("node_contacts", &ContactStatistics::node_contacts)
       .def_ro("wall_contacts", &ContactStatistics::wall_contacts);

@@ -253,12 +253,7 @@ real ContactModel::stable_time_step(const Model& model) const {
   return dt;
 }
 
-bool ContactModel::needs_rebuild(const Model& model, const State& state, std::uint64_t broken_bonds) const {
-  if (!built_ || broken_bonds != broken_at_build_) return true;
-  const real half_skin = 0.5 * skin_;
-  for (const Wall& wall : walls_) {
-    if (wall.motion_bound(time_at_build_, state.time) > half_skin) return true;
-  }
+real ContactModel::largest_displacement(const Model& model, const State& state) const {
   const auto& x = state.positions;
   const std::int64_t n = model.node_count();
   real worst = 0;
@@ -271,7 +266,79 @@ bool ContactModel::needs_rebuild(const Model& model, const State& state, std::ui
     }
     worst = std::max(worst, d2);
   }
-  return worst > half_skin * half_skin;
+  return std::sqrt(worst);
+}
+
+bool ContactModel::needs_rebuild(const Model& model, const State& state) const {
+  if (!built_) return true;
+  const real half_skin = 0.5 * skin_;
+  for (const Wall& wall : walls_) {
+    if (wall.motion_bound(time_at_build_, state.time) > half_skin) return true;
+  }
+  return largest_displacement(model, state) > half_skin;
+}
+
+void ContactModel::update_after_breaks(const Model& model, const State& state, std::uint64_t broken_bonds) {
+  // Bonds broke, nothing moved far: no grid search. The lists gain every newly unbonded pair
+  // that could come within its Rc before the next rebuild: a node moves at most skin/2 from
+  // where the lists were built before that, so a pair now at d stays beyond d - skin - 2 w (w:
+  // the largest displacement since the build so far); then the bodies are labelled again.
+  label_bodies(model, state, broken_bonds);
+  const index_t n = model.node_count();
+  const auto& x = state.positions;
+  const auto& node_particle = model.node_particle();
+  const auto& node_material = model.node_material();
+  const real extra = skin_ + 2 * largest_displacement(model, state);
+  std::vector<std::vector<index_t>> added(n);
+  std::vector<index_t> counts(n, 0);
+#pragma omp parallel for schedule(static)
+  for (std::int64_t ii = 0; ii < static_cast<std::int64_t>(n); ++ii) {
+    const index_t i = static_cast<index_t>(ii);
+    const NodeBonds bonds = model.node_bonds(i);
+    const std::uint8_t* bits = state.bonds.node(i);
+    const index_t m = node_material[i];
+    if (!law_set_[m * material_count_ + m]) continue;
+    const real limit =
+        contact::resolve_contact_radius(laws_[m * material_count_ + m], particle_side_[node_particle[i]],
+                                        particle_side_[node_particle[i]]) +
+        extra;
+    const index_t* listed = pair_partner_.data() + pair_offsets_[i];
+    const index_t listed_count = pair_offsets_[i + 1] - pair_offsets_[i];
+    for (index_t b = 0; b < bonds.count; ++b) {
+      if (bits[b >> 3] == 0xff) {  // eight intact bonds
+        b |= 7;
+        continue;
+      }
+      if (BondStates::intact(bits, b)) continue;
+      const index_t j = bonds.neighbor(b);
+      const real dx = x[3 * j] - x[3 * i], dy = x[3 * j + 1] - x[3 * i + 1], dz = x[3 * j + 2] - x[3 * i + 2];
+      if (dx * dx + dy * dy + dz * dz > limit * limit) continue;
+      if (std::binary_search(listed, listed + listed_count, j)) continue;
+      added[i].push_back(j);
+    }
+    counts[i] = static_cast<index_t>(added[i].size());
+  }
+  std::vector<index_t> offsets(static_cast<std::size_t>(n) + 1, 0);
+  for (index_t i = 0; i < n; ++i)
+    offsets[i + 1] = offsets[i] + (pair_offsets_[i + 1] - pair_offsets_[i]) + counts[i];
+  if (offsets[n] != pair_offsets_[n]) {
+    std::vector<index_t> partners(offsets[n]);
+#pragma omp parallel for schedule(static)
+    for (std::int64_t ii = 0; ii < static_cast<std::int64_t>(n); ++ii) {
+      const index_t i = static_cast<index_t>(ii);
+      index_t* out = partners.data() + offsets[i];
+      const index_t* begin = pair_partner_.data() + pair_offsets_[i];
+      const index_t* end = pair_partner_.data() + pair_offsets_[i + 1];
+      std::sort(added[i].begin(), added[i].end());
+      std::merge(begin, end, added[i].begin(), added[i].end(), out);
+    }
+    pair_offsets_ = std::move(offsets);
+    pair_partner_ = std::move(partners);
+  }
+  finish_lists(model);
+  broken_at_build_ = broken_bonds;
+  ++statistics_.list_updates;
+  statistics_.list_entries = pair_partner_.size();
 }
 
 void ContactModel::label_bodies(const Model& model, const State& state, std::uint64_t broken_bonds) {
@@ -307,7 +374,95 @@ void ContactModel::label_bodies(const Model& model, const State& state, std::uin
   for (index_t i = 0; i < n; ++i) body_nodes_[fill[node_body_[i]]++] = i;
 }
 
-void ContactModel::rebuild(const Model& model, const State& state, std::uint64_t broken_bonds) {
+void ContactModel::finish_lists(const Model& model) {
+  // Everything that follows from the lists and the bodies: slots, reduced masses, the laws of
+  // the slots, the collision history carried over by slot, and the per-entry scratch.
+  const index_t n = model.node_count();
+  const auto& node_body = node_body_;
+  // Slots: one per pair of bodies that appear in the lists, in sorted order.
+  const std::vector<std::array<index_t, 2>> old_slots = slots_;
+  const std::vector<real> old_approach = slot_approach_;
+  const std::vector<real> old_normal = slot_last_normal_;
+  const std::size_t old_particle_slots = particle_slot_count_;
+  slots_.clear();
+  for (index_t i = 0; i < n; ++i) {
+    for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
+      const index_t p = node_body[i], q = node_body[pair_partner_[e]];
+      slots_.push_back({std::min(p, q), std::max(p, q)});
+    }
+  }
+  std::sort(slots_.begin(), slots_.end());
+  slots_.erase(std::unique(slots_.begin(), slots_.end()), slots_.end());
+  const std::size_t particle_slots = slots_.size();
+  particle_slot_count_ = particle_slots;
+  pair_slot_.resize(pair_partner_.size());
+  for (index_t i = 0; i < n; ++i) {
+    for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
+      const index_t p = node_body[i], q = node_body[pair_partner_[e]];
+      const std::array<index_t, 2> key{std::min(p, q), std::max(p, q)};
+      pair_slot_[e] =
+          static_cast<index_t>(std::lower_bound(slots_.begin(), slots_.end(), key) - slots_.begin());
+    }
+  }
+  std::vector<std::array<index_t, 2>> wall_keys;
+  for (index_t i = 0; i < n; ++i) {
+    for (index_t e = wall_offsets_[i]; e < wall_offsets_[i + 1]; ++e)
+      wall_keys.push_back({node_body[i], wall_entry_[e][0]});
+  }
+  std::sort(wall_keys.begin(), wall_keys.end());
+  wall_keys.erase(std::unique(wall_keys.begin(), wall_keys.end()), wall_keys.end());
+  slots_.insert(slots_.end(), wall_keys.begin(), wall_keys.end());
+  wall_slot_.resize(wall_entry_.size());
+  for (index_t i = 0; i < n; ++i) {
+    for (index_t e = wall_offsets_[i]; e < wall_offsets_[i + 1]; ++e) {
+      const std::array<index_t, 2> key{node_body[i], wall_entry_[e][0]};
+      wall_slot_[e] = static_cast<index_t>(
+          particle_slots + (std::lower_bound(wall_keys.begin(), wall_keys.end(), key) - wall_keys.begin()));
+    }
+  }
+  // Reduced masses of the bodies (particles, or fragments once bonds break): two bodies
+  // m_p m_q / (m_p + m_q); unbonded nodes of one body (a crack that has not separated it),
+  // about m_p / 4; a body and a rigid wall, or a body whose every node is prescribed (a held
+  // particle, a meshed wall), the moving body's mass; two such bodies, 0 (no dashpot).
+  slot_reduced_mass_.resize(slots_.size());
+  slot_law_.resize(slots_.size());
+  for (std::size_t s = 0; s < slots_.size(); ++s) {
+    slot_law_[s] = s >= particle_slots ? wall_law(slots_[s][1], body_particle_[slots_[s][0]])
+                                       : pair_law(body_particle_[slots_[s][0]], body_particle_[slots_[s][1]]);
+    const index_t bp = slots_[s][0];
+    const real mp = body_kinematic_[bp] ? 0.0 : body_mass_[bp];
+    if (s >= particle_slots) {
+      slot_reduced_mass_[s] = mp;
+    } else if (slots_[s][0] == slots_[s][1]) {
+      slot_reduced_mass_[s] = 0.25 * mp;
+    } else {
+      const index_t bq = slots_[s][1];
+      const real mq = body_kinematic_[bq] ? 0.0 : body_mass_[bq];
+      slot_reduced_mass_[s] = mp == 0 || mq == 0 ? mp + mq : mp * mq / (mp + mq);
+    }
+  }
+  slot_stiffness_.assign(slots_.size(), 0);
+  slot_approach_.assign(slots_.size(), 0);
+  slot_last_normal_.assign(3 * slots_.size(), 0);
+  for (std::size_t slot = 0; slot < slots_.size(); ++slot) {
+    const bool wall = slot >= particle_slots;
+    const auto begin = old_slots.begin() + (wall ? old_particle_slots : 0);
+    const auto end = wall ? old_slots.end() : old_slots.begin() + old_particle_slots;
+    const auto previous = std::lower_bound(begin, end, slots_[slot]);
+    if (previous != end && *previous == slots_[slot]) {
+      const std::size_t old = previous - old_slots.begin();
+      slot_approach_[slot] = old_approach[old];
+      for (int k = 0; k < 3; ++k) slot_last_normal_[3 * slot + k] = old_normal[3 * old + k];
+    }
+  }
+  pair_stiffness_.assign(pair_partner_.size(), 0);
+  wall_entry_stiffness_.assign(wall_entry_.size(), 0);
+  pair_distance_.assign(pair_partner_.size(), 0);
+  wall_points_.assign(wall_entry_.size(), {});
+  wall_entry_reaction_.assign(wall_entry_.size(), {0, 0, 0, 0, 0, 0});
+}
+
+void ContactModel::rebuild(const Model& model, const State& state, std::uint64_t broken_bonds, bool finish) {
   if (skin_ < 0) skin_ = 0.5 * max_contact_radius_;
   const auto& x = state.positions;
   const index_t n = model.node_count();
@@ -317,7 +472,6 @@ void ContactModel::rebuild(const Model& model, const State& state, std::uint64_t
   const std::size_t particle_count = particles.size();
   const real reach = max_contact_radius_ + skin_;
   label_bodies(model, state, broken_bonds);
-  const auto& node_body = node_body_;
 
   // Broad phase: bounding spheres of particles; a particle takes part when another particle's
   // sphere or a wall is within reach, or when it has broken bonds (fragments may touch).
@@ -440,87 +594,7 @@ void ContactModel::rebuild(const Model& model, const State& state, std::uint64_t
   for (index_t i = 0; i < n; ++i)
     wall_entry_.insert(wall_entry_.end(), per_node[i].begin(), per_node[i].end());
 
-  // Slots: one per pair of bodies that appear in the lists, in sorted order.
-  const std::vector<std::array<index_t, 2>> old_slots = slots_;
-  const std::vector<real> old_approach = slot_approach_;
-  const std::vector<real> old_normal = slot_last_normal_;
-  const std::size_t old_particle_slots = particle_slot_count_;
-  slots_.clear();
-  for (index_t i = 0; i < n; ++i) {
-    for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
-      const index_t p = node_body[i], q = node_body[pair_partner_[e]];
-      slots_.push_back({std::min(p, q), std::max(p, q)});
-    }
-  }
-  std::sort(slots_.begin(), slots_.end());
-  slots_.erase(std::unique(slots_.begin(), slots_.end()), slots_.end());
-  const std::size_t particle_slots = slots_.size();
-  particle_slot_count_ = particle_slots;
-  pair_slot_.resize(pair_partner_.size());
-  for (index_t i = 0; i < n; ++i) {
-    for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
-      const index_t p = node_body[i], q = node_body[pair_partner_[e]];
-      const std::array<index_t, 2> key{std::min(p, q), std::max(p, q)};
-      pair_slot_[e] =
-          static_cast<index_t>(std::lower_bound(slots_.begin(), slots_.end(), key) - slots_.begin());
-    }
-  }
-  std::vector<std::array<index_t, 2>> wall_keys;
-  for (index_t i = 0; i < n; ++i) {
-    for (index_t e = wall_offsets_[i]; e < wall_offsets_[i + 1]; ++e)
-      wall_keys.push_back({node_body[i], wall_entry_[e][0]});
-  }
-  std::sort(wall_keys.begin(), wall_keys.end());
-  wall_keys.erase(std::unique(wall_keys.begin(), wall_keys.end()), wall_keys.end());
-  slots_.insert(slots_.end(), wall_keys.begin(), wall_keys.end());
-  wall_slot_.resize(wall_entry_.size());
-  for (index_t i = 0; i < n; ++i) {
-    for (index_t e = wall_offsets_[i]; e < wall_offsets_[i + 1]; ++e) {
-      const std::array<index_t, 2> key{node_body[i], wall_entry_[e][0]};
-      wall_slot_[e] = static_cast<index_t>(
-          particle_slots + (std::lower_bound(wall_keys.begin(), wall_keys.end(), key) - wall_keys.begin()));
-    }
-  }
-  // Reduced masses of the bodies (particles, or fragments once bonds break): two bodies
-  // m_p m_q / (m_p + m_q); unbonded nodes of one body (a crack that has not separated it),
-  // about m_p / 4; a body and a rigid wall, or a body whose every node is prescribed (a held
-  // particle, a meshed wall), the moving body's mass; two such bodies, 0 (no dashpot).
-  slot_reduced_mass_.resize(slots_.size());
-  slot_law_.resize(slots_.size());
-  for (std::size_t s = 0; s < slots_.size(); ++s) {
-    slot_law_[s] = s >= particle_slots ? wall_law(slots_[s][1], body_particle_[slots_[s][0]])
-                                       : pair_law(body_particle_[slots_[s][0]], body_particle_[slots_[s][1]]);
-    const index_t bp = slots_[s][0];
-    const real mp = body_kinematic_[bp] ? 0.0 : body_mass_[bp];
-    if (s >= particle_slots) {
-      slot_reduced_mass_[s] = mp;
-    } else if (slots_[s][0] == slots_[s][1]) {
-      slot_reduced_mass_[s] = 0.25 * mp;
-    } else {
-      const index_t bq = slots_[s][1];
-      const real mq = body_kinematic_[bq] ? 0.0 : body_mass_[bq];
-      slot_reduced_mass_[s] = mp == 0 || mq == 0 ? mp + mq : mp * mq / (mp + mq);
-    }
-  }
-  slot_stiffness_.assign(slots_.size(), 0);
-  slot_approach_.assign(slots_.size(), 0);
-  slot_last_normal_.assign(3 * slots_.size(), 0);
-  for (std::size_t slot = 0; slot < slots_.size(); ++slot) {
-    const bool wall = slot >= particle_slots;
-    const auto begin = old_slots.begin() + (wall ? old_particle_slots : 0);
-    const auto end = wall ? old_slots.end() : old_slots.begin() + old_particle_slots;
-    const auto previous = std::lower_bound(begin, end, slots_[slot]);
-    if (previous != end && *previous == slots_[slot]) {
-      const std::size_t old = previous - old_slots.begin();
-      slot_approach_[slot] = old_approach[old];
-      for (int k = 0; k < 3; ++k) slot_last_normal_[3 * slot + k] = old_normal[3 * old + k];
-    }
-  }
-  pair_stiffness_.assign(pair_partner_.size(), 0);
-  wall_entry_stiffness_.assign(wall_entry_.size(), 0);
-  pair_distance_.assign(pair_partner_.size(), 0);
-  wall_points_.assign(wall_entry_.size(), {});
-  wall_entry_reaction_.assign(wall_entry_.size(), {0, 0, 0, 0, 0, 0});
+  if (finish) finish_lists(model);
 
   positions_at_build_ = x;
   time_at_build_ = state.time;
@@ -594,6 +668,8 @@ ContactCheckpoint ContactModel::checkpoint() const {
   c.particle_slot_count = particle_slot_count_;
   c.slot_approach = slot_approach_;
   c.slot_normal = slot_last_normal_;
+  c.pair_offsets = pair_offsets_;
+  c.pair_partners = pair_partner_;
   c.last_time = last_time_;
   c.has_last_time = has_last_time_;
   c.statistics = statistics_;
@@ -620,7 +696,17 @@ void ContactModel::restore(const Model& model, const State& state, const Contact
     State at_build = state;
     at_build.positions = saved.positions_at_build;
     at_build.time = saved.time_at_build;
-    rebuild(model, at_build, saved.broken_at_build);
+    // Lists updated after bond breaks are not those of a search: take the saved ones (a
+    // checkpoint without them predates these updates, and a search gives them again).
+    const bool saved_lists = saved.pair_offsets.size() == static_cast<std::size_t>(model.node_count()) + 1 &&
+                             saved.pair_offsets.back() == saved.pair_partners.size();
+    rebuild(model, at_build, saved.broken_at_build, !saved_lists);
+    if (saved_lists) {
+      pair_offsets_ = saved.pair_offsets;
+      pair_partner_ = saved.pair_partners;
+      statistics_.list_entries = pair_partner_.size();
+      finish_lists(model);
+    }
   }
   last_time_ = saved.last_time;
   has_last_time_ = saved.has_last_time;
@@ -631,7 +717,11 @@ void ContactModel::restore(const Model& model, const State& state, const Contact
 void ContactModel::add_forces(const Model& model, State& state, std::uint64_t broken_bonds) {
   if (!active()) return;
   const auto search_start = std::chrono::steady_clock::now();
-  if (needs_rebuild(model, state, broken_bonds)) rebuild(model, state, broken_bonds);
+  if (needs_rebuild(model, state)) {
+    rebuild(model, state, broken_bonds);
+  } else if (broken_bonds != broken_at_build_) {
+    update_after_breaks(model, state, broken_bonds);
+  }
   search_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - search_start).count();
   const auto& x = state.positions;
   const auto& v = state.velocities;

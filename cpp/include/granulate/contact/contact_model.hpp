@@ -15,7 +15,8 @@
 namespace granulate {
 
 struct ContactStatistics {
-  std::uint64_t rebuilds = 0;       ///< neighbour-list builds so far
+  std::uint64_t rebuilds = 0;       ///< neighbour-list builds so far (grid searches)
+  std::uint64_t list_updates = 0;   ///< updates after bond breaks (no search)
   std::uint64_t list_entries = 0;   ///< node-pair entries in the current lists (both directions)
   std::uint64_t node_contacts = 0;  ///< node pairs in contact at the last evaluation (once each)
   std::uint64_t wall_contacts = 0;  ///< node-wall contacts at the last evaluation
@@ -33,7 +34,8 @@ struct ContactCheckpoint {
   std::vector<std::array<index_t, 2>> slots;
   std::uint64_t particle_slot_count = 0;
   std::vector<real> slot_approach;
-  std::vector<real> slot_normal;  ///< 3 per slot: the collision's last contact normal
+  std::vector<real> slot_normal;                     ///< 3 per slot: the collision's last contact normal
+  std::vector<index_t> pair_offsets, pair_partners;  ///< the lists (updated after bond breaks)
   real last_time = 0;
   bool has_last_time = false;
   ContactStatistics statistics;
@@ -97,8 +99,14 @@ class ContactModel {
   void restore(const Model& model, const State& state, const ContactCheckpoint& saved);
 
  private:
-  bool needs_rebuild(const Model& model, const State& state, std::uint64_t broken_bonds) const;
-  void rebuild(const Model& model, const State& state, std::uint64_t broken_bonds);
+  real largest_displacement(const Model& model, const State& state) const;  ///< since the build [m]
+  bool needs_rebuild(const Model& model, const State& state) const;
+  /// A grid search at the current positions; `finish`: then finish_lists.
+  void rebuild(const Model& model, const State& state, std::uint64_t broken_bonds, bool finish = true);
+  /// After bonds broke (and nothing moved half the skin): new unbonded pairs into the lists.
+  void update_after_breaks(const Model& model, const State& state, std::uint64_t broken_bonds);
+  /// Slots, reduced masses, slot laws and scratch from the lists and the bodies.
+  void finish_lists(const Model& model);
   /// Bodies for the dashpots: particles while whole, fragments (connected components of intact
   /// bonds) once bonds break; labelled at every list build (a break forces a build).
   void label_bodies(const Model& model, const State& state, std::uint64_t broken_bonds);
