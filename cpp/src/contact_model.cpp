@@ -269,16 +269,19 @@ real ContactModel::largest_displacement(const Model& model, const State& state) 
   return std::sqrt(worst);
 }
 
-bool ContactModel::needs_rebuild(const Model& model, const State& state) const {
+bool ContactModel::needs_rebuild(const Model& model, const State& state, real& moved) const {
+  moved = 0;
   if (!built_) return true;
   const real half_skin = 0.5 * skin_;
   for (const Wall& wall : walls_) {
     if (wall.motion_bound(time_at_build_, state.time) > half_skin) return true;
   }
-  return largest_displacement(model, state) > half_skin;
+  moved = largest_displacement(model, state);
+  return moved > half_skin;
 }
 
-void ContactModel::update_after_breaks(const Model& model, const State& state, std::uint64_t broken_bonds) {
+void ContactModel::update_after_breaks(const Model& model, const State& state, std::uint64_t broken_bonds,
+                                       real moved) {
   // Bonds broke, nothing moved far: no grid search. The lists gain every newly unbonded pair
   // that could come within its Rc before the next rebuild: a node moves at most skin/2 from
   // where the lists were built before that, so a pair now at d stays beyond d - skin - 2 w (w:
@@ -288,7 +291,7 @@ void ContactModel::update_after_breaks(const Model& model, const State& state, s
   const auto& x = state.positions;
   const auto& node_particle = model.node_particle();
   const auto& node_material = model.node_material();
-  const real extra = skin_ + 2 * largest_displacement(model, state);
+  const real extra = skin_ + 2 * moved;
   std::vector<std::vector<index_t>> added(n);
   std::vector<index_t> counts(n, 0);
 #pragma omp parallel for schedule(static)
@@ -717,10 +720,11 @@ void ContactModel::restore(const Model& model, const State& state, const Contact
 void ContactModel::add_forces(const Model& model, State& state, std::uint64_t broken_bonds) {
   if (!active()) return;
   const auto search_start = std::chrono::steady_clock::now();
-  if (needs_rebuild(model, state)) {
+  real moved = 0;  // largest node displacement since the build
+  if (needs_rebuild(model, state, moved)) {
     rebuild(model, state, broken_bonds);
   } else if (broken_bonds != broken_at_build_) {
-    update_after_breaks(model, state, broken_bonds);
+    update_after_breaks(model, state, broken_bonds, moved);
   }
   search_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - search_start).count();
   const auto& x = state.positions;

@@ -92,10 +92,7 @@ void Simulation::add_prescribed_motion(PrescribedMotion motion) {
     motion.components = 0b111;
   }
   motions_.push_back(std::move(motion));
-  const std::uint8_t all = model_->dimension() == 2 ? 0b011 : 0b111;
-  std::vector<std::uint8_t> kinematic = fixity();
-  for (std::uint8_t& k : kinematic) k = (k & all) == all ? 1 : 0;
-  contact_.set_kinematic_nodes(std::move(kinematic));
+  kinematic_stale_ = true;
   forces_current_ = false;
 }
 
@@ -152,7 +149,17 @@ void Simulation::apply_prescribed_motion(bool positions_too) {
   }
 }
 
+void Simulation::update_kinematic_nodes() {
+  if (!kinematic_stale_) return;  // once after the loading is set, not per motion added
+  const std::uint8_t all = model_->dimension() == 2 ? 0b011 : 0b111;
+  std::vector<std::uint8_t> kinematic = fixity();
+  for (std::uint8_t& k : kinematic) k = (k & all) == all ? 1 : 0;
+  contact_.set_kinematic_nodes(std::move(kinematic));
+  kinematic_stale_ = false;
+}
+
 void Simulation::compute_forces() {
+  update_kinematic_nodes();
   const Model& m = *model_;
   const auto& materials = m.materials();
   const auto& node_material = m.node_material();
@@ -313,6 +320,7 @@ void Simulation::restore(const State& state, const ContactCheckpoint& contact) {
     throw InputError("the checkpoint's state does not match this model (nodes or bonds differ)");
   }
   state_ = state;
+  update_kinematic_nodes();  // the contact lists are rebuilt below with the held bodies known
   broken_bond_copies_ = state_.bonds.broken(model_->bond_offsets(), 0, model_->node_count());
   contact_.restore(*model_, state_, contact);
   forces_current_ = true;

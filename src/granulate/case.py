@@ -1057,28 +1057,19 @@ def _named(name: str, named: dict[str, Body], what: str) -> Body:
 def _load(sim: Simulation, load: BaseModel, case: CaseContext, named: dict[str, Body]) -> None:
     select: SelectSpec = load.nodes  # type: ignore[attr-defined]
     region = None if select.region is None else case.shape(select.region)
-    if select.body is None:
-        nodes = sim.select(region, ids=select.ids)
-    else:
+    ids = None if select.ids is None else np.asarray(select.ids, dtype=np.int64)
+    if select.body is not None:  # any of the bodies named
         chosen = [select.body] if isinstance(select.body, str) else select.body
-        bodies = [_named(b, named, "loading selects body") for b in chosen]
-        parts = []
-        for body in bodies:
-            try:
-                parts.append(sim.select(region, body=body, ids=select.ids))
-            except InputError:
-                if len(bodies) == 1:
-                    raise
-        if not parts:
-            raise InputError(f"loading selects no node of bodies {chosen}")
-        nodes = np.unique(np.concatenate(parts)).astype(np.uint32)
+        body_nodes = np.concatenate(
+            [_named(b, named, "loading selects body").nodes for b in chosen]
+        )
+        ids = body_nodes if ids is None else np.intersect1d(ids, body_nodes)
     if select.exclude:
         left_out = np.concatenate(
             [_named(b, named, "loading excludes body").nodes for b in select.exclude]
         )
-        nodes = np.setdiff1d(nodes, left_out).astype(np.uint32)
-        if len(nodes) == 0:
-            raise InputError("loading selects no node once the excluded bodies are left out")
+        ids = np.setdiff1d(np.arange(sim.node_count) if ids is None else ids, left_out)
+    nodes = sim.select(region, ids=ids)
     if isinstance(load, FixSpec):
         sim.fix(nodes, load.components)
     elif isinstance(load, DisplacementSpec):

@@ -497,22 +497,16 @@ def _translate(path: Path, compat: bool, output: Path | None) -> Translation:
             continue
 
     # ---------------------------------------------------------------- materials
-    def material_of(z: int, seen: tuple[int, ...] = ()) -> dict[str, Any]:
-        zk = f"Zone_{z}"
-        info = material_block.get(zk)
-        if not isinstance(info, dict):
-            problems.add(f"Material.{zk}: missing (every zone needs a material)")
-            return {}
-        if "Copy_Material_Data" in info:
-            other = info["Copy_Material_Data"]
-            if other not in zones or other in (*seen, z):
-                problems.add(f"Material.{zk}.Copy_Material_Data: no zone {other!r} to copy")
-                return {}
-            return material_of(other, (*seen, z))
-        return info
-
     for z in zones:
-        info = material_of(z)
+        info = _copied(
+            material_block,
+            f"Zone_{z}",
+            "Copy_Material_Data",
+            lambda other: f"Zone_{other}" if other in zones else None,
+            "Material",
+            "every zone needs a material",
+            problems,
+        )
         if not info:
             continue
         where = f"Material.Zone_{z}"
@@ -559,11 +553,9 @@ def _translate(path: Path, compat: bool, output: Path | None) -> Translation:
             if "Gc" in info and _number(info["Gc"], f"{where}.Gc", problems) > 0:
                 spec["fracture_energy"] = _number(info["Gc"], f"{where}.Gc", problems)
             elif "KIc" in info:
-                e = _youngs(spec)
+                e = _youngs(spec, where, problems)
                 kic = _number(info["KIc"], f"{where}.KIc", problems, positive=True)
-                if e is None:
-                    problems.add(f"{where}: KIc needs the elastic constants to give Gc")
-                else:
+                if e is not None:
                     spec["fracture_energy"] = kic * kic / e
                     notes.append(f"{where}: Gc = KIc^2 / E = {kic * kic / e:.6g} J/m^2 (PeriDEM's)")
             else:
@@ -694,24 +686,11 @@ def _translate(path: Path, compat: bool, output: Path | None) -> Translation:
         keys = {f"Zone_{a}{b}": (a, b) for a in zones for b in zones if a <= b}
         problems.unknown("Contact", contact_block, set(keys))
 
-        def contact_of(a: int, b: int, seen: tuple[tuple[int, int], ...] = ()) -> dict[str, Any]:
-            key = f"Zone_{a}{b}"
-            info = contact_block.get(key)
-            if not isinstance(info, dict):
-                problems.add(f"Contact.{key}: missing (zones {a} and {b} may touch)")
-                return {}
-            if "Copy_Contact_Data" in info:
-                other = info["Copy_Contact_Data"]
-                if (
-                    not isinstance(other, list)
-                    or len(other) != 2
-                    or tuple(sorted(other)) in (*seen, (a, b))
-                    or f"Zone_{min(other)}{max(other)}" not in keys
-                ):
-                    problems.add(f"Contact.{key}.Copy_Contact_Data: no zone pair {other!r} to copy")
-                    return {}
-                return contact_of(min(other), max(other), (*seen, (a, b)))
-            return info
+        def pair_key(other: Any) -> str | None:
+            if not (isinstance(other, list) and len(other) == 2):
+                return None
+            key = f"Zone_{min(other)}{max(other)}"
+            return key if key in keys else None
 
         friction_used = False
         damping_used = False
@@ -719,7 +698,15 @@ def _translate(path: Path, compat: bool, output: Path | None) -> Translation:
             if a in walls and b in walls:
                 pairs.append({"materials": [f"zone_{a}", f"zone_{b}"], "contact": None})
                 continue
-            info = contact_of(a, b)
+            info = _copied(
+                contact_block,
+                key,
+                "Copy_Contact_Data",
+                pair_key,
+                "Contact",
+                f"zones {a} and {b} may touch",
+                problems,
+            )
             if not info:
                 continue
             where = f"Contact.{key}"
@@ -1091,20 +1078,51 @@ def _translate(path: Path, compat: bool, output: Path | None) -> Translation:
     return Translation(case, source, notes)
 
 
-def _youngs(spec: dict[str, Any]) -> float | None:
-    """E from the two elastic constants given."""
-    e, k, g, nu = (
-        spec.get(n) for n in ("youngs_modulus", "bulk_modulus", "shear_modulus", "poisson_ratio")
-    )
-    if e is not None:
-        return e
-    if k is not None and g is not None:
-        return 9 * k * g / (3 * k + g)
-    if k is not None and nu is not None:
-        return 3 * k * (1 - 2 * nu)
-    if g is not None and nu is not None:
-        return 2 * g * (1 + nu)
-    return None
+def _copied(
+    block: dict[str, Any],
+    key: str,
+    copy_key: str,
+    target: Any,
+    section: str,
+    missing: str,
+    problems: _Problems,
+) -> dict[str, Any]:
+    """The block ``section.key``, following ``copy_key`` links (``target(value)``: the key a
+    link names, or None when it names nothing); {} with a problem reported for a missing block,
+    a bad link or a cycle."""
+    seen: list[str] = []
+    while True:
+        info = block.get(key)
+        if not isinstance(info, dict):
+            problems.add(f"{section}.{key}: missing ({missing})")
+            return {}
+        if copy_key not in info:
+            return info
+        seen.append(key)
+        other = target(info[copy_key])
+        if other is None or other in seen:
+            problems.add(f"{section}.{key}.{copy_key}: nothing to copy at {info[copy_key]!r}")
+            return {}
+        key = other
+
+
+def _youngs(spec: dict[str, Any], where: str, problems: _Problems) -> float | None:
+    """E [Pa] from the two elastic constants of a material spec (granulate.Material derives
+    them); None with a problem reported when they are missing or inconsistent."""
+    from pydantic import ValidationError
+
+    from granulate.materials import Material
+
+    constants = ("youngs_modulus", "bulk_modulus", "shear_modulus", "poisson_ratio")
+    try:
+        material = Material(
+            density=1.0, fracture=False, **{n: spec[n] for n in constants if n in spec}
+        )
+        K, G = material.elastic_moduli()
+    except (ValidationError, ValueError):
+        problems.add(f"{where}: KIc needs two consistent elastic constants to give Gc")
+        return None
+    return 9 * K * G / (3 * K + G)
 
 
 def to_yaml(translation: Translation, compat: bool) -> str:

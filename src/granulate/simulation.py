@@ -664,8 +664,7 @@ class Simulation:
                     radius[a, b] = contact.contact_radius_factor * min(sizes, default=0.0)
                 log_e = np.log(epsilon)
                 betan[a, b] = factor * (-2 * log_e / np.sqrt(np.pi**2 + log_e**2))
-                k_a = material_a.core_params(1.0).bulk_modulus
-                k_b = material_b.core_params(1.0).bulk_modulus
+                k_a, k_b = material_a.elastic_moduli()[0], material_b.elastic_moduli()[0]
                 kappa[a, b] = 2 * k_a * k_b / (k_a + k_b)  # PeriDEM's harmonic mean
         core.set_peridem_damping(
             np.asarray(centers, dtype=np.uint32),
@@ -1385,18 +1384,18 @@ class Simulation:
         """The frame (when the step is a frame step) and the history row (when it is a
         history step) of the current step."""
         out = self._output
-        assert out is not None and self._model is not None
-        core = self._build()
-        phi, z = core.damage()
-        if core.step % out.every == 0 or out.frames == 0:
-            self._write_vtu_frame(phi, z)
-        if core.step % out.history_every == 0 or out.history is None:
+        assert out is not None
+        step = self._build().step
+        if step % out.every == 0 or out.frames == 0:
+            self._write_vtu_frame()
+        if step % out.history_every == 0 or out.history is None:
             self._write_history_row()
 
-    def _write_vtu_frame(self, phi: NDArray[np.float64], z: NDArray[np.float64]) -> None:
+    def _write_vtu_frame(self) -> None:
         out = self._output
         assert out is not None and self._model is not None
         core = self._build()
+        phi, z = core.damage()
         volumes = self._model.volumes
         available = {
             "Displacement": lambda: core.positions - self._reference,

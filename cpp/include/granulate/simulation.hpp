@@ -114,6 +114,8 @@ class Simulation {
   ContactModel contact_;
   contact::PeridemDamping peridem_damping_;
   bool forces_current_ = false;
+  bool kinematic_stale_ = false;  // prescribed motions changed: the contact's held bodies
+  void update_kinematic_nodes();
   PhaseTimes phase_times_;
 };
 

@@ -100,11 +100,13 @@ class ContactModel {
 
  private:
   real largest_displacement(const Model& model, const State& state) const;  ///< since the build [m]
-  bool needs_rebuild(const Model& model, const State& state) const;
+  /// Whether the lists must be searched again; `moved`: the largest node displacement since the
+  /// build (0 when not computed).
+  bool needs_rebuild(const Model& model, const State& state, real& moved) const;
   /// A grid search at the current positions; `finish`: then finish_lists.
   void rebuild(const Model& model, const State& state, std::uint64_t broken_bonds, bool finish = true);
   /// After bonds broke (and nothing moved half the skin): new unbonded pairs into the lists.
-  void update_after_breaks(const Model& model, const State& state, std::uint64_t broken_bonds);
+  void update_after_breaks(const Model& model, const State& state, std::uint64_t broken_bonds, real moved);
   /// Slots, reduced masses, slot laws and scratch from the lists and the bodies.
   void finish_lists(const Model& model);
   /// Bodies for the dashpots: particles while whole, fragments (connected components of intact
