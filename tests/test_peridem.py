@@ -219,8 +219,9 @@ def test_compression_deck_settles_like_peridem(tmp_path: Path) -> None:
     rows = history(out)
     assert rows[-1]["broken_bonds"] == 0
     assert rows[-1]["p16_uy"] == pytest.approx(-3e-3, rel=1e-9)
-    # Bouncing grains (no damping) first reach the top wall after step 12,000 and push it up.
-    assert max(abs(r["p16_fy"]) for r in rows if r["step"] < 12_000) < 1e-12
+    # Bouncing grains (no damping) reach the top wall late and push it up. When they first touch
+    # it is chaotic: step 12,400, or 11,600 after a change of the bond loops' round-off.
+    assert max(abs(r["p16_fy"]) for r in rows if r["step"] < 10_000) < 1e-12
     assert max(r["p16_fy"] for r in rows) > 0.05
     assert min(r["p15_fy"] for r in rows) < -0.05  # the grains load the container
 

@@ -140,9 +140,9 @@ index_t Model::add_particle(index_t shape_index, index_t material, std::span<con
                            ? m.critical_stretch * std::sqrt(m.params.horizon / horizon)
                            : m.critical_stretch;
   particles_.push_back(p);
-  particle_weight_scale_.push_back(std::pow(scale, dimension_));
+  const real volume_scale = std::pow(scale, dimension_);
   reference_positions_.insert(reference_positions_.end(), positions.begin(), positions.end());
-  for (real v : shape.volumes) volumes_.push_back(particle_weight_scale_.back() * v);
+  for (real v : shape.volumes) volumes_.push_back(volume_scale * v);
   node_particle_.insert(node_particle_.end(), n, id);
   node_material_.insert(node_material_.end(), n, material);
   node_density_.insert(node_density_.end(), n, materials_[material].params.density);
@@ -163,6 +163,7 @@ void Model::finalize() {
   if (finalized_) return;
   if (particles_.empty()) throw InputError("the model has no particles; add at least one body");
   build_bonds();
+  build_bond_schedule();
   // The shapes' node positions were only needed to build the bond families (a body used once
   // would otherwise hold its nodes twice).
   for (Shape& shape : shapes_) std::vector<real>().swap(shape.positions);
@@ -182,6 +183,7 @@ BondFamilies Model::build_family(index_t shape_index, real horizon, InfluenceKin
   // lattices) are then never two cells apart after rounding.
   const CellGrid grid = CellGrid::build(x, 0, nodes, horizon * (1.0 + 1e-6));
   family.offsets.assign(nodes + 1, 0);
+  family.forward.assign(nodes, 0);
 #pragma omp parallel for schedule(static)
   for (std::int64_t aa = 0; aa < static_cast<std::int64_t>(nodes); ++aa) {
     const index_t a = static_cast<index_t>(aa);
@@ -202,6 +204,7 @@ BondFamilies Model::build_family(index_t shape_index, real horizon, InfluenceKin
     index_t filled = 0;
     grid.for_each_within(x, a, horizon, dimension_, [&](index_t j, real) { out[filled++] = j; });
     std::sort(out, out + filled);
+    family.forward[a] = static_cast<index_t>(std::upper_bound(out, out + filled, a) - family.neighbors.data());
     for (index_t b = family.offsets[a]; b < family.offsets[a + 1]; ++b) {
       const index_t j = family.neighbors[b];
       const real r = std::sqrt((x[3 * j] - x[3 * a]) * (x[3 * j] - x[3 * a]) +
@@ -214,8 +217,7 @@ BondFamilies Model::build_family(index_t shape_index, real horizon, InfluenceKin
       // Partial volume: a neighbour cell cut by the horizon counts for its share inside.
       const real partial = r > horizon - 0.5 * h ? std::min(1.0, (horizon + 0.5 * h - r) / h) : 1.0;
       family.lengths[b] = r;
-      family.weights[b] = static_cast<float>(influence(influence_kind, std::min(r / horizon, 1.0)) *
-                                             shape.volumes[j] * partial);
+      family.weights[b] = static_cast<float>(influence(influence_kind, std::min(r / horizon, 1.0)) * partial);
     }
   }
   if (!coincident.empty()) {
@@ -290,6 +292,62 @@ void Model::build_bonds() {
                      " has no neighbour within the horizon (" + std::to_string(isolated.size()) +
                      " such nodes); increase the horizon or refine the mesh");
   }
+}
+
+void Model::build_bond_schedule() {
+  // Blocks of about `target` forward bonds: enough blocks per colour for the threads, few enough
+  // that a block's work dwarfs its scheduling. The cut depends on the model only.
+  const index_t n = node_count();
+  std::size_t forward_total = 0;
+  for (index_t i = 0; i < n; ++i) {
+    const NodeBonds bonds = node_bonds(i);
+    forward_total += static_cast<std::size_t>(bonds.count - bonds.forward);
+  }
+  const std::size_t target = std::clamp<std::size_t>(forward_total / 64, 1024, 16384);
+  BondSchedule& s = bond_schedule_;
+  s = {};
+  s.block_starts.push_back(0);
+  std::vector<index_t> reach;  // one past the highest node each block touches
+  std::size_t in_block = 0;
+  index_t block_reach = 0;
+  for (index_t i = 0; i < n; ++i) {
+    const NodeBonds bonds = node_bonds(i);
+    in_block += static_cast<std::size_t>(bonds.count - bonds.forward);
+    block_reach = std::max(block_reach, i + 1);
+    if (bonds.count > bonds.forward) block_reach = std::max(block_reach, bonds.neighbor(bonds.count - 1) + 1);
+    if (in_block >= target || i + 1 == n) {
+      s.block_starts.push_back(i + 1);
+      reach.push_back(block_reach);
+      in_block = 0;
+      block_reach = 0;
+    }
+  }
+  // Greedy colouring in block order: a block takes the smallest colour that no earlier block
+  // still reaching into it has.
+  const index_t blocks = static_cast<index_t>(reach.size());
+  std::vector<index_t> colour(blocks, 0), active;
+  index_t colours = 0;
+  for (index_t k = 0; k < blocks; ++k) {
+    const index_t start = s.block_starts[k];
+    std::erase_if(active, [&](index_t l) { return reach[l] <= start; });
+    std::vector<bool> taken(colours + 1, false);
+    for (index_t l : active) taken[colour[l]] = true;
+    while (taken[colour[k]]) ++colour[k];
+    colours = std::max(colours, colour[k] + 1);
+    active.push_back(k);
+  }
+  s.colour_offsets.assign(colours + 1, 0);
+  for (index_t k = 0; k < blocks; ++k) ++s.colour_offsets[colour[k] + 1];
+  for (index_t c = 0; c < colours; ++c) s.colour_offsets[c + 1] += s.colour_offsets[c];
+  s.blocks.resize(blocks);
+  std::vector<index_t> next(s.colour_offsets.begin(), s.colour_offsets.end() - 1);
+  for (index_t k = 0; k < blocks; ++k) s.blocks[next[colour[k]]++] = k;
+}
+
+index_t NodeBonds::find(index_t j) const {
+  const index_t local = j - first_node;
+  const index_t* found = std::lower_bound(neighbors, neighbors + count, local);
+  return found != neighbors + count && *found == local ? static_cast<index_t>(found - neighbors) : count;
 }
 
 index_t Model::fragments(const BondStates& intact, index_t* labels) const {

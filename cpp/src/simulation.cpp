@@ -158,6 +158,98 @@ void Simulation::update_kinematic_nodes() {
   kinematic_stale_ = false;
 }
 
+namespace {
+
+/// Adds V_j J beta r e of node i's forward bonds to i's sum and V_i J beta r e to j's (the sums
+/// of w r e in the dilatation). With CanBreak, a bond past the critical stretch breaks instead:
+/// its bit at i is cleared and (i, j) is appended to `broken`.
+template <bool CanBreak>
+void add_dilatation_terms(index_t i, const NodeBonds& bonds, std::uint8_t* bond_bits, CriticalStretch criterion,
+                          const real* x, const real* volumes, real* sums,
+                          std::vector<std::array<index_t, 2>>& broken) {
+  const real* const xi = x + 3 * std::size_t{i};
+  const real volume_i = volumes[i];
+  real sum = 0;
+  for (index_t b = bonds.forward; b < bonds.count; ++b) {
+    if (!BondStates::intact(bond_bits, b)) continue;
+    const index_t j = bonds.neighbor(b);
+    const real* const xj = x + 3 * std::size_t{j};
+    const real dx = xj[0] - xi[0], dy = xj[1] - xi[1], dz = xj[2] - xi[2];
+    const real r = bonds.length(b);
+    const real e = std::sqrt(dx * dx + dy * dy + dz * dz) - r;
+    if constexpr (CanBreak) {
+      if (criterion.breaks(e / r)) [[unlikely]] {
+        BondStates::clear(bond_bits, b);
+        broken.push_back({i, j});
+        continue;
+      }
+    }
+    const real term = lps::dilatation_term(bonds.influence_weight(b), r, e);
+    sum += volumes[j] * term;
+    sums[j] += volume_i * term;
+  }
+  sums[i] += sum;
+}
+
+/// What the pair-force loop reads and writes, as raw pointers (kept in registers).
+struct PairForceArrays {
+  const real* positions;
+  const real* volumes;
+  const real* pressures;
+  const lps::NodeCoefficients* coefficients;
+  const real* pmb_stiffness;
+  real* forces;
+};
+
+/// Adds the pair forces of node i's forward bonds to both ends: w_ij s y/|y| to i and
+/// -w_ji s y/|y| to j, with s the LPS (Lps) or PMB scalar force state of the bond without its
+/// weight and w_ij = J beta_ij V_j.
+template <bool Lps>
+void add_pair_forces(index_t i, const NodeBonds& bonds, const std::uint8_t* bond_bits, PairForceArrays a) {
+  const real* const x = a.positions;
+  real* const f = a.forces;
+  const real pressure_i = Lps ? a.pressures[i] : 0;
+  const real deviatoric_i = Lps ? a.coefficients[i].deviatoric_stiffness : 0;
+  const real stiffness_i = Lps ? 0 : a.pmb_stiffness[i];
+  const real volume_i = a.volumes[i];
+  const real* const xi = x + 3 * std::size_t{i};
+  real fx = 0, fy = 0, fz = 0;
+  for (index_t b = bonds.forward; b < bonds.count; ++b) {
+    if (!BondStates::intact(bond_bits, b)) continue;
+    const index_t j = bonds.neighbor(b);
+    const real* const xj = x + 3 * std::size_t{j};  // one base register for the three components
+    const real dx = xj[0] - xi[0], dy = xj[1] - xi[1], dz = xj[2] - xi[2];
+    const real length = std::sqrt(dx * dx + dy * dy + dz * dz);
+    if (!(length > 0)) continue;
+    const real r = bonds.length(b);
+    const real omega = bonds.influence_weight(b);
+    const real e = length - r;
+    real scalar;
+    if constexpr (Lps) {
+      scalar = lps::pair_force(omega, r, e, pressure_i, a.pressures[j], deviatoric_i,
+                               a.coefficients[j].deviatoric_stiffness);
+    } else {
+      scalar = pmb::pair_force(stiffness_i + a.pmb_stiffness[j], omega, e / r);
+    }
+    const real over = scalar / length;
+    const real gx = over * dx, gy = over * dy, gz = over * dz;
+    const real volume_j = a.volumes[j];
+    fx += volume_j * gx;
+    fy += volume_j * gy;
+    fz += volume_j * gz;
+    real* const fj = f + 3 * std::size_t{j};
+    fj[0] -= volume_i * gx;
+    fj[1] -= volume_i * gy;
+    fj[2] -= volume_i * gz;
+  }
+  real* const fi = f + 3 * std::size_t{i};
+  fi[0] += fx;
+  fi[1] += fy;
+  fi[2] += fz;
+}
+
+}  // namespace
+
 void Simulation::compute_forces() {
   update_kinematic_nodes();
   const Model& m = *model_;
@@ -172,70 +264,86 @@ void Simulation::compute_forces() {
   const std::int64_t n = m.node_count();
   const auto g = body_acceleration_;
 
-  // Pass 1: stretch, irreversible breaking, dilatation. Each node updates only its own bond
-  // copies; both copies of a bond see bitwise the same stretch, so they break together.
-  std::uint64_t newly_broken = 0;
-#pragma omp parallel for schedule(static) reduction(+ : newly_broken)
-  for (std::int64_t ii = 0; ii < n; ++ii) {
-    const index_t i = static_cast<index_t>(ii);
-    const Material& material = materials[node_material[i]];
-    const CriticalStretch criterion{m.particles()[m.node_particle()[i]].critical_stretch,
-                                    material.params.break_in_compression};
-    const bool can_break = material.params.fracture;
-    const NodeBonds bonds = m.node_bonds(i);
-    std::uint8_t* bond_bits = intact.node(i);
-    real sum = 0;
-    for (index_t b = 0; b < bonds.count; ++b) {
-      if (!BondStates::intact(bond_bits, b)) continue;
-      const real r = bonds.length(b);
-      const real e = bond_extension(i, bonds.neighbor(b), r, x);
-      if (can_break && criterion.breaks(e / r)) {
-        BondStates::clear(bond_bits, b);
-        ++newly_broken;
-        continue;
+  // Each bond is evaluated once, at its lower-numbered end, and its terms are added to both
+  // ends; the bond schedule's colours keep concurrent blocks on disjoint nodes (see
+  // BondSchedule), so there are no atomics and the sums do not depend on the thread count.
+  const BondSchedule& schedule = m.bond_schedule();
+  const auto& volume = m.volumes();
+  auto for_each_node_by_colour = [&schedule](auto&& body) {
+    for (std::size_t c = 0; c + 1 < schedule.colour_offsets.size(); ++c) {
+      const std::int64_t first = schedule.colour_offsets[c], last = schedule.colour_offsets[c + 1];
+#pragma omp for schedule(dynamic, 1)
+      for (std::int64_t k = first; k < last; ++k) {
+        const index_t block = schedule.blocks[k];
+        for (index_t i = schedule.block_starts[block]; i < schedule.block_starts[block + 1]; ++i) body(i);
       }
-      sum += lps::dilatation_term(bonds.weight(b), r, e);
     }
-    if (material.params.model == ForceModel::lps) {
-      theta[i] = lps_coefficients[i].dilatation_scale * sum;
-      pressure_[i] = lps_coefficients[i].dilatation_coupling * theta[i];
+  };
+
+  // Pass 1: stretch, irreversible breaking, sum_j w r e at both ends. A bond breaks at the end
+  // that evaluates it; its other copy is cleared below, before any loop reads it. (Raw pointers:
+  // the compiler keeps them in registers across the stores into other nodes' sums.)
+  const real* const positions = x.data();
+  const real* const volumes = volume.data();
+  real* const dilatation_sums = theta.data();
+  std::vector<std::array<index_t, 2>> broken;  // (evaluating node, neighbour)
+#pragma omp parallel
+  {
+#pragma omp for schedule(static)
+    for (std::int64_t i = 0; i < n; ++i) dilatation_sums[i] = 0;
+    std::vector<std::array<index_t, 2>> broken_here;
+    for_each_node_by_colour([&](index_t i) {
+      const Material& material = materials[node_material[i]];
+      const NodeBonds bonds = m.node_bonds(i);
+      if (material.params.fracture) {
+        const CriticalStretch criterion{m.particles()[m.node_particle()[i]].critical_stretch,
+                                        material.params.break_in_compression};
+        add_dilatation_terms<true>(i, bonds, intact.node(i), criterion, positions, volumes, dilatation_sums,
+                                   broken_here);
+      } else {
+        add_dilatation_terms<false>(i, bonds, intact.node(i), {}, positions, volumes, dilatation_sums,
+                                    broken_here);
+      }
+    });
+    if (!broken_here.empty()) {
+#pragma omp critical(granulate_broken_bonds)
+      broken.insert(broken.end(), broken_here.begin(), broken_here.end());
     }
   }
+  for (const auto& [i, j] : broken) {
+    const NodeBonds bonds = m.node_bonds(j);
+    BondStates::clear(intact.node(j), bonds.find(i));
+  }
+  const std::uint64_t newly_broken = 2 * broken.size();
 
-  // Pass 2: each node gathers its own force density (no scatter, no atomics).
+  // Dilatation and pressure of LPS nodes; body forces and damping start each node's sum.
 #pragma omp parallel for schedule(static)
   for (std::int64_t ii = 0; ii < n; ++ii) {
     const index_t i = static_cast<index_t>(ii);
-    const Material& material = materials[node_material[i]];
-    const bool is_lps = material.params.model == ForceModel::lps;
-    const real stiffness_i = m.pmb_stiffness()[i];
-    const real pressure_i = pressure_[i];
-    const real deviatoric_i = lps_coefficients[i].deviatoric_stiffness;
-    const NodeBonds bonds = m.node_bonds(i);
-    const std::uint8_t* bond_bits = intact.node(i);
-    real fx = 0, fy = 0, fz = 0;
-    for (index_t b = 0; b < bonds.count; ++b) {
-      if (!BondStates::intact(bond_bits, b)) continue;
-      const index_t j = bonds.neighbor(b);
-      const real dx = x[3 * j] - x[3 * i], dy = x[3 * j + 1] - x[3 * i + 1], dz = x[3 * j + 2] - x[3 * i + 2];
-      const real length = std::sqrt(dx * dx + dy * dy + dz * dz);
-      if (!(length > 0)) continue;
-      const real r = bonds.length(b);
-      const real w = bonds.weight(b);
-      const real e = length - r;
-      const real scalar = is_lps ? lps::pair_force(w, r, e, pressure_i, pressure_[j], deviatoric_i,
-                                                   lps_coefficients[j].deviatoric_stiffness)
-                                 : pmb::pair_force(stiffness_i + m.pmb_stiffness()[j], w, e / r);
-      const real over = scalar / length;
-      fx += over * dx;
-      fy += over * dy;
-      fz += over * dz;
+    if (materials[node_material[i]].params.model == ForceModel::lps) {
+      theta[i] *= lps_coefficients[i].dilatation_scale;
+      pressure_[i] = lps_coefficients[i].dilatation_coupling * theta[i];
+    } else {
+      theta[i] = 0;
     }
     const real* vi = &state_.velocities[3 * i];
-    f[3 * i] = fx + density[i] * (g[0] - viscous_damping_ * vi[0]);
-    f[3 * i + 1] = fy + density[i] * (g[1] - viscous_damping_ * vi[1]);
-    f[3 * i + 2] = fz + density[i] * (g[2] - viscous_damping_ * vi[2]);
+    f[3 * i] = density[i] * (g[0] - viscous_damping_ * vi[0]);
+    f[3 * i + 1] = density[i] * (g[1] - viscous_damping_ * vi[1]);
+    f[3 * i + 2] = density[i] * (g[2] - viscous_damping_ * vi[2]);
   }
+
+  // Pass 2: pair forces, w_ij s y/|y| on i and -w_ji s y/|y| on j (w_ij = J beta V_j).
+  const PairForceArrays arrays{x.data(), volume.data(), pressure_.data(), lps_coefficients.data(),
+                               m.pmb_stiffness().data(), f.data()};
+#pragma omp parallel
+  for_each_node_by_colour([&](index_t i) {
+    const NodeBonds bonds = m.node_bonds(i);
+    if (materials[node_material[i]].params.model == ForceModel::lps) {
+      add_pair_forces<true>(i, bonds, intact.node(i), arrays);
+    } else {
+      add_pair_forces<false>(i, bonds, intact.node(i), arrays);
+    }
+  });
 
   broken_bond_copies_ += newly_broken;
 
@@ -308,7 +416,8 @@ std::array<std::size_t, 2> Simulation::memory_bytes() const {
                       bytes(m.node_material()) + bytes(m.node_density()) + bytes(m.bond_offsets()) +
                       bytes(m.weighted_volume()) + bytes(m.lps_coefficients()) + bytes(m.pmb_stiffness()) +
                       contact_.memory_bytes();
-  for (const BondFamilies& f : m.families()) other += bytes(f.offsets);
+  for (const BondFamilies& f : m.families()) other += bytes(f.offsets) + bytes(f.forward);
+  other += m.bond_schedule().memory_bytes();
   for (const Shape& s : m.shapes()) other += bytes(s.positions) + bytes(s.volumes);
   return {bonds, other};
 }
@@ -374,7 +483,7 @@ void Simulation::strain_energy_density(real* out) const {
       if (!state_.bonds.intact(i, b)) continue;
       const index_t j = bonds.neighbor(b);
       const real r = bonds.length(b);
-      const real e = bond_extension(i, j, r, state_.positions);
+      const real e = bond_extension(i, j, r, state_.positions.data());
       sum += is_lps
                  ? lps::deviatoric_energy_term(bonds.weight(b), r, e, theta, inverse_dimension)
                  : pmb::energy_term(m.pmb_stiffness()[i] + m.pmb_stiffness()[j], bonds.weight(b), e / r, r);
@@ -406,7 +515,7 @@ void Simulation::damage(real* phi, real* z) const {
       all += w;
       if (state_.bonds.intact(i, b)) intact += w;
       max_stretch =
-          std::max(max_stretch, std::abs(bond_extension(i, bonds.neighbor(b), r, state_.positions) / r));
+          std::max(max_stretch, std::abs(bond_extension(i, bonds.neighbor(b), r, state_.positions.data()) / r));
     }
     if (phi) phi[i] = all > 0 ? 1.0 - intact / all : 0.0;
     if (z) z[i] = std::isfinite(s0) ? max_stretch / s0 : 0.0;
@@ -419,13 +528,11 @@ void Simulation::break_bonds(const std::vector<std::array<index_t, 2>>& pairs) {
     if (i >= m.node_count() || j >= m.node_count() || m.node_particle()[i] != m.node_particle()[j]) {
       throw InputError("nodes " + std::to_string(i) + " and " + std::to_string(j) + " are not bonded");
     }
-    const NodeBonds bonds = m.node_bonds(i);
-    const index_t local = j - bonds.first_node;
-    const index_t* found = std::lower_bound(bonds.neighbors, bonds.neighbors + bonds.count, local);
-    if (found == bonds.neighbors + bonds.count || *found != local) {
+    const index_t b = m.node_bonds(i).find(j);
+    if (b == m.node_bonds(i).count) {
       throw InputError("nodes " + std::to_string(i) + " and " + std::to_string(j) + " are not bonded");
     }
-    return {i, static_cast<index_t>(found - bonds.neighbors)};
+    return {i, b};
   };
   for (const auto& [i, j] : pairs) {
     const auto forward = copy_of(i, j), backward = copy_of(j, i);

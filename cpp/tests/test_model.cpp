@@ -1,4 +1,5 @@
 // Bond families, forces against -dE/dx by finite differences, Newton's third law, input errors.
+#include <cmath>
 #include <memory>
 #include <random>
 
@@ -11,7 +12,7 @@ namespace {
 
 /// A block of n^d lattice nodes of spacing h with a material of horizon 3h.
 std::shared_ptr<Model> lattice_block(int dimension, int n, ForceModel force_model, InfluenceKind influence,
-                                     bool fracture = false, double offset = 0.0) {
+                                     bool fracture = false, double offset = 0.0, double volume_spread = 0.0) {
   const double h = 1e-3;
   auto model = std::make_shared<Model>(dimension, PlaneMode::strain);
   MaterialParams p;
@@ -31,7 +32,9 @@ std::shared_ptr<Model> lattice_block(int dimension, int n, ForceModel force_mode
       for (int i = 0; i < n; ++i) {
         x.insert(x.end(),
                  {offset + (i + 0.5) * h, offset + (j + 0.5) * h, dimension == 3 ? (k + 0.5) * h : 0.0});
-        v.push_back(dimension == 3 ? h * h * h : h * h);
+        // volume_spread > 0: unequal volumes, a smooth pattern so no volume is near zero
+        const double factor = 1.0 + volume_spread * std::sin(1.7 * i + 2.3 * j + 0.9 * k);
+        v.push_back(factor * (dimension == 3 ? h * h * h : h * h));
       }
   model->add_particle(x, v, material, h);
   return model;
@@ -119,9 +122,11 @@ TEST_CASE("a shape placed many times shares one bond family; lengths and weights
 }
 
 TEST_CASE("forces equal -dE/dx (finite differences), Newton's third law holds") {
+  // Unequal volumes: each bond is evaluated once and gives w_ij = J beta V_j to i and
+  // w_ji = J beta V_i to j, which only -dE/dx with V_i != V_j tells apart.
   for (int d : {2, 3}) {
     for (ForceModel force_model : {ForceModel::lps, ForceModel::pmb}) {
-      auto model = lattice_block(d, d == 2 ? 8 : 5, force_model, InfluenceKind::linear);
+      auto model = lattice_block(d, d == 2 ? 8 : 5, force_model, InfluenceKind::linear, false, 0.0, 0.3);
       Simulation sim(model);
       std::mt19937 rng(42);
       std::uniform_real_distribution<double> jitter(-2e-5, 2e-5);
@@ -175,6 +180,41 @@ TEST_CASE("lps dilatation of an interior node equals the trace of a homogeneous 
   }
 }
 
+TEST_CASE("bond schedule: every node in one block, blocks of a colour touch disjoint nodes") {
+  for (int d : {2, 3}) {
+    auto model = lattice_block(d, d == 2 ? 60 : 16, ForceModel::lps, InfluenceKind::linear);
+    model->finalize();
+    const BondSchedule& s = model->bond_schedule();
+    const index_t n = model->node_count();
+    CHECK(s.block_starts.front() == 0 && s.block_starts.back() == n);
+    CHECK(s.blocks.size() + 1 == s.block_starts.size());
+    CHECK(s.blocks.size() >= 32);  // enough blocks to share between threads
+    CHECK(s.colour_offsets.size() >= 3);
+    std::vector<int> seen(s.blocks.size(), 0);
+    for (std::size_t c = 0; c + 1 < s.colour_offsets.size(); ++c) {
+      std::vector<index_t> owner(n, ~index_t{0});  // the block of this colour touching a node
+      for (index_t k = s.colour_offsets[c]; k < s.colour_offsets[c + 1]; ++k) {
+        const index_t block = s.blocks[k];
+        ++seen[block];
+        for (index_t i = s.block_starts[block]; i < s.block_starts[block + 1]; ++i) {
+          const NodeBonds bonds = model->node_bonds(i);
+          std::vector<index_t> touched{i};
+          for (index_t b = bonds.forward; b < bonds.count; ++b) {
+            CHECK(bonds.neighbor(b) > i);
+            touched.push_back(bonds.neighbor(b));
+          }
+          for (index_t b = 0; b < bonds.forward; ++b) CHECK(bonds.neighbor(b) < i);
+          for (index_t t : touched) {
+            CHECK(owner[t] == ~index_t{0} || owner[t] == block);
+            owner[t] = block;
+          }
+        }
+      }
+    }
+    for (int count : seen) CHECK(count == 1);
+  }
+}
+
 TEST_CASE("bonds break irreversibly at the critical stretch") {
   auto model = lattice_block(2, 8, ForceModel::lps, InfluenceKind::linear, true);
   Simulation sim(model);
@@ -187,6 +227,17 @@ TEST_CASE("bonds break irreversibly at the critical stretch") {
   for (std::size_t k = 0; k < x.size(); k += 3) x[k] /= 1.0 + 1.5 * s0;  // back to the reference
   sim.compute_forces();
   CHECK(sim.broken_bonds() == broken);
+  // A bond breaks at the end that evaluates it; its other copy breaks with it.
+  std::uint64_t broken_copies = 0;
+  for (index_t i = 0; i < model->node_count(); ++i) {
+    const NodeBonds bonds = model->node_bonds(i);
+    for (index_t b = 0; b < bonds.count; ++b) {
+      const index_t j = bonds.neighbor(b);
+      CHECK(sim.state().bonds.intact(i, b) == sim.state().bonds.intact(j, model->node_bonds(j).find(i)));
+      if (!sim.state().bonds.intact(i, b)) ++broken_copies;
+    }
+  }
+  CHECK(broken_copies == 2 * broken);
 }
 
 TEST_CASE("fragments are the connected components of intact bonds") {

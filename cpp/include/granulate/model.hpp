@@ -38,14 +38,18 @@ struct Particle {
 
 /// Bond families of one shape for one horizon (in shape units) and influence function, in CSR
 /// form over the shape's nodes: the bonds of local node a are offsets[a] .. offsets[a+1]-1, each
-/// bond stored once per end, so force loops gather without atomics. Shared by every particle
-/// placed from the shape with the same horizon/scale: lengths scale with the particle, weights
-/// with its scale^d.
+/// bond stored once per end (a node's whole family, for diagnostics, damage and fragments).
+/// The force loops evaluate a bond once, at its lower-numbered end: bonds forward[a] ..
+/// offsets[a+1]-1 of node a join it to higher-numbered nodes (neighbors are sorted). Shared by
+/// every particle placed from the shape with the same horizon/scale: lengths scale with the
+/// particle; the volumes in w_ij = J beta_ij V_j are the particle's own.
 struct BondFamilies {
   std::vector<index_t> offsets;    ///< size shape nodes + 1
+  std::vector<index_t> forward;    ///< size shape nodes: first bond of a with neighbour > a
   std::vector<index_t> neighbors;  ///< local j, sorted ascending within a family
-  /// w_ij = J(r/delta) V_j beta_ij at scale 1 [m^d], in single precision (4 bytes of the 16 a
-  /// bond takes; a relative error of 6e-8 in a bond's force, none at rest since e = 0).
+  /// J(r/delta) beta_ij (influence times partial volume, dimensionless, the same at both ends of
+  /// a bond), in single precision (4 bytes of the 16 a bond takes; a relative error of 6e-8 in
+  /// a bond's force, none at rest since e = 0).
   std::vector<float> weights;
   std::vector<real> lengths;  ///< r = |X_j - X_i| at scale 1 [m]
   index_t shape = 0;
@@ -60,15 +64,35 @@ struct NodeBonds {
   const index_t* neighbors = nullptr;
   const real* lengths = nullptr;
   const float* weights = nullptr;
+  const real* particle_volumes = nullptr;  ///< volumes of the particle's nodes (local index)
   index_t count = 0;
+  index_t forward = 0;  ///< bonds forward .. count-1 join this node to higher-numbered nodes
   index_t first_node = 0;
   real length_scale = 1;
-  real weight_scale = 1;
   std::size_t first = 0;
 
   index_t neighbor(index_t b) const { return first_node + neighbors[b]; }
   real length(index_t b) const { return length_scale * lengths[b]; }
-  real weight(index_t b) const { return weight_scale * static_cast<real>(weights[b]); }
+  /// J(r/delta) beta_ij: the weight without the neighbour's volume (symmetric in i and j).
+  real influence_weight(index_t b) const { return static_cast<real>(weights[b]); }
+  /// w_ij = J(r/delta) beta_ij V_j [m^d].
+  real weight(index_t b) const { return influence_weight(b) * particle_volumes[neighbors[b]]; }
+  /// The bond to node j (global index), or count if there is none.
+  index_t find(index_t j) const;
+};
+
+/// The order of the force loops that evaluate each bond once, at its lower-numbered end, and add
+/// the result to both ends. Nodes are cut into blocks of consecutive nodes; a block touches its
+/// nodes and their forward neighbours, all within [block_starts[k], reach). Blocks whose ranges
+/// overlap get different colours, so the blocks of one colour run in parallel without atomics,
+/// and every node receives its terms in the same order for any number of threads.
+struct BondSchedule {
+  std::vector<index_t> block_starts;    ///< blocks + 1
+  std::vector<index_t> colour_offsets;  ///< colours + 1, into `blocks`
+  std::vector<index_t> blocks;          ///< block numbers grouped by colour, ascending in each
+  std::size_t memory_bytes() const {
+    return (block_starts.capacity() + colour_offsets.capacity() + blocks.capacity()) * sizeof(index_t);
+  }
 };
 
 class Model {
@@ -128,13 +152,15 @@ class Model {
     b.neighbors = f.neighbors.data() + f.offsets[a];
     b.lengths = f.lengths.data() + f.offsets[a];
     b.weights = f.weights.data() + f.offsets[a];
+    b.particle_volumes = volumes_.data() + p.first_node;
     b.count = f.offsets[a + 1] - f.offsets[a];
+    b.forward = f.forward[a] - f.offsets[a];
     b.first_node = p.first_node;
     b.length_scale = p.scale;
-    b.weight_scale = particle_weight_scale_[node_particle_[i]];
     b.first = bond_offsets_[i];
     return b;
   }
+  const BondSchedule& bond_schedule() const { return bond_schedule_; }
   const std::vector<real>& weighted_volume() const { return weighted_volume_; }
   const std::vector<lps::NodeCoefficients>& lps_coefficients() const { return lps_coefficients_; }
   /// k_i = d^2 kappa_d / sum_j w_ij r_ij of PMB nodes (0 for LPS nodes), see pmb.hpp.
@@ -152,6 +178,7 @@ class Model {
  private:
   void require_not_finalized(const char* what) const;
   void build_bonds();
+  void build_bond_schedule();
   BondFamilies build_family(index_t shape, real horizon, InfluenceKind influence) const;
 
   int dimension_;
@@ -161,7 +188,6 @@ class Model {
   std::map<std::pair<ForceModel, InfluenceKind>, FractureCoefficients> fracture_coefficients_;
   std::vector<Shape> shapes_;
   std::vector<Particle> particles_;
-  std::vector<real> particle_weight_scale_;  // scale^d
   std::vector<real> reference_positions_;
   std::vector<real> volumes_;
   std::vector<index_t> node_particle_;
@@ -169,6 +195,7 @@ class Model {
   std::vector<real> node_density_;
   std::vector<BondFamilies> families_;
   std::vector<std::size_t> bond_offsets_;
+  BondSchedule bond_schedule_;
   std::vector<real> weighted_volume_;
   std::vector<lps::NodeCoefficients> lps_coefficients_;
   std::vector<real> pmb_stiffness_;

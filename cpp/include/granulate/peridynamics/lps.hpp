@@ -10,6 +10,8 @@
 //   W_i     = kappa_d theta_i^2 / 2 + (a_d G / (2 m_i)) sum_j w_ij (e - theta_i r / d)^2
 // which equals t_ij = (d kappa_d theta / m) J r + (a_d G / m) J (e - theta r / d) of DESIGN.md.
 // kappa_d and a_d: 3D K and 15; plane strain K + G/3 and 8; plane stress 9KG/(3K+4G) and 8.
+// The force loops pass weight = J beta (symmetric in i and j) and multiply by V_j for node i and
+// by V_i for node j, so one evaluation of a bond serves both ends (Simulation::compute_forces).
 #pragma once
 
 #include "granulate/types.hpp"

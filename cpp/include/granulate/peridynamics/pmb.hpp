@@ -7,7 +7,8 @@
 // k_i = d^2 kappa_d / mu_i with mu_i = sum_j w_ij r_ij (the node's discrete moment), so that a
 // node with a complete family reproduces the classical energy d^2 kappa_d eps^2 / 2 of an
 // isotropic expansion exactly (the continuum c = 2 d^2 kappa_d / int J r dV underestimates the
-// lattice stiffness by 10-13 % at horizon 3h because of the partial volumes).
+// lattice stiffness by 10-13 % at horizon 3h because of the partial volumes). As for LPS, the
+// force loops pass weight = J beta and multiply by the volume of the other end.
 #pragma once
 
 #include "granulate/types.hpp"
