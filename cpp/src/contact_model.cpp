@@ -387,24 +387,47 @@ void ContactModel::finish_lists(const Model& model) {
   const std::vector<real> old_approach = slot_approach_;
   const std::vector<real> old_normal = slot_last_normal_;
   const std::size_t old_particle_slots = particle_slot_count_;
-  slots_.clear();
+  // Bucketed by the first body (a counting sort), so the sorts are per body and small, and an
+  // entry finds its slot among its first body's few slots (fragments make many entries).
+  const index_t bodies = static_cast<index_t>(body_mass_.size());
+  std::vector<index_t> bucket(static_cast<std::size_t>(bodies) + 1, 0);
+  for (index_t i = 0; i < n; ++i) {
+    for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
+      ++bucket[std::min(node_body[i], node_body[pair_partner_[e]]) + 1];
+    }
+  }
+  for (index_t a = 0; a < bodies; ++a) bucket[a + 1] += bucket[a];
+  std::vector<index_t> second(bucket.back()), filled(bucket.begin(), bucket.end() - 1);
   for (index_t i = 0; i < n; ++i) {
     for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
       const index_t p = node_body[i], q = node_body[pair_partner_[e]];
-      slots_.push_back({std::min(p, q), std::max(p, q)});
+      const index_t a = std::min(p, q), b = std::max(p, q);
+      if (filled[a] > bucket[a] && second[filled[a] - 1] == b) continue;  // as the entry before
+      second[filled[a]++] = b;
     }
   }
-  std::sort(slots_.begin(), slots_.end());
-  slots_.erase(std::unique(slots_.begin(), slots_.end()), slots_.end());
+  slots_.clear();
+  std::vector<index_t> body_slots(static_cast<std::size_t>(bodies) + 1, 0);  // slots of first body a
+  for (index_t a = 0; a < bodies; ++a) {
+    const auto begin = second.begin() + bucket[a], end = second.begin() + filled[a];
+    std::sort(begin, end);
+    const auto last = std::unique(begin, end);
+    for (auto it = begin; it != last; ++it) slots_.push_back({a, *it});
+    body_slots[a + 1] = static_cast<index_t>(slots_.size());
+  }
   const std::size_t particle_slots = slots_.size();
   particle_slot_count_ = particle_slots;
   pair_slot_.resize(pair_partner_.size());
-  for (index_t i = 0; i < n; ++i) {
+#pragma omp parallel for schedule(static)
+  for (std::int64_t ii = 0; ii < static_cast<std::int64_t>(n); ++ii) {
+    const index_t i = static_cast<index_t>(ii);
     for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
       const index_t p = node_body[i], q = node_body[pair_partner_[e]];
-      const std::array<index_t, 2> key{std::min(p, q), std::max(p, q)};
-      pair_slot_[e] =
-          static_cast<index_t>(std::lower_bound(slots_.begin(), slots_.end(), key) - slots_.begin());
+      const index_t a = std::min(p, q);
+      const std::array<index_t, 2> key{a, std::max(p, q)};
+      pair_slot_[e] = static_cast<index_t>(
+          std::lower_bound(slots_.begin() + body_slots[a], slots_.begin() + body_slots[a + 1], key) -
+          slots_.begin());
     }
   }
   std::vector<std::array<index_t, 2>> wall_keys;
@@ -447,17 +470,18 @@ void ContactModel::finish_lists(const Model& model) {
   slot_stiffness_.assign(slots_.size(), 0);
   slot_approach_.assign(slots_.size(), 0);
   slot_last_normal_.assign(3 * slots_.size(), 0);
-  for (std::size_t slot = 0; slot < slots_.size(); ++slot) {
-    const bool wall = slot >= particle_slots;
-    const auto begin = old_slots.begin() + (wall ? old_particle_slots : 0);
-    const auto end = wall ? old_slots.end() : old_slots.begin() + old_particle_slots;
-    const auto previous = std::lower_bound(begin, end, slots_[slot]);
-    if (previous != end && *previous == slots_[slot]) {
-      const std::size_t old = previous - old_slots.begin();
-      slot_approach_[slot] = old_approach[old];
-      for (int k = 0; k < 3; ++k) slot_last_normal_[3 * slot + k] = old_normal[3 * old + k];
+  // Old and new slots are sorted within their two parts (particle pairs, walls): merge walks.
+  auto carry_over = [&](std::size_t slot, std::size_t slot_end, std::size_t old, std::size_t old_end) {
+    for (; slot < slot_end && old < old_end; ++slot) {
+      while (old < old_end && old_slots[old] < slots_[slot]) ++old;
+      if (old < old_end && old_slots[old] == slots_[slot]) {
+        slot_approach_[slot] = old_approach[old];
+        for (int k = 0; k < 3; ++k) slot_last_normal_[3 * slot + k] = old_normal[3 * old + k];
+      }
     }
-  }
+  };
+  carry_over(0, particle_slots, 0, old_particle_slots);
+  carry_over(particle_slots, slots_.size(), old_particle_slots, old_slots.size());
   pair_stiffness_.assign(pair_partner_.size(), 0);
   wall_entry_stiffness_.assign(wall_entry_.size(), 0);
   pair_distance_.assign(pair_partner_.size(), 0);
