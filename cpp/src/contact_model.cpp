@@ -285,55 +285,49 @@ void ContactModel::update_after_breaks(const Model& model, const State& state, s
   // Bonds broke, nothing moved far: no grid search. The lists gain every newly unbonded pair
   // that could come within its Rc before the next rebuild: a node moves at most skin/2 from
   // where the lists were built before that, so a pair now at d stays beyond d - skin - 2 w (w:
-  // the largest displacement since the build so far); then the bodies are labelled again.
+  // the largest displacement since the build so far). A pair left out now stays out of reach
+  // until the next rebuild (w only grows), so only the bonds broken since the last update are
+  // candidates. Then the bodies are labelled again.
   label_bodies(model, state, broken_bonds);
   const index_t n = model.node_count();
   const auto& x = state.positions;
   const auto& node_particle = model.node_particle();
   const auto& node_material = model.node_material();
   const real extra = skin_ + 2 * moved;
-  std::vector<std::vector<index_t>> added(n);
-  std::vector<index_t> counts(n, 0);
-#pragma omp parallel for schedule(static)
-  for (std::int64_t ii = 0; ii < static_cast<std::int64_t>(n); ++ii) {
-    const index_t i = static_cast<index_t>(ii);
-    const NodeBonds bonds = model.node_bonds(i);
-    const std::uint8_t* bits = state.bonds.node(i);
-    const index_t m = node_material[i];
+  std::vector<std::array<index_t, 2>> added;  // (node, partner), both ways
+  for (const auto& [i, j] : newly_broken_) {
+    const index_t m = node_material[i];  // a bond joins two nodes of one particle
     if (!law_set_[m * material_count_ + m]) continue;
     const real limit =
         contact::resolve_contact_radius(laws_[m * material_count_ + m], particle_side_[node_particle[i]],
                                         particle_side_[node_particle[i]]) +
         extra;
-    const index_t* listed = pair_partner_.data() + pair_offsets_[i];
-    const index_t listed_count = pair_offsets_[i + 1] - pair_offsets_[i];
-    for (index_t b = 0; b < bonds.count; ++b) {
-      if (bits[b >> 3] == 0xff) {  // eight intact bonds
-        b |= 7;
-        continue;
-      }
-      if (BondStates::intact(bits, b)) continue;
-      const index_t j = bonds.neighbor(b);
-      const real dx = x[3 * j] - x[3 * i], dy = x[3 * j + 1] - x[3 * i + 1], dz = x[3 * j + 2] - x[3 * i + 2];
-      if (dx * dx + dy * dy + dz * dz > limit * limit) continue;
-      if (std::binary_search(listed, listed + listed_count, j)) continue;
-      added[i].push_back(j);
-    }
-    counts[i] = static_cast<index_t>(added[i].size());
+    const real dx = x[3 * j] - x[3 * i], dy = x[3 * j + 1] - x[3 * i + 1], dz = x[3 * j + 2] - x[3 * i + 2];
+    if (dx * dx + dy * dy + dz * dz > limit * limit) continue;
+    const index_t* listed = pair_partner_.data();
+    if (std::binary_search(listed + pair_offsets_[i], listed + pair_offsets_[i + 1], j)) continue;
+    added.push_back({i, j});
+    added.push_back({j, i});
   }
-  std::vector<index_t> offsets(static_cast<std::size_t>(n) + 1, 0);
-  for (index_t i = 0; i < n; ++i)
-    offsets[i + 1] = offsets[i] + (pair_offsets_[i + 1] - pair_offsets_[i]) + counts[i];
-  if (offsets[n] != pair_offsets_[n]) {
+  newly_broken_.clear();
+  if (!added.empty()) {
+    std::sort(added.begin(), added.end());
+    added.erase(std::unique(added.begin(), added.end()), added.end());
+    std::vector<index_t> offsets(static_cast<std::size_t>(n) + 1, 0);
+    for (const auto& [i, j] : added) ++offsets[i + 1];
+    for (index_t i = 0; i < n; ++i) offsets[i + 1] += offsets[i] + (pair_offsets_[i + 1] - pair_offsets_[i]);
     std::vector<index_t> partners(offsets[n]);
-#pragma omp parallel for schedule(static)
-    for (std::int64_t ii = 0; ii < static_cast<std::int64_t>(n); ++ii) {
-      const index_t i = static_cast<index_t>(ii);
-      index_t* out = partners.data() + offsets[i];
+    auto next = added.begin();
+    for (index_t i = 0; i < n; ++i) {
       const index_t* begin = pair_partner_.data() + pair_offsets_[i];
       const index_t* end = pair_partner_.data() + pair_offsets_[i + 1];
-      std::sort(added[i].begin(), added[i].end());
-      std::merge(begin, end, added[i].begin(), added[i].end(), out);
+      index_t* out = partners.data() + offsets[i];
+      while (next != added.end() && (*next)[0] == i) {  // merge the (sorted) new partners in
+        while (begin != end && *begin < (*next)[1]) *out++ = *begin++;
+        *out++ = (*next)[1];
+        ++next;
+      }
+      out = std::copy(begin, end, out);
     }
     pair_offsets_ = std::move(offsets);
     pair_partner_ = std::move(partners);
@@ -345,6 +339,9 @@ void ContactModel::update_after_breaks(const Model& model, const State& state, s
 }
 
 void ContactModel::label_bodies(const Model& model, const State& state, std::uint64_t broken_bonds) {
+  if (bodies_labelled_ && broken_bonds == broken_at_labelling_) return;
+  bodies_labelled_ = true;
+  broken_at_labelling_ = broken_bonds;
   const index_t n = model.node_count();
   node_body_.resize(n);
   if (broken_bonds == 0) {  // every particle is whole: the bodies are the particles
@@ -498,6 +495,7 @@ void ContactModel::rebuild(const Model& model, const State& state, std::uint64_t
   const auto& node_material = model.node_material();
   const std::size_t particle_count = particles.size();
   const real reach = max_contact_radius_ + skin_;
+  newly_broken_.clear();  // the search finds every unbonded pair
   label_bodies(model, state, broken_bonds);
 
   // Broad phase: bounding spheres of particles; a particle takes part when another particle's
@@ -566,26 +564,32 @@ void ContactModel::rebuild(const Model& model, const State& state, std::uint64_t
     if (r2 > limit * limit) return false;
     return node_particle[i] != node_particle[j] || !intact_bond(model, state, i, j);
   };
+  // One search: each thread keeps its nodes' partners, then copies them into place.
   const std::int64_t searched_count = static_cast<std::int64_t>(searched.size());
-#pragma omp parallel for schedule(static)
-  for (std::int64_t a = 0; a < searched_count; ++a) {
-    const index_t i = searched[a];
-    index_t count = 0;
-    grid.for_each_within(x, i, reach, dimension_,
-                         [&](index_t j, real r2) { count += accept(i, j, r2) ? 1 : 0; });
-    pair_offsets_[i + 1] = count;
-  }
-  for (index_t i = 0; i < n; ++i) pair_offsets_[i + 1] += pair_offsets_[i];
-  pair_partner_.resize(pair_offsets_[n]);
-#pragma omp parallel for schedule(static)
-  for (std::int64_t a = 0; a < searched_count; ++a) {
-    const index_t i = searched[a];
-    index_t* out = pair_partner_.data() + pair_offsets_[i];
-    index_t filled = 0;
-    grid.for_each_within(x, i, reach, dimension_, [&](index_t j, real r2) {
-      if (accept(i, j, r2)) out[filled++] = j;
-    });
-    std::sort(out, out + filled);
+#pragma omp parallel
+  {
+    std::vector<index_t> found_partners;
+    std::vector<std::array<index_t, 2>> found_nodes;  // (node, first of its partners)
+#pragma omp for schedule(static)
+    for (std::int64_t a = 0; a < searched_count; ++a) {
+      const index_t i = searched[a];
+      const std::size_t first = found_partners.size();
+      grid.for_each_within(x, i, reach, dimension_, [&](index_t j, real r2) {
+        if (accept(i, j, r2)) found_partners.push_back(j);
+      });
+      std::sort(found_partners.begin() + static_cast<std::ptrdiff_t>(first), found_partners.end());
+      pair_offsets_[i + 1] = static_cast<index_t>(found_partners.size() - first);
+      found_nodes.push_back({i, static_cast<index_t>(first)});
+    }
+#pragma omp single
+    {
+      for (index_t i = 0; i < n; ++i) pair_offsets_[i + 1] += pair_offsets_[i];
+      pair_partner_.resize(pair_offsets_[n]);
+    }
+    for (const auto& [i, first] : found_nodes) {
+      std::copy_n(found_partners.begin() + first, pair_offsets_[i + 1] - pair_offsets_[i],
+                  pair_partner_.begin() + pair_offsets_[i]);
+    }
   }
 
   // Node-wall candidates.
@@ -712,6 +716,8 @@ void ContactModel::restore(const Model& model, const State& state, const Contact
     throw InputError("the checkpoint's contact data do not match this model (nodes or walls differ)");
   }
   skin_ = saved.skin;
+  bodies_labelled_ = false;  // the restored bonds may differ from the current ones
+  newly_broken_.clear();
   slots_ = saved.slots;
   particle_slot_count_ = saved.particle_slot_count;
   slot_approach_ = saved.slot_approach;

@@ -315,6 +315,7 @@ void Simulation::compute_forces() {
     BondStates::clear(intact.node(j), bonds.find(i));
   }
   const std::uint64_t newly_broken = 2 * broken.size();
+  contact_.bonds_broke(broken);
 
   // Dilatation and pressure of LPS nodes; body forces and damping start each node's sum.
 #pragma omp parallel for schedule(static)
@@ -540,6 +541,8 @@ void Simulation::break_bonds(const std::vector<std::array<index_t, 2>>& pairs) {
       BondStates::clear(state_.bonds.node(forward[0]), forward[1]);
       BondStates::clear(state_.bonds.node(backward[0]), backward[1]);
       broken_bond_copies_ += 2;
+      const std::array<index_t, 2> pair{i, j};
+      contact_.bonds_broke({&pair, 1});
     }
   }
   forces_current_ = false;

@@ -1,4 +1,6 @@
 // Contact law sub-models, walls' distance queries, Newton's third law of node contacts.
+#include <algorithm>
+#include <cmath>
 #include <memory>
 #include <random>
 
@@ -200,4 +202,66 @@ TEST_CASE("triangle-mesh wall: signed distance and normal towards the particles"
   Wall degenerate = wall;
   degenerate.surfaces[0].mesh_triangles.push_back({0, 1, 1});
   CHECK_THROWS(degenerate.validate(3), InputError);
+}
+
+TEST_CASE("lists updated after bond breaks hold every unbonded pair within Rc") {
+  // A brittle plate whose halves are driven into each other at 60 m/s: bonds break over many
+  // steps (3,001 here), mostly while nothing has moved half the skin, so the lists are updated
+  // (the newly unbonded pairs inserted: 102 updates, 29 rebuilds). At every step, every pair of
+  // nodes without an intact bond closer than Rc must be listed (86,452 such pairs seen).
+  auto model = std::make_shared<Model>(2, PlaneMode::strain);
+  MaterialParams p;
+  p.density = 1000;
+  p.bulk_modulus = 1e9;
+  p.shear_modulus = 6e8;
+  p.horizon = 3e-3;
+  p.fracture_energy = 0.01;
+  p.fracture = true;
+  model->add_material(p);
+  std::vector<double> x, v;
+  const int n = 16;
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      x.insert(x.end(), {(i + 0.5) * 1e-3, (j + 0.5) * 1e-3, 0.0});
+      v.push_back(1e-6);
+    }
+  model->add_particle(x, v, 0, 1e-3);
+  Simulation sim(model);
+  contact::Law law;
+  law.contact_radius = 0.9e-3;
+  law.normal_stiffness = 1e18;
+  law.damping_ratio = 0.1;
+  sim.contact().set_law(0, 0, law);
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> jitter(-0.5, 0.5);
+  auto& velocity = sim.state().velocities;
+  for (index_t i = 0; i < model->node_count(); ++i) {
+    const double side = model->reference_positions()[3 * i] < n * 0.5e-3 ? -1.0 : 1.0;
+    velocity[3 * i] = -side * 30.0 + jitter(rng);
+    velocity[3 * i + 1] = jitter(rng);
+  }
+  sim.set_time_step(0.5 * sim.stable_time_step());
+  const auto& X = sim.state().positions;
+  std::size_t missing = 0, close_unbonded = 0;
+  for (int step = 0; step < 300; ++step) {
+    sim.run(1);
+    const ContactCheckpoint lists = sim.contact().checkpoint();
+    for (index_t i = 0; i < model->node_count(); ++i) {
+      const NodeBonds bonds = model->node_bonds(i);
+      for (index_t j = 0; j < model->node_count(); ++j) {
+        if (j == i || std::hypot(X[3 * j] - X[3 * i], X[3 * j + 1] - X[3 * i + 1]) >= law.contact_radius)
+          continue;
+        const index_t b = bonds.find(j);
+        if (b != bonds.count && sim.state().bonds.intact(i, b)) continue;
+        ++close_unbonded;
+        const auto begin = lists.pair_partners.begin() + lists.pair_offsets[i];
+        const auto end = lists.pair_partners.begin() + lists.pair_offsets[i + 1];
+        if (!std::binary_search(begin, end, j)) ++missing;
+      }
+    }
+  }
+  CHECK(sim.broken_bonds() > 1000);
+  CHECK(sim.contact().statistics().list_updates > 20);
+  CHECK(close_unbonded > 0);
+  CHECK(missing == 0);
 }

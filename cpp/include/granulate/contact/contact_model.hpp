@@ -5,6 +5,7 @@
 
 #include <array>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "granulate/contact/contact_law.hpp"
@@ -62,6 +63,7 @@ class ContactModel {
   void set_kinematic_nodes(std::vector<std::uint8_t> kinematic) {
     node_kinematic_ = std::move(kinematic);
     built_ = false;
+    bodies_labelled_ = false;
   }
   real skin() const { return skin_; }
 
@@ -76,6 +78,12 @@ class ContactModel {
 
   /// Adds contact force densities to state.forces at time t; updates wall reactions.
   void add_forces(const Model& model, State& state, std::uint64_t broken_bonds);
+  /// Bonds (i, j) that broke since the last evaluation: the candidates the next list update
+  /// inserts (a pair broken earlier and not inserted then cannot reach its Rc before the next
+  /// rebuild; see update_after_breaks).
+  void bonds_broke(std::span<const std::array<index_t, 2>> pairs) {
+    if (active()) newly_broken_.insert(newly_broken_.end(), pairs.begin(), pairs.end());
+  }
 
   /// Per wall: force (x, y, z) and torque about its centre (x, y, z) exerted by the particles
   /// [N, N m; per unit thickness in 2D], from the last evaluation.
@@ -105,12 +113,14 @@ class ContactModel {
   bool needs_rebuild(const Model& model, const State& state, real& moved) const;
   /// A grid search at the current positions; `finish`: then finish_lists.
   void rebuild(const Model& model, const State& state, std::uint64_t broken_bonds, bool finish = true);
-  /// After bonds broke (and nothing moved half the skin): new unbonded pairs into the lists.
+  /// After bonds broke (and nothing moved half the skin): the pairs of newly_broken_ into the
+  /// lists.
   void update_after_breaks(const Model& model, const State& state, std::uint64_t broken_bonds, real moved);
   /// Slots, reduced masses, slot laws and scratch from the lists and the bodies.
   void finish_lists(const Model& model);
   /// Bodies for the dashpots: particles while whole, fragments (connected components of intact
-  /// bonds) once bonds break; labelled at every list build (a break forces a build).
+  /// bonds) once bonds break; labelled again at a list build or update when bonds broke since
+  /// (bonds never heal, so the count tells) or the held nodes changed.
   void label_bodies(const Model& model, const State& state, std::uint64_t broken_bonds);
 
   /// Rc and kn of the pair of particles p, q (resolve() of their materials' law).
@@ -136,6 +146,8 @@ class ContactModel {
   std::vector<index_t> body_material_;
   std::vector<index_t> body_particle_;
   std::vector<index_t> body_node_offsets_, body_nodes_;  // CSR: nodes of each body
+  bool bodies_labelled_ = false;
+  std::uint64_t broken_at_labelling_ = 0;
   int dimension_ = 3;
 
   // Lists (rebuilt): node pairs and node-wall-surface candidates, CSR by node.
@@ -143,6 +155,7 @@ class ContactModel {
   std::vector<real> positions_at_build_;
   real time_at_build_ = 0;
   std::uint64_t broken_at_build_ = 0;
+  std::vector<std::array<index_t, 2>> newly_broken_;  // bonds broken since the last list change
   std::vector<index_t> pair_offsets_, pair_partner_, pair_slot_;
   std::vector<index_t> wall_offsets_;
   std::vector<std::array<index_t, 2>> wall_entry_;  // (wall, surface)
