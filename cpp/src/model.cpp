@@ -296,12 +296,16 @@ void Model::build_bonds() {
 
 void Model::build_bond_schedule() {
   // Blocks of about `target` forward bonds: enough blocks per colour for the threads, few enough
-  // that a block's work dwarfs its scheduling. The cut depends on the model only.
+  // that a block's work dwarfs its scheduling. Particles of up to 4 targets are not cut (their
+  // blocks never overlap, so they need one colour and one barrier per pass). The cut depends on
+  // the model only.
   const index_t n = node_count();
   std::size_t forward_total = 0;
+  std::vector<std::size_t> particle_forward(particles_.size(), 0);
   for (index_t i = 0; i < n; ++i) {
     const NodeBonds bonds = node_bonds(i);
     forward_total += static_cast<std::size_t>(bonds.count - bonds.forward);
+    particle_forward[node_particle_[i]] += static_cast<std::size_t>(bonds.count - bonds.forward);
   }
   const std::size_t target = std::clamp<std::size_t>(forward_total / 64, 1024, 16384);
   BondSchedule& s = bond_schedule_;
@@ -315,7 +319,10 @@ void Model::build_bond_schedule() {
     in_block += static_cast<std::size_t>(bonds.count - bonds.forward);
     block_reach = std::max(block_reach, i + 1);
     if (bonds.count > bonds.forward) block_reach = std::max(block_reach, bonds.neighbor(bonds.count - 1) + 1);
-    if (in_block >= target || i + 1 == n) {
+    const Particle& particle = particles_[node_particle_[i]];
+    const bool may_cut = i + 1 == particle.first_node + particle.node_count ||
+                         particle_forward[node_particle_[i]] > 4 * target;
+    if ((in_block >= target && may_cut) || i + 1 == n) {
       s.block_starts.push_back(i + 1);
       reach.push_back(block_reach);
       in_block = 0;

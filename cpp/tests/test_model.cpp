@@ -1,4 +1,5 @@
 // Bond families, forces against -dE/dx by finite differences, Newton's third law, input errors.
+#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <random>
@@ -212,6 +213,36 @@ TEST_CASE("bond schedule: every node in one block, blocks of a colour touch disj
       }
     }
     for (int count : seen) CHECK(count == 1);
+  }
+}
+
+TEST_CASE("bond schedule: small particles are not cut, so their blocks need one colour") {
+  auto model = std::make_shared<Model>(2, PlaneMode::strain);
+  MaterialParams p;
+  p.density = 1000;
+  p.bulk_modulus = 1e9;
+  p.shear_modulus = 6e8;
+  p.horizon = 3e-3;
+  p.fracture = false;
+  model->add_material(p);
+  std::vector<index_t> particle_starts;
+  for (int body = 0; body < 200; ++body) {
+    std::vector<double> x, v;
+    for (int j = 0; j < 10; ++j)
+      for (int i = 0; i < 10; ++i) {
+        x.insert(x.end(), {(i + 0.5) * 1e-3 + body * 11e-3, (j + 0.5) * 1e-3, 0.0});
+        v.push_back(1e-6);
+      }
+    particle_starts.push_back(model->node_count());
+    model->add_particle(x, v, 0, 1e-3);
+  }
+  model->finalize();
+  const BondSchedule& s = model->bond_schedule();
+  CHECK(s.colour_offsets.size() == 2);
+  CHECK(s.blocks.size() >= 32);
+  for (index_t start : s.block_starts) {
+    CHECK(start == model->node_count() ||
+          std::binary_search(particle_starts.begin(), particle_starts.end(), start));
   }
 }
 
