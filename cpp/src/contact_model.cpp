@@ -12,24 +12,15 @@ namespace {
 
 using vec = std::array<real, 3>;
 
-/// Rigid-body motion of a particle: centre of mass, velocity and angular velocity (least-squares
-/// fit of its node velocities: V = sum m v / M, omega = I^-1 sum m (x - X) x (v - V)).
-struct RigidMotion {
+/// Centre of mass and mean velocity of a body (V = sum m v / M): the body-level dashpot acts on
+/// the bodies' approach speed along the contact normal.
+struct BodyMotion {
   vec centre{0, 0, 0};
   vec velocity{0, 0, 0};
-  vec angular_velocity{0, 0, 0};
-
-  vec velocity_at(const real* x) const {
-    const vec r{x[0] - centre[0], x[1] - centre[1], x[2] - centre[2]};
-    return {velocity[0] + angular_velocity[1] * r[2] - angular_velocity[2] * r[1],
-            velocity[1] + angular_velocity[2] * r[0] - angular_velocity[0] * r[2],
-            velocity[2] + angular_velocity[0] * r[1] - angular_velocity[1] * r[0]};
-  }
 };
 
-RigidMotion rigid_motion(const Model& model, const State& state, const index_t* nodes, index_t count,
-                         int dimension) {
-  RigidMotion motion;
+BodyMotion body_motion(const Model& model, const State& state, const index_t* nodes, index_t count) {
+  BodyMotion motion;
   const auto& x = state.positions;
   const auto& v = state.velocities;
   real mass = 0;
@@ -45,42 +36,6 @@ RigidMotion rigid_motion(const Model& model, const State& state, const index_t* 
   for (int k = 0; k < 3; ++k) {
     motion.centre[k] /= mass;
     motion.velocity[k] /= mass;
-  }
-  vec momentum{0, 0, 0};
-  real I[3][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
-  for (index_t slot = 0; slot < count; ++slot) {
-    const index_t i = nodes[slot];
-    const real m = model.node_density()[i] * model.volumes()[i];
-    const vec r{x[3 * i] - motion.centre[0], x[3 * i + 1] - motion.centre[1],
-                x[3 * i + 2] - motion.centre[2]};
-    const vec u{v[3 * i] - motion.velocity[0], v[3 * i + 1] - motion.velocity[1],
-                v[3 * i + 2] - motion.velocity[2]};
-    momentum[0] += m * (r[1] * u[2] - r[2] * u[1]);
-    momentum[1] += m * (r[2] * u[0] - r[0] * u[2]);
-    momentum[2] += m * (r[0] * u[1] - r[1] * u[0]);
-    const real r2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
-    for (int a = 0; a < 3; ++a) {
-      for (int b = 0; b < 3; ++b) I[a][b] += m * ((a == b ? r2 : 0.0) - r[a] * r[b]);
-    }
-  }
-  if (dimension == 2) {
-    if (I[2][2] > 0) motion.angular_velocity[2] = momentum[2] / I[2][2];
-    return motion;
-  }
-  const real det = I[0][0] * (I[1][1] * I[2][2] - I[1][2] * I[2][1]) -
-                   I[0][1] * (I[1][0] * I[2][2] - I[1][2] * I[2][0]) +
-                   I[0][2] * (I[1][0] * I[2][1] - I[1][1] * I[2][0]);
-  if (!(std::abs(det) > 0)) return motion;
-  const real inverse[3][3] = {
-      {(I[1][1] * I[2][2] - I[1][2] * I[2][1]) / det, (I[0][2] * I[2][1] - I[0][1] * I[2][2]) / det,
-       (I[0][1] * I[1][2] - I[0][2] * I[1][1]) / det},
-      {(I[1][2] * I[2][0] - I[1][0] * I[2][2]) / det, (I[0][0] * I[2][2] - I[0][2] * I[2][0]) / det,
-       (I[0][2] * I[1][0] - I[0][0] * I[1][2]) / det},
-      {(I[1][0] * I[2][1] - I[1][1] * I[2][0]) / det, (I[0][1] * I[2][0] - I[0][0] * I[2][1]) / det,
-       (I[0][0] * I[1][1] - I[0][1] * I[1][0]) / det}};
-  for (int a = 0; a < 3; ++a) {
-    motion.angular_velocity[a] =
-        inverse[a][0] * momentum[0] + inverse[a][1] * momentum[1] + inverse[a][2] * momentum[2];
   }
   return motion;
 }
@@ -101,10 +56,8 @@ void require_valid(const contact::Law& law, const char* what) {
 
 bool intact_bond(const Model& model, const State& state, index_t i, index_t j) {
   const NodeBonds bonds = model.node_bonds(i);
-  const index_t local = j - bonds.first_node;  // j is in i's particle
-  const index_t* found = std::lower_bound(bonds.neighbors, bonds.neighbors + bonds.count, local);
-  if (found == bonds.neighbors + bonds.count || *found != local) return false;
-  return state.bonds.intact(i, static_cast<index_t>(found - bonds.neighbors));
+  const index_t b = bonds.find(j);
+  return b != bonds.count && state.bonds.intact(i, b);
 }
 
 }  // namespace
@@ -828,13 +781,13 @@ void ContactModel::add_forces(const Model& model, State& state, std::uint64_t br
     touching_body[slots_[slot][0]] = 1;
     if (slot < particle_slot_count_) touching_body[slots_[slot][1]] = 1;
   }
-  std::vector<RigidMotion> bodies(body_mass_.size());
+  std::vector<BodyMotion> bodies(body_mass_.size());
   const std::int64_t body_count = static_cast<std::int64_t>(body_mass_.size());
 #pragma omp parallel for schedule(dynamic, 16)
   for (std::int64_t p = 0; p < body_count; ++p) {
     if (touching_body[p]) {
-      bodies[p] = rigid_motion(model, state, body_nodes_.data() + body_node_offsets_[p],
-                               body_node_offsets_[p + 1] - body_node_offsets_[p], dimension_);
+      bodies[p] = body_motion(model, state, body_nodes_.data() + body_node_offsets_[p],
+                              body_node_offsets_[p + 1] - body_node_offsets_[p]);
     }
   }
   // Spring force and stiffness-weighted normal per slot (from the first body to the second, or
@@ -868,7 +821,7 @@ void ContactModel::add_forces(const Model& model, State& state, std::uint64_t br
   const real dt = has_last_time_ ? t - last_time_ : 0.0;
   last_time_ = t;
   has_last_time_ = true;
-  std::vector<real> body_damping(3 * body_mass_.size(), 0.0);
+  std::vector<real> body_damping(3 * body_mass_.size(), 0.0);  // force, then acceleration (pass C)
   std::vector<std::array<real, 6>> wall_damping(walls_.size(), {0, 0, 0, 0, 0, 0});
   for (std::size_t slot = 0; slot < slot_count; ++slot) {
     const bool wall_slot = slot >= particle_slot_count_;
@@ -931,18 +884,26 @@ void ContactModel::add_forces(const Model& model, State& state, std::uint64_t br
     }
   }
 
+  // The dashpot of a body is a uniform acceleration of its nodes.
+  for (std::size_t b = 0; b < body_mass_.size(); ++b) {
+    if (touching_body[b]) {
+      for (int k = 0; k < 3; ++k) body_damping[3 * b + k] /= body_mass_[b];
+    }
+  }
+
   // Pass C: forces; each node gathers its own.
+  const real* const density = model.node_density().data();
 #pragma omp parallel for schedule(static)
   for (std::int64_t ii = 0; ii < n; ++ii) {
     const index_t i = static_cast<index_t>(ii);
+    const index_t body = node_body[i];
+    if (touching_body[body]) {
+      for (int k = 0; k < 3; ++k) f[3 * i + k] += density[i] * body_damping[3 * body + k];
+    }
+    if (pair_offsets_[i] == pair_offsets_[i + 1] && wall_offsets_[i] == wall_offsets_[i + 1]) continue;
     const real* xi = &x[3 * i];
     const real* vi = &v[3 * i];
-    const index_t body = node_body[i];
     vec total{0, 0, 0};
-    if (touching_body[body]) {
-      for (int k = 0; k < 3; ++k)
-        total[k] = body_damping[3 * body + k] * model.node_density()[i] * volume[i] / body_mass_[body];
-    }
     for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
       if (pair_stiffness_[e] == 0) continue;
       const index_t j = pair_partner_[e];

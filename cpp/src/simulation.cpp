@@ -281,8 +281,7 @@ void Simulation::compute_forces() {
   };
 
   // Pass 1: stretch, irreversible breaking, sum_j w r e at both ends. A bond breaks at the end
-  // that evaluates it; its other copy is cleared below, before any loop reads it. (Raw pointers:
-  // the compiler keeps them in registers across the stores into other nodes' sums.)
+  // that evaluates it; its other copy is cleared below, before any loop reads it.
   const real* const positions = x.data();
   const real* const volumes = volume.data();
   real* const dilatation_sums = theta.data();
