@@ -64,7 +64,9 @@ def test_free_body_falls_with_gravity() -> None:
         displacement = np.average(sim.displacements, axis=0, weights=sim.volumes)
         expected = 0.5 * g * sim.time**2
         # Round-off of the internal forces (zero in exact arithmetic) moves x by ~1e-18 m.
-        np.testing.assert_allclose(displacement, expected, rtol=1e-9, atol=1e-9 * np.abs(expected).max())
+        np.testing.assert_allclose(
+            displacement, expected, rtol=1e-9, atol=1e-9 * np.abs(expected).max()
+        )
 
 
 def test_force_density_accelerates_the_body() -> None:

@@ -204,7 +204,8 @@ BondFamilies Model::build_family(index_t shape_index, real horizon, InfluenceKin
     index_t filled = 0;
     grid.for_each_within(x, a, horizon, dimension_, [&](index_t j, real) { out[filled++] = j; });
     std::sort(out, out + filled);
-    family.forward[a] = static_cast<index_t>(std::upper_bound(out, out + filled, a) - family.neighbors.data());
+    family.forward[a] =
+        static_cast<index_t>(std::upper_bound(out, out + filled, a) - family.neighbors.data());
     for (index_t b = family.offsets[a]; b < family.offsets[a + 1]; ++b) {
       const index_t j = family.neighbors[b];
       const real r = std::sqrt((x[3 * j] - x[3 * a]) * (x[3 * j] - x[3 * a]) +

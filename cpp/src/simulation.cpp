@@ -164,8 +164,8 @@ namespace {
 /// of w r e in the dilatation). With CanBreak, a bond past the critical stretch breaks instead:
 /// its bit at i is cleared and (i, j) is appended to `broken`.
 template <bool CanBreak>
-void add_dilatation_terms(index_t i, const NodeBonds& bonds, std::uint8_t* bond_bits, CriticalStretch criterion,
-                          const real* x, const real* volumes, real* sums,
+void add_dilatation_terms(index_t i, const NodeBonds& bonds, std::uint8_t* bond_bits,
+                          CriticalStretch criterion, const real* x, const real* volumes, real* sums,
                           std::vector<std::array<index_t, 2>>& broken) {
   const real* const xi = x + 3 * std::size_t{i};
   const real volume_i = volumes[i];
@@ -333,8 +333,8 @@ void Simulation::compute_forces() {
   }
 
   // Pass 2: pair forces, w_ij s y/|y| on i and -w_ji s y/|y| on j (w_ij = J beta V_j).
-  const PairForceArrays arrays{x.data(), volume.data(), pressure_.data(), lps_coefficients.data(),
-                               m.pmb_stiffness().data(), f.data()};
+  const PairForceArrays arrays{
+      x.data(), volume.data(), pressure_.data(), lps_coefficients.data(), m.pmb_stiffness().data(), f.data()};
 #pragma omp parallel
   for_each_node_by_colour([&](index_t i) {
     const NodeBonds bonds = m.node_bonds(i);
@@ -514,8 +514,8 @@ void Simulation::damage(real* phi, real* z) const {
       const real w = bonds.weight(b), r = bonds.length(b);
       all += w;
       if (state_.bonds.intact(i, b)) intact += w;
-      max_stretch =
-          std::max(max_stretch, std::abs(bond_extension(i, bonds.neighbor(b), r, state_.positions.data()) / r));
+      max_stretch = std::max(max_stretch,
+                             std::abs(bond_extension(i, bonds.neighbor(b), r, state_.positions.data()) / r));
     }
     if (phi) phi[i] = all > 0 ? 1.0 - intact / all : 0.0;
     if (z) z[i] = std::isfinite(s0) ? max_stretch / s0 : 0.0;

@@ -5,6 +5,7 @@
 #include <random>
 
 #include "check.hpp"
+#include "fixtures.hpp"
 #include "granulate/simulation.hpp"
 
 using namespace granulate;
@@ -117,22 +118,8 @@ TEST_CASE("moving walls: reference frame and surface velocity") {
 
 TEST_CASE("node contact forces obey Newton's third law to round-off") {
   auto model = std::make_shared<Model>(2, PlaneMode::strain);
-  MaterialParams p;
-  p.density = 1000;
-  p.bulk_modulus = 1e9;
-  p.shear_modulus = 6e8;
-  p.horizon = 3e-3;
-  p.fracture = false;
-  model->add_material(p);
-  for (int body = 0; body < 2; ++body) {
-    std::vector<double> x, v;
-    for (int j = 0; j < 6; ++j)
-      for (int i = 0; i < 6; ++i) {
-        x.insert(x.end(), {(i + 0.5) * 1e-3 + body * 6.5e-3, (j + 0.5) * 1e-3 + body * 0.3e-3, 0.0});
-        v.push_back(1e-6);
-      }
-    model->add_particle(x, v, 0, 1e-3);
-  }
+  model->add_material(granulate_test::test_material());
+  for (int body = 0; body < 2; ++body) granulate_test::add_square(*model, 0, 6, body * 6.5e-3, body * 0.3e-3);
   Simulation sim(model);
   contact::Law law;
   law.contact_radius = 0.95e-3;
@@ -210,22 +197,9 @@ TEST_CASE("lists updated after bond breaks hold every unbonded pair within Rc") 
   // (the newly unbonded pairs inserted: 102 updates, 29 rebuilds). At every step, every pair of
   // nodes without an intact bond closer than Rc must be listed (86,452 such pairs seen).
   auto model = std::make_shared<Model>(2, PlaneMode::strain);
-  MaterialParams p;
-  p.density = 1000;
-  p.bulk_modulus = 1e9;
-  p.shear_modulus = 6e8;
-  p.horizon = 3e-3;
-  p.fracture_energy = 0.01;
-  p.fracture = true;
-  model->add_material(p);
-  std::vector<double> x, v;
+  model->add_material(granulate_test::test_material(0.01));
   const int n = 16;
-  for (int j = 0; j < n; ++j)
-    for (int i = 0; i < n; ++i) {
-      x.insert(x.end(), {(i + 0.5) * 1e-3, (j + 0.5) * 1e-3, 0.0});
-      v.push_back(1e-6);
-    }
-  model->add_particle(x, v, 0, 1e-3);
+  granulate_test::add_square(*model, 0, n, 0.0, 0.0);
   Simulation sim(model);
   contact::Law law;
   law.contact_radius = 0.9e-3;

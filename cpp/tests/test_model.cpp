@@ -5,6 +5,7 @@
 #include <random>
 
 #include "check.hpp"
+#include "fixtures.hpp"
 #include "granulate/simulation.hpp"
 
 using namespace granulate;
@@ -218,23 +219,11 @@ TEST_CASE("bond schedule: every node in one block, blocks of a colour touch disj
 
 TEST_CASE("bond schedule: small particles are not cut, so their blocks need one colour") {
   auto model = std::make_shared<Model>(2, PlaneMode::strain);
-  MaterialParams p;
-  p.density = 1000;
-  p.bulk_modulus = 1e9;
-  p.shear_modulus = 6e8;
-  p.horizon = 3e-3;
-  p.fracture = false;
-  model->add_material(p);
+  model->add_material(granulate_test::test_material());
   std::vector<index_t> particle_starts;
   for (int body = 0; body < 200; ++body) {
-    std::vector<double> x, v;
-    for (int j = 0; j < 10; ++j)
-      for (int i = 0; i < 10; ++i) {
-        x.insert(x.end(), {(i + 0.5) * 1e-3 + body * 11e-3, (j + 0.5) * 1e-3, 0.0});
-        v.push_back(1e-6);
-      }
     particle_starts.push_back(model->node_count());
-    model->add_particle(x, v, 0, 1e-3);
+    granulate_test::add_square(*model, 0, 10, body * 11e-3, 0.0);
   }
   model->finalize();
   const BondSchedule& s = model->bond_schedule();
