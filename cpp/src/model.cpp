@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -296,10 +297,17 @@ void Model::build_bonds() {
 }
 
 void Model::build_bond_schedule() {
-  // Blocks of about `target` forward bonds: enough blocks per colour for the threads, few enough
-  // that a block's work dwarfs its scheduling. Particles of up to 4 targets are not cut (their
-  // blocks never overlap, so they need one colour and one barrier per pass). The cut depends on
+  // Blocks of consecutive nodes with about `target` bonds to evaluate: enough blocks per colour
+  // for the threads, few enough that a block's work dwarfs its scheduling. The cut depends on
   // the model only.
+  // - Particles of up to 4 targets are not cut: consecutive ones form a block. Their blocks
+  //   never share a node, so many-grain models need one colour.
+  // - Larger particles numbered in bands (every bond joins nodes less than a quarter of the
+  //   particle apart, as on lattices and our meshes) are cut into ranges: a range touches only
+  //   the ranges within a band, so each colour holds at least about four ranges.
+  // - Larger particles numbered otherwise (a mesh file numbered at random, say) would need a
+  //   colour per range: their nodes gather instead (each evaluates all its bonds and writes only
+  //   its own sums), twice the bond evaluations but parallel.
   const index_t n = node_count();
   std::size_t forward_total = 0;
   std::vector<std::size_t> particle_forward(particles_.size(), 0);
@@ -311,38 +319,63 @@ void Model::build_bond_schedule() {
   const std::size_t target = std::clamp<std::size_t>(forward_total / 64, 1024, 16384);
   BondSchedule& s = bond_schedule_;
   s = {};
+  s.particle_gathers.assign(particles_.size(), 0);
   s.block_starts.push_back(0);
-  std::vector<index_t> reach;  // one past the highest node each block touches
-  std::size_t in_block = 0;
-  index_t block_reach = 0;
-  for (index_t i = 0; i < n; ++i) {
-    const NodeBonds bonds = node_bonds(i);
-    in_block += static_cast<std::size_t>(bonds.count - bonds.forward);
-    block_reach = std::max(block_reach, i + 1);
-    if (bonds.count > bonds.forward) block_reach = std::max(block_reach, bonds.neighbor(bonds.count - 1) + 1);
-    const Particle& particle = particles_[node_particle_[i]];
-    const bool may_cut = i + 1 == particle.first_node + particle.node_count ||
-                         particle_forward[node_particle_[i]] > 4 * target;
-    if ((in_block >= target && may_cut) || i + 1 == n) {
-      s.block_starts.push_back(i + 1);
-      reach.push_back(block_reach);
-      in_block = 0;
-      block_reach = 0;
+  std::size_t in_block = 0;  // bonds evaluated by the open block
+  auto close_block = [&](index_t end) {
+    if (s.block_starts.back() != end) s.block_starts.push_back(end);
+    in_block = 0;
+  };
+  for (std::size_t q = 0; q < particles_.size(); ++q) {
+    const Particle& particle = particles_[q];
+    const index_t first = particle.first_node, last = first + particle.node_count;
+    if (particle_forward[q] <= 4 * target) {
+      in_block += particle_forward[q];
+      if (in_block >= target) close_block(last);
+      continue;
     }
+    close_block(first);
+    index_t band = 0;  // the longest bond, in node numbers
+    for (index_t i = first; i < last; ++i) {
+      const NodeBonds bonds = node_bonds(i);
+      if (bonds.count > bonds.forward) band = std::max(band, bonds.neighbor(bonds.count - 1) - i);
+    }
+    const bool gathers = 4 * std::size_t{band} > particle.node_count;
+    s.particle_gathers[q] = gathers ? 1 : 0;
+    for (index_t i = first; i < last; ++i) {
+      const NodeBonds bonds = node_bonds(i);
+      in_block += static_cast<std::size_t>(gathers ? bonds.count : bonds.count - bonds.forward);
+      if (in_block >= target) close_block(i + 1);
+    }
+    close_block(last);
   }
-  // Greedy colouring in block order: a block takes the smallest colour that no earlier block
-  // still reaching into it has.
-  const index_t blocks = static_cast<index_t>(reach.size());
-  std::vector<index_t> colour(blocks, 0), active;
+  close_block(n);
+
+  // Greedy colouring in block order: a block takes the smallest colour that no block touching
+  // one of its nodes (itself or, unless it gathers, a forward neighbour) has yet; colours past
+  // 64 are not shared.
+  const index_t blocks = static_cast<index_t>(s.block_starts.size() - 1);
+  std::vector<std::uint64_t> taken_at(n, 0);  // bit c: a block of colour c touches the node
+  std::vector<index_t> colour(blocks, 0);
   index_t colours = 0;
+  std::vector<index_t> touched;
   for (index_t k = 0; k < blocks; ++k) {
-    const index_t start = s.block_starts[k];
-    std::erase_if(active, [&](index_t l) { return reach[l] <= start; });
-    std::vector<bool> taken(colours + 1, false);
-    for (index_t l : active) taken[colour[l]] = true;
-    while (taken[colour[k]]) ++colour[k];
+    touched.clear();
+    for (index_t i = s.block_starts[k]; i < s.block_starts[k + 1]; ++i) {
+      touched.push_back(i);
+      if (s.particle_gathers[node_particle_[i]]) continue;
+      const NodeBonds bonds = node_bonds(i);
+      for (index_t b = bonds.forward; b < bonds.count; ++b) touched.push_back(bonds.neighbor(b));
+    }
+    std::uint64_t used = 0;
+    for (index_t i : touched) used |= taken_at[i];
+    if (~used == 0) {
+      colour[k] = std::max<index_t>(colours, 64);  // a colour of its own
+    } else {
+      colour[k] = static_cast<index_t>(std::countr_one(used));
+      for (index_t i : touched) taken_at[i] |= std::uint64_t{1} << colour[k];
+    }
     colours = std::max(colours, colour[k] + 1);
-    active.push_back(k);
   }
   s.colour_offsets.assign(colours + 1, 0);
   for (index_t k = 0; k < blocks; ++k) ++s.colour_offsets[colour[k] + 1];

@@ -161,16 +161,17 @@ void Simulation::update_kinematic_nodes() {
 namespace {
 
 /// Adds V_j J beta r e of node i's forward bonds to i's sum and V_i J beta r e to j's (the sums
-/// of w r e in the dilatation). With CanBreak, a bond past the critical stretch breaks instead:
-/// its bit at i is cleared and (i, j) is appended to `broken`.
-template <bool CanBreak>
+/// of w r e in the dilatation); with Gather, of all i's bonds to i's sum only. With CanBreak, a
+/// bond past the critical stretch breaks instead: its bit at i is cleared and (i, j) is
+/// appended to `broken` (by the lower-numbered end only, when both ends evaluate it).
+template <bool CanBreak, bool Gather>
 void add_dilatation_terms(index_t i, const NodeBonds& bonds, std::uint8_t* bond_bits,
                           CriticalStretch criterion, const real* x, const real* volumes, real* sums,
                           std::vector<std::array<index_t, 2>>& broken) {
   const real* const xi = x + 3 * std::size_t{i};
   const real volume_i = volumes[i];
   real sum = 0;
-  for (index_t b = bonds.forward; b < bonds.count; ++b) {
+  for (index_t b = Gather ? 0 : bonds.forward; b < bonds.count; ++b) {
     if (!BondStates::intact(bond_bits, b)) continue;
     const index_t j = bonds.neighbor(b);
     const real* const xj = x + 3 * std::size_t{j};
@@ -180,13 +181,13 @@ void add_dilatation_terms(index_t i, const NodeBonds& bonds, std::uint8_t* bond_
     if constexpr (CanBreak) {
       if (criterion.breaks(e / r)) [[unlikely]] {
         BondStates::clear(bond_bits, b);
-        broken.push_back({i, j});
+        if (!Gather || j > i) broken.push_back({i, j});
         continue;
       }
     }
     const real term = lps::dilatation_term(bonds.influence_weight(b), r, e);
     sum += volumes[j] * term;
-    sums[j] += volume_i * term;
+    if constexpr (!Gather) sums[j] += volume_i * term;
   }
   sums[i] += sum;
 }
@@ -203,8 +204,8 @@ struct PairForceArrays {
 
 /// Adds the pair forces of node i's forward bonds to both ends: w_ij s y/|y| to i and
 /// -w_ji s y/|y| to j, with s the LPS (Lps) or PMB scalar force state of the bond without its
-/// weight and w_ij = J beta_ij V_j.
-template <bool Lps>
+/// weight and w_ij = J beta_ij V_j; with Gather, of all i's bonds to i only.
+template <bool Lps, bool Gather>
 void add_pair_forces(index_t i, const NodeBonds& bonds, const std::uint8_t* bond_bits, PairForceArrays a) {
   const real* const x = a.positions;
   real* const f = a.forces;
@@ -214,7 +215,7 @@ void add_pair_forces(index_t i, const NodeBonds& bonds, const std::uint8_t* bond
   const real volume_i = a.volumes[i];
   const real* const xi = x + 3 * std::size_t{i};
   real fx = 0, fy = 0, fz = 0;
-  for (index_t b = bonds.forward; b < bonds.count; ++b) {
+  for (index_t b = Gather ? 0 : bonds.forward; b < bonds.count; ++b) {
     if (!BondStates::intact(bond_bits, b)) continue;
     const index_t j = bonds.neighbor(b);
     const real* const xj = x + 3 * std::size_t{j};  // one base register for the three components
@@ -237,10 +238,12 @@ void add_pair_forces(index_t i, const NodeBonds& bonds, const std::uint8_t* bond
     fx += volume_j * gx;
     fy += volume_j * gy;
     fz += volume_j * gz;
-    real* const fj = f + 3 * std::size_t{j};
-    fj[0] -= volume_i * gx;
-    fj[1] -= volume_i * gy;
-    fj[2] -= volume_i * gz;
+    if constexpr (!Gather) {
+      real* const fj = f + 3 * std::size_t{j};
+      fj[0] -= volume_i * gx;
+      fj[1] -= volume_i * gy;
+      fj[2] -= volume_i * gz;
+    }
   }
   real* const fi = f + 3 * std::size_t{i};
   fi[0] += fx;
@@ -294,14 +297,22 @@ void Simulation::compute_forces() {
     for_each_node_by_colour([&](index_t i) {
       const Material& material = materials[node_material[i]];
       const NodeBonds bonds = m.node_bonds(i);
-      if (material.params.fracture) {
-        const CriticalStretch criterion{m.particles()[m.node_particle()[i]].critical_stretch,
-                                        material.params.break_in_compression};
-        add_dilatation_terms<true>(i, bonds, intact.node(i), criterion, positions, volumes, dilatation_sums,
-                                   broken_here);
+      const CriticalStretch criterion{m.particles()[m.node_particle()[i]].critical_stretch,
+                                      material.params.break_in_compression};
+      const bool breaks = material.params.fracture, gathers = schedule.particle_gathers[m.node_particle()[i]];
+      std::uint8_t* const bits = intact.node(i);
+      if (breaks && !gathers) {
+        add_dilatation_terms<true, false>(i, bonds, bits, criterion, positions, volumes, dilatation_sums,
+                                          broken_here);
+      } else if (!gathers) {
+        add_dilatation_terms<false, false>(i, bonds, bits, criterion, positions, volumes, dilatation_sums,
+                                           broken_here);
+      } else if (breaks) {
+        add_dilatation_terms<true, true>(i, bonds, bits, criterion, positions, volumes, dilatation_sums,
+                                         broken_here);
       } else {
-        add_dilatation_terms<false>(i, bonds, intact.node(i), {}, positions, volumes, dilatation_sums,
-                                    broken_here);
+        add_dilatation_terms<false, true>(i, bonds, bits, criterion, positions, volumes, dilatation_sums,
+                                          broken_here);
       }
     });
     if (!broken_here.empty()) {
@@ -338,10 +349,16 @@ void Simulation::compute_forces() {
 #pragma omp parallel
   for_each_node_by_colour([&](index_t i) {
     const NodeBonds bonds = m.node_bonds(i);
-    if (materials[node_material[i]].params.model == ForceModel::lps) {
-      add_pair_forces<true>(i, bonds, intact.node(i), arrays);
+    const bool lps = materials[node_material[i]].params.model == ForceModel::lps;
+    const bool gathers = schedule.particle_gathers[m.node_particle()[i]];
+    if (lps && !gathers) {
+      add_pair_forces<true, false>(i, bonds, intact.node(i), arrays);
+    } else if (!gathers) {
+      add_pair_forces<false, false>(i, bonds, intact.node(i), arrays);
+    } else if (lps) {
+      add_pair_forces<true, true>(i, bonds, intact.node(i), arrays);
     } else {
-      add_pair_forces<false>(i, bonds, intact.node(i), arrays);
+      add_pair_forces<false, true>(i, bonds, intact.node(i), arrays);
     }
   });
 

@@ -1,5 +1,6 @@
 // Bond families, forces against -dE/dx by finite differences, Newton's third law, input errors.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <memory>
 #include <random>
@@ -182,38 +183,105 @@ TEST_CASE("lps dilatation of an interior node equals the trace of a homogeneous 
   }
 }
 
+namespace {
+
+/// The schedule's invariants: every node in exactly one block, every block in one colour, the
+/// blocks of a colour touch disjoint nodes (a node and its forward neighbours, all higher).
+void check_schedule(const Model& model) {
+  const BondSchedule& s = model.bond_schedule();
+  const index_t n = model.node_count();
+  CHECK(s.block_starts.front() == 0 && s.block_starts.back() == n);
+  CHECK(s.blocks.size() + 1 == s.block_starts.size());
+  std::vector<int> block_seen(s.blocks.size(), 0), node_seen(n, 0);
+  for (std::size_t c = 0; c + 1 < s.colour_offsets.size(); ++c) {
+    std::vector<index_t> owner(n, ~index_t{0});  // the block of this colour touching a node
+    for (index_t k = s.colour_offsets[c]; k < s.colour_offsets[c + 1]; ++k) {
+      const index_t block = s.blocks[k];
+      ++block_seen[block];
+      for (index_t i = s.block_starts[block]; i < s.block_starts[block + 1]; ++i) {
+        ++node_seen[i];
+        const NodeBonds bonds = model.node_bonds(i);
+        std::vector<index_t> touched{i};
+        for (index_t b = bonds.forward; b < bonds.count; ++b) {
+          CHECK(bonds.neighbor(b) > i);
+          if (!s.particle_gathers[model.node_particle()[i]]) touched.push_back(bonds.neighbor(b));
+        }
+        for (index_t b = 0; b < bonds.forward; ++b) CHECK(bonds.neighbor(b) < i);
+        for (index_t t : touched) {
+          CHECK(owner[t] == ~index_t{0} || owner[t] == block);
+          owner[t] = block;
+        }
+      }
+    }
+  }
+  for (int count : block_seen) CHECK(count == 1);
+  for (int count : node_seen) CHECK(count == 1);
+}
+
+}  // namespace
+
 TEST_CASE("bond schedule: every node in one block, blocks of a colour touch disjoint nodes") {
   for (int d : {2, 3}) {
     auto model = lattice_block(d, d == 2 ? 60 : 16, ForceModel::lps, InfluenceKind::linear);
     model->finalize();
+    check_schedule(*model);
+    // Bands of 3 rows (2D) or 3 planes (3D) cut into ranges: each colour has ranges enough for
+    // two threads.
     const BondSchedule& s = model->bond_schedule();
-    const index_t n = model->node_count();
-    CHECK(s.block_starts.front() == 0 && s.block_starts.back() == n);
-    CHECK(s.blocks.size() + 1 == s.block_starts.size());
-    CHECK(s.blocks.size() >= 32);  // enough blocks to share between threads
-    CHECK(s.colour_offsets.size() >= 3);
-    std::vector<int> seen(s.blocks.size(), 0);
-    for (std::size_t c = 0; c + 1 < s.colour_offsets.size(); ++c) {
-      std::vector<index_t> owner(n, ~index_t{0});  // the block of this colour touching a node
-      for (index_t k = s.colour_offsets[c]; k < s.colour_offsets[c + 1]; ++k) {
-        const index_t block = s.blocks[k];
-        ++seen[block];
-        for (index_t i = s.block_starts[block]; i < s.block_starts[block + 1]; ++i) {
-          const NodeBonds bonds = model->node_bonds(i);
-          std::vector<index_t> touched{i};
-          for (index_t b = bonds.forward; b < bonds.count; ++b) {
-            CHECK(bonds.neighbor(b) > i);
-            touched.push_back(bonds.neighbor(b));
-          }
-          for (index_t b = 0; b < bonds.forward; ++b) CHECK(bonds.neighbor(b) < i);
-          for (index_t t : touched) {
-            CHECK(owner[t] == ~index_t{0} || owner[t] == block);
-            owner[t] = block;
-          }
-        }
+    CHECK(s.particle_gathers[0] == 0);
+    CHECK(s.blocks.size() >= 4 * (s.colour_offsets.size() - 1));
+  }
+}
+
+TEST_CASE("bond schedule: a large particle numbered at random gathers, with the same forces") {
+  // Ranges of a randomly numbered mesh would each reach across the whole body (a colour each):
+  // its nodes gather instead, in parallel blocks of one colour. Forces equal those of the same
+  // lattice numbered in order, for the same displaced positions (to round-off: other sums).
+  for (int d : {2, 3}) {
+    const int side = d == 2 ? 60 : 16;
+    std::vector<std::array<double, 3>> nodes;
+    for (int k = 0; k < (d == 3 ? side : 1); ++k)
+      for (int j = 0; j < side; ++j)
+        for (int i = 0; i < side; ++i)
+          nodes.push_back({(i + 0.5) * 1e-3, (j + 0.5) * 1e-3, d == 3 ? (k + 0.5) * 1e-3 : 0.0});
+    std::vector<std::size_t> shuffled(nodes.size());
+    for (std::size_t a = 0; a < nodes.size(); ++a) shuffled[a] = a;
+    std::shuffle(shuffled.begin(), shuffled.end(), std::mt19937(7));
+    auto build = [&](bool random) {
+      std::vector<double> x, v;
+      for (std::size_t a = 0; a < nodes.size(); ++a) {
+        const auto& p = nodes[random ? shuffled[a] : a];
+        x.insert(x.end(), p.begin(), p.end());
+        v.push_back(d == 3 ? 1e-9 : 1e-6);
       }
-    }
-    for (int count : seen) CHECK(count == 1);
+      auto model = std::make_shared<Model>(d, PlaneMode::strain);
+      model->add_material(granulate_test::test_material());
+      model->add_particle(x, v, 0, 1e-3);
+      return model;
+    };
+    auto ordered = build(false), random = build(true);
+    Simulation a(ordered), b(random);
+    check_schedule(*random);
+    const BondSchedule& s = random->bond_schedule();
+    CHECK(s.particle_gathers[0] == 1 && ordered->bond_schedule().particle_gathers[0] == 0);
+    CHECK(s.colour_offsets.size() == 2 && s.blocks.size() >= 8);
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<double> jitter(-2e-5, 2e-5);
+    for (std::size_t q = 0; q < nodes.size(); ++q)
+      for (int c = 0; c < d; ++c) a.state().positions[3 * q + c] += jitter(rng);
+    for (std::size_t q = 0; q < nodes.size(); ++q)
+      for (int c = 0; c < 3; ++c) b.state().positions[3 * q + c] = a.state().positions[3 * shuffled[q] + c];
+    a.compute_forces();
+    b.compute_forces();
+    double scale = 0, worst = 0;
+    for (std::size_t q = 0; q < nodes.size(); ++q)
+      for (int c = 0; c < 3; ++c) {
+        scale = std::max(scale, std::abs(a.state().forces[3 * shuffled[q] + c]));
+        worst =
+            std::max(worst, std::abs(a.state().forces[3 * shuffled[q] + c] - b.state().forces[3 * q + c]));
+      }
+    CHECK(scale > 0);
+    CHECK(worst < 1e-12 * scale);
   }
 }
 
@@ -226,6 +294,7 @@ TEST_CASE("bond schedule: small particles are not cut, so their blocks need one 
     granulate_test::add_square(*model, 0, 10, body * 11e-3, 0.0);
   }
   model->finalize();
+  check_schedule(*model);
   const BondSchedule& s = model->bond_schedule();
   CHECK(s.colour_offsets.size() == 2);
   CHECK(s.blocks.size() >= 32);

@@ -81,17 +81,21 @@ struct NodeBonds {
   index_t find(index_t j) const;
 };
 
-/// The order of the force loops that evaluate each bond once, at its lower-numbered end, and add
-/// the result to both ends. Nodes are cut into blocks of consecutive nodes; a block touches its
-/// nodes and their forward neighbours, all within [block_starts[k], reach). Blocks whose ranges
-/// overlap get different colours, so the blocks of one colour run in parallel without atomics,
-/// and every node receives its terms in the same order for any number of threads.
+/// The order of the force loops, which evaluate each bond once, at its lower-numbered end, and
+/// add the result to both ends. Nodes are cut into blocks of consecutive nodes (small particles
+/// whole); a block touches its nodes and their forward neighbours. Blocks that touch a common
+/// node get different colours, so the blocks of one colour run in parallel without atomics,
+/// and every node receives its terms in the same order for any number of threads. Nodes of a
+/// large particle whose numbering is not banded gather instead (particle_gathers): each
+/// evaluates all its bonds and writes only its own sums (see Model::build_bond_schedule).
 struct BondSchedule {
-  std::vector<index_t> block_starts;    ///< blocks + 1
-  std::vector<index_t> colour_offsets;  ///< colours + 1, into `blocks`
-  std::vector<index_t> blocks;          ///< block numbers grouped by colour, ascending in each
+  std::vector<index_t> block_starts;           ///< blocks + 1 (node numbers)
+  std::vector<index_t> colour_offsets;         ///< colours + 1, into `blocks`
+  std::vector<index_t> blocks;                 ///< block numbers grouped by colour, ascending in each
+  std::vector<std::uint8_t> particle_gathers;  ///< per particle: 1 if its nodes gather
   std::size_t memory_bytes() const {
-    return (block_starts.capacity() + colour_offsets.capacity() + blocks.capacity()) * sizeof(index_t);
+    return (block_starts.capacity() + colour_offsets.capacity() + blocks.capacity()) * sizeof(index_t) +
+           particle_gathers.capacity();
   }
 };
 
