@@ -270,6 +270,7 @@ void Simulation::compute_forces() {
   // Each bond is evaluated once, at its lower-numbered end, and its terms are added to both
   // ends; the bond schedule's colours keep concurrent blocks on disjoint nodes (see
   // BondSchedule), so there are no atomics and the sums do not depend on the thread count.
+  // Nodes of a particle that gathers evaluate all their bonds and write only their own sums.
   const BondSchedule& schedule = m.bond_schedule();
   const auto& volume = m.volumes();
   auto for_each_node_by_colour = [&schedule](auto&& body) {
@@ -284,7 +285,8 @@ void Simulation::compute_forces() {
   };
 
   // Pass 1: stretch, irreversible breaking, sum_j w r e at both ends. A bond breaks at the end
-  // that evaluates it; its other copy is cleared below, before any loop reads it.
+  // that evaluates it; its other copy is cleared below, before any loop reads it (when both
+  // ends gather, both see bitwise the same stretch and each clears its own).
   const real* const positions = x.data();
   const real* const volumes = volume.data();
   real* const dilatation_sums = theta.data();
