@@ -34,6 +34,7 @@ from __future__ import annotations
 import difflib
 import math
 import os
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -861,18 +862,24 @@ def _translate(path: Path, compat: bool, output: Path | None) -> Translation:
             return []
         return sorted(set(dirs))
 
+    def bc_sets(
+        name: str, block: dict[str, Any], other_keys: set[str]
+    ) -> Iterator[tuple[str, dict[str, Any], dict[str, Any] | None, list[int]]]:
+        """The Set_k blocks of a Displacement_BC or Force_BC block, checked: (where, the
+        block, its nodes, its directions)."""
+        count = block.get("Sets", 0) or 0
+        problems.unknown(
+            name, block, other_keys | {"Sets"} | {f"Set_{s}" for s in range(1, count + 1)}
+        )
+        for s in range(1, count + 1):
+            where = f"{name}.Set_{s}"
+            info = _block(block, f"Set_{s}", name, problems)
+            problems.unknown(where, info, _SET_KEYS)
+            yield where, info, select(info, where), directions(info, where)
+
     moved: dict[str, set[int]] = {}
     displacement = _block(deck, "Displacement_BC", "deck", problems)
-    sets = displacement.get("Sets", 0) if displacement else 0
-    problems.unknown(
-        "Displacement_BC", displacement, {"Sets"} | {f"Set_{s}" for s in range(1, (sets or 0) + 1)}
-    )
-    for s in range(1, (sets or 0) + 1):
-        where = f"Displacement_BC.Set_{s}"
-        info = _block(displacement, f"Set_{s}", "Displacement_BC", problems)
-        problems.unknown(where, info, _SET_KEYS)
-        nodes = select(info, where)
-        dirs = directions(info, where)
+    for where, info, nodes, dirs in bc_sets("Displacement_BC", displacement, set()):
         if nodes is None or not dirs:
             continue
         axes = "".join("xyz"[d - 1] for d in dirs)
@@ -932,22 +939,13 @@ def _translate(path: Path, compat: bool, output: Path | None) -> Translation:
                 )
 
     force_bc = _block(deck, "Force_BC", "deck", problems)
-    fsets = force_bc.get("Sets", 0) if force_bc else 0
-    problems.unknown(
-        "Force_BC", force_bc, {"Gravity", "Sets"} | {f"Set_{s}" for s in range(1, (fsets or 0) + 1)}
-    )
     gravity = None
     if force_bc.get("Gravity") is not None:
         g = _numbers(force_bc["Gravity"], "Force_BC.Gravity", problems)
         gravity = g[:dimension] if len(g) >= dimension else None
         if gravity is None:
             problems.add(f"Force_BC.Gravity: expected {dimension} or 3 components")
-    for s in range(1, (fsets or 0) + 1):
-        where = f"Force_BC.Set_{s}"
-        info = _block(force_bc, f"Set_{s}", "Force_BC", problems)
-        problems.unknown(where, info, _SET_KEYS)
-        nodes = select(info, where)
-        dirs = directions(info, where)
+    for where, info, nodes, dirs in bc_sets("Force_BC", force_bc, {"Gravity"}):
         spatial = _block(info, "Spatial_Function", where, problems).get("Type", "constant")
         if spatial != "constant":
             problems.add(
