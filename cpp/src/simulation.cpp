@@ -160,6 +160,14 @@ void Simulation::update_kinematic_nodes() {
 
 namespace {
 
+/// |x_j - x_i| - length (inline: it is the inner step of the bond loops).
+inline real bond_extension(index_t i, index_t j, real length, const real* x) {
+  const real* const xi = x + 3 * std::size_t{i};
+  const real* const xj = x + 3 * std::size_t{j};
+  const real dx = xj[0] - xi[0], dy = xj[1] - xi[1], dz = xj[2] - xi[2];
+  return std::sqrt(dx * dx + dy * dy + dz * dz) - length;
+}
+
 /// Adds V_j J beta r e of node i's forward bonds to i's sum and V_i J beta r e to j's (the sums
 /// of w r e in the dilatation); with Gather, of all i's bonds to i's sum only. With CanBreak, a
 /// bond past the critical stretch breaks instead: its bit at i is cleared and (i, j) is
@@ -168,16 +176,13 @@ template <bool CanBreak, bool Gather>
 void add_dilatation_terms(index_t i, const NodeBonds& bonds, std::uint8_t* bond_bits,
                           CriticalStretch criterion, const real* x, const real* volumes, real* sums,
                           std::vector<std::array<index_t, 2>>& broken) {
-  const real* const xi = x + 3 * std::size_t{i};
   const real volume_i = volumes[i];
   real sum = 0;
   for (index_t b = Gather ? 0 : bonds.forward; b < bonds.count; ++b) {
     if (!BondStates::intact(bond_bits, b)) continue;
     const index_t j = bonds.neighbor(b);
-    const real* const xj = x + 3 * std::size_t{j};
-    const real dx = xj[0] - xi[0], dy = xj[1] - xi[1], dz = xj[2] - xi[2];
     const real r = bonds.length(b);
-    const real e = std::sqrt(dx * dx + dy * dy + dz * dz) - r;
+    const real e = bond_extension(i, j, r, x);
     if constexpr (CanBreak) {
       if (criterion.breaks(e / r)) [[unlikely]] {
         BondStates::clear(bond_bits, b);
@@ -544,11 +549,10 @@ void Simulation::damage(real* phi, real* z) const {
 void Simulation::break_bonds(const std::vector<std::array<index_t, 2>>& pairs) {
   const Model& m = *model_;
   auto copy_of = [&](index_t i, index_t j) -> std::array<index_t, 2> {  // (node, its bond)
-    if (i >= m.node_count() || j >= m.node_count() || m.node_particle()[i] != m.node_particle()[j]) {
-      throw InputError("nodes " + std::to_string(i) + " and " + std::to_string(j) + " are not bonded");
-    }
-    const index_t b = m.node_bonds(i).find(j);
-    if (b == m.node_bonds(i).count) {
+    const bool same_particle =
+        i < m.node_count() && j < m.node_count() && m.node_particle()[i] == m.node_particle()[j];
+    const index_t b = same_particle ? m.node_bonds(i).find(j) : 0;
+    if (!same_particle || b == m.node_bonds(i).count) {
       throw InputError("nodes " + std::to_string(i) + " and " + std::to_string(j) + " are not bonded");
     }
     return {i, b};

@@ -94,14 +94,6 @@ class Simulation {
  private:
   void apply_prescribed_motion(bool positions_too);
   void check_stability() const;
-  /// |x_j - x_i| - length (inline: it is the inner step of the bond loops).
-  static real bond_extension(index_t i, index_t j, real length, const real* x) {
-    const real* const xi = x + 3 * std::size_t{i};
-    const real* const xj = x + 3 * std::size_t{j};
-    const real dx = xj[0] - xi[0], dy = xj[1] - xi[1], dz = xj[2] - xi[2];
-    return std::sqrt(dx * dx + dy * dy + dz * dz) - length;
-  }
-
   std::shared_ptr<Model> model_;
   State state_;
   real time_step_ = 0;
