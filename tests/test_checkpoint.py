@@ -151,19 +151,26 @@ def test_stop_criteria_end_the_run_at_a_fixed_step(tmp_path: Path) -> None:
     assert settled.step == 100
 
 
-def test_checkpoints_without_the_collision_normal_still_restore() -> None:
-    """Checkpoints written before slots kept their last contact normal restore (no normal)."""
-    sim = gr.Simulation(2)
-    sim.add_body(
-        gr.Rectangle((0, 0), (2e-3, 1e-3)),
-        gr.Material(
-            density=1000, youngs_modulus=1e6, poisson_ratio=0.25, fracture=False, horizon_factor=3
-        ),
-        2.5e-4,
-    )
-    sim.run(5)
+def test_checkpoints_of_the_earlier_contact_model_are_refused(tmp_path: Path) -> None:
+    """Format 1 (before friction springs and per-node contact radii) cannot continue the same
+    trajectory: it is refused with the reason and the fix, and the file is left alone."""
+    import json
+
+    sim = tumbling_drum(tmp_path / "a")
+    sim.run(1000)
+    checkpoint = tmp_path / "a" / "checkpoint.npz"
+    with np.load(checkpoint) as archive:
+        data = {name: archive[name] for name in archive.files}
+    header = json.loads(bytes(data["__header__"]).decode())
+    header["format"] = 1
+    data["__header__"] = np.frombuffer(json.dumps(header).encode(), np.uint8)
+    old = tmp_path / "old.npz"
+    np.savez(old, **data)
+    before = old.read_bytes()
+    with pytest.raises(gr.InputError, match=r"format 1 predates.*run without --resume"):
+        tumbling_drum(tmp_path / "b").load_checkpoint(old)
+    assert old.read_bytes() == before
     state = dict(sim.core.checkpoint())
-    assert "contact_slot_normal" in state
-    del state["contact_slot_normal"]
-    sim.core.restore(state)
-    assert sim.step == 5
+    del state["contact_pair_shear"]
+    with pytest.raises(gr.InputError, match="no 'contact_pair_shear' entry"):
+        sim.core.restore(state)

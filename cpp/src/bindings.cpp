@@ -90,6 +90,8 @@ nb::dict checkpoint_dict(const Simulation& self) {
                                  c.statistics.wall_contacts, c.statistics.list_updates});
   d["contact_pair_offsets"] = copy_out(c.pair_offsets);
   d["contact_pair_partners"] = copy_out(c.pair_partners);
+  d["contact_pair_shear"] = copy_out(c.pair_shear);
+  d["contact_wall_shear"] = copy_out(c.wall_shear);
   std::vector<real> reactions;
   for (const auto& r : c.wall_reactions) reactions.insert(reactions.end(), r.begin(), r.end());
   d["contact_wall_reactions"] = copy_out(reactions);
@@ -118,23 +120,16 @@ void restore_dict(Simulation& self, const nb::dict& d) {
   for (std::size_t k = 0; k < slots.size(); k += 2) c.slots.push_back({slots[k], slots[k + 1]});
   c.particle_slot_count = scalar<std::uint64_t>(d, "contact_particle_slot_count");
   c.slot_approach = entry<real>(d, "contact_slot_approach");
-  // Checkpoints written before the collision normal was kept have no entry: no normal yet.
-  c.slot_normal = d.contains("contact_slot_normal") ? entry<real>(d, "contact_slot_normal")
-                                                    : std::vector<real>(3 * c.slots.size(), 0.0);
+  c.slot_normal = entry<real>(d, "contact_slot_normal");
   c.last_time = scalar<real>(d, "contact_last_time");
   c.has_last_time = scalar<bool>(d, "contact_has_last_time");
   const auto statistics = entry<std::uint64_t>(d, "contact_statistics");
-  if (statistics.size() != 4 && statistics.size() != 5) {
-    throw InputError("the checkpoint's contact statistics are malformed");
-  }
-  c.statistics = {statistics[0], statistics.size() > 4 ? statistics[4] : 0, statistics[1], statistics[2],
-                  statistics[3]};
-  // Checkpoints written before lists were updated after bond breaks have no lists: a search
-  // at the build positions gives them.
-  if (d.contains("contact_pair_offsets")) {
-    c.pair_offsets = entry<index_t>(d, "contact_pair_offsets");
-    c.pair_partners = entry<index_t>(d, "contact_pair_partners");
-  }
+  if (statistics.size() != 5) throw InputError("the checkpoint's contact statistics are malformed");
+  c.statistics = {statistics[0], statistics[4], statistics[1], statistics[2], statistics[3]};
+  c.pair_offsets = entry<index_t>(d, "contact_pair_offsets");
+  c.pair_partners = entry<index_t>(d, "contact_pair_partners");
+  c.pair_shear = entry<real>(d, "contact_pair_shear");
+  c.wall_shear = entry<real>(d, "contact_wall_shear");
   const auto reactions = entry<real>(d, "contact_wall_reactions");
   if (reactions.size() % 6) throw InputError("the checkpoint's wall reactions are malformed");
   for (std::size_t k = 0; k < reactions.size(); k += 6) {
@@ -317,8 +312,9 @@ NB_MODULE(_core, m) {
       .def_rw("stiffness_factor", &contact::Law::stiffness_factor)
       .def_rw("damping_ratio", &contact::Law::damping_ratio)
       .def_rw("friction", &contact::Law::friction)
-      .def_rw("slip_velocity", &contact::Law::slip_velocity)
-      .def_rw("peridem_friction", &contact::Law::peridem_friction);
+      .def_rw("tangential_stiffness_ratio", &contact::Law::tangential_stiffness_ratio)
+      .def_rw("peridem_friction", &contact::Law::peridem_friction)
+      .def_rw("node_pair", &contact::Law::node_pair);
   m.def("damping_ratio_from_restitution", &contact::damping_ratio_from_restitution, "restitution"_a);
 
   nb::enum_<WallSurface::Kind>(m, "WallSurfaceKind")

@@ -12,45 +12,104 @@ namespace {
 
 using vec = std::array<real, 3>;
 
-/// Centre of mass and mean velocity of a body (V = sum m v / M): the body-level dashpot acts on
-/// the bodies' approach speed along the contact normal.
-struct BodyMotion {
-  vec centre{0, 0, 0};
-  vec velocity{0, 0, 0};
-};
+vec cross(const vec& a, const vec& b) {
+  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+}
 
-BodyMotion body_motion(const Model& model, const State& state, const index_t* nodes, index_t count) {
-  BodyMotion motion;
+real dot(const vec& a, const vec& b) {
+  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+/// Symmetric 3x3 matrix (xx, yy, zz, xy, xz, yz) times a vector.
+vec symmetric_times(const std::array<real, 6>& m, const vec& v) {
+  return {m[0] * v[0] + m[3] * v[1] + m[4] * v[2], m[3] * v[0] + m[1] * v[1] + m[5] * v[2],
+          m[4] * v[0] + m[5] * v[1] + m[2] * v[2]};
+}
+
+/// Inverse of an inertia tensor (xx, yy, zz, xy, xz, yz); in 2D only the zz part (a planar body
+/// turns about z). Zero for a body without rotational inertia (one node, or nodes on a line).
+std::array<real, 6> inverse_inertia(const std::array<real, 6>& m, int dimension) {
+  if (dimension == 2) return {0, 0, m[2] > 0 ? 1 / m[2] : 0.0, 0, 0, 0};
+  const real cxx = m[1] * m[2] - m[5] * m[5], cyy = m[0] * m[2] - m[4] * m[4],
+             czz = m[0] * m[1] - m[3] * m[3];
+  const real cxy = m[4] * m[5] - m[3] * m[2], cxz = m[3] * m[5] - m[4] * m[1],
+             cyz = m[3] * m[4] - m[0] * m[5];
+  const real det = m[0] * cxx + m[3] * cxy + m[4] * cxz;
+  const real scale = (m[0] + m[1] + m[2]) / 3;
+  if (!(det > 1e-9 * scale * scale * scale)) return {0, 0, 0, 0, 0, 0};
+  return {cxx / det, cyy / det, czz / det, cxy / det, cxz / det, cyz / det};
+}
+
+/// Rigid-body motion of a body from its nodes (one pass, moments about its first node, so far
+/// from the origin nothing cancels): centre c, velocity V = sum m v / M, inertia
+/// I = sum m (|r|^2 1 - r r^T) and angular momentum L = sum m r x (v - V) about c, omega = I^-1 L.
+BodyMotion measure_body(const Model& model, const State& state, const index_t* nodes, index_t count,
+                        int dimension) {
   const auto& x = state.positions;
   const auto& v = state.velocities;
+  const vec origin{x[3 * nodes[0]], x[3 * nodes[0] + 1], x[3 * nodes[0] + 2]};
   real mass = 0;
+  vec first{0, 0, 0}, momentum{0, 0, 0}, spin{0, 0, 0};
+  std::array<real, 6> second{0, 0, 0, 0, 0, 0};  // sum m r r^T: xx, yy, zz, xy, xz, yz
   for (index_t slot = 0; slot < count; ++slot) {
     const index_t i = nodes[slot];
     const real m = model.node_density()[i] * model.volumes()[i];
+    const vec r{x[3 * i] - origin[0], x[3 * i + 1] - origin[1], x[3 * i + 2] - origin[2]};
+    const vec p{m * v[3 * i], m * v[3 * i + 1], m * v[3 * i + 2]};
     mass += m;
+    const vec rp = cross(r, p);
     for (int k = 0; k < 3; ++k) {
-      motion.centre[k] += m * x[3 * i + k];
-      motion.velocity[k] += m * v[3 * i + k];
+      first[k] += m * r[k];
+      momentum[k] += p[k];
+      spin[k] += rp[k];
     }
+    second[0] += m * r[0] * r[0];
+    second[1] += m * r[1] * r[1];
+    second[2] += m * r[2] * r[2];
+    second[3] += m * r[0] * r[1];
+    second[4] += m * r[0] * r[2];
+    second[5] += m * r[1] * r[2];
   }
+  BodyMotion motion;
+  motion.mass = mass;
+  const vec d{first[0] / mass, first[1] / mass, first[2] / mass};  // centre - origin
   for (int k = 0; k < 3; ++k) {
-    motion.centre[k] /= mass;
-    motion.velocity[k] /= mass;
+    motion.centre[k] = origin[k] + d[k];
+    motion.velocity[k] = momentum[k] / mass;
   }
+  // Second moments about the centre, then the inertia tensor.
+  const std::array<real, 6> s{second[0] - mass * d[0] * d[0], second[1] - mass * d[1] * d[1],
+                              second[2] - mass * d[2] * d[2], second[3] - mass * d[0] * d[1],
+                              second[4] - mass * d[0] * d[2], second[5] - mass * d[1] * d[2]};
+  const std::array<real, 6> inertia{s[1] + s[2], s[0] + s[2], s[0] + s[1], -s[3], -s[4], -s[5]};
+  const vec moment = cross(d, momentum);  // L about c: sum m r x v - M d x V
+  const vec angular_momentum{spin[0] - moment[0], spin[1] - moment[1], spin[2] - moment[2]};
+  motion.inverse_inertia = inverse_inertia(inertia, dimension);
+  motion.angular_velocity = symmetric_times(motion.inverse_inertia, angular_momentum);
   return motion;
+}
+
+/// The contact point with the largest spring of a node-wall entry's points (the friction point).
+std::size_t deepest_point(const WallContact* points, std::size_t count) {
+  std::size_t best = 0;
+  for (std::size_t k = 1; k < count; ++k) {
+    if (points[k].distance < points[best].distance) best = k;
+  }
+  return best;
 }
 
 void require_valid(const contact::Law& law, const char* what) {
   const bool radius = law.contact_radius > 0 || (law.contact_radius == 0 && law.contact_radius_factor > 0);
   const bool stiffness = law.normal_stiffness > 0 || (law.normal_stiffness == 0 && law.stiffness_factor > 0);
   if (!radius || !stiffness || !(law.damping_ratio >= 0) || !(law.damping_ratio < 1) ||
-      !(law.friction >= 0) || !(law.slip_velocity > 0) ||
+      !(law.friction >= 0) || !(law.tangential_stiffness_ratio > 0) ||
+      !(law.tangential_stiffness_ratio <= 1) ||
       !std::isfinite(law.contact_radius + law.contact_radius_factor) ||
       !std::isfinite(law.normal_stiffness + law.stiffness_factor)) {
     throw InputError(
         std::string(what) +
-        " needs a positive contact radius (or factor), stiffness (or factor) and slip velocity, a "
-        "damping ratio in [0, 1) and a non-negative friction coefficient");
+        " needs a positive contact radius (or factor) and stiffness (or factor), a damping ratio in "
+        "[0, 1), a non-negative friction coefficient and a tangential stiffness ratio in (0, 1]");
   }
 }
 
@@ -84,8 +143,8 @@ contact::PairLaw ContactModel::pair_law(index_t p, index_t q) const {
 }
 
 contact::PairLaw ContactModel::wall_law(index_t wall, index_t p) const {
-  return contact::resolve(wall_laws_[wall * material_count_ + particle_material_[p]], particle_side_[p],
-                          particle_side_[p], dimension_);
+  return contact::resolve_wall(wall_laws_[wall * material_count_ + particle_material_[p]], particle_side_[p],
+                               dimension_);
 }
 
 void ContactModel::set_law(index_t a, index_t b, const contact::Law& law) {
@@ -95,11 +154,11 @@ void ContactModel::set_law(index_t a, index_t b, const contact::Law& law) {
   laws_[b * material_count_ + a] = law;
   law_set_[a * material_count_ + b] = law_set_[b * material_count_ + a] = 1;
   any_law_ = true;
+  const real coarsest_a = material_max_mesh_size_[a], coarsest_b = material_max_mesh_size_[b];
   max_contact_radius_ = std::max(
-      max_contact_radius_,
-      law.contact_radius > 0
-          ? law.contact_radius
-          : law.contact_radius_factor * std::min(material_max_mesh_size_[a], material_max_mesh_size_[b]));
+      max_contact_radius_, law.contact_radius > 0 ? law.contact_radius
+                           : law.node_pair ? law.contact_radius_factor * std::min(coarsest_a, coarsest_b)
+                                           : 0.5 * law.contact_radius_factor * (coarsest_a + coarsest_b));
   built_ = false;
 }
 
@@ -119,10 +178,11 @@ void ContactModel::set_wall_law(index_t wall, index_t material, const contact::L
   require_valid(law, "wall contact law");
   wall_laws_[wall * material_count_ + material] = law;
   wall_law_set_[wall * material_count_ + material] = 1;
+  const real coarsest = material_max_mesh_size_[material];
   max_contact_radius_ =
-      std::max(max_contact_radius_, law.contact_radius > 0
-                                        ? law.contact_radius
-                                        : law.contact_radius_factor * material_max_mesh_size_[material]);
+      std::max(max_contact_radius_, law.contact_radius > 0 ? law.contact_radius
+                                    : law.node_pair        ? law.contact_radius_factor * coarsest
+                                                           : 0.5 * law.contact_radius_factor * coarsest);
   built_ = false;
 }
 
@@ -141,9 +201,9 @@ real ContactModel::stable_time_step(const Model& model) const {
     const index_t p = model.node_particle()[i];
     largest_volume[p] = std::max(largest_volume[p], model.volumes()[i]);
   }
-  // max over partners q of kn(p, q) V_max(q). kn depends on q only through the finer particle's
-  // horizon, so sort each material's particles by mesh size: partners finer than p give
-  // kn(q) V(q) (a prefix maximum), coarser ones kn(p) V(q) (a suffix maximum of V).
+  // max over partners q of kn(p, q) V_max(q) (an upper bound of kn min(V_p, V_q) too). kn depends on q only
+  // through the finer particle's horizon, so sort each material's particles by mesh size: partners finer than
+  // p give kn(q) V(q) (a prefix maximum), coarser ones kn(p) V(q) (a suffix maximum of V).
   std::vector<real> stiffness(count, 0);
   std::vector<std::vector<index_t>> by_material(material_count_);
   for (std::size_t p = 0; p < count; ++p)
@@ -183,8 +243,12 @@ real ContactModel::stable_time_step(const Model& model) const {
                              [&](index_t q, real value) { return particle_side_[q].mesh_size < value; });
         const std::size_t e = static_cast<std::size_t>(first_equal - partners_b.begin());
         const real finer = k > 0 ? prefix[k - 1] : 0.0;
-        const real coarser =
-            e < partners_b.size() ? pair_law(p, partners_b[e]).normal_stiffness * suffix[e] : 0.0;
+        // kn V_j (node-pair law), or kn min(V_i, V_j) (a coarse node meets many finer nodes, each
+        // with the finer volume squared: their sum per unit volume of i stays below kn V_j).
+        const real coarser = e < partners_b.size()
+                                 ? pair_law(p, partners_b[e]).normal_stiffness *
+                                       (law.node_pair ? suffix[e] : std::min(largest_volume[p], suffix[e]))
+                                 : 0.0;
         stiffness[p] = std::max({stiffness[p], finer, coarser});
       }
     }
@@ -242,6 +306,7 @@ void ContactModel::update_after_breaks(const Model& model, const State& state, s
   // until the next rebuild (w only grows), so only the bonds broken since the last update are
   // candidates. Then the bodies are labelled again.
   label_bodies(model, state, broken_bonds);
+  keep_history();
   const index_t n = model.node_count();
   const auto& x = state.positions;
   const auto& node_particle = model.node_particle();
@@ -325,6 +390,78 @@ void ContactModel::label_bodies(const Model& model, const State& state, std::uin
   body_nodes_.resize(n);
   std::vector<index_t> fill(body_node_offsets_.begin(), body_node_offsets_.end() - 1);
   for (index_t i = 0; i < n; ++i) body_nodes_[fill[node_body_[i]]++] = i;
+}
+
+void ContactModel::keep_history() {
+  // Copies of the lists (a list update edits them in place), the springs themselves.
+  if (history_kept_) return;  // lists changed twice before finish_lists: the first kept lists stay
+  history_kept_ = true;
+  kept_pair_offsets_ = pair_offsets_;
+  kept_pair_partner_ = pair_partner_;
+  kept_pair_shear_ = std::move(pair_shear_);
+  kept_wall_offsets_ = wall_offsets_;
+  kept_wall_entry_ = wall_entry_;
+  kept_wall_shear_ = std::move(wall_shear_);
+}
+
+void ContactModel::carry_over_friction(index_t n) {
+  // The friction springs of entries in both the kept and the new lists carry over (a merge walk
+  // per node: both lists are sorted by partner, wall entries by (wall, surface)); new entries
+  // start unstretched.
+  pair_shear_.assign(3 * pair_partner_.size(), 0.0);
+  wall_shear_.assign(3 * wall_entry_.size(), 0.0);
+  if (!history_kept_) return;
+  history_kept_ = false;
+  auto walk = [](const auto& old_offsets, const auto& old_keys, const std::vector<real>& old_shear,
+                 const auto& offsets, const auto& keys, std::vector<real>& shear, index_t node) {
+    if (old_offsets.size() <= node + 1 || old_shear.size() != 3 * old_keys.size()) return;
+    index_t old = old_offsets[node];
+    for (index_t e = offsets[node]; e < offsets[node + 1]; ++e) {
+      while (old < old_offsets[node + 1] && old_keys[old] < keys[e]) ++old;
+      if (old < old_offsets[node + 1] && old_keys[old] == keys[e]) {
+        for (int k = 0; k < 3; ++k) shear[3 * e + k] = old_shear[3 * old + k];
+      }
+    }
+  };
+#pragma omp parallel for schedule(static)
+  for (std::int64_t ii = 0; ii < static_cast<std::int64_t>(n); ++ii) {
+    const index_t i = static_cast<index_t>(ii);
+    walk(kept_pair_offsets_, kept_pair_partner_, kept_pair_shear_, pair_offsets_, pair_partner_, pair_shear_,
+         i);
+    walk(kept_wall_offsets_, kept_wall_entry_, kept_wall_shear_, wall_offsets_, wall_entry_, wall_shear_, i);
+  }
+  kept_pair_offsets_ = {};
+  kept_pair_partner_ = {};
+  kept_pair_shear_ = {};
+  kept_wall_offsets_ = {};
+  kept_wall_entry_ = {};
+  kept_wall_shear_ = {};
+}
+
+void ContactModel::group_contact_nodes(const Model& model) {
+  const index_t n = model.node_count();
+  const index_t bodies = static_cast<index_t>(body_mass_.size());
+  body_contact_offsets_.assign(static_cast<std::size_t>(bodies) + 1, 0);
+  auto has_entries = [&](index_t i) {
+    return pair_offsets_[i] != pair_offsets_[i + 1] || wall_offsets_[i] != wall_offsets_[i + 1];
+  };
+  for (index_t i = 0; i < n; ++i) {
+    if (has_entries(i)) ++body_contact_offsets_[node_body_[i] + 1];
+  }
+  for (index_t b = 0; b < bodies; ++b) body_contact_offsets_[b + 1] += body_contact_offsets_[b];
+  contact_nodes_.resize(body_contact_offsets_[bodies]);
+  std::vector<index_t> fill(body_contact_offsets_.begin(), body_contact_offsets_.end() - 1);
+  for (index_t i = 0; i < n; ++i) {
+    if (has_entries(i)) contact_nodes_[fill[node_body_[i]]++] = i;
+  }
+  node_couple_.assign(contact_nodes_.size(), vec3{0, 0, 0});
+  touching_body_.assign(bodies, 0);
+  body_motion_.assign(bodies, BodyMotion{});
+  body_load_.assign(bodies, {0, 0, 0, 0, 0, 0});
+  slot_force_.assign(slots_.size(), 0);
+  slot_normal_.assign(slots_.size(), vec3{0, 0, 0});
+  slot_point_.assign(slots_.size(), vec3{0, 0, 0});
+  wall_damping_.assign(walls_.size(), {0, 0, 0, 0, 0, 0});
 }
 
 void ContactModel::finish_lists(const Model& model) {
@@ -432,6 +569,8 @@ void ContactModel::finish_lists(const Model& model) {
   };
   carry_over(0, particle_slots, 0, old_particle_slots);
   carry_over(particle_slots, slots_.size(), old_particle_slots, old_slots.size());
+  carry_over_friction(n);
+  group_contact_nodes(model);
   pair_stiffness_.assign(pair_partner_.size(), 0);
   wall_entry_stiffness_.assign(wall_entry_.size(), 0);
   pair_distance_.assign(pair_partner_.size(), 0);
@@ -441,6 +580,7 @@ void ContactModel::finish_lists(const Model& model) {
 
 void ContactModel::rebuild(const Model& model, const State& state, std::uint64_t broken_bonds, bool finish) {
   if (skin_ < 0) skin_ = 0.5 * max_contact_radius_;
+  keep_history();
   const auto& x = state.positions;
   const index_t n = model.node_count();
   const auto& particles = model.particles();
@@ -638,7 +778,9 @@ std::size_t ContactModel::memory_bytes() const {
          bytes(wall_slot_) + bytes(slots_) + bytes(slot_reduced_mass_) + bytes(slot_law_) +
          bytes(slot_stiffness_) + bytes(slot_approach_) + bytes(slot_last_normal_) + bytes(pair_stiffness_) +
          bytes(pair_distance_) + bytes(wall_points_) + bytes(wall_entry_stiffness_) +
-         bytes(wall_entry_reaction_);
+         bytes(wall_entry_reaction_) + bytes(pair_shear_) + bytes(wall_shear_) + bytes(contact_nodes_) +
+         bytes(body_contact_offsets_) + bytes(node_couple_) + bytes(touching_body_) + bytes(body_motion_) +
+         bytes(body_load_) + bytes(slot_force_) + bytes(slot_normal_) + bytes(slot_point_);
 }
 
 ContactCheckpoint ContactModel::checkpoint() const {
@@ -654,6 +796,8 @@ ContactCheckpoint ContactModel::checkpoint() const {
   c.slot_normal = slot_last_normal_;
   c.pair_offsets = pair_offsets_;
   c.pair_partners = pair_partner_;
+  c.pair_shear = pair_shear_;
+  c.wall_shear = wall_shear_;
   c.last_time = last_time_;
   c.has_last_time = has_last_time_;
   c.statistics = statistics_;
@@ -669,6 +813,7 @@ void ContactModel::restore(const Model& model, const State& state, const Contact
     throw InputError("the checkpoint's contact data do not match this model (nodes or walls differ)");
   }
   skin_ = saved.skin;
+  history_kept_ = false;
   bodies_labelled_ = false;  // the restored bonds may differ from the current ones
   newly_broken_.clear();
   slots_ = saved.slots;
@@ -691,8 +836,14 @@ void ContactModel::restore(const Model& model, const State& state, const Contact
       pair_offsets_ = saved.pair_offsets;
       pair_partner_ = saved.pair_partners;
       statistics_.list_entries = pair_partner_.size();
+      history_kept_ = false;  // the saved springs below, not those of the lists before
       finish_lists(model);
     }
+    if (saved.pair_shear.size() != pair_shear_.size() || saved.wall_shear.size() != wall_shear_.size()) {
+      throw InputError("the checkpoint's friction springs do not match its contact lists");
+    }
+    pair_shear_ = saved.pair_shear;
+    wall_shear_ = saved.wall_shear;
   }
   last_time_ = saved.last_time;
   has_last_time_ = saved.has_last_time;
@@ -710,17 +861,32 @@ void ContactModel::add_forces(const Model& model, State& state, std::uint64_t br
     update_after_breaks(model, state, broken_bonds, moved);
   }
   search_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - search_start).count();
+  const real dt = has_last_time_ ? state.time - last_time_ : 0.0;
+  last_time_ = state.time;
+  has_last_time_ = true;
+  measure_contacts(model, state);  // A: distances, springs, wall contact points
+  sum_slot_stiffness();            // B: K per pair of bodies; the touching bodies
+  measure_bodies(model, state);    //    rigid-body motion of the touching bodies
+  sum_slot_springs(model, state);  //    spring force, normal and contact point per slot
+  slot_dashpots(state, dt);        //    the body dashpots, as loads on the bodies
+  node_forces(model, state, dt);   // C: springs, friction, fragment dashpots, per node
+  body_loads(model, state);        // E: dashpots and friction couples as rigid-body loads
+  sum_wall_reactions();            // D: wall reactions
+}
+
+real ContactModel::node_radius(const contact::Law& law, const Model& model, index_t i, index_t j,
+                               real contact_radius) const {
+  const auto& owner = model.node_particle();
+  return contact::node_share(law, particle_side_[owner[i]], particle_side_[owner[j]], contact_radius);
+}
+
+void ContactModel::measure_contacts(const Model& model, const State& state) {
+  // The only geometry pass: distance and spring stiffness of every pair entry in contact, and the
+  // contact points (normals in the world frame) of every wall entry. The later passes read these.
   const auto& x = state.positions;
-  const auto& v = state.velocities;
-  auto& f = state.forces;
   const auto& volume = model.volumes();
-  const auto& node_material = model.node_material();
   const std::int64_t n = model.node_count();
   const real t = state.time;
-
-  // Pass A, the only geometry pass: distance and spring stiffness k = kn V_i V_j of every pair
-  // entry in contact, and the contact points (normals in the world frame) of every wall entry.
-  // The later passes read these back.
 #pragma omp parallel
   {
     std::vector<WallContact> found;  // scratch of this thread
@@ -735,7 +901,7 @@ void ContactModel::add_forces(const Model& model, State& state, std::uint64_t br
         const real distance = std::sqrt(dx * dx + dy * dy + dz * dz);
         pair_distance_[e] = distance;
         pair_stiffness_[e] = distance < law.contact_radius && distance > 0
-                                 ? law.normal_stiffness * volume[i] * volume[j]
+                                 ? contact::pair_stiffness(law, volume[i], volume[j])
                                  : 0.0;
       }
       for (index_t e = wall_offsets_[i]; e < wall_offsets_[i + 1]; ++e) {
@@ -754,7 +920,10 @@ void ContactModel::add_forces(const Model& model, State& state, std::uint64_t br
       }
     }
   }
-  // Pass B: K per pair of bodies, summed in node order (each node pair is listed twice).
+}
+
+void ContactModel::sum_slot_stiffness() {
+  // K per pair of bodies, summed in entry order (each node pair is listed twice).
   std::fill(slot_stiffness_.begin(), slot_stiffness_.end(), 0.0);
   std::uint64_t touching = 0, wall_touching = 0;
   for (std::size_t e = 0; e < pair_stiffness_.size(); ++e) {
@@ -767,99 +936,133 @@ void ContactModel::add_forces(const Model& model, State& state, std::uint64_t br
   }
   statistics_.node_contacts = touching / 2;
   statistics_.wall_contacts = wall_touching;
-
-  // Damping between bodies (see contact_law.hpp): per pair of touching bodies, a dashpot
-  // 2 zeta sqrt(M K_s) along the mean contact normal on the bodies' approach speed, applied to
-  // each body as a uniform acceleration. K_s = F / x is the secant stiffness of the collision
-  // (contact force over the approach since the bodies touched); the sum of the contact springs
-  // K overestimates it when the bodies deform, and the dashpot would then overdamp.
-  const auto& node_body = node_body_;
-  const std::size_t slot_count = slots_.size();
-  std::vector<std::uint8_t> touching_body(body_mass_.size(), 0);
-  for (std::size_t slot = 0; slot < slot_count; ++slot) {
-    if (slot_stiffness_[slot] == 0) continue;
-    touching_body[slots_[slot][0]] = 1;
-    if (slot < particle_slot_count_) touching_body[slots_[slot][1]] = 1;
+  std::fill(touching_body_.begin(), touching_body_.end(), 0);
+  for (std::size_t slot = 0; slot < slots_.size(); ++slot) {
+    if (slot_stiffness_[slot] == 0 && !(slot_approach_[slot] > 0)) continue;
+    touching_body_[slots_[slot][0]] = 1;
+    if (slot < particle_slot_count_) touching_body_[slots_[slot][1]] = 1;
   }
-  std::vector<BodyMotion> bodies(body_mass_.size());
+}
+
+void ContactModel::measure_bodies(const Model& model, const State& state) {
   const std::int64_t body_count = static_cast<std::int64_t>(body_mass_.size());
 #pragma omp parallel for schedule(dynamic, 16)
-  for (std::int64_t p = 0; p < body_count; ++p) {
-    if (touching_body[p]) {
-      bodies[p] = body_motion(model, state, body_nodes_.data() + body_node_offsets_[p],
-                              body_node_offsets_[p + 1] - body_node_offsets_[p]);
+  for (std::int64_t b = 0; b < body_count; ++b) {
+    body_load_[b] = {0, 0, 0, 0, 0, 0};
+    if (touching_body_[b]) {
+      body_motion_[b] = measure_body(model, state, body_nodes_.data() + body_node_offsets_[b],
+                                     body_node_offsets_[b + 1] - body_node_offsets_[b], dimension_);
     }
   }
-  // Spring force and stiffness-weighted normal per slot (from the first body to the second, or
-  // from the wall to the particle), summed in node order.
-  std::vector<vec> slot_normal(slot_count, vec{0, 0, 0});
-  std::vector<real> slot_force(slot_count, 0);
-  for (index_t i = 0; i < static_cast<index_t>(n); ++i) {
+}
+
+void ContactModel::sum_slot_springs(const Model& model, const State& state) {
+  // Spring force, spring-weighted normal (from the first body to the second, or from the wall to
+  // the particle) and spring-weighted contact point per slot, summed in node order.
+  const auto& x = state.positions;
+  const auto& volume = model.volumes();
+  const auto& node_material = model.node_material();
+  std::fill(slot_force_.begin(), slot_force_.end(), 0.0);
+  std::fill(slot_normal_.begin(), slot_normal_.end(), vec3{0, 0, 0});
+  std::fill(slot_point_.begin(), slot_point_.end(), vec3{0, 0, 0});
+  for (const index_t i : contact_nodes_) {
     for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
       const index_t j = pair_partner_[e];
       const std::size_t slot = pair_slot_[e];
-      if (pair_stiffness_[e] == 0 || node_body[i] == node_body[j] || node_body[i] != slots_[slot][0])
+      if (pair_stiffness_[e] == 0 || node_body_[i] == node_body_[j] || node_body_[i] != slots_[slot][0])
         continue;
-      const contact::PairLaw& law = slot_law_[slot];
-      const vec d{x[3 * j] - x[3 * i], x[3 * j + 1] - x[3 * i + 1], x[3 * j + 2] - x[3 * i + 2]};
+      const real contact_radius = slot_law_[slot].contact_radius;
       const real distance = pair_distance_[e];
-      const real spring = contact::normal_force(pair_stiffness_[e], law.contact_radius - distance);
-      slot_force[slot] += spring;
-      for (int k = 0; k < 3; ++k) slot_normal[slot][k] += spring * d[k] / distance;
+      const real overlap = contact_radius - distance;
+      const real spring = contact::normal_force(pair_stiffness_[e], overlap);
+      const real lever = node_radius(laws_[node_material[i] * material_count_ + node_material[j]], model, i,
+                                     j, contact_radius) -
+                         0.5 * overlap;
+      slot_force_[slot] += spring;
+      for (int k = 0; k < 3; ++k) {
+        const real normal = (x[3 * j + k] - x[3 * i + k]) / distance;
+        slot_normal_[slot][k] += spring * normal;
+        slot_point_[slot][k] += spring * (x[3 * i + k] + lever * normal);
+      }
     }
     for (index_t e = wall_offsets_[i]; e < wall_offsets_[i + 1]; ++e) {
-      const contact::PairLaw& law = slot_law_[wall_slot_[e]];
+      const std::size_t slot = wall_slot_[e];
+      const contact::PairLaw& law = slot_law_[slot];
       const WallPoints& points = wall_points_[e];
       for (std::size_t k = 0; k < points.count; ++k) {
-        const real spring = contact::normal_force(law.normal_stiffness * volume[i] * volume[i],
-                                                  law.contact_radius - points.points[k].distance);
-        slot_force[wall_slot_[e]] += spring;
-        for (int c = 0; c < 3; ++c) slot_normal[wall_slot_[e]][c] += spring * points.points[k].normal[c];
+        const real overlap = law.contact_radius - points.points[k].distance;
+        const real spring = contact::normal_force(law.normal_stiffness * volume[i] * volume[i], overlap);
+        const real lever = law.contact_radius - 0.5 * overlap;
+        slot_force_[slot] += spring;
+        for (int c = 0; c < 3; ++c) {
+          slot_normal_[slot][c] += spring * points.points[k].normal[c];
+          slot_point_[slot][c] += spring * (x[3 * i + c] - lever * points.points[k].normal[c]);
+        }
       }
     }
   }
-  const real dt = has_last_time_ ? t - last_time_ : 0.0;
-  last_time_ = t;
-  has_last_time_ = true;
-  std::vector<real> body_damping(3 * body_mass_.size(), 0.0);  // force, then acceleration (pass C)
-  std::vector<std::array<real, 6>> wall_damping(walls_.size(), {0, 0, 0, 0, 0, 0});
-  for (std::size_t slot = 0; slot < slot_count; ++slot) {
+}
+
+void ContactModel::slot_dashpots(const State& state, real dt) {
+  // Damping between bodies (see contact_law.hpp): per pair of touching bodies, a dashpot
+  // 2 zeta sqrt(M K_s) along the mean contact normal on the approach speed of the bodies at the
+  // contact point, applied to each body at that point as a rigid-body load. K_s = F / x is the
+  // secant stiffness of the collision (contact force over the approach since the bodies
+  // touched); the sum of the contact springs K overestimates it when the bodies deform, and the
+  // dashpot would then overdamp.
+  const real t = state.time;
+  std::fill(wall_damping_.begin(), wall_damping_.end(), std::array<real, 6>{0, 0, 0, 0, 0, 0});
+  auto load = [&](index_t body, const vec& point, const vec& force) {
+    const BodyMotion& motion = body_motion_[body];
+    const vec torque =
+        cross({point[0] - motion.centre[0], point[1] - motion.centre[1], point[2] - motion.centre[2]}, force);
+    for (int k = 0; k < 3; ++k) {
+      body_load_[body][k] += force[k];
+      body_load_[body][3 + k] += torque[k];
+    }
+  };
+  auto point_velocity = [&](index_t body, const vec& point) {
+    const BodyMotion& motion = body_motion_[body];
+    const vec turn = cross(motion.angular_velocity, {point[0] - motion.centre[0], point[1] - motion.centre[1],
+                                                     point[2] - motion.centre[2]});
+    return vec{motion.velocity[0] + turn[0], motion.velocity[1] + turn[1], motion.velocity[2] + turn[2]};
+  };
+  for (std::size_t slot = 0; slot < slots_.size(); ++slot) {
     const bool wall_slot = slot >= particle_slot_count_;
     const index_t p = slots_[slot][0], q = slots_[slot][1];
-    const real norm =
-        std::sqrt(slot_normal[slot][0] * slot_normal[slot][0] + slot_normal[slot][1] * slot_normal[slot][1] +
-                  slot_normal[slot][2] * slot_normal[slot][2]);
     if (!wall_slot && p == q) {  // fragments of one body: damped node pair by node pair
       slot_approach_[slot] = 0;
       continue;
     }
+    const vec& sum = slot_normal_[slot];
+    const real norm = std::sqrt(dot(sum, sum));
     // A collision lasts until the bodies are back where they first touched (approach x = 0),
     // not while springs are in contact: the surface nodes of deformable bodies chatter (touch,
     // part, touch again) within one collision when the contact is stiffer than the material,
     // and a dashpot restarted at each touch would damp the collision many times over.
-    const bool in_contact = slot_stiffness_[slot] > 0 && norm > 0;
+    const bool in_contact = slot_stiffness_[slot] > 0 && norm > 0 && slot_force_[slot] > 0;
     real* last_normal = &slot_last_normal_[3 * slot];
     if (in_contact) {
-      for (int k = 0; k < 3; ++k) last_normal[k] = slot_normal[slot][k] / norm;
+      for (int k = 0; k < 3; ++k) last_normal[k] = sum[k] / norm;
     } else if (!(slot_approach_[slot] > 0)) {
       slot_approach_[slot] = 0;
       continue;
     }
     const vec normal{last_normal[0], last_normal[1], last_normal[2]};
-    real approach;  // closing speed of the two bodies along the normal
-    real zeta;
-    if (wall_slot) {
-      const vec wall_velocity = walls_[q].velocity_at(bodies[p].centre.data(), t);
-      approach = -((bodies[p].velocity[0] - wall_velocity[0]) * normal[0] +
-                   (bodies[p].velocity[1] - wall_velocity[1]) * normal[1] +
-                   (bodies[p].velocity[2] - wall_velocity[2]) * normal[2]);
-      zeta = wall_laws_[q * material_count_ + body_material_[p]].damping_ratio;
-    } else {
-      approach = (bodies[p].velocity[0] - bodies[q].velocity[0]) * normal[0] +
-                 (bodies[p].velocity[1] - bodies[q].velocity[1]) * normal[1] +
-                 (bodies[p].velocity[2] - bodies[q].velocity[2]) * normal[2];
-      zeta = laws_[body_material_[p] * material_count_ + body_material_[q]].damping_ratio;
-    }
+    // The contact point: spring-weighted, or the first body's centre in a gap of the collision.
+    const vec point =
+        in_contact ? vec{slot_point_[slot][0] / slot_force_[slot], slot_point_[slot][1] / slot_force_[slot],
+                         slot_point_[slot][2] / slot_force_[slot]}
+                   : body_motion_[p].centre;
+    const vec velocity_p = point_velocity(p, point);
+    const vec velocity_q = wall_slot ? walls_[q].velocity_at(point.data(), t) : point_velocity(q, point);
+    const vec relative{velocity_p[0] - velocity_q[0], velocity_p[1] - velocity_q[1],
+                       velocity_p[2] - velocity_q[2]};
+    // Closing speed along the normal (which points from p to q, or from the wall to p).
+    const real approach = wall_slot ? -dot(relative, normal) : dot(relative, normal);
+    const real zeta = wall_slot
+                          ? wall_laws_[q * material_count_ + body_material_[p]].damping_ratio
+                          : laws_[body_material_[p] * material_count_ + body_material_[q]].damping_ratio;
     slot_approach_[slot] += approach * dt;
     if (!in_contact) {  // a gap within the collision: no spring, no dashpot
       slot_approach_[slot] = std::max(0.0, slot_approach_[slot]);
@@ -867,103 +1070,172 @@ void ContactModel::add_forces(const Model& model, State& state, std::uint64_t br
     }
     if (zeta == 0) continue;
     const real K = slot_stiffness_[slot];
-    const real secant = slot_approach_[slot] > 0 ? std::min(K, slot_force[slot] / slot_approach_[slot]) : K;
+    const real secant = slot_approach_[slot] > 0 ? std::min(K, slot_force_[slot] / slot_approach_[slot]) : K;
     const real damping = 2.0 * zeta * std::sqrt(slot_reduced_mass_[slot] * secant) * approach;
-    for (int k = 0; k < 3; ++k) body_damping[3 * p + k] += (wall_slot ? damping : -damping) * normal[k];
-    if (wall_slot) {  // the wall takes the opposite force, at the body's centre of mass
-      const vec arm{bodies[p].centre[0] - walls_[q].center[0], bodies[p].centre[1] - walls_[q].center[1],
-                    bodies[p].centre[2] - walls_[q].center[2]};
+    if (wall_slot) {  // the wall takes the opposite force, at the contact point
+      load(p, point, {damping * normal[0], damping * normal[1], damping * normal[2]});
+      const vec arm{point[0] - walls_[q].center[0], point[1] - walls_[q].center[1],
+                    point[2] - walls_[q].center[2]};
       const vec on_wall{-damping * normal[0], -damping * normal[1], -damping * normal[2]};
-      auto& r = wall_damping[q];
-      for (int k = 0; k < 3; ++k) r[k] += on_wall[k];
-      r[3] += arm[1] * on_wall[2] - arm[2] * on_wall[1];
-      r[4] += arm[2] * on_wall[0] - arm[0] * on_wall[2];
-      r[5] += arm[0] * on_wall[1] - arm[1] * on_wall[0];
+      const vec torque = cross(arm, on_wall);
+      for (int k = 0; k < 3; ++k) {
+        wall_damping_[q][k] += on_wall[k];
+        wall_damping_[q][3 + k] += torque[k];
+      }
     } else {
-      for (int k = 0; k < 3; ++k) body_damping[3 * q + k] += damping * normal[k];
+      load(p, point, {-damping * normal[0], -damping * normal[1], -damping * normal[2]});
+      load(q, point, {damping * normal[0], damping * normal[1], damping * normal[2]});
     }
   }
+}
 
-  // The dashpot of a body is a uniform acceleration of its nodes.
-  for (std::size_t b = 0; b < body_mass_.size(); ++b) {
-    if (touching_body[b]) {
-      for (int k = 0; k < 3; ++k) body_damping[3 * b + k] /= body_mass_[b];
-    }
-  }
-
-  // Pass C: forces; each node gathers its own.
-  const real* const density = model.node_density().data();
+void ContactModel::node_forces(const Model& model, State& state, real dt) {
+  // Each node gathers its own contact forces (and updates its own friction springs); the
+  // couple of each friction force about the node, (p - x_i) x F_t, is kept for pass E.
+  const auto& x = state.positions;
+  const auto& v = state.velocities;
+  auto& f = state.forces;
+  const auto& volume = model.volumes();
+  const auto& node_material = model.node_material();
+  const real t = state.time;
+  const std::int64_t count = static_cast<std::int64_t>(contact_nodes_.size());
 #pragma omp parallel for schedule(static)
-  for (std::int64_t ii = 0; ii < n; ++ii) {
-    const index_t i = static_cast<index_t>(ii);
-    const index_t body = node_body[i];
-    if (touching_body[body]) {
-      for (int k = 0; k < 3; ++k) f[3 * i + k] += density[i] * body_damping[3 * body + k];
-    }
-    if (pair_offsets_[i] == pair_offsets_[i + 1] && wall_offsets_[i] == wall_offsets_[i + 1]) continue;
+  for (std::int64_t slot = 0; slot < count; ++slot) {
+    const index_t i = contact_nodes_[slot];
+    const index_t body = node_body_[i];
+    const vec& spin_i = body_motion_[body].angular_velocity;
     const real* xi = &x[3 * i];
     const real* vi = &v[3 * i];
-    vec total{0, 0, 0};
+    vec total{0, 0, 0}, couple{0, 0, 0};
     for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
-      if (pair_stiffness_[e] == 0) continue;
+      if (pair_stiffness_[e] == 0) {
+        for (int k = 0; k < 3; ++k) pair_shear_[3 * e + k] = 0;  // apart: the spring is released
+        continue;
+      }
       const index_t j = pair_partner_[e];
       const contact::Law& law = laws_[node_material[i] * material_count_ + node_material[j]];
       const real contact_radius = slot_law_[pair_slot_[e]].contact_radius;
-      const vec d{x[3 * j] - xi[0], x[3 * j + 1] - xi[1], x[3 * j + 2] - xi[2]};
       const real distance = pair_distance_[e];
-      const vec normal{d[0] / distance, d[1] / distance, d[2] / distance};  // from i to j
+      const vec normal{(x[3 * j] - xi[0]) / distance, (x[3 * j + 1] - xi[1]) / distance,
+                       (x[3 * j + 2] - xi[2]) / distance};  // from i to j
       const vec relative{vi[0] - v[3 * j], vi[1] - v[3 * j + 1], vi[2] - v[3 * j + 2]};
-      const real approach = relative[0] * normal[0] + relative[1] * normal[1] + relative[2] * normal[2];
+      const real approach = dot(relative, normal);
       const real k = pair_stiffness_[e];
-      real push = contact::normal_force(k, contact_radius - distance);
-      if (body == node_body[j]) {  // unbonded nodes of one body: a node-pair dashpot
+      const real overlap = contact_radius - distance;
+      real push = contact::normal_force(k, overlap);
+      if (body == node_body_[j]) {  // unbonded nodes of one body: a node-pair dashpot
         const real K = slot_stiffness_[pair_slot_[e]];
         const real c = 2.0 * law.damping_ratio * k * std::sqrt(slot_reduced_mass_[pair_slot_[e]] / K);
         push = std::max(0.0, push + contact::damping_force(c, approach));
       }
-      const real tangential[3] = {relative[0] - approach * normal[0], relative[1] - approach * normal[1],
-                                  relative[2] - approach * normal[2]};
-      real friction[3];
-      contact::friction_force(law, push, tangential, friction);
-      for (int k3 = 0; k3 < 3; ++k3) total[k3] += -push * normal[k3] + friction[k3];
+      real friction[3] = {0, 0, 0};
+      if (law.peridem_friction) {
+        const real tangential[3] = {relative[0] - approach * normal[0], relative[1] - approach * normal[1],
+                                    relative[2] - approach * normal[2]};
+        contact::peridem_friction_force(law.friction, push, tangential, friction);
+      } else if (law.friction > 0) {
+        // Slip of the contact point p = x_i + lever_i n: the nodes' velocities plus each body's
+        // rotation about the node (the node lies inside its particle, p on the surface).
+        const real lever_i = node_radius(law, model, i, j, contact_radius) - 0.5 * overlap;
+        const real lever_j = node_radius(law, model, j, i, contact_radius) - 0.5 * overlap;
+        const vec turn_i = cross(spin_i, {lever_i * normal[0], lever_i * normal[1], lever_i * normal[2]});
+        const vec turn_j = cross(body_motion_[node_body_[j]].angular_velocity,
+                                 {-lever_j * normal[0], -lever_j * normal[1], -lever_j * normal[2]});
+        const real slip[3] = {(vi[0] + turn_i[0]) - (v[3 * j] + turn_j[0]),
+                              (vi[1] + turn_i[1]) - (v[3 * j + 1] + turn_j[1]),
+                              (vi[2] + turn_i[2]) - (v[3 * j + 2] + turn_j[2])};
+        contact::tangential_force(law.tangential_stiffness_ratio * k, law.friction, push, normal.data(), slip,
+                                  dt, &pair_shear_[3 * e], friction);
+        const vec moment = cross({lever_i * normal[0], lever_i * normal[1], lever_i * normal[2]},
+                                 {friction[0], friction[1], friction[2]});
+        for (int c = 0; c < 3; ++c) couple[c] += moment[c];
+      }
+      for (int c = 0; c < 3; ++c) total[c] += -push * normal[c] + friction[c];
     }
     for (index_t e = wall_offsets_[i]; e < wall_offsets_[i + 1]; ++e) {
       std::array<real, 6>& reaction = wall_entry_reaction_[e];
       reaction = {0, 0, 0, 0, 0, 0};
-      if (wall_entry_stiffness_[e] == 0) continue;
+      if (wall_entry_stiffness_[e] == 0) {
+        for (int k = 0; k < 3; ++k) wall_shear_[3 * e + k] = 0;
+        continue;
+      }
       const Wall& wall = walls_[wall_entry_[e][0]];
       const contact::Law& law = wall_laws_[wall_entry_[e][0] * material_count_ + node_material[i]];
       const contact::PairLaw& resolved = slot_law_[wall_slot_[e]];
       const WallPoints& points = wall_points_[e];
-      const vec wall_velocity = wall.velocity_at(xi, t);
-      const vec relative{vi[0] - wall_velocity[0], vi[1] - wall_velocity[1], vi[2] - wall_velocity[2]};
       const real k = resolved.normal_stiffness * volume[i] * volume[i];
-      vec force{0, 0, 0};
+      vec push_force{0, 0, 0};
+      real push_total = 0;
       for (std::size_t point = 0; point < points.count; ++point) {
-        const vec& normal = points.points[point].normal;  // towards the particle
         const real push = contact::normal_force(k, resolved.contact_radius - points.points[point].distance);
-        const real normal_speed = relative[0] * normal[0] + relative[1] * normal[1] + relative[2] * normal[2];
-        const real tangential[3] = {relative[0] - normal_speed * normal[0],
-                                    relative[1] - normal_speed * normal[1],
-                                    relative[2] - normal_speed * normal[2]};
-        real friction[3];
-        contact::friction_force(law, push, tangential, friction);
-        for (int k3 = 0; k3 < 3; ++k3) force[k3] += push * normal[k3] + friction[k3];
+        push_total += push;
+        for (int c = 0; c < 3; ++c) push_force[c] += push * points.points[point].normal[c];
       }
-      for (int k3 = 0; k3 < 3; ++k3) total[k3] += force[k3];
-      const vec arm{xi[0] - wall.center[0], xi[1] - wall.center[1], xi[2] - wall.center[2]};
-      reaction = {-force[0],
-                  -force[1],
-                  -force[2],
-                  -(arm[1] * force[2] - arm[2] * force[1]),
-                  -(arm[2] * force[0] - arm[0] * force[2]),
-                  -(arm[0] * force[1] - arm[1] * force[0])};
+      // Friction at the deepest point: p = x_i - lever n, n from the wall towards the node.
+      const WallContact& deepest = points.points[deepest_point(points.points.data(), points.count)];
+      const vec& normal = deepest.normal;
+      const real lever = resolved.contact_radius - 0.5 * (resolved.contact_radius - deepest.distance);
+      const vec arm{-lever * normal[0], -lever * normal[1], -lever * normal[2]};  // p - x_i
+      const vec point{xi[0] + arm[0], xi[1] + arm[1], xi[2] + arm[2]};
+      const vec wall_velocity = wall.velocity_at(point.data(), t);
+      real friction[3] = {0, 0, 0};
+      if (law.peridem_friction) {
+        const vec relative{vi[0] - wall_velocity[0], vi[1] - wall_velocity[1], vi[2] - wall_velocity[2]};
+        const real speed = dot(relative, normal);
+        const real tangential[3] = {relative[0] - speed * normal[0], relative[1] - speed * normal[1],
+                                    relative[2] - speed * normal[2]};
+        contact::peridem_friction_force(law.friction, push_total, tangential, friction);
+      } else if (law.friction > 0) {
+        const vec turn = cross(spin_i, arm);
+        const real slip[3] = {vi[0] + turn[0] - wall_velocity[0], vi[1] + turn[1] - wall_velocity[1],
+                              vi[2] + turn[2] - wall_velocity[2]};
+        contact::tangential_force(law.tangential_stiffness_ratio * k, law.friction, push_total, normal.data(),
+                                  slip, dt, &wall_shear_[3 * e], friction);
+        const vec moment = cross(arm, {friction[0], friction[1], friction[2]});
+        for (int c = 0; c < 3; ++c) couple[c] += moment[c];
+      }
+      const vec force{push_force[0] + friction[0], push_force[1] + friction[1], push_force[2] + friction[2]};
+      for (int c = 0; c < 3; ++c) total[c] += force[c];
+      // The wall takes -force at the contact point.
+      const vec lever_arm{point[0] - wall.center[0], point[1] - wall.center[1], point[2] - wall.center[2]};
+      const vec torque = cross(lever_arm, force);
+      reaction = {-force[0], -force[1], -force[2], -torque[0], -torque[1], -torque[2]};
     }
-    for (int k3 = 0; k3 < 3; ++k3) f[3 * i + k3] += total[k3] / volume[i];
+    for (int c = 0; c < 3; ++c) f[3 * i + c] += total[c] / volume[i];
+    node_couple_[slot] = couple;
   }
+}
 
-  // Pass D: wall reactions, summed in node order, plus the dashpots' share.
-  wall_reactions_ = wall_damping;
+void ContactModel::body_loads(const Model& model, State& state) {
+  // Dashpot forces at contact points and the friction couples, as rigid-body loads: every node of
+  // the body gets rho_i (F / M + alpha x (x_i - c)), alpha = I^-1 tau. They add up to F and tau.
+  const auto& x = state.positions;
+  auto& f = state.forces;
+  const real* const density = model.node_density().data();
+  const std::int64_t body_count = static_cast<std::int64_t>(body_mass_.size());
+#pragma omp parallel for schedule(dynamic, 16)
+  for (std::int64_t b = 0; b < body_count; ++b) {
+    if (!touching_body_[b]) continue;
+    std::array<real, 6> total = body_load_[b];
+    for (index_t k = body_contact_offsets_[b]; k < body_contact_offsets_[b + 1]; ++k) {
+      for (int c = 0; c < 3; ++c) total[3 + c] += node_couple_[k][c];
+    }
+    if (total == std::array<real, 6>{0, 0, 0, 0, 0, 0}) continue;
+    const BodyMotion& motion = body_motion_[b];
+    const vec acceleration{total[0] / motion.mass, total[1] / motion.mass, total[2] / motion.mass};
+    const vec turn = symmetric_times(motion.inverse_inertia, {total[3], total[4], total[5]});
+    for (index_t k = body_node_offsets_[b]; k < body_node_offsets_[b + 1]; ++k) {
+      const index_t i = body_nodes_[k];
+      const vec spin = cross(turn, {x[3 * i] - motion.centre[0], x[3 * i + 1] - motion.centre[1],
+                                    x[3 * i + 2] - motion.centre[2]});
+      for (int c = 0; c < 3; ++c) f[3 * i + c] += density[i] * (acceleration[c] + spin[c]);
+    }
+  }
+}
+
+void ContactModel::sum_wall_reactions() {
+  // Wall reactions, summed in entry order, plus the dashpots' share.
+  wall_reactions_ = wall_damping_;
   for (std::size_t e = 0; e < wall_entry_.size(); ++e) {
     auto& reaction = wall_reactions_[wall_entry_[e][0]];
     for (int k = 0; k < 6; ++k) reaction[k] += wall_entry_reaction_[e][k];

@@ -18,17 +18,32 @@ TEST_CASE("damping ratio from restitution: e = exp(-pi zeta / sqrt(1 - zeta^2))"
   CHECK(contact::damping_ratio_from_restitution(1.0) == 0.0);
 }
 
-TEST_CASE("friction opposes slip, saturates at mu N, is regularised near zero slip") {
-  contact::Law law;
-  law.friction = 0.5;
-  law.slip_velocity = 1e-3;
-  const real fast[3] = {2.0, 0, 0}, slow[3] = {0, 5e-4, 0};
-  real force[3];
-  contact::friction_force(law, 10.0, fast, force);
-  CHECK_CLOSE(force[0], -5.0, 1e-15);
-  contact::friction_force(law, 10.0, slow, force);
-  CHECK_CLOSE(force[1], -2.5, 1e-12);
-  CHECK(force[0] == 0.0);
+TEST_CASE("the friction spring sticks below mu F_n, slides at it, turns with the normal, is odd") {
+  const real normal[3] = {0, 1, 0}, slip[3] = {2.0, 0.5, 0}, dt = 1e-3;
+  real shear[3] = {0, 0, 0}, force[3];
+  // Stick: xi = v_t dt (the normal part of the slip is dropped), F = -kt xi.
+  contact::tangential_force(100.0, 0.5, 10.0, normal, slip, dt, shear, force);
+  CHECK_CLOSE(shear[0], 2e-3, 1e-15);
+  CHECK(shear[1] == 0.0 && shear[2] == 0.0);
+  CHECK_CLOSE(force[0], -0.2, 1e-14);
+  // Sliding: the spring would carry 100 x 0.502 = 50.2 > mu F_n = 5, so it is shortened to 5.
+  shear[0] = 0.5;
+  contact::tangential_force(100.0, 0.5, 10.0, normal, slip, dt, shear, force);
+  CHECK_CLOSE(force[0], -5.0, 1e-14);
+  CHECK_CLOSE(shear[0], 0.05, 1e-15);
+  // A turned normal: the spring is turned into the new tangent plane, keeping its length.
+  const real turned[3] = {std::sqrt(0.5), std::sqrt(0.5), 0}, still[3] = {0, 0, 0};
+  real kept[3] = {0.01, 0, 0};
+  contact::tangential_force(100.0, 0.5, 10.0, turned, still, dt, kept, force);
+  CHECK_CLOSE(std::hypot(kept[0], kept[1]), 0.01, 1e-15);
+  CHECK(std::abs(kept[0] * turned[0] + kept[1] * turned[1]) < 1e-17);
+  // The other entry of the pair (normal, slip and spring negated) computes exactly -force.
+  real mine[3] = {3e-4, 0, 1e-4}, theirs[3] = {-3e-4, -0.0, -1e-4}, mine_force[3], their_force[3];
+  const real n2[3] = {0.6, 0.8, 0}, n2_back[3] = {-0.6, -0.8, -0.0};
+  const real s2[3] = {0.3, -0.2, 0.7}, s2_back[3] = {-0.3, 0.2, -0.7};
+  contact::tangential_force(100.0, 0.3, 2.0, n2, s2, dt, mine, mine_force);
+  contact::tangential_force(100.0, 0.3, 2.0, n2_back, s2_back, dt, theirs, their_force);
+  for (int k = 0; k < 3; ++k) CHECK(mine_force[k] == -their_force[k] && mine[k] == -theirs[k]);
 }
 
 TEST_CASE("relative contact laws resolve per pair, symmetrically, from the finer particle") {
@@ -40,7 +55,13 @@ TEST_CASE("relative contact laws resolve per pair, symmetrically, from the finer
     const contact::PairLaw ab = contact::resolve(law, fine, coarse, dimension);
     const contact::PairLaw ba = contact::resolve(law, coarse, fine, dimension);
     CHECK(ab.contact_radius == ba.contact_radius && ab.normal_stiffness == ba.normal_stiffness);
-    CHECK_CLOSE(ab.contact_radius, 0.95e-3, 1e-15);
+    // Each node's contact radius is 0.95 h / 2 of its own particle: Rc = 0.95 (1 + 2) mm / 2.
+    CHECK_CLOSE(ab.contact_radius, 1.425e-3, 1e-15);
+    CHECK_CLOSE(contact::resolve_wall(law, coarse, dimension).contact_radius, 0.95e-3, 1e-15);
+    law.node_pair = true;  // PeriDEM's law: the finer mesh size, for pairs and walls
+    CHECK_CLOSE(contact::resolve(law, coarse, fine, dimension).contact_radius, 0.95e-3, 1e-15);
+    CHECK_CLOSE(contact::resolve_wall(law, coarse, dimension).contact_radius, 1.9e-3, 1e-15);
+    law.node_pair = false;
     const double effective = 2 * 1e9 * 3e9 / 4e9;
     const double expected = dimension == 3 ? 2 * 18 * effective / (std::numbers::pi * std::pow(3e-3, 5))
                                            : 2 * 12 * effective / (std::numbers::pi * std::pow(3e-3, 4));

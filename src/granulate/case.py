@@ -458,13 +458,22 @@ class ContactSpec(Spec):
 
     restitution: Annotated[float, Field(gt=0, le=1)] = 1.0
     friction: NonNegative = 0.0
-    contact_radius_factor: Positive = Field(0.95, description="Rc / h of the finer particle")
+    contact_radius_factor: Positive = Field(
+        0.95, description="each node's contact radius is factor x h / 2 of its particle"
+    )
     contact_radius: Positive | None = Field(None, description="absolute Rc [m]")
     normal_stiffness: Positive | None = Field(None, description="absolute kn")
     stiffness_factor: Positive = 1.0
-    slip_velocity: Positive = Field(1e-4, description="[m/s]")
+    tangential_stiffness_ratio: Annotated[float, Field(gt=0, le=1)] = Field(
+        2.0 / 7.0, description="kt / kn of the friction spring"
+    )
     friction_law: Literal["coulomb", "peridem"] = Field(
         "coulomb", description="'peridem': PeriDEM's friction (speeds sliding up), comparisons only"
+    )
+    pair_law: Literal["granulate", "peridem"] = Field(
+        "granulate",
+        description="'peridem': PeriDEM's node-pair law (one Rc from the finer mesh, springs "
+        "kn V_i V_j), comparisons only",
     )
 
     def make(self) -> Contact:

@@ -33,8 +33,8 @@ class Contact:
         contact_radius: absolute Rc [m]; overrides the factor.
         normal_stiffness: absolute kn [N/m^7 in 3D, N/m^6 in 2D]; overrides the default.
         stiffness_factor: multiplies the default kn.
-        slip_velocity: friction regularisation: below this slip speed [m/s] friction grows
-            linearly from zero (keep it well below the velocities of interest).
+        tangential_stiffness_ratio: kt / kn of the friction spring of each contact (Cundall &
+            Strack), in (0, 1]; default 2/7.
         friction_law: "coulomb" (default), or "peridem": PeriDEM's friction, mu |F_n| along
             the slip velocity (it speeds sliding up instead of resisting it); for comparisons
             with PeriDEM only.
@@ -46,10 +46,13 @@ class Contact:
     contact_radius: float | None = None
     normal_stiffness: float | None = None
     stiffness_factor: float = 1.0
-    slip_velocity: float = 1e-4
+    tangential_stiffness_ratio: float = 2.0 / 7.0
     friction_law: str = "coulomb"
+    pair_law: str = "granulate"
 
     def __post_init__(self) -> None:
+        if self.pair_law not in ("granulate", "peridem"):
+            raise InputError(f"pair_law must be 'granulate' or 'peridem', got {self.pair_law!r}")
         if self.friction_law not in ("coulomb", "peridem"):
             raise InputError(
                 f"friction_law must be 'coulomb' or 'peridem', got {self.friction_law!r}"
@@ -58,7 +61,12 @@ class Contact:
             raise InputError(f"restitution must be in (0, 1], got {self.restitution}")
         if not (self.friction >= 0 and math.isfinite(self.friction)):
             raise InputError(f"friction must be a non-negative number, got {self.friction}")
-        for name in ("contact_radius_factor", "stiffness_factor", "slip_velocity"):
+        if not 0 < self.tangential_stiffness_ratio <= 1:
+            raise InputError(
+                "tangential_stiffness_ratio must be in (0, 1], got "
+                f"{self.tangential_stiffness_ratio}"
+            )
+        for name in ("contact_radius_factor", "stiffness_factor"):
             value = getattr(self, name)
             if not (value > 0 and math.isfinite(value)):
                 raise InputError(f"{name} must be positive, got {value}")

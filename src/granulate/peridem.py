@@ -769,6 +769,8 @@ def _translate(path: Path, compat: bool, output: Path | None) -> Translation:
                 friction_used = friction_used or spec["friction"] > 0
                 if compat:
                     spec["friction_law"] = "peridem"
+            if compat:  # one Rc per particle pair, springs kn V_i V_j
+                spec["pair_law"] = "peridem"
             pairs.append({"materials": [f"zone_{a}", f"zone_{b}"], "contact": spec})
         notes.append(
             f"contact radius: Contact_Radius_Factor x the smallest node spacing of all particles "

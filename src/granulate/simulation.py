@@ -884,8 +884,9 @@ class Simulation:
         law.stiffness_factor = contact.stiffness_factor
         law.damping_ratio = _core.damping_ratio_from_restitution(contact.restitution)
         law.friction = contact.friction
-        law.slip_velocity = contact.slip_velocity
+        law.tangential_stiffness_ratio = contact.tangential_stiffness_ratio
         law.peridem_friction = contact.friction_law == "peridem"
+        law.node_pair = contact.pair_law == "peridem"
         return law
 
     def _set_contact_laws(self, core: _core.Simulation, materials: list[Material]) -> None:

@@ -21,7 +21,7 @@ import numpy as np
 from granulate.errors import InputError
 from granulate.io.atomic import atomic_write
 
-FORMAT = 1
+FORMAT = 2  # 2: per-contact friction springs and per-node contact radii (granulate 0.2)
 HEADER = "__header__"
 
 
@@ -59,7 +59,9 @@ def load(path: str | Path) -> tuple[dict[str, Any], dict[str, Any]]:
     if header.get("format") != FORMAT:
         raise InputError(
             f"checkpoint {file} has format {header.get('format')!r}; this granulate reads "
-            f"format {FORMAT}"
+            f"format {FORMAT} (format 1 predates the contact model with friction springs and "
+            "per-node contact radii, whose trajectories differ); run without --resume to start "
+            "over"
         )
     state: dict[str, Any] = {}
     for name, value in data.items():

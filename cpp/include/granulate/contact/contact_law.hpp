@@ -1,29 +1,46 @@
-// Node-to-node (and node-to-wall) contact: normal spring, damping, Coulomb friction.
+// Node-to-node (and node-to-wall) contact: normal spring, damping, Coulomb friction with stick.
 //
-// Two nodes i, j interact when R = |x_j - x_i| < Rc and no intact bond joins them. With
-// n = (x_j - x_i)/R, overlap delta_n = Rc - R and node volumes V_i, V_j, the contact between two
-// bodies is the sum of three sub-models:
-//   normal:   F_n = k_ij delta_n on each node pair, k_ij = kn V_i V_j [N; N/m in 2D], along -n.
+// Each node i has a contact radius rho_i = factor h_i / 2 (h_i: its particle's mesh size), so its
+// contact sphere reaches the particle's surface (a lattice's or ring discretisation's outer nodes
+// lie h/2 inside it). Two nodes i, j interact when R = |x_j - x_i| < Rc = rho_i + rho_j and no
+// intact bond joins them; a node touches a wall when its distance D to the surface is < rho_i.
+// With n = (x_j - x_i)/R and the overlap delta = Rc - R, the contact is the sum of three
+// sub-models:
+//   normal:   F_n = k_ij delta on each node pair along -n, k_ij = kn min(V_i, V_j)^2 [N/m; N/m^2
+//             per unit thickness in 2D]: a fine particle's surface node meets about one node of a
+//             coarse particle, so the contact is as stiff per unit area whatever the two meshes.
 //   damping:  one dashpot per pair of touching bodies, F_d = 2 zeta sqrt(M K_s) dx/dt along the
-//             mean contact normal, applied to each body as a uniform acceleration. dx/dt is the
-//             approach speed of the bodies, M their reduced mass (a particle's own mass against a
-//             wall), K_s = F / x the secant stiffness of the collision (total spring force over the
-//             approach x since the bodies touched; at most the sum K of the springs). A collision
-//             lasts until x is back to 0, through the gaps where chattering surface nodes part for
-//             a few steps (contacts much stiffer than the material). zeta follows
-//             from the requested coefficient of restitution of a linear spring-dashpot:
+//             mean contact normal m, acting at the collision's contact point p (the spring-weighted
+//             mean of the node pairs' contact points) on each body as a rigid-body load: every
+//             node of the body gets rho_i (F / M + alpha x (x_i - c)), alpha = I^-1 (p - c) x F,
+//             with c, M, I the body's centre, mass and inertia tensor. The two bodies get equal
+//             and opposite forces at one point, so linear and angular momentum are conserved to
+//             round-off. dx/dt is the approach speed of the bodies' centres along m, M their
+//             reduced mass (a particle's own mass against a wall), K_s = F / x the secant stiffness
+//             of the collision (total spring force over the approach x since the bodies touched; at
+//             most the sum K of the springs). A collision lasts until x is back to 0, through the
+//             gaps where chattering surface nodes part for a few steps. zeta follows from the
+//             requested coefficient of restitution of a linear spring-dashpot:
 //             zeta = -ln e / sqrt(pi^2 + ln^2 e). Acting on the bodies rather than on the contact
 //             nodes, the dashpot dissipates c (dx/dt)^2 whatever the bodies' deformation, so a
 //             collision of deformable bodies rebounds with e (checked in tests/validation).
 //             Fragments of one particle are damped node pair by node pair instead
 //             (c_ij = 2 zeta k_ij sqrt(M / K), force clipped at zero).
-//   friction: F_t = -mu F_n min(1, |v_t| / v_slip) v_t / |v_t| on each node pair, v_t the
-//             tangential velocity of i relative to j (regularised Coulomb: no chatter near zero slip).
-//             Law::peridem_friction gives PeriDEM's +mu F_n v_t / |v_t| instead (comparisons only).
+//   friction: Cundall & Strack (1979): a tangential spring kt = ratio x k_ij on the tangential
+//             displacement xi of the contact point since the pair touched, capped at mu F_n (then
+//             xi is shortened: sliding). The contact point is the middle of the overlap,
+//             p = x_i + (rho_i - delta / 2) n, on the particles' surfaces: its slip is the nodes'
+//             relative velocity plus each body's rotation times the node's lever to p, and the
+//             force acts there (the node gets it, its body the couple (p - x_i) x F_t as a
+//             rigid-body load), so a disc rolls on its radius and both bodies are pushed at one
+//             point (no torque on the pair). xi is kept per node pair (and per node-wall entry)
+//             across neighbour-list rebuilds and checkpoints. Law::peridem_friction gives
+//             PeriDEM's +mu F_n v_t / |v_t| instead (comparisons only).
 // The force density on node i is F / V_i. Every term comes in equal and opposite pairs, so
 // Newton's third law holds to round-off.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -35,16 +52,20 @@ namespace granulate::contact {
 /// contact radius and the normal stiffness are either absolute or relative to the two particles
 /// in contact (see resolve), so one law serves particles of every size.
 struct Law {
-  real contact_radius = 0;         ///< Rc [m]; 0: contact_radius_factor x the finer mesh size
-  real contact_radius_factor = 0;  ///< Rc / h, used when contact_radius is 0
+  real contact_radius = 0;         ///< Rc of a node pair [m]; 0: from contact_radius_factor
+  real contact_radius_factor = 0;  ///< each node's contact radius / its mesh size x 2 (see resolve)
   real normal_stiffness = 0;       ///< kn [N/m^7 in 3D; N/m^6 in 2D]; 0: stiffness_factor x default
   real stiffness_factor = 0;       ///< multiplies the default kn, used when normal_stiffness is 0
   real damping_ratio = 0;          ///< zeta, from the restitution coefficient
   real friction = 0;               ///< mu
-  real slip_velocity = 1e-4;       ///< v_slip [m/s] of the friction regularisation
-  /// PeriDEM's friction, for comparisons only: mu F_n along +v_t (it speeds sliding up), not
-  /// regularised. See friction_force.
+  real tangential_stiffness_ratio = 2.0 / 7.0;  ///< kt / k_ij of the friction spring
+  /// PeriDEM's friction, for comparisons only: mu F_n along +v_t (it speeds sliding up), no
+  /// stick. See peridem_friction_force.
   bool peridem_friction = false;
+  /// PeriDEM's node-pair law (--peridem-compat): one Rc for a pair of particles, factor x the
+  /// finer mesh size (also against walls), and pair springs kn V_i V_j. Otherwise each node has
+  /// its own contact radius (see resolve) and the pair spring is kn min(V_i, V_j)^2.
+  bool node_pair = false;
 };
 
 /// One particle's side of a contact.
@@ -58,6 +79,7 @@ struct ContactSide {
 struct PairLaw {
   real contact_radius = 0;
   real normal_stiffness = 0;
+  bool node_pair = false;  ///< PeriDEM's pair spring kn V_i V_j (else kn min(V_i, V_j)^2)
 };
 
 /// The finer of two particles (smaller h; on a tie, the smaller horizon), so laws are symmetric.
@@ -66,30 +88,65 @@ inline const ContactSide& finer(const ContactSide& a, const ContactSide& b) {
   return a.horizon <= b.horizon ? a : b;
 }
 
-/// Rc of a law between particles a and b: absolute, or factor x the finer mesh size.
-inline real resolve_contact_radius(const Law& law, const ContactSide& a, const ContactSide& b) {
-  return law.contact_radius > 0 ? law.contact_radius : law.contact_radius_factor * finer(a, b).mesh_size;
+/// Contact radius of one node of particle a [m]: factor x h_a / 2. A lattice's or a conforming
+/// discretisation's outermost nodes lie h/2 inside the surface, so with the default factor
+/// (0.95) a node's contact sphere reaches (almost) to the particle's surface, whatever the mesh
+/// size: two particles touch where their surfaces meet, and a particle rests on a wall at its
+/// radius. An absolute Rc gives each node Rc / 2.
+inline real node_contact_radius(const Law& law, const ContactSide& a) {
+  return law.contact_radius > 0 ? 0.5 * law.contact_radius : 0.5 * law.contact_radius_factor * a.mesh_size;
 }
 
-/// Rc and kn of a law between particles a and b (a particle and a wall: pass it twice). The
-/// default kn is the stiffness of a peridynamic bond one horizon long (PMB micromodulus,
-/// constant influence) for the harmonic mean of the moduli: 18 K_eff / (pi delta^5) in 3D,
-/// 12 kappa_eff / (pi delta^4) in 2D, K_eff = 2 K_a K_b / (K_a + K_b), delta the finer
-/// particle's horizon.
-inline PairLaw resolve(const Law& law, const ContactSide& a, const ContactSide& b, int dimension) {
-  PairLaw out;
-  out.contact_radius = resolve_contact_radius(law, a, b);
-  if (law.normal_stiffness > 0) {
-    out.normal_stiffness = law.normal_stiffness;
-  } else {
-    const real effective = 2 * a.modulus * b.modulus / (a.modulus + b.modulus);
-    const real delta = finer(a, b).horizon;
-    const real delta4 = delta * delta * delta * delta;
-    out.normal_stiffness =
-        law.stiffness_factor * (dimension == 3 ? 18 * effective / (std::numbers::pi * delta4 * delta)
-                                               : 12 * effective / (std::numbers::pi * delta4));
+/// Rc of a node pair of particles a and b: the sum of the two nodes' contact radii, so a coarse
+/// particle's nodes reach as far as its own spacing requires and a fine particle's nodes cannot
+/// slip between them (PeriDEM's node-pair law: absolute, or factor x the finer mesh size).
+inline real resolve_contact_radius(const Law& law, const ContactSide& a, const ContactSide& b) {
+  if (law.node_pair) {
+    return law.contact_radius > 0 ? law.contact_radius : law.contact_radius_factor * finer(a, b).mesh_size;
   }
-  return out;
+  return node_contact_radius(law, a) + node_contact_radius(law, b);
+}
+
+/// Node a's share of a pair's Rc (its contact radius, for the contact point): h_a / (h_a + h_b)
+/// of Rc with a relative radius, half of it with an absolute one or PeriDEM's node-pair law.
+inline real node_share(const Law& law, const ContactSide& a, const ContactSide& b, real contact_radius) {
+  if (law.node_pair || law.contact_radius > 0) return 0.5 * contact_radius;
+  return contact_radius * a.mesh_size / (a.mesh_size + b.mesh_size);
+}
+
+/// Default kn of a law between particles a and b: the stiffness of a peridynamic bond one horizon
+/// long (PMB micromodulus, constant influence) for the harmonic mean of the moduli:
+/// 18 K_eff / (pi delta^5) in 3D, 12 kappa_eff / (pi delta^4) in 2D,
+/// K_eff = 2 K_a K_b / (K_a + K_b), delta the finer particle's horizon.
+inline real resolve_normal_stiffness(const Law& law, const ContactSide& a, const ContactSide& b,
+                                     int dimension) {
+  if (law.normal_stiffness > 0) return law.normal_stiffness;
+  const real effective = 2 * a.modulus * b.modulus / (a.modulus + b.modulus);
+  const real delta = finer(a, b).horizon;
+  const real delta4 = delta * delta * delta * delta;
+  return law.stiffness_factor * (dimension == 3 ? 18 * effective / (std::numbers::pi * delta4 * delta)
+                                                : 12 * effective / (std::numbers::pi * delta4));
+}
+
+/// Rc and kn of a law between particles a and b.
+inline PairLaw resolve(const Law& law, const ContactSide& a, const ContactSide& b, int dimension) {
+  return {resolve_contact_radius(law, a, b), resolve_normal_stiffness(law, a, b, dimension), law.node_pair};
+}
+
+/// Rc (node to wall surface) and kn of a law between particle a and a rigid wall: the node's own
+/// contact radius (PeriDEM's node-pair law: the pair Rc).
+inline PairLaw resolve_wall(const Law& law, const ContactSide& a, int dimension) {
+  return {law.node_pair ? resolve_contact_radius(law, a, a) : node_contact_radius(law, a),
+          resolve_normal_stiffness(law, a, a, dimension), law.node_pair};
+}
+
+/// Spring stiffness of a node pair [N/m]: kn min(V_i, V_j)^2, so a fine particle's nodes against
+/// a coarse particle's are as stiff per unit of contact area as against nodes of their own size
+/// (each fine surface node meets about one coarse node). PeriDEM's node-pair law: kn V_i V_j.
+inline real pair_stiffness(const PairLaw& law, real volume_i, real volume_j) {
+  if (law.node_pair) return law.normal_stiffness * volume_i * volume_j;
+  const real smaller = std::min(volume_i, volume_j);
+  return law.normal_stiffness * smaller * smaller;
 }
 
 /// zeta of a linear spring-dashpot with restitution e (0 < e <= 1).
@@ -109,22 +166,41 @@ inline real damping_force(real pair_damping, real approach_speed) {
   return pair_damping * approach_speed;
 }
 
-/// Friction sub-model: tangential force [N] on i, written into force[3], from the tangential
-/// velocity of i relative to j and the (non-negative) normal force.
-inline void friction_force(const Law& law, real normal, const real tangential_velocity[3], real force[3]) {
+/// PeriDEM's friction (comparisons only): mu F_n along the tangential velocity of i relative to
+/// j, written into force[3]; it speeds sliding up instead of resisting it.
+inline void peridem_friction_force(real mu, real normal, const real tangential_velocity[3], real force[3]) {
   const real speed = std::sqrt(tangential_velocity[0] * tangential_velocity[0] +
                                tangential_velocity[1] * tangential_velocity[1] +
                                tangential_velocity[2] * tangential_velocity[2]);
-  if (!(speed > 0) || law.friction == 0 || normal == 0) {
-    force[0] = force[1] = force[2] = 0;
-    return;
+  for (int k = 0; k < 3; ++k)
+    force[k] = speed > 0 && normal != 0 ? mu * normal * tangential_velocity[k] / speed : 0;
+}
+
+/// Friction sub-model (Cundall & Strack 1979): the tangential spring of one contact. `shear` is
+/// the contact's tangential displacement xi [m] (i's contact point relative to j's since they
+/// touched); it is first turned into the plane normal to the unit `normal` (keeping its length),
+/// then advanced by the tangential part of `slip` [m/s] x dt. The force on i is -kt xi, capped at
+/// mu F_n (`normal_force`, >= 0): when capped, xi shrinks to the length that carries mu F_n
+/// (the contact slides). Writes the force [N] into force[3]. Every operation is odd in (normal,
+/// slip, shear), so the pair's other entry computes exactly the opposite force.
+inline void tangential_force(real kt, real mu, real normal_force, const real normal[3], const real slip[3],
+                             real dt, real shear[3], real force[3]) {
+  const real length = std::sqrt(shear[0] * shear[0] + shear[1] * shear[1] + shear[2] * shear[2]);
+  const real along = shear[0] * normal[0] + shear[1] * normal[1] + shear[2] * normal[2];
+  for (int k = 0; k < 3; ++k) shear[k] -= along * normal[k];
+  const real projected = std::sqrt(shear[0] * shear[0] + shear[1] * shear[1] + shear[2] * shear[2]);
+  if (projected > 0) {
+    for (int k = 0; k < 3; ++k) shear[k] *= length / projected;
   }
-  if (law.peridem_friction) {  // PeriDEM's sign: along the slip, full mu F_n at any speed
-    for (int k = 0; k < 3; ++k) force[k] = law.friction * normal * tangential_velocity[k] / speed;
-    return;
+  const real slip_normal = slip[0] * normal[0] + slip[1] * normal[1] + slip[2] * normal[2];
+  for (int k = 0; k < 3; ++k) shear[k] += (slip[k] - slip_normal * normal[k]) * dt;
+  const real stretched = std::sqrt(shear[0] * shear[0] + shear[1] * shear[1] + shear[2] * shear[2]);
+  const real limit = mu * normal_force;
+  if (kt * stretched > limit) {
+    const real scale = stretched > 0 ? limit / (kt * stretched) : 0.0;
+    for (int k = 0; k < 3; ++k) shear[k] *= scale;
   }
-  const real magnitude = law.friction * normal * std::min(1.0, speed / law.slip_velocity);
-  for (int k = 0; k < 3; ++k) force[k] = -magnitude * tangential_velocity[k] / speed;
+  for (int k = 0; k < 3; ++k) force[k] = -kt * shear[k];
 }
 
 }  // namespace granulate::contact

@@ -15,6 +15,19 @@
 
 namespace granulate {
 
+using vec3 = std::array<real, 3>;
+
+/// Rigid-body motion of a body in contact: centre of mass, mean velocity, angular velocity
+/// omega = I^-1 L, and the inverse inertia tensor about the centre (symmetric: xx, yy, zz, xy,
+/// xz, yz; zero for a body without rotational inertia, such as a one-node fragment).
+struct BodyMotion {
+  vec3 centre{0, 0, 0};
+  vec3 velocity{0, 0, 0};
+  vec3 angular_velocity{0, 0, 0};
+  std::array<real, 6> inverse_inertia{0, 0, 0, 0, 0, 0};
+  real mass = 0;
+};
+
 struct ContactStatistics {
   std::uint64_t rebuilds = 0;       ///< neighbour-list builds so far (grid searches)
   std::uint64_t list_updates = 0;   ///< updates after bond breaks (no search)
@@ -37,6 +50,8 @@ struct ContactCheckpoint {
   std::vector<real> slot_approach;
   std::vector<real> slot_normal;                     ///< 3 per slot: the collision's last contact normal
   std::vector<index_t> pair_offsets, pair_partners;  ///< the lists (updated after bond breaks)
+  std::vector<real> pair_shear;                      ///< 3 per list entry: friction springs
+  std::vector<real> wall_shear;                      ///< 3 per node-wall entry: friction springs
   real last_time = 0;
   bool has_last_time = false;
   ContactStatistics statistics;
@@ -116,12 +131,33 @@ class ContactModel {
   /// After bonds broke (and nothing moved half the skin): the pairs of newly_broken_ into the
   /// lists.
   void update_after_breaks(const Model& model, const State& state, std::uint64_t broken_bonds, real moved);
-  /// Slots, reduced masses, slot laws and scratch from the lists and the bodies.
+  /// Slots, reduced masses, slot laws, the friction history carried over from the lists before
+  /// (keep_history) and scratch, from the lists and the bodies.
   void finish_lists(const Model& model);
+  /// Moves the lists and their friction springs aside before the lists change, for finish_lists.
+  void keep_history();
+  /// Friction springs of the new lists from the kept ones (entries in both keep theirs).
+  void carry_over_friction(index_t node_count);
+  /// Nodes with list entries, grouped by body (each group in node order), and the per-step
+  /// scratch of bodies and slots.
+  void group_contact_nodes(const Model& model);
   /// Bodies for the dashpots: particles while whole, fragments (connected components of intact
   /// bonds) once bonds break; labelled again at a list build or update when bonds broke since
   /// (bonds never heal, so the count tells) or the held nodes changed.
   void label_bodies(const Model& model, const State& state, std::uint64_t broken_bonds);
+
+  // The passes of add_forces, in order (see there).
+  void measure_contacts(const Model& model, const State& state);
+  void sum_slot_stiffness();
+  void measure_bodies(const Model& model, const State& state);
+  void sum_slot_springs(const Model& model, const State& state);
+  void slot_dashpots(const State& state, real dt);
+  void node_forces(const Model& model, State& state, real dt);
+  void body_loads(const Model& model, State& state);
+  void sum_wall_reactions();
+  /// Contact radius of node i in a contact of law `law` with node j (its share of the pair's Rc).
+  real node_radius(const contact::Law& law, const Model& model, index_t i, index_t j,
+                   real contact_radius) const;
 
   /// Rc and kn of the pair of particles p, q (resolve() of their materials' law).
   contact::PairLaw pair_law(index_t p, index_t q) const;
@@ -170,6 +206,23 @@ class ContactModel {
   // bodies since they touched (for the secant stiffness F / x of the dashpot).
   std::vector<real> slot_approach_;
   std::vector<real> slot_last_normal_;  // 3 per slot: normal of the last evaluation in contact
+  // Friction springs (tangential displacement xi, 3 per entry), carried over by keep_history.
+  std::vector<real> pair_shear_, wall_shear_;
+  std::vector<index_t> kept_pair_offsets_, kept_pair_partner_, kept_wall_offsets_;
+  std::vector<std::array<index_t, 2>> kept_wall_entry_;
+  std::vector<real> kept_pair_shear_, kept_wall_shear_;
+  bool history_kept_ = false;
+  // Nodes with entries, grouped by body: contact_nodes_[body_contact_offsets_[b] ...], and the
+  // friction couple (p - x_i) x F_t each of them puts on its body (pass C, summed in pass E).
+  std::vector<index_t> contact_nodes_, body_contact_offsets_;
+  std::vector<vec3> node_couple_;
+  // Per step, per body and per slot (sized at list changes).
+  std::vector<std::uint8_t> touching_body_;
+  std::vector<BodyMotion> body_motion_;
+  std::vector<std::array<real, 6>> body_load_;  // force, then torque about the centre
+  std::vector<real> slot_force_;
+  std::vector<vec3> slot_normal_, slot_point_;  // spring-weighted normal and contact point sums
+  std::vector<std::array<real, 6>> wall_damping_;
   real last_time_ = 0;
   bool has_last_time_ = false;
   // Scratch, per entry.
@@ -181,7 +234,6 @@ class ContactModel {
     std::array<WallContact, 6> points{};
   };
   std::vector<WallPoints> wall_points_;
-  std::vector<real> pair_damping_;
   std::vector<real> wall_entry_stiffness_;
   std::vector<std::array<real, 6>> wall_entry_reaction_;
   std::vector<std::array<real, 6>> wall_reactions_;

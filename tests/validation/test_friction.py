@@ -1,0 +1,162 @@
+"""Static friction and the contact surface (DESIGN.md section 6): a body on an incline sticks
+below the friction angle and slides at g (sin a - mu cos a) above it; a body at rest never spins
+up; a disc at rest sits at its radius; a disc and a sphere roll at 2/3 and 5/7 of their launch
+speed (Cundall-Strack springs acting at the surface, see contact_law.hpp)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import granulate as gr
+
+RUBBER = gr.Material(density=1000, youngs_modulus=5e6, poisson_ratio=0.25, fracture=False)
+SOFT = gr.Material(density=1200, bulk_modulus=2.16e7, shear_modulus=1.296e7, fracture=False)
+
+
+def rigid_motion(sim: gr.Simulation, body: gr.Body) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Centre, velocity and angular velocity (about z in 2D, a vector in 3D) of a body."""
+    nodes = slice(body.first_node, body.first_node + body.node_count)
+    mass = sim.volumes[nodes] * body.material.density
+    x, v = sim.positions[nodes], sim.velocities[nodes]
+    centre = np.average(x, axis=0, weights=mass)
+    velocity = np.average(v, axis=0, weights=mass)
+    r = x - centre
+    momentum = np.sum(mass[:, None] * np.cross(r, v - velocity), axis=0)
+    inertia = np.einsum("n,nij->ij", mass, _inertia_terms(r))
+    if sim.dimension == 2:
+        return centre, velocity, np.array([0.0, 0.0, momentum[2] / inertia[2, 2]])
+    return centre, velocity, np.linalg.solve(inertia, momentum)
+
+
+def _inertia_terms(r: np.ndarray) -> np.ndarray:
+    return np.einsum("ni,ni->n", r, r)[:, None, None] * np.eye(3) - np.einsum("ni,nj->nij", r, r)
+
+
+def block_on_incline(dimension: int, angle: float, mu: float) -> tuple[gr.Simulation, gr.Body]:
+    """A rubber block on a floor with gravity tilted by `angle` degrees: an incline."""
+    a, g = np.radians(angle), 9.81
+    sim = gr.Simulation(dimension, gravity=(g * np.sin(a), -g * np.cos(a), 0)[:dimension])
+    sim.contact = gr.Contact(restitution=0.3, friction=mu)
+    h = 1e-3
+    if dimension == 2:
+        block = sim.add_body(gr.Rectangle((0, 0.45 * h), (10 * h, 5.45 * h)), RUBBER, h)
+        sim.add_wall(gr.Plane((0, 0), (0, 1)), name="floor")
+    else:
+        block = sim.add_body(gr.Box((0, 0.45 * h, 0), (6 * h, 3.45 * h, 6 * h)), RUBBER, h)
+        sim.add_wall(gr.Plane((0, 0, 0), (0, 1, 0)), name="floor")
+    return sim, block
+
+
+@pytest.mark.validation
+@pytest.mark.parametrize("dimension", [2, 3])
+def test_block_on_an_incline_below_the_friction_angle_stays_put(dimension: int) -> None:
+    """mu = 0.5 (friction angle 26.6 degrees), incline 20 degrees: once the springs have taken
+    the load (0.1 s), the block moves less than 1e-3 of its size in 0.9 s (measured 1e-6 m in 2D,
+    0 in 3D; the regularised law crept at the speed that balanced the load)."""
+    sim, block = block_on_incline(dimension, 20.0, 0.5)
+    sim.run(until=0.1)
+    start = rigid_motion(sim, block)[0]
+    sim.run(until=1.0)
+    drift = np.linalg.norm(rigid_motion(sim, block)[0] - start)
+    size = 10e-3 if dimension == 2 else 6e-3
+    assert drift < 1e-3 * size, f"crept {drift:.3g} m"
+
+
+@pytest.mark.validation
+@pytest.mark.parametrize("dimension", [2, 3])
+def test_block_on_an_incline_above_the_friction_angle_accelerates_at_coulomb_rate(
+    dimension: int,
+) -> None:
+    """Incline 35 degrees, mu = 0.5: a = g (sin a - mu cos a) = 1.609 m/s^2 within 2 %
+    (measured 1.6116 in 2D, 1.6091 in 3D)."""
+    angle, mu = 35.0, 0.5
+    sim, block = block_on_incline(dimension, angle, mu)
+    sim.run(until=0.1)
+    v0, t0 = rigid_motion(sim, block)[1][0], sim.time
+    sim.run(until=0.3)
+    acceleration = (rigid_motion(sim, block)[1][0] - v0) / (sim.time - t0)
+    a = np.radians(angle)
+    expected = 9.81 * (np.sin(a) - mu * np.cos(a))
+    assert acceleration == pytest.approx(expected, rel=0.02)
+
+
+@pytest.mark.validation
+@pytest.mark.parametrize("gravity", [9.81, 100.0])
+@pytest.mark.parametrize("mu", [0.0, 0.3, 1.0])
+def test_a_disc_at_rest_on_a_wall_never_spins_up_and_sits_at_its_radius(
+    mu: float, gravity: float
+) -> None:
+    """Dropped from 0.02 h above its resting height onto a floor (g = 100 made the regularised
+    friction flip sign every step and spin the disc up, equally for every mu): after 20 ms the
+    disc neither spins nor slides, and its centre is at its radius within 0.1 h (the nodes'
+    contact spheres reach the surface; the node-pair law left it 0.4 h too high)."""
+    sim = gr.Simulation(2, gravity=(0, -gravity))
+    sim.contact = gr.Contact(restitution=0.5, friction=mu)
+    radius, h = 1e-3, 1e-4
+    disc = sim.add_body(gr.Disc((0, radius + 0.02 * h), radius), SOFT, h)
+    sim.add_wall(gr.Plane((0, 0), (0, 1)), name="floor")
+    sim.run(until=0.02)
+    centre, velocity, spin = rigid_motion(sim, disc)
+    assert abs(spin[2]) * radius < 1e-7, f"spins at {spin[2]:.3g} rad/s"
+    assert abs(velocity[0]) < 1e-7
+    assert abs(centre[1] - radius) < 0.1 * h, f"rests at {(centre[1] - radius) / h:+.3f} h"
+
+
+@pytest.mark.validation
+@pytest.mark.parametrize("discretization", ["lattice", "conforming"])
+def test_resting_sphere_sits_at_its_radius(discretization: str) -> None:
+    sim = gr.Simulation(3, gravity=(0, -9.81, 0), viscous_damping=30.0)
+    sim.contact = gr.Contact(restitution=0.5, friction=0.3)
+    radius, h = 1e-3, 0.25e-3
+    sphere = sim.add_body(gr.Sphere((0, radius, 0), radius), SOFT, h, discretization=discretization)
+    sim.add_wall(gr.Plane((0, 0, 0), (0, 1, 0)), name="floor")
+    sim.run(until=0.02)
+    centre = rigid_motion(sim, sphere)[0]
+    assert abs(centre[1] - radius) < 0.1 * h, f"rests at {(centre[1] - radius) / h:+.3f} h"
+
+
+def roll(dimension: int, nodes_across_radius: int, time: float) -> tuple[float, float]:
+    """A conforming disc (sphere) set sliding at v0 without spin on a floor with mu = 0.3: the
+    ratio v / v0 and the slip (v - omega R) / v, averaged over the rolling phase (from
+    v0 / (2 mu g), after slipping ends at v0 / (3 mu g) for a disc, 2 v0 / (7 mu g) for a
+    sphere, until `time`)."""
+    g, mu, v0, radius = 9.81, 0.3, 0.1, 1e-3
+    h = radius / nodes_across_radius
+    sim = gr.Simulation(dimension, gravity=(0, -g, 0)[:dimension])
+    sim.contact = gr.Contact(restitution=1.0, friction=mu)
+    if dimension == 2:
+        body = sim.add_body(gr.Disc((0, radius), radius), SOFT, h, discretization="conforming")
+        sim.add_wall(gr.Plane((0, 0), (0, 1)), name="floor")
+    else:
+        body = sim.add_body(gr.Sphere((0, radius, 0), radius), SOFT, h, discretization="conforming")
+        sim.add_wall(gr.Plane((0, 0, 0), (0, 1, 0)), name="floor")
+    sim.run(until=0.01)  # land
+    sim.velocities[:, 0] += v0
+    start = sim.time
+    sim.run(until=start + 0.5 * v0 / (mu * g))
+    speeds, slips = [], []
+    while sim.time < start + time:
+        sim.run(50)
+        _, velocity, spin = rigid_motion(sim, body)
+        speeds.append(velocity[0] / v0)
+        slips.append((velocity[0] + spin[2] * radius) / velocity[0])
+    return float(np.mean(speeds)), float(np.mean(slips))
+
+
+@pytest.mark.validation
+def test_disc_rolls_at_two_thirds_of_its_launch_speed() -> None:
+    """Friction acts at the surface (radius R), not at the outer nodes (R - h/2, which gave
+    0.646 v0 with 4.7 % slip). R/h = 10: 2/3 v0 within 2 %, slip < 1 %."""
+    speed, slip = roll(2, 10, 0.03)
+    assert speed == pytest.approx(2 / 3, rel=0.02)
+    assert abs(slip) < 0.01
+
+
+@pytest.mark.validation
+def test_sphere_rolls_at_five_sevenths_of_its_launch_speed(full: bool) -> None:
+    """As above for a sphere: 5/7 v0 within 2 % and slip < 1 % at R/h = 10 (--full, about
+    150 s); the smoke size R/h = 6 is bumpier and rolls at 0.697 v0 (-2.4 %): 3 % there."""
+    speed, slip = roll(3, 10 if full else 6, 0.05 if full else 0.03)
+    assert speed == pytest.approx(5 / 7, rel=0.02 if full else 0.03)
+    assert abs(slip) < 0.01
