@@ -171,6 +171,6 @@ def test_checkpoints_of_the_earlier_contact_model_are_refused(tmp_path: Path) ->
         tumbling_drum(tmp_path / "b").load_checkpoint(old)
     assert old.read_bytes() == before
     state = dict(sim.core.checkpoint())
-    del state["contact_pair_shear"]
-    with pytest.raises(gr.InputError, match="no 'contact_pair_shear' entry"):
+    del state["contact_pair_springs"]
+    with pytest.raises(gr.InputError, match="no 'contact_pair_springs' entry"):
         sim.core.restore(state)

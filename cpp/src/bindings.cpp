@@ -90,8 +90,9 @@ nb::dict checkpoint_dict(const Simulation& self) {
                                  c.statistics.wall_contacts, c.statistics.list_updates});
   d["contact_pair_offsets"] = copy_out(c.pair_offsets);
   d["contact_pair_partners"] = copy_out(c.pair_partners);
-  d["contact_pair_shear"] = copy_out(c.pair_shear);
-  d["contact_wall_shear"] = copy_out(c.wall_shear);
+  d["contact_springs"] = copy_out(c.springs);
+  d["contact_pair_springs"] = copy_out(c.pair_springs);
+  d["contact_wall_springs"] = copy_out(c.wall_springs);
   std::vector<real> reactions;
   for (const auto& r : c.wall_reactions) reactions.insert(reactions.end(), r.begin(), r.end());
   d["contact_wall_reactions"] = copy_out(reactions);
@@ -128,8 +129,9 @@ void restore_dict(Simulation& self, const nb::dict& d) {
   c.statistics = {statistics[0], statistics[4], statistics[1], statistics[2], statistics[3]};
   c.pair_offsets = entry<index_t>(d, "contact_pair_offsets");
   c.pair_partners = entry<index_t>(d, "contact_pair_partners");
-  c.pair_shear = entry<real>(d, "contact_pair_shear");
-  c.wall_shear = entry<real>(d, "contact_wall_shear");
+  c.springs = entry<real>(d, "contact_springs");
+  c.pair_springs = entry<index_t>(d, "contact_pair_springs");
+  c.wall_springs = entry<index_t>(d, "contact_wall_springs");
   const auto reactions = entry<real>(d, "contact_wall_reactions");
   if (reactions.size() % 6) throw InputError("the checkpoint's wall reactions are malformed");
   for (std::size_t k = 0; k < reactions.size(); k += 6) {

@@ -393,49 +393,82 @@ void ContactModel::label_bodies(const Model& model, const State& state, std::uin
 }
 
 void ContactModel::keep_history() {
-  // Copies of the lists (a list update edits them in place), the springs themselves.
+  // Copies of the lists (a list update edits them in place), and the entries' springs.
   if (history_kept_) return;  // lists changed twice before finish_lists: the first kept lists stay
   history_kept_ = true;
   kept_pair_offsets_ = pair_offsets_;
   kept_pair_partner_ = pair_partner_;
-  kept_pair_shear_ = std::move(pair_shear_);
+  kept_pair_spring_ = std::move(pair_spring_);
   kept_wall_offsets_ = wall_offsets_;
   kept_wall_entry_ = wall_entry_;
-  kept_wall_shear_ = std::move(wall_shear_);
+  kept_wall_spring_ = std::move(wall_spring_);
 }
 
 void ContactModel::carry_over_friction(index_t n) {
-  // The friction springs of entries in both the kept and the new lists carry over (a merge walk
-  // per node: both lists are sorted by partner, wall entries by (wall, surface)); new entries
-  // start unstretched.
-  pair_shear_.assign(3 * pair_partner_.size(), 0.0);
-  wall_shear_.assign(3 * wall_entry_.size(), 0.0);
+  // The springs of entries in both the kept and the new lists carry over (a merge walk per node:
+  // both lists are sorted by partner, wall entries by (wall, surface)); new entries have none.
+  pair_spring_.assign(pair_partner_.size(), no_spring);
+  wall_spring_.assign(wall_entry_.size(), no_spring);
   if (!history_kept_) return;
   history_kept_ = false;
-  auto walk = [](const auto& old_offsets, const auto& old_keys, const std::vector<real>& old_shear,
-                 const auto& offsets, const auto& keys, std::vector<real>& shear, index_t node) {
-    if (old_offsets.size() <= node + 1 || old_shear.size() != 3 * old_keys.size()) return;
+  auto walk = [](const auto& old_offsets, const auto& old_keys, const std::vector<index_t>& old_springs,
+                 const auto& offsets, const auto& keys, std::vector<index_t>& new_springs, index_t node) {
+    if (old_offsets.size() <= node + 1 || old_springs.size() != old_keys.size()) return;
     index_t old = old_offsets[node];
     for (index_t e = offsets[node]; e < offsets[node + 1]; ++e) {
       while (old < old_offsets[node + 1] && old_keys[old] < keys[e]) ++old;
-      if (old < old_offsets[node + 1] && old_keys[old] == keys[e]) {
-        for (int k = 0; k < 3; ++k) shear[3 * e + k] = old_shear[3 * old + k];
-      }
+      if (old < old_offsets[node + 1] && old_keys[old] == keys[e]) new_springs[e] = old_springs[old];
     }
   };
 #pragma omp parallel for schedule(static)
   for (std::int64_t ii = 0; ii < static_cast<std::int64_t>(n); ++ii) {
     const index_t i = static_cast<index_t>(ii);
-    walk(kept_pair_offsets_, kept_pair_partner_, kept_pair_shear_, pair_offsets_, pair_partner_, pair_shear_,
+    walk(kept_pair_offsets_, kept_pair_partner_, kept_pair_spring_, pair_offsets_, pair_partner_,
+         pair_spring_, i);
+    walk(kept_wall_offsets_, kept_wall_entry_, kept_wall_spring_, wall_offsets_, wall_entry_, wall_spring_,
          i);
-    walk(kept_wall_offsets_, kept_wall_entry_, kept_wall_shear_, wall_offsets_, wall_entry_, wall_shear_, i);
   }
   kept_pair_offsets_ = {};
   kept_pair_partner_ = {};
-  kept_pair_shear_ = {};
+  kept_pair_spring_ = {};
   kept_wall_offsets_ = {};
   kept_wall_entry_ = {};
-  kept_wall_shear_ = {};
+  kept_wall_spring_ = {};
+  collect_free_springs();
+}
+
+void ContactModel::collect_free_springs() {
+  std::vector<std::uint8_t> held(springs_.size(), 0);
+  for (const index_t s : pair_spring_) {
+    if (s != no_spring) held[s] = 1;
+  }
+  for (const index_t s : wall_spring_) {
+    if (s != no_spring) held[s] = 1;
+  }
+  free_springs_.clear();
+  for (std::size_t s = springs_.size(); s-- > 0;) {  // popped from the back: smallest first
+    if (!held[s]) free_springs_.push_back(static_cast<index_t>(s));
+  }
+}
+
+void ContactModel::assign_springs() {
+  auto update = [&](index_t& spring, bool touching) {
+    if (touching && spring == no_spring) {
+      if (free_springs_.empty()) {
+        spring = static_cast<index_t>(springs_.size());
+        springs_.push_back({0, 0, 0});
+      } else {
+        spring = free_springs_.back();
+        free_springs_.pop_back();
+        springs_[spring] = {0, 0, 0};
+      }
+    } else if (!touching && spring != no_spring) {  // apart: the spring is released
+      free_springs_.push_back(spring);
+      spring = no_spring;
+    }
+  };
+  for (std::size_t e = 0; e < pair_spring_.size(); ++e) update(pair_spring_[e], pair_stiffness_[e] > 0);
+  for (std::size_t e = 0; e < wall_spring_.size(); ++e) update(wall_spring_[e], wall_entry_stiffness_[e] > 0);
 }
 
 void ContactModel::group_contact_nodes(const Model& model) {
@@ -455,12 +488,9 @@ void ContactModel::group_contact_nodes(const Model& model) {
     if (has_entries(i)) contact_nodes_[fill[node_body_[i]]++] = i;
   }
   node_couple_.assign(contact_nodes_.size(), vec3{0, 0, 0});
-  touching_body_.assign(bodies, 0);
-  body_motion_.assign(bodies, BodyMotion{});
-  body_load_.assign(bodies, {0, 0, 0, 0, 0, 0});
-  slot_force_.assign(slots_.size(), 0);
-  slot_normal_.assign(slots_.size(), vec3{0, 0, 0});
-  slot_point_.assign(slots_.size(), vec3{0, 0, 0});
+  body_touch_.assign(bodies, not_touching);
+  touching_bodies_.clear();
+  slot_touch_.assign(slots_.size(), not_touching);
   wall_damping_.assign(walls_.size(), {0, 0, 0, 0, 0, 0});
 }
 
@@ -573,7 +603,6 @@ void ContactModel::finish_lists(const Model& model) {
   group_contact_nodes(model);
   pair_stiffness_.assign(pair_partner_.size(), 0);
   wall_entry_stiffness_.assign(wall_entry_.size(), 0);
-  pair_distance_.assign(pair_partner_.size(), 0);
   wall_points_.assign(wall_entry_.size(), {});
   wall_entry_reaction_.assign(wall_entry_.size(), {0, 0, 0, 0, 0, 0});
 }
@@ -777,10 +806,11 @@ std::size_t ContactModel::memory_bytes() const {
          bytes(pair_partner_) + bytes(pair_slot_) + bytes(wall_offsets_) + bytes(wall_entry_) +
          bytes(wall_slot_) + bytes(slots_) + bytes(slot_reduced_mass_) + bytes(slot_law_) +
          bytes(slot_stiffness_) + bytes(slot_approach_) + bytes(slot_last_normal_) + bytes(pair_stiffness_) +
-         bytes(pair_distance_) + bytes(wall_points_) + bytes(wall_entry_stiffness_) +
-         bytes(wall_entry_reaction_) + bytes(pair_shear_) + bytes(wall_shear_) + bytes(contact_nodes_) +
-         bytes(body_contact_offsets_) + bytes(node_couple_) + bytes(touching_body_) + bytes(body_motion_) +
-         bytes(body_load_) + bytes(slot_force_) + bytes(slot_normal_) + bytes(slot_point_);
+         bytes(wall_points_) + bytes(wall_entry_stiffness_) + bytes(wall_entry_reaction_) + bytes(springs_) +
+         bytes(free_springs_) + bytes(pair_spring_) + bytes(wall_spring_) + bytes(contact_nodes_) +
+         bytes(body_contact_offsets_) + bytes(node_couple_) + bytes(body_touch_) + bytes(touching_bodies_) +
+         bytes(slot_touch_) + bytes(body_motion_) + bytes(body_load_) + bytes(slot_force_) +
+         bytes(slot_normal_) + bytes(slot_point_);
 }
 
 ContactCheckpoint ContactModel::checkpoint() const {
@@ -796,8 +826,9 @@ ContactCheckpoint ContactModel::checkpoint() const {
   c.slot_normal = slot_last_normal_;
   c.pair_offsets = pair_offsets_;
   c.pair_partners = pair_partner_;
-  c.pair_shear = pair_shear_;
-  c.wall_shear = wall_shear_;
+  for (const vec3& spring : springs_) c.springs.insert(c.springs.end(), spring.begin(), spring.end());
+  c.pair_springs = pair_spring_;
+  c.wall_springs = wall_spring_;
   c.last_time = last_time_;
   c.has_last_time = has_last_time_;
   c.statistics = statistics_;
@@ -839,11 +870,22 @@ void ContactModel::restore(const Model& model, const State& state, const Contact
       history_kept_ = false;  // the saved springs below, not those of the lists before
       finish_lists(model);
     }
-    if (saved.pair_shear.size() != pair_shear_.size() || saved.wall_shear.size() != wall_shear_.size()) {
+    const std::size_t pool = saved.springs.size() / 3;
+    auto valid = [&](const std::vector<index_t>& held, std::size_t entries) {
+      return held.size() == entries &&
+             std::all_of(held.begin(), held.end(), [&](index_t s) { return s == no_spring || s < pool; });
+    };
+    if (saved.springs.size() % 3 || !valid(saved.pair_springs, pair_partner_.size()) ||
+        !valid(saved.wall_springs, wall_entry_.size())) {
       throw InputError("the checkpoint's friction springs do not match its contact lists");
     }
-    pair_shear_ = saved.pair_shear;
-    wall_shear_ = saved.wall_shear;
+    springs_.resize(pool);
+    for (std::size_t k = 0; k < pool; ++k) {
+      springs_[k] = {saved.springs[3 * k], saved.springs[3 * k + 1], saved.springs[3 * k + 2]};
+    }
+    pair_spring_ = saved.pair_springs;
+    wall_spring_ = saved.wall_springs;
+    collect_free_springs();
   }
   last_time_ = saved.last_time;
   has_last_time_ = saved.has_last_time;
@@ -899,10 +941,9 @@ void ContactModel::measure_contacts(const Model& model, const State& state) {
         const real dx = x[3 * j] - x[3 * i], dy = x[3 * j + 1] - x[3 * i + 1],
                    dz = x[3 * j + 2] - x[3 * i + 2];
         const real distance = std::sqrt(dx * dx + dy * dy + dz * dz);
-        pair_distance_[e] = distance;
         pair_stiffness_[e] = distance < law.contact_radius && distance > 0
-                                 ? contact::pair_stiffness(law, volume[i], volume[j])
-                                 : 0.0;
+                                 ? static_cast<float>(contact::pair_stiffness(law, volume[i], volume[j]))
+                                 : 0.0f;
       }
       for (index_t e = wall_offsets_[i]; e < wall_offsets_[i + 1]; ++e) {
         const Wall& wall = walls_[wall_entry_[e][0]];
@@ -936,23 +977,38 @@ void ContactModel::sum_slot_stiffness() {
   }
   statistics_.node_contacts = touching / 2;
   statistics_.wall_contacts = wall_touching;
-  std::fill(touching_body_.begin(), touching_body_.end(), 0);
+  assign_springs();
+  // The touching bodies (in a collision, or in a gap of one) and the slots in contact, numbered
+  // in slot order.
+  for (const index_t b : touching_bodies_) body_touch_[b] = not_touching;
+  touching_bodies_.clear();
+  auto touch = [&](index_t body) {
+    if (body_touch_[body] != not_touching) return;
+    body_touch_[body] = static_cast<index_t>(touching_bodies_.size());
+    touching_bodies_.push_back(body);
+  };
+  index_t in_contact = 0;
   for (std::size_t slot = 0; slot < slots_.size(); ++slot) {
+    slot_touch_[slot] = slot_stiffness_[slot] > 0 ? in_contact++ : not_touching;
     if (slot_stiffness_[slot] == 0 && !(slot_approach_[slot] > 0)) continue;
-    touching_body_[slots_[slot][0]] = 1;
-    if (slot < particle_slot_count_) touching_body_[slots_[slot][1]] = 1;
+    touch(slots_[slot][0]);
+    if (slot < particle_slot_count_) touch(slots_[slot][1]);
   }
+  body_motion_.resize(touching_bodies_.size());
+  body_load_.resize(touching_bodies_.size());
+  slot_force_.assign(in_contact, 0.0);
+  slot_normal_.assign(in_contact, vec3{0, 0, 0});
+  slot_point_.assign(in_contact, vec3{0, 0, 0});
 }
 
 void ContactModel::measure_bodies(const Model& model, const State& state) {
-  const std::int64_t body_count = static_cast<std::int64_t>(body_mass_.size());
+  const std::int64_t count = static_cast<std::int64_t>(touching_bodies_.size());
 #pragma omp parallel for schedule(dynamic, 16)
-  for (std::int64_t b = 0; b < body_count; ++b) {
-    body_load_[b] = {0, 0, 0, 0, 0, 0};
-    if (touching_body_[b]) {
-      body_motion_[b] = measure_body(model, state, body_nodes_.data() + body_node_offsets_[b],
-                                     body_node_offsets_[b + 1] - body_node_offsets_[b], dimension_);
-    }
+  for (std::int64_t k = 0; k < count; ++k) {
+    const index_t b = touching_bodies_[k];
+    body_load_[k] = {0, 0, 0, 0, 0, 0};
+    body_motion_[k] = measure_body(model, state, body_nodes_.data() + body_node_offsets_[b],
+                                   body_node_offsets_[b + 1] - body_node_offsets_[b], dimension_);
   }
 }
 
@@ -962,41 +1018,43 @@ void ContactModel::sum_slot_springs(const Model& model, const State& state) {
   const auto& x = state.positions;
   const auto& volume = model.volumes();
   const auto& node_material = model.node_material();
-  std::fill(slot_force_.begin(), slot_force_.end(), 0.0);
-  std::fill(slot_normal_.begin(), slot_normal_.end(), vec3{0, 0, 0});
-  std::fill(slot_point_.begin(), slot_point_.end(), vec3{0, 0, 0});
   for (const index_t i : contact_nodes_) {
     for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
       const index_t j = pair_partner_[e];
       const std::size_t slot = pair_slot_[e];
       if (pair_stiffness_[e] == 0 || node_body_[i] == node_body_[j] || node_body_[i] != slots_[slot][0])
         continue;
+      const index_t touch = slot_touch_[slot];
       const real contact_radius = slot_law_[slot].contact_radius;
-      const real distance = pair_distance_[e];
+      const real distance = std::sqrt((x[3 * j] - x[3 * i]) * (x[3 * j] - x[3 * i]) +
+                                      (x[3 * j + 1] - x[3 * i + 1]) * (x[3 * j + 1] - x[3 * i + 1]) +
+                                      (x[3 * j + 2] - x[3 * i + 2]) * (x[3 * j + 2] - x[3 * i + 2]));
       const real overlap = contact_radius - distance;
       const real spring = contact::normal_force(pair_stiffness_[e], overlap);
       const real lever = node_radius(laws_[node_material[i] * material_count_ + node_material[j]], model, i,
                                      j, contact_radius) -
                          0.5 * overlap;
-      slot_force_[slot] += spring;
+      slot_force_[touch] += spring;
       for (int k = 0; k < 3; ++k) {
         const real normal = (x[3 * j + k] - x[3 * i + k]) / distance;
-        slot_normal_[slot][k] += spring * normal;
-        slot_point_[slot][k] += spring * (x[3 * i + k] + lever * normal);
+        slot_normal_[touch][k] += spring * normal;
+        slot_point_[touch][k] += spring * (x[3 * i + k] + lever * normal);
       }
     }
     for (index_t e = wall_offsets_[i]; e < wall_offsets_[i + 1]; ++e) {
       const std::size_t slot = wall_slot_[e];
+      if (wall_entry_stiffness_[e] == 0) continue;
+      const index_t touch = slot_touch_[slot];
       const contact::PairLaw& law = slot_law_[slot];
       const WallPoints& points = wall_points_[e];
       for (std::size_t k = 0; k < points.count; ++k) {
         const real overlap = law.contact_radius - points.points[k].distance;
         const real spring = contact::normal_force(law.normal_stiffness * volume[i] * volume[i], overlap);
         const real lever = law.contact_radius - 0.5 * overlap;
-        slot_force_[slot] += spring;
+        slot_force_[touch] += spring;
         for (int c = 0; c < 3; ++c) {
-          slot_normal_[slot][c] += spring * points.points[k].normal[c];
-          slot_point_[slot][c] += spring * (x[3 * i + c] - lever * points.points[k].normal[c]);
+          slot_normal_[touch][c] += spring * points.points[k].normal[c];
+          slot_point_[touch][c] += spring * (x[3 * i + c] - lever * points.points[k].normal[c]);
         }
       }
     }
@@ -1013,16 +1071,17 @@ void ContactModel::slot_dashpots(const State& state, real dt) {
   const real t = state.time;
   std::fill(wall_damping_.begin(), wall_damping_.end(), std::array<real, 6>{0, 0, 0, 0, 0, 0});
   auto load = [&](index_t body, const vec& point, const vec& force) {
-    const BodyMotion& motion = body_motion_[body];
+    const index_t touch = body_touch_[body];
+    const BodyMotion& motion = body_motion_[touch];
     const vec torque =
         cross({point[0] - motion.centre[0], point[1] - motion.centre[1], point[2] - motion.centre[2]}, force);
     for (int k = 0; k < 3; ++k) {
-      body_load_[body][k] += force[k];
-      body_load_[body][3 + k] += torque[k];
+      body_load_[touch][k] += force[k];
+      body_load_[touch][3 + k] += torque[k];
     }
   };
   auto point_velocity = [&](index_t body, const vec& point) {
-    const BodyMotion& motion = body_motion_[body];
+    const BodyMotion& motion = body_motion_[body_touch_[body]];
     const vec turn = cross(motion.angular_velocity, {point[0] - motion.centre[0], point[1] - motion.centre[1],
                                                      point[2] - motion.centre[2]});
     return vec{motion.velocity[0] + turn[0], motion.velocity[1] + turn[1], motion.velocity[2] + turn[2]};
@@ -1034,13 +1093,14 @@ void ContactModel::slot_dashpots(const State& state, real dt) {
       slot_approach_[slot] = 0;
       continue;
     }
-    const vec& sum = slot_normal_[slot];
+    const index_t touch = slot_touch_[slot];
+    const vec sum = touch == not_touching ? vec{0, 0, 0} : slot_normal_[touch];
     const real norm = std::sqrt(dot(sum, sum));
     // A collision lasts until the bodies are back where they first touched (approach x = 0),
     // not while springs are in contact: the surface nodes of deformable bodies chatter (touch,
     // part, touch again) within one collision when the contact is stiffer than the material,
     // and a dashpot restarted at each touch would damp the collision many times over.
-    const bool in_contact = slot_stiffness_[slot] > 0 && norm > 0 && slot_force_[slot] > 0;
+    const bool in_contact = touch != not_touching && norm > 0 && slot_force_[touch] > 0;
     real* last_normal = &slot_last_normal_[3 * slot];
     if (in_contact) {
       for (int k = 0; k < 3; ++k) last_normal[k] = sum[k] / norm;
@@ -1050,10 +1110,10 @@ void ContactModel::slot_dashpots(const State& state, real dt) {
     }
     const vec normal{last_normal[0], last_normal[1], last_normal[2]};
     // The contact point: spring-weighted, or the first body's centre in a gap of the collision.
-    const vec point =
-        in_contact ? vec{slot_point_[slot][0] / slot_force_[slot], slot_point_[slot][1] / slot_force_[slot],
-                         slot_point_[slot][2] / slot_force_[slot]}
-                   : body_motion_[p].centre;
+    const vec point = in_contact ? vec{slot_point_[touch][0] / slot_force_[touch],
+                                       slot_point_[touch][1] / slot_force_[touch],
+                                       slot_point_[touch][2] / slot_force_[touch]}
+                                 : body_motion_[body_touch_[p]].centre;
     const vec velocity_p = point_velocity(p, point);
     const vec velocity_q = wall_slot ? walls_[q].velocity_at(point.data(), t) : point_velocity(q, point);
     const vec relative{velocity_p[0] - velocity_q[0], velocity_p[1] - velocity_q[1],
@@ -1070,7 +1130,7 @@ void ContactModel::slot_dashpots(const State& state, real dt) {
     }
     if (zeta == 0) continue;
     const real K = slot_stiffness_[slot];
-    const real secant = slot_approach_[slot] > 0 ? std::min(K, slot_force_[slot] / slot_approach_[slot]) : K;
+    const real secant = slot_approach_[slot] > 0 ? std::min(K, slot_force_[touch] / slot_approach_[slot]) : K;
     const real damping = 2.0 * zeta * std::sqrt(slot_reduced_mass_[slot] * secant) * approach;
     if (wall_slot) {  // the wall takes the opposite force, at the contact point
       load(p, point, {damping * normal[0], damping * normal[1], damping * normal[2]});
@@ -1103,21 +1163,18 @@ void ContactModel::node_forces(const Model& model, State& state, real dt) {
   for (std::int64_t slot = 0; slot < count; ++slot) {
     const index_t i = contact_nodes_[slot];
     const index_t body = node_body_[i];
-    const vec& spin_i = body_motion_[body].angular_velocity;
+    const vec& spin_i = body_spin(body);
     const real* xi = &x[3 * i];
     const real* vi = &v[3 * i];
     vec total{0, 0, 0}, couple{0, 0, 0};
     for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
-      if (pair_stiffness_[e] == 0) {
-        for (int k = 0; k < 3; ++k) pair_shear_[3 * e + k] = 0;  // apart: the spring is released
-        continue;
-      }
+      if (pair_stiffness_[e] == 0) continue;
       const index_t j = pair_partner_[e];
       const contact::Law& law = laws_[node_material[i] * material_count_ + node_material[j]];
       const real contact_radius = slot_law_[pair_slot_[e]].contact_radius;
-      const real distance = pair_distance_[e];
-      const vec normal{(x[3 * j] - xi[0]) / distance, (x[3 * j + 1] - xi[1]) / distance,
-                       (x[3 * j + 2] - xi[2]) / distance};  // from i to j
+      const vec d{x[3 * j] - xi[0], x[3 * j + 1] - xi[1], x[3 * j + 2] - xi[2]};  // as in pass A
+      const real distance = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+      const vec normal{d[0] / distance, d[1] / distance, d[2] / distance};  // from i to j
       const vec relative{vi[0] - v[3 * j], vi[1] - v[3 * j + 1], vi[2] - v[3 * j + 2]};
       const real approach = dot(relative, normal);
       const real k = pair_stiffness_[e];
@@ -1139,13 +1196,13 @@ void ContactModel::node_forces(const Model& model, State& state, real dt) {
         const real lever_i = node_radius(law, model, i, j, contact_radius) - 0.5 * overlap;
         const real lever_j = node_radius(law, model, j, i, contact_radius) - 0.5 * overlap;
         const vec turn_i = cross(spin_i, {lever_i * normal[0], lever_i * normal[1], lever_i * normal[2]});
-        const vec turn_j = cross(body_motion_[node_body_[j]].angular_velocity,
+        const vec turn_j = cross(body_spin(node_body_[j]),
                                  {-lever_j * normal[0], -lever_j * normal[1], -lever_j * normal[2]});
         const real slip[3] = {(vi[0] + turn_i[0]) - (v[3 * j] + turn_j[0]),
                               (vi[1] + turn_i[1]) - (v[3 * j + 1] + turn_j[1]),
                               (vi[2] + turn_i[2]) - (v[3 * j + 2] + turn_j[2])};
         contact::tangential_force(law.tangential_stiffness_ratio * k, law.friction, push, normal.data(), slip,
-                                  dt, &pair_shear_[3 * e], friction);
+                                  dt, springs_[pair_spring_[e]].data(), friction);
         const vec moment = cross({lever_i * normal[0], lever_i * normal[1], lever_i * normal[2]},
                                  {friction[0], friction[1], friction[2]});
         for (int c = 0; c < 3; ++c) couple[c] += moment[c];
@@ -1155,10 +1212,7 @@ void ContactModel::node_forces(const Model& model, State& state, real dt) {
     for (index_t e = wall_offsets_[i]; e < wall_offsets_[i + 1]; ++e) {
       std::array<real, 6>& reaction = wall_entry_reaction_[e];
       reaction = {0, 0, 0, 0, 0, 0};
-      if (wall_entry_stiffness_[e] == 0) {
-        for (int k = 0; k < 3; ++k) wall_shear_[3 * e + k] = 0;
-        continue;
-      }
+      if (wall_entry_stiffness_[e] == 0) continue;
       const Wall& wall = walls_[wall_entry_[e][0]];
       const contact::Law& law = wall_laws_[wall_entry_[e][0] * material_count_ + node_material[i]];
       const contact::PairLaw& resolved = slot_law_[wall_slot_[e]];
@@ -1190,7 +1244,7 @@ void ContactModel::node_forces(const Model& model, State& state, real dt) {
         const real slip[3] = {vi[0] + turn[0] - wall_velocity[0], vi[1] + turn[1] - wall_velocity[1],
                               vi[2] + turn[2] - wall_velocity[2]};
         contact::tangential_force(law.tangential_stiffness_ratio * k, law.friction, push_total, normal.data(),
-                                  slip, dt, &wall_shear_[3 * e], friction);
+                                  slip, dt, springs_[wall_spring_[e]].data(), friction);
         const vec moment = cross(arm, {friction[0], friction[1], friction[2]});
         for (int c = 0; c < 3; ++c) couple[c] += moment[c];
       }
@@ -1212,16 +1266,16 @@ void ContactModel::body_loads(const Model& model, State& state) {
   const auto& x = state.positions;
   auto& f = state.forces;
   const real* const density = model.node_density().data();
-  const std::int64_t body_count = static_cast<std::int64_t>(body_mass_.size());
+  const std::int64_t count = static_cast<std::int64_t>(touching_bodies_.size());
 #pragma omp parallel for schedule(dynamic, 16)
-  for (std::int64_t b = 0; b < body_count; ++b) {
-    if (!touching_body_[b]) continue;
-    std::array<real, 6> total = body_load_[b];
+  for (std::int64_t touch = 0; touch < count; ++touch) {
+    const index_t b = touching_bodies_[touch];
+    std::array<real, 6> total = body_load_[touch];
     for (index_t k = body_contact_offsets_[b]; k < body_contact_offsets_[b + 1]; ++k) {
       for (int c = 0; c < 3; ++c) total[3 + c] += node_couple_[k][c];
     }
     if (total == std::array<real, 6>{0, 0, 0, 0, 0, 0}) continue;
-    const BodyMotion& motion = body_motion_[b];
+    const BodyMotion& motion = body_motion_[touch];
     const vec acceleration{total[0] / motion.mass, total[1] / motion.mass, total[2] / motion.mass};
     const vec turn = symmetric_times(motion.inverse_inertia, {total[3], total[4], total[5]});
     for (index_t k = body_node_offsets_[b]; k < body_node_offsets_[b + 1]; ++k) {

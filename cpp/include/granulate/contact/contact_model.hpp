@@ -50,8 +50,9 @@ struct ContactCheckpoint {
   std::vector<real> slot_approach;
   std::vector<real> slot_normal;                     ///< 3 per slot: the collision's last contact normal
   std::vector<index_t> pair_offsets, pair_partners;  ///< the lists (updated after bond breaks)
-  std::vector<real> pair_shear;                      ///< 3 per list entry: friction springs
-  std::vector<real> wall_shear;                      ///< 3 per node-wall entry: friction springs
+  /// Friction springs: the pool (3 per spring) and each list entry's spring (none: 2^32 - 1).
+  std::vector<real> springs;
+  std::vector<index_t> pair_springs, wall_springs;
   real last_time = 0;
   bool has_last_time = false;
   ContactStatistics statistics;
@@ -136,8 +137,13 @@ class ContactModel {
   void finish_lists(const Model& model);
   /// Moves the lists and their friction springs aside before the lists change, for finish_lists.
   void keep_history();
-  /// Friction springs of the new lists from the kept ones (entries in both keep theirs).
+  /// Friction springs of the new lists from the kept ones (entries in both keep theirs; the
+  /// springs of entries that left the lists go back to the pool).
   void carry_over_friction(index_t node_count);
+  /// Gives each entry in contact a spring and takes back those of entries apart (entry order).
+  void assign_springs();
+  /// The free list: every pool spring no entry holds, in increasing order.
+  void collect_free_springs();
   /// Nodes with list entries, grouped by body (each group in node order), and the per-step
   /// scratch of bodies and slots.
   void group_contact_nodes(const Model& model);
@@ -206,28 +212,42 @@ class ContactModel {
   // bodies since they touched (for the secant stiffness F / x of the dashpot).
   std::vector<real> slot_approach_;
   std::vector<real> slot_last_normal_;  // 3 per slot: normal of the last evaluation in contact
-  // Friction springs (tangential displacement xi, 3 per entry), carried over by keep_history.
-  std::vector<real> pair_shear_, wall_shear_;
+  // Friction springs (tangential displacement xi) of the entries in contact, in a pool: each
+  // entry holds the index of its spring (no_spring when apart), given and taken back in pass B
+  // in entry order, carried over at list changes by keep_history.
+  static constexpr index_t no_spring = ~index_t{0};
+  std::vector<vec3> springs_;
+  std::vector<index_t> free_springs_;
+  std::vector<index_t> pair_spring_, wall_spring_;
   std::vector<index_t> kept_pair_offsets_, kept_pair_partner_, kept_wall_offsets_;
   std::vector<std::array<index_t, 2>> kept_wall_entry_;
-  std::vector<real> kept_pair_shear_, kept_wall_shear_;
+  std::vector<index_t> kept_pair_spring_, kept_wall_spring_;
   bool history_kept_ = false;
   // Nodes with entries, grouped by body: contact_nodes_[body_contact_offsets_[b] ...], and the
   // friction couple (p - x_i) x F_t each of them puts on its body (pass C, summed in pass E).
   std::vector<index_t> contact_nodes_, body_contact_offsets_;
   std::vector<vec3> node_couple_;
-  // Per step, per body and per slot (sized at list changes).
-  std::vector<std::uint8_t> touching_body_;
-  std::vector<BodyMotion> body_motion_;
-  std::vector<std::array<real, 6>> body_load_;  // force, then torque about the centre
-  std::vector<real> slot_force_;
+  // Per step: the touching bodies (in a collision, or in a gap of one) and the slots in contact,
+  // numbered compactly (fragments can outnumber nodes' neighbours when grains shatter).
+  static constexpr index_t not_touching = ~index_t{0};
+  std::vector<index_t> body_touch_;  // per body: its index among the touching bodies, or none
+  std::vector<index_t> touching_bodies_;
+  std::vector<BodyMotion> body_motion_;         // per touching body
+  std::vector<std::array<real, 6>> body_load_;  // per touching body: force, torque about the centre
+  std::vector<index_t> slot_touch_;             // per slot: its index among the slots in contact
+  std::vector<real> slot_force_;                // per slot in contact: spring force, and the
   std::vector<vec3> slot_normal_, slot_point_;  // spring-weighted normal and contact point sums
+  /// Angular velocity of a body (zero if it touches nothing).
+  const vec3& body_spin(index_t body) const {
+    static constexpr vec3 none{0, 0, 0};
+    return body_touch_[body] == not_touching ? none : body_motion_[body_touch_[body]].angular_velocity;
+  }
   std::vector<std::array<real, 6>> wall_damping_;
   real last_time_ = 0;
   bool has_last_time_ = false;
-  // Scratch, per entry.
-  std::vector<real> pair_stiffness_;
-  std::vector<real> pair_distance_;
+  // Scratch, per entry: the spring stiffness k of the pair in contact, 0 if apart (single
+  // precision, 4 bytes: list entries outnumber nodes when grains shatter).
+  std::vector<float> pair_stiffness_;
   /// Contact points of a wall entry (at most one per box face), normals in the world frame.
   struct WallPoints {
     std::uint8_t count = 0;
