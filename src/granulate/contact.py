@@ -1,17 +1,24 @@
 """Contact parameters between particles, and between particles and walls.
 
-Two nodes interact when they are closer than the contact radius Rc and no intact bond joins
-them (nodes of different particles, or of fragments of one particle). The pair force is a
-spring kn (Rc - R) V_i V_j, a dashpot sized so that two bodies colliding head-on rebound with
-the requested coefficient of restitution, and regularised Coulomb friction (see
-cpp/include/granulate/contact/contact_law.hpp for the formulas).
+Every node is a contact sphere of radius rho_i = contact_radius_factor x h_i / 2 (h_i: its
+particle's mesh size), reaching the particle's surface. Two nodes interact when they are closer
+than Rc = rho_i + rho_j and no intact bond joins them (nodes of different particles, or of
+fragments of one particle); a node touches a wall closer than rho_i. The pair force is a spring
+kn (Rc - R) min(V_i, V_j)^2, a dashpot sized so that two bodies colliding head-on rebound with
+the requested coefficient of restitution (acting on both bodies at the contact point), and
+Coulomb friction with stick: a tangential spring per contact (Cundall & Strack), capped at
+mu F_n, acting on the particles' surfaces (see cpp/include/granulate/contact/contact_law.hpp
+for the formulas). Particles of different sizes meshed with the same nodes per radius collide
+like equal ones; a particle at rest sits at its radius.
 
-Defaults: Rc = 0.95 times the smaller mesh size of the two bodies; kn = c / delta, the stiffness
-of a peridynamic bond one horizon long (PMB micromodulus c, constant influence) for the
-harmonic mean of the two moduli: 18 K_eff / (pi delta^5) in 3D and 12 kappa_eff / (pi delta^4)
-in 2D (kappa: the planar bulk modulus), with delta the horizon of the finer particle. Both are
-resolved per pair of particles in the core (contact::resolve), so particles of any size share one
-law.
+Defaults: contact_radius_factor 0.95; kn = c / delta, the stiffness of a peridynamic bond one
+horizon long (PMB micromodulus c, constant influence) for the harmonic mean of the two moduli:
+18 K_eff / (pi delta^5) in 3D and 12 kappa_eff / (pi delta^4) in 2D (kappa: the planar bulk
+modulus), with delta the horizon of the finer particle. Both are resolved per pair of particles
+in the core (contact::resolve), so particles of any size share one law. This kn keeps the time
+step near the peridynamic one but makes the contact layer softer than the grains; for Hertzian
+contacts (the grains' elasticity governing) raise stiffness_factor to about 100 E*/K (see
+ARCHITECTURE.md, "Choosing kn").
 """
 
 from __future__ import annotations
@@ -29,15 +36,21 @@ class Contact:
     Attributes:
         restitution: coefficient of restitution e of a head-on collision, in (0, 1].
         friction: Coulomb friction coefficient mu >= 0.
-        contact_radius_factor: Rc as a multiple of the smaller mesh size (default 0.95).
-        contact_radius: absolute Rc [m]; overrides the factor.
+        contact_radius_factor: each node's contact radius is factor x h / 2 of its own
+            particle (default 0.95), so a node pair's Rc is factor x (h_i + h_j) / 2.
+        contact_radius: absolute Rc [m] of a node pair (each node's radius Rc / 2);
+            overrides the factor.
         normal_stiffness: absolute kn [N/m^7 in 3D, N/m^6 in 2D]; overrides the default.
         stiffness_factor: multiplies the default kn.
         tangential_stiffness_ratio: kt / kn of the friction spring of each contact (Cundall &
             Strack), in (0, 1]; default 2/7.
-        friction_law: "coulomb" (default), or "peridem": PeriDEM's friction, mu |F_n| along
-            the slip velocity (it speeds sliding up instead of resisting it); for comparisons
-            with PeriDEM only.
+        friction_law: "coulomb" (default: the friction spring), or "peridem": PeriDEM's
+            friction, mu |F_n| along the slip velocity (it speeds sliding up instead of
+            resisting it); for comparisons with PeriDEM only.
+        pair_law: "granulate" (default: per-node contact radii, springs kn min(V_i, V_j)^2),
+            or "peridem": PeriDEM's node-pair law, one Rc per pair of particles (factor x the
+            finer mesh size, also against walls) and springs kn V_i V_j; for comparisons with
+            PeriDEM only (set by --peridem-compat).
     """
 
     restitution: float = 1.0
