@@ -487,7 +487,6 @@ void ContactModel::group_contact_nodes(const Model& model) {
   for (index_t i = 0; i < n; ++i) {
     if (has_entries(i)) contact_nodes_[fill[node_body_[i]]++] = i;
   }
-  node_couple_.assign(contact_nodes_.size(), vec3{0, 0, 0});
   body_touch_.assign(bodies, not_touching);
   touching_bodies_.clear();
   slot_touch_.assign(slots_.size(), not_touching);
@@ -808,9 +807,9 @@ std::size_t ContactModel::memory_bytes() const {
          bytes(slot_stiffness_) + bytes(slot_approach_) + bytes(slot_last_normal_) + bytes(pair_stiffness_) +
          bytes(wall_points_) + bytes(wall_entry_stiffness_) + bytes(wall_entry_reaction_) + bytes(springs_) +
          bytes(free_springs_) + bytes(pair_spring_) + bytes(wall_spring_) + bytes(contact_nodes_) +
-         bytes(body_contact_offsets_) + bytes(node_couple_) + bytes(body_touch_) + bytes(touching_bodies_) +
-         bytes(slot_touch_) + bytes(body_motion_) + bytes(body_load_) + bytes(slot_force_) +
-         bytes(slot_normal_) + bytes(slot_point_);
+         bytes(body_contact_offsets_) + bytes(body_touch_) + bytes(touching_bodies_) + bytes(slot_touch_) +
+         bytes(body_motion_) + bytes(body_load_) + bytes(slot_force_) + bytes(slot_normal_) +
+         bytes(slot_point_);
 }
 
 ContactCheckpoint ContactModel::checkpoint() const {
@@ -1150,114 +1149,161 @@ void ContactModel::slot_dashpots(const State& state, real dt) {
 }
 
 void ContactModel::node_forces(const Model& model, State& state, real dt) {
-  // Each node gathers its own contact forces (and updates its own friction springs); the
-  // couple of each friction force about the node, (p - x_i) x F_t, is kept for pass E.
-  const auto& x = state.positions;
-  const auto& v = state.velocities;
-  auto& f = state.forces;
-  const auto& volume = model.volumes();
-  const auto& node_material = model.node_material();
-  const real t = state.time;
+  // Each node gathers its own contact forces and updates its own friction springs.
   const std::int64_t count = static_cast<std::int64_t>(contact_nodes_.size());
 #pragma omp parallel for schedule(static)
-  for (std::int64_t slot = 0; slot < count; ++slot) {
-    const index_t i = contact_nodes_[slot];
-    const index_t body = node_body_[i];
-    const vec& spin_i = body_spin(body);
-    const real* xi = &x[3 * i];
-    const real* vi = &v[3 * i];
-    vec total{0, 0, 0}, couple{0, 0, 0};
+  for (std::int64_t k = 0; k < count; ++k) {
+    const index_t i = contact_nodes_[k];
+    vec total{0, 0, 0};
     for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
       if (pair_stiffness_[e] == 0) continue;
-      const index_t j = pair_partner_[e];
-      const contact::Law& law = laws_[node_material[i] * material_count_ + node_material[j]];
-      const real contact_radius = slot_law_[pair_slot_[e]].contact_radius;
-      const vec d{x[3 * j] - xi[0], x[3 * j + 1] - xi[1], x[3 * j + 2] - xi[2]};  // as in pass A
-      const real distance = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-      const vec normal{d[0] / distance, d[1] / distance, d[2] / distance};  // from i to j
-      const vec relative{vi[0] - v[3 * j], vi[1] - v[3 * j + 1], vi[2] - v[3 * j + 2]};
-      const real approach = dot(relative, normal);
-      const real k = pair_stiffness_[e];
-      const real overlap = contact_radius - distance;
-      real push = contact::normal_force(k, overlap);
-      if (body == node_body_[j]) {  // unbonded nodes of one body: a node-pair dashpot
-        const real K = slot_stiffness_[pair_slot_[e]];
-        const real c = 2.0 * law.damping_ratio * k * std::sqrt(slot_reduced_mass_[pair_slot_[e]] / K);
-        push = std::max(0.0, push + contact::damping_force(c, approach));
-      }
-      real friction[3] = {0, 0, 0};
-      if (law.peridem_friction) {
-        const real tangential[3] = {relative[0] - approach * normal[0], relative[1] - approach * normal[1],
-                                    relative[2] - approach * normal[2]};
-        contact::peridem_friction_force(law.friction, push, tangential, friction);
-      } else if (law.friction > 0) {
-        // Slip of the contact point p = x_i + lever_i n: the nodes' velocities plus each body's
-        // rotation about the node (the node lies inside its particle, p on the surface).
-        const real lever_i = node_radius(law, model, i, j, contact_radius) - 0.5 * overlap;
-        const real lever_j = node_radius(law, model, j, i, contact_radius) - 0.5 * overlap;
-        const vec turn_i = cross(spin_i, {lever_i * normal[0], lever_i * normal[1], lever_i * normal[2]});
-        const vec turn_j = cross(body_spin(node_body_[j]),
-                                 {-lever_j * normal[0], -lever_j * normal[1], -lever_j * normal[2]});
-        const real slip[3] = {(vi[0] + turn_i[0]) - (v[3 * j] + turn_j[0]),
-                              (vi[1] + turn_i[1]) - (v[3 * j + 1] + turn_j[1]),
-                              (vi[2] + turn_i[2]) - (v[3 * j + 2] + turn_j[2])};
-        contact::tangential_force(law.tangential_stiffness_ratio * k, law.friction, push, normal.data(), slip,
-                                  dt, springs_[pair_spring_[e]].data(), friction);
-        const vec moment = cross({lever_i * normal[0], lever_i * normal[1], lever_i * normal[2]},
-                                 {friction[0], friction[1], friction[2]});
-        for (int c = 0; c < 3; ++c) couple[c] += moment[c];
-      }
-      for (int c = 0; c < 3; ++c) total[c] += -push * normal[c] + friction[c];
+      const vec force = pair_force(model, state, i, e, dt);
+      for (int c = 0; c < 3; ++c) total[c] += force[c];
     }
     for (index_t e = wall_offsets_[i]; e < wall_offsets_[i + 1]; ++e) {
-      std::array<real, 6>& reaction = wall_entry_reaction_[e];
-      reaction = {0, 0, 0, 0, 0, 0};
+      wall_entry_reaction_[e] = {0, 0, 0, 0, 0, 0};
       if (wall_entry_stiffness_[e] == 0) continue;
-      const Wall& wall = walls_[wall_entry_[e][0]];
-      const contact::Law& law = wall_laws_[wall_entry_[e][0] * material_count_ + node_material[i]];
-      const contact::PairLaw& resolved = slot_law_[wall_slot_[e]];
-      const WallPoints& points = wall_points_[e];
-      const real k = resolved.normal_stiffness * volume[i] * volume[i];
-      vec push_force{0, 0, 0};
-      real push_total = 0;
-      for (std::size_t point = 0; point < points.count; ++point) {
-        const real push = contact::normal_force(k, resolved.contact_radius - points.points[point].distance);
-        push_total += push;
-        for (int c = 0; c < 3; ++c) push_force[c] += push * points.points[point].normal[c];
-      }
-      // Friction at the deepest point: p = x_i - lever n, n from the wall towards the node.
-      const WallContact& deepest = points.points[deepest_point(points.points.data(), points.count)];
-      const vec& normal = deepest.normal;
-      const real lever = resolved.contact_radius - 0.5 * (resolved.contact_radius - deepest.distance);
-      const vec arm{-lever * normal[0], -lever * normal[1], -lever * normal[2]};  // p - x_i
-      const vec point{xi[0] + arm[0], xi[1] + arm[1], xi[2] + arm[2]};
-      const vec wall_velocity = wall.velocity_at(point.data(), t);
-      real friction[3] = {0, 0, 0};
-      if (law.peridem_friction) {
-        const vec relative{vi[0] - wall_velocity[0], vi[1] - wall_velocity[1], vi[2] - wall_velocity[2]};
-        const real speed = dot(relative, normal);
-        const real tangential[3] = {relative[0] - speed * normal[0], relative[1] - speed * normal[1],
-                                    relative[2] - speed * normal[2]};
-        contact::peridem_friction_force(law.friction, push_total, tangential, friction);
-      } else if (law.friction > 0) {
-        const vec turn = cross(spin_i, arm);
-        const real slip[3] = {vi[0] + turn[0] - wall_velocity[0], vi[1] + turn[1] - wall_velocity[1],
-                              vi[2] + turn[2] - wall_velocity[2]};
-        contact::tangential_force(law.tangential_stiffness_ratio * k, law.friction, push_total, normal.data(),
-                                  slip, dt, springs_[wall_spring_[e]].data(), friction);
-        const vec moment = cross(arm, {friction[0], friction[1], friction[2]});
-        for (int c = 0; c < 3; ++c) couple[c] += moment[c];
-      }
-      const vec force{push_force[0] + friction[0], push_force[1] + friction[1], push_force[2] + friction[2]};
+      const vec force = wall_force(model, state, i, e, dt);
       for (int c = 0; c < 3; ++c) total[c] += force[c];
-      // The wall takes -force at the contact point.
-      const vec lever_arm{point[0] - wall.center[0], point[1] - wall.center[1], point[2] - wall.center[2]};
-      const vec torque = cross(lever_arm, force);
-      reaction = {-force[0], -force[1], -force[2], -torque[0], -torque[1], -torque[2]};
     }
-    for (int c = 0; c < 3; ++c) f[3 * i + c] += total[c] / volume[i];
-    node_couple_[slot] = couple;
+    for (int c = 0; c < 3; ++c) state.forces[3 * i + c] += total[c] / model.volumes()[i];
   }
+}
+
+ContactModel::PairGeometry ContactModel::pair_geometry(const Model& model, const State& state, index_t i,
+                                                       index_t e) const {
+  const auto& x = state.positions;
+  const index_t j = pair_partner_[e];
+  const contact::Law& law = laws_[model.node_material()[i] * material_count_ + model.node_material()[j]];
+  const real contact_radius = slot_law_[pair_slot_[e]].contact_radius;
+  const vec d{x[3 * j] - x[3 * i], x[3 * j + 1] - x[3 * i + 1], x[3 * j + 2] - x[3 * i + 2]};  // as in A
+  const real distance = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+  PairGeometry g;
+  g.normal = {d[0] / distance, d[1] / distance, d[2] / distance};
+  g.overlap = contact_radius - distance;
+  g.lever_i = node_radius(law, model, i, j, contact_radius) - 0.5 * g.overlap;
+  g.lever_j = node_radius(law, model, j, i, contact_radius) - 0.5 * g.overlap;
+  return g;
+}
+
+vec3 ContactModel::pair_force(const Model& model, const State& state, index_t i, index_t e, real dt) {
+  // Spring along the line of the nodes, the fragment dashpot, and friction at the contact point
+  // p = x_i + lever_i n, whose slip adds each body's rotation about its node to the nodes'
+  // velocities (the node lies inside its particle, p on the surface).
+  const auto& v = state.velocities;
+  const index_t j = pair_partner_[e];
+  const contact::Law& law = laws_[model.node_material()[i] * material_count_ + model.node_material()[j]];
+  const PairGeometry g = pair_geometry(model, state, i, e);
+  const vec& n = g.normal;  // from i to j
+  const vec relative{v[3 * i] - v[3 * j], v[3 * i + 1] - v[3 * j + 1], v[3 * i + 2] - v[3 * j + 2]};
+  const real approach = dot(relative, n);
+  const real k = pair_stiffness_[e];
+  real push = contact::normal_force(k, g.overlap);
+  if (node_body_[i] == node_body_[j]) {  // unbonded nodes of one body: a node-pair dashpot
+    const real K = slot_stiffness_[pair_slot_[e]];
+    const real c = 2.0 * law.damping_ratio * k * std::sqrt(slot_reduced_mass_[pair_slot_[e]] / K);
+    push = std::max(0.0, push + contact::damping_force(c, approach));
+  }
+  real friction[3] = {0, 0, 0};
+  if (law.peridem_friction) {
+    const real tangential[3] = {relative[0] - approach * n[0], relative[1] - approach * n[1],
+                                relative[2] - approach * n[2]};
+    contact::peridem_friction_force(law.friction, push, tangential, friction);
+  } else if (law.friction > 0) {
+    const vec turn_i =
+        cross(body_spin(node_body_[i]), {g.lever_i * n[0], g.lever_i * n[1], g.lever_i * n[2]});
+    const vec turn_j =
+        cross(body_spin(node_body_[j]), {-g.lever_j * n[0], -g.lever_j * n[1], -g.lever_j * n[2]});
+    const real slip[3] = {(v[3 * i] + turn_i[0]) - (v[3 * j] + turn_j[0]),
+                          (v[3 * i + 1] + turn_i[1]) - (v[3 * j + 1] + turn_j[1]),
+                          (v[3 * i + 2] + turn_i[2]) - (v[3 * j + 2] + turn_j[2])};
+    contact::tangential_force(law.tangential_stiffness_ratio * k, law.friction, push, n.data(), slip, dt,
+                              springs_[pair_spring_[e]].data(), friction);
+  }
+  return {-push * n[0] + friction[0], -push * n[1] + friction[1], -push * n[2] + friction[2]};
+}
+
+ContactModel::WallGeometry ContactModel::wall_geometry(const Model& model, index_t i, index_t e) const {
+  // Friction acts at the deepest point: p = x_i - lever n, n from the wall towards the node.
+  const contact::PairLaw& resolved = slot_law_[wall_slot_[e]];
+  const WallPoints& points = wall_points_[e];
+  const WallContact& deepest = points.points[deepest_point(points.points.data(), points.count)];
+  const real lever = resolved.contact_radius - 0.5 * (resolved.contact_radius - deepest.distance);
+  WallGeometry g;
+  g.normal = deepest.normal;
+  g.arm = {-lever * g.normal[0], -lever * g.normal[1], -lever * g.normal[2]};
+  g.stiffness = resolved.normal_stiffness * model.volumes()[i] * model.volumes()[i];
+  return g;
+}
+
+vec3 ContactModel::wall_force(const Model& model, const State& state, index_t i, index_t e, real dt) {
+  // Springs at every contact point of the entry, friction at the deepest; the wall takes the
+  // opposite force at the contact point.
+  const real* xi = &state.positions[3 * i];
+  const real* vi = &state.velocities[3 * i];
+  const Wall& wall = walls_[wall_entry_[e][0]];
+  const contact::Law& law = wall_laws_[wall_entry_[e][0] * material_count_ + model.node_material()[i]];
+  const contact::PairLaw& resolved = slot_law_[wall_slot_[e]];
+  const WallPoints& points = wall_points_[e];
+  const WallGeometry g = wall_geometry(model, i, e);
+  vec force{0, 0, 0};
+  real push_total = 0;
+  for (std::size_t point = 0; point < points.count; ++point) {
+    const real push =
+        contact::normal_force(g.stiffness, resolved.contact_radius - points.points[point].distance);
+    push_total += push;
+    for (int c = 0; c < 3; ++c) force[c] += push * points.points[point].normal[c];
+  }
+  const vec point{xi[0] + g.arm[0], xi[1] + g.arm[1], xi[2] + g.arm[2]};
+  const vec wall_velocity = wall.velocity_at(point.data(), state.time);
+  real friction[3] = {0, 0, 0};
+  if (law.peridem_friction) {
+    const vec relative{vi[0] - wall_velocity[0], vi[1] - wall_velocity[1], vi[2] - wall_velocity[2]};
+    const real speed = dot(relative, g.normal);
+    const real tangential[3] = {relative[0] - speed * g.normal[0], relative[1] - speed * g.normal[1],
+                                relative[2] - speed * g.normal[2]};
+    contact::peridem_friction_force(law.friction, push_total, tangential, friction);
+  } else if (law.friction > 0) {
+    const vec turn = cross(body_spin(node_body_[i]), g.arm);
+    const real slip[3] = {vi[0] + turn[0] - wall_velocity[0], vi[1] + turn[1] - wall_velocity[1],
+                          vi[2] + turn[2] - wall_velocity[2]};
+    contact::tangential_force(law.tangential_stiffness_ratio * g.stiffness, law.friction, push_total,
+                              g.normal.data(), slip, dt, springs_[wall_spring_[e]].data(), friction);
+  }
+  for (int c = 0; c < 3; ++c) force[c] += friction[c];
+  const vec torque =
+      cross({point[0] - wall.center[0], point[1] - wall.center[1], point[2] - wall.center[2]}, force);
+  wall_entry_reaction_[e] = {-force[0], -force[1], -force[2], -torque[0], -torque[1], -torque[2]};
+  return force;
+}
+
+vec3 ContactModel::friction_couple(const Model& model, const State& state, index_t i) const {
+  // The couple (p - x_i) x F_t of node i's friction forces about the node, from the springs as
+  // pass C left them (F_t = -kt xi, capped or not).
+  vec couple{0, 0, 0};
+  const auto& node_material = model.node_material();
+  for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
+    if (pair_spring_[e] == no_spring) continue;
+    const contact::Law& law = laws_[node_material[i] * material_count_ + node_material[pair_partner_[e]]];
+    if (law.peridem_friction || law.friction == 0) continue;
+    const PairGeometry g = pair_geometry(model, state, i, e);
+    const real kt = law.tangential_stiffness_ratio * static_cast<real>(pair_stiffness_[e]);
+    const vec& xi = springs_[pair_spring_[e]];
+    const vec moment = cross({g.lever_i * g.normal[0], g.lever_i * g.normal[1], g.lever_i * g.normal[2]},
+                             {-kt * xi[0], -kt * xi[1], -kt * xi[2]});
+    for (int c = 0; c < 3; ++c) couple[c] += moment[c];
+  }
+  for (index_t e = wall_offsets_[i]; e < wall_offsets_[i + 1]; ++e) {
+    if (wall_spring_[e] == no_spring) continue;
+    const contact::Law& law = wall_laws_[wall_entry_[e][0] * material_count_ + node_material[i]];
+    if (law.peridem_friction || law.friction == 0) continue;
+    const WallGeometry g = wall_geometry(model, i, e);
+    const real kt = law.tangential_stiffness_ratio * g.stiffness;
+    const vec& xi = springs_[wall_spring_[e]];
+    const vec moment = cross(g.arm, {-kt * xi[0], -kt * xi[1], -kt * xi[2]});
+    for (int c = 0; c < 3; ++c) couple[c] += moment[c];
+  }
+  return couple;
 }
 
 void ContactModel::body_loads(const Model& model, State& state) {
@@ -1272,7 +1318,8 @@ void ContactModel::body_loads(const Model& model, State& state) {
     const index_t b = touching_bodies_[touch];
     std::array<real, 6> total = body_load_[touch];
     for (index_t k = body_contact_offsets_[b]; k < body_contact_offsets_[b + 1]; ++k) {
-      for (int c = 0; c < 3; ++c) total[3 + c] += node_couple_[k][c];
+      const vec couple = friction_couple(model, state, contact_nodes_[k]);
+      for (int c = 0; c < 3; ++c) total[3 + c] += couple[c];
     }
     if (total == std::array<real, 6>{0, 0, 0, 0, 0, 0}) continue;
     const BodyMotion& motion = body_motion_[touch];

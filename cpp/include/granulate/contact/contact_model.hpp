@@ -161,6 +161,26 @@ class ContactModel {
   void node_forces(const Model& model, State& state, real dt);
   void body_loads(const Model& model, State& state);
   void sum_wall_reactions();
+  /// A node pair in contact: normal from i to j, overlap, and the levers of the contact point
+  /// p = x_i + lever_i n = x_j - lever_j n (the middle of the overlap).
+  struct PairGeometry {
+    vec3 normal{0, 0, 0};
+    real overlap = 0, lever_i = 0, lever_j = 0;
+  };
+  PairGeometry pair_geometry(const Model& model, const State& state, index_t i, index_t e) const;
+  /// Force on node i of its list entry e (updates the entry's friction spring).
+  vec3 pair_force(const Model& model, const State& state, index_t i, index_t e, real dt);
+  /// A node-wall entry in contact: the deepest point's normal (towards the node), the arm
+  /// p - x_i of its contact point and the spring stiffness kn V_i^2.
+  struct WallGeometry {
+    vec3 normal{0, 0, 0}, arm{0, 0, 0};
+    real stiffness = 0;
+  };
+  WallGeometry wall_geometry(const Model& model, index_t i, index_t e) const;
+  /// Force on node i of its wall entry e (updates the spring; sets the entry's reaction).
+  vec3 wall_force(const Model& model, const State& state, index_t i, index_t e, real dt);
+  /// Sum of (p - x_i) x F_t over node i's friction forces, from the springs.
+  vec3 friction_couple(const Model& model, const State& state, index_t i) const;
   /// Contact radius of node i in a contact of law `law` with node j (its share of the pair's Rc).
   real node_radius(const contact::Law& law, const Model& model, index_t i, index_t j,
                    real contact_radius) const;
@@ -223,10 +243,8 @@ class ContactModel {
   std::vector<std::array<index_t, 2>> kept_wall_entry_;
   std::vector<index_t> kept_pair_spring_, kept_wall_spring_;
   bool history_kept_ = false;
-  // Nodes with entries, grouped by body: contact_nodes_[body_contact_offsets_[b] ...], and the
-  // friction couple (p - x_i) x F_t each of them puts on its body (pass C, summed in pass E).
+  // Nodes with entries, grouped by body: contact_nodes_[body_contact_offsets_[b] ...].
   std::vector<index_t> contact_nodes_, body_contact_offsets_;
-  std::vector<vec3> node_couple_;
   // Per step: the touching bodies (in a collision, or in a gap of one) and the slots in contact,
   // numbered compactly (fragments can outnumber nodes' neighbours when grains shatter).
   static constexpr index_t not_touching = ~index_t{0};
