@@ -1029,7 +1029,7 @@ void ContactModel::sum_slot_springs(const Model& model, const State& state) {
                                       (x[3 * j + 1] - x[3 * i + 1]) * (x[3 * j + 1] - x[3 * i + 1]) +
                                       (x[3 * j + 2] - x[3 * i + 2]) * (x[3 * j + 2] - x[3 * i + 2]));
       const real overlap = contact_radius - distance;
-      const real spring = contact::normal_force(pair_stiffness_[e], overlap);
+      const real spring = contact::normal_force(entry_stiffness(model, i, e), overlap);
       const real lever = node_radius(laws_[node_material[i] * material_count_ + node_material[j]], model, i,
                                      j, contact_radius) -
                          0.5 * overlap;
@@ -1170,6 +1170,11 @@ void ContactModel::node_forces(const Model& model, State& state, real dt) {
   }
 }
 
+real ContactModel::entry_stiffness(const Model& model, index_t i, index_t e) const {
+  return contact::pair_stiffness(slot_law_[pair_slot_[e]], model.volumes()[i],
+                                 model.volumes()[pair_partner_[e]]);
+}
+
 ContactModel::PairGeometry ContactModel::pair_geometry(const Model& model, const State& state, index_t i,
                                                        index_t e) const {
   const auto& x = state.positions;
@@ -1197,7 +1202,7 @@ vec3 ContactModel::pair_force(const Model& model, const State& state, index_t i,
   const vec& n = g.normal;  // from i to j
   const vec relative{v[3 * i] - v[3 * j], v[3 * i + 1] - v[3 * j + 1], v[3 * i + 2] - v[3 * j + 2]};
   const real approach = dot(relative, n);
-  const real k = pair_stiffness_[e];
+  const real k = entry_stiffness(model, i, e);
   real push = contact::normal_force(k, g.overlap);
   if (node_body_[i] == node_body_[j]) {  // unbonded nodes of one body: a node-pair dashpot
     const real K = slot_stiffness_[pair_slot_[e]];
@@ -1287,7 +1292,7 @@ vec3 ContactModel::friction_couple(const Model& model, const State& state, index
     const contact::Law& law = laws_[node_material[i] * material_count_ + node_material[pair_partner_[e]]];
     if (law.peridem_friction || law.friction == 0) continue;
     const PairGeometry g = pair_geometry(model, state, i, e);
-    const real kt = law.tangential_stiffness_ratio * static_cast<real>(pair_stiffness_[e]);
+    const real kt = law.tangential_stiffness_ratio * entry_stiffness(model, i, e);
     const vec& xi = springs_[pair_spring_[e]];
     const vec moment = cross({g.lever_i * g.normal[0], g.lever_i * g.normal[1], g.lever_i * g.normal[2]},
                              {-kt * xi[0], -kt * xi[1], -kt * xi[2]});

@@ -168,6 +168,9 @@ class ContactModel {
     real overlap = 0, lever_i = 0, lever_j = 0;
   };
   PairGeometry pair_geometry(const Model& model, const State& state, index_t i, index_t e) const;
+  /// Spring stiffness k of node i's list entry e in double precision (pair_stiffness_ keeps it
+  /// in single precision, as the in-contact flag and for the sums of pass B).
+  real entry_stiffness(const Model& model, index_t i, index_t e) const;
   /// Force on node i of its list entry e (updates the entry's friction spring).
   vec3 pair_force(const Model& model, const State& state, index_t i, index_t e, real dt);
   /// A node-wall entry in contact: the deepest point's normal (towards the node), the arm
