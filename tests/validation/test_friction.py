@@ -160,3 +160,31 @@ def test_sphere_rolls_at_five_sevenths_of_its_launch_speed(full: bool) -> None:
     speed, slip = roll(3, 10 if full else 6, 0.05 if full else 0.03)
     assert speed == pytest.approx(5 / 7, rel=0.02 if full else 0.03)
     assert abs(slip) < 0.01
+
+
+def stack_height(mu: float) -> float:
+    """Two touching discs on a floor with a third in their groove, under gravity (background
+    damping settles them): the top disc's final height over the radius after 0.12 s."""
+    sim = gr.Simulation(2, gravity=(0, -9.81), viscous_damping=20.0)
+    sim.contact = gr.Contact(restitution=0.3, friction=mu)
+    radius = 1e-3
+    disc = gr.ReferenceShape.from_shape(
+        gr.Disc((0, 0), radius), 0.25e-3, discretization="conforming"
+    )
+    lift = radius + 0.02e-3
+    for x in (-radius, radius):
+        sim.add_particle(disc, SOFT, position=(x, lift))
+    top = sim.add_particle(disc, SOFT, position=(0, lift + np.sqrt((2.1e-3) ** 2 - radius**2)))
+    sim.add_wall(gr.Plane((0, 0), (0, 1)), name="floor")
+    sim.run(until=0.12)
+    return float(rigid_motion(sim, top)[0][1] / radius)
+
+
+@pytest.mark.validation
+def test_a_stack_of_discs_holds_with_friction_and_collapses_without() -> None:
+    """Rigid discs need mu >= 2 - sqrt(3) = 0.27 at both contacts for this stack to stand (the
+    bottom discs would roll apart under the top one). mu = 0.5 holds it at its height
+    (1 + sqrt(3) = 2.73 R; measured 2.68), mu = 0.1 lets it collapse to the floor (the top disc
+    ends at its radius; measured 0.99 at 0.1 s)."""
+    assert stack_height(0.5) > 2.6
+    assert stack_height(0.1) < 1.1
