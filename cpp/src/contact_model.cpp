@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <map>
 
 #include "granulate/cell_grid.hpp"
 
@@ -71,7 +72,6 @@ BodyMotion measure_body(const Model& model, const State& state, const index_t* n
     second[5] += m * r[1] * r[2];
   }
   BodyMotion motion;
-  motion.mass = mass;
   const vec d{first[0] / mass, first[1] / mass, first[2] / mass};  // centre - origin
   for (int k = 0; k < 3; ++k) {
     motion.centre[k] = origin[k] + d[k];
@@ -306,7 +306,6 @@ void ContactModel::update_after_breaks(const Model& model, const State& state, s
   // until the next rebuild (w only grows), so only the bonds broken since the last update are
   // candidates. Then the bodies are labelled again.
   label_bodies(model, state, broken_bonds);
-  keep_history();
   const index_t n = model.node_count();
   const auto& x = state.positions;
   const auto& node_particle = model.node_particle();
@@ -334,21 +333,25 @@ void ContactModel::update_after_breaks(const Model& model, const State& state, s
     std::vector<index_t> offsets(static_cast<std::size_t>(n) + 1, 0);
     for (const auto& [i, j] : added) ++offsets[i + 1];
     for (index_t i = 0; i < n; ++i) offsets[i + 1] += offsets[i] + (pair_offsets_[i + 1] - pair_offsets_[i]);
-    std::vector<index_t> partners(offsets[n]);
+    // Merge the (sorted) new partners in; listed entries keep their friction springs.
+    std::vector<index_t> partners(offsets[n]), springs(offsets[n], no_spring);
     auto next = added.begin();
     for (index_t i = 0; i < n; ++i) {
-      const index_t* begin = pair_partner_.data() + pair_offsets_[i];
-      const index_t* end = pair_partner_.data() + pair_offsets_[i + 1];
-      index_t* out = partners.data() + offsets[i];
-      while (next != added.end() && (*next)[0] == i) {  // merge the (sorted) new partners in
-        while (begin != end && *begin < (*next)[1]) *out++ = *begin++;
-        *out++ = (*next)[1];
+      index_t old = pair_offsets_[i], out = offsets[i];
+      auto copy_old = [&] {
+        springs[out] = pair_spring_[old];
+        partners[out++] = pair_partner_[old++];
+      };
+      while (next != added.end() && (*next)[0] == i) {
+        while (old < pair_offsets_[i + 1] && pair_partner_[old] < (*next)[1]) copy_old();
+        partners[out++] = (*next)[1];
         ++next;
       }
-      out = std::copy(begin, end, out);
+      while (old < pair_offsets_[i + 1]) copy_old();
     }
     pair_offsets_ = std::move(offsets);
     pair_partner_ = std::move(partners);
+    pair_spring_ = std::move(springs);
   }
   finish_lists(model);
   broken_at_build_ = broken_bonds;
@@ -405,12 +408,17 @@ void ContactModel::keep_history() {
 }
 
 void ContactModel::carry_over_friction(index_t n) {
-  // The springs of entries in both the kept and the new lists carry over (a merge walk per node:
-  // both lists are sorted by partner, wall entries by (wall, surface)); new entries have none.
+  // After a rebuild, the springs of entries in both the kept and the new lists carry over (a
+  // merge walk per node: both lists are sorted by partner, wall entries by (wall, surface)); new
+  // entries have none.
+  if (!history_kept_) {  // a list update carried the springs over itself
+    pair_spring_.resize(pair_partner_.size(), no_spring);
+    wall_spring_.resize(wall_entry_.size(), no_spring);
+    return;
+  }
+  history_kept_ = false;
   pair_spring_.assign(pair_partner_.size(), no_spring);
   wall_spring_.assign(wall_entry_.size(), no_spring);
-  if (!history_kept_) return;
-  history_kept_ = false;
   auto walk = [](const auto& old_offsets, const auto& old_keys, const std::vector<index_t>& old_springs,
                  const auto& offsets, const auto& keys, std::vector<index_t>& new_springs, index_t node) {
     if (old_offsets.size() <= node + 1 || old_springs.size() != old_keys.size()) return;
@@ -566,11 +574,19 @@ void ContactModel::finish_lists(const Model& model) {
   // m_p m_q / (m_p + m_q); unbonded nodes of one body (a crack that has not separated it),
   // about m_p / 4; a body and a rigid wall, or a body whose every node is prescribed (a held
   // particle, a meshed wall), the moving body's mass; two such bodies, 0 (no dashpot).
+  // The laws of the slots: one per pair of particles (or particle and wall) that the slots
+  // meet, however many fragments the particles broke into.
   slot_reduced_mass_.resize(slots_.size());
-  slot_law_.resize(slots_.size());
+  slot_law_index_.resize(slots_.size());
+  resolved_laws_.clear();
+  std::map<std::array<index_t, 3>, index_t> law_of;  // (kind: 0 particles, 1 wall; p; q or wall)
   for (std::size_t s = 0; s < slots_.size(); ++s) {
-    slot_law_[s] = s >= particle_slots ? wall_law(slots_[s][1], body_particle_[slots_[s][0]])
-                                       : pair_law(body_particle_[slots_[s][0]], body_particle_[slots_[s][1]]);
+    const bool wall = s >= particle_slots;
+    const index_t p = body_particle_[slots_[s][0]], q = wall ? slots_[s][1] : body_particle_[slots_[s][1]];
+    const auto [found, added] =
+        law_of.try_emplace({wall ? 1u : 0u, p, q}, static_cast<index_t>(resolved_laws_.size()));
+    if (added) resolved_laws_.push_back(wall ? wall_law(q, p) : pair_law(p, q));
+    slot_law_index_[s] = found->second;
     const index_t bp = slots_[s][0];
     const real mp = body_kinematic_[bp] ? 0.0 : body_mass_[bp];
     if (s >= particle_slots) {
@@ -803,13 +819,13 @@ std::size_t ContactModel::memory_bytes() const {
   return bytes(laws_) + bytes(wall_laws_) + bytes(node_body_) + bytes(body_mass_) +
          bytes(body_node_offsets_) + bytes(body_nodes_) + bytes(positions_at_build_) + bytes(pair_offsets_) +
          bytes(pair_partner_) + bytes(pair_slot_) + bytes(wall_offsets_) + bytes(wall_entry_) +
-         bytes(wall_slot_) + bytes(slots_) + bytes(slot_reduced_mass_) + bytes(slot_law_) +
-         bytes(slot_stiffness_) + bytes(slot_approach_) + bytes(slot_last_normal_) + bytes(pair_stiffness_) +
-         bytes(wall_points_) + bytes(wall_entry_stiffness_) + bytes(wall_entry_reaction_) + bytes(springs_) +
-         bytes(free_springs_) + bytes(pair_spring_) + bytes(wall_spring_) + bytes(contact_nodes_) +
-         bytes(body_contact_offsets_) + bytes(body_touch_) + bytes(touching_bodies_) + bytes(slot_touch_) +
-         bytes(body_motion_) + bytes(body_load_) + bytes(slot_force_) + bytes(slot_normal_) +
-         bytes(slot_point_);
+         bytes(wall_slot_) + bytes(slots_) + bytes(slot_reduced_mass_) + bytes(slot_law_index_) +
+         bytes(resolved_laws_) + bytes(slot_stiffness_) + bytes(slot_approach_) + bytes(slot_last_normal_) +
+         bytes(pair_stiffness_) + bytes(wall_points_) + bytes(wall_entry_stiffness_) +
+         bytes(wall_entry_reaction_) + bytes(springs_) + bytes(free_springs_) + bytes(pair_spring_) +
+         bytes(wall_spring_) + bytes(contact_nodes_) + bytes(body_contact_offsets_) + bytes(body_touch_) +
+         bytes(touching_bodies_) + bytes(slot_touch_) + bytes(body_motion_) + bytes(body_load_) +
+         bytes(slot_force_) + bytes(slot_normal_) + bytes(slot_point_);
 }
 
 ContactCheckpoint ContactModel::checkpoint() const {
@@ -936,7 +952,7 @@ void ContactModel::measure_contacts(const Model& model, const State& state) {
       const index_t i = static_cast<index_t>(ii);
       for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
         const index_t j = pair_partner_[e];
-        const contact::PairLaw& law = slot_law_[pair_slot_[e]];
+        const contact::PairLaw& law = slot_law(pair_slot_[e]);
         const real dx = x[3 * j] - x[3 * i], dy = x[3 * j + 1] - x[3 * i + 1],
                    dz = x[3 * j + 2] - x[3 * i + 2];
         const real distance = std::sqrt(dx * dx + dy * dy + dz * dz);
@@ -946,7 +962,7 @@ void ContactModel::measure_contacts(const Model& model, const State& state) {
       }
       for (index_t e = wall_offsets_[i]; e < wall_offsets_[i + 1]; ++e) {
         const Wall& wall = walls_[wall_entry_[e][0]];
-        const contact::PairLaw& law = slot_law_[wall_slot_[e]];
+        const contact::PairLaw& law = slot_law(wall_slot_[e]);
         found.clear();
         wall.contacts(wall_entry_[e][1], wall.to_reference(&x[3 * i], t), law.contact_radius, dimension_,
                       found);
@@ -1024,7 +1040,7 @@ void ContactModel::sum_slot_springs(const Model& model, const State& state) {
       if (pair_stiffness_[e] == 0 || node_body_[i] == node_body_[j] || node_body_[i] != slots_[slot][0])
         continue;
       const index_t touch = slot_touch_[slot];
-      const real contact_radius = slot_law_[slot].contact_radius;
+      const real contact_radius = slot_law(slot).contact_radius;
       const real distance = std::sqrt((x[3 * j] - x[3 * i]) * (x[3 * j] - x[3 * i]) +
                                       (x[3 * j + 1] - x[3 * i + 1]) * (x[3 * j + 1] - x[3 * i + 1]) +
                                       (x[3 * j + 2] - x[3 * i + 2]) * (x[3 * j + 2] - x[3 * i + 2]));
@@ -1044,7 +1060,7 @@ void ContactModel::sum_slot_springs(const Model& model, const State& state) {
       const std::size_t slot = wall_slot_[e];
       if (wall_entry_stiffness_[e] == 0) continue;
       const index_t touch = slot_touch_[slot];
-      const contact::PairLaw& law = slot_law_[slot];
+      const contact::PairLaw& law = slot_law(slot);
       const WallPoints& points = wall_points_[e];
       for (std::size_t k = 0; k < points.count; ++k) {
         const real overlap = law.contact_radius - points.points[k].distance;
@@ -1171,7 +1187,7 @@ void ContactModel::node_forces(const Model& model, State& state, real dt) {
 }
 
 real ContactModel::entry_stiffness(const Model& model, index_t i, index_t e) const {
-  return contact::pair_stiffness(slot_law_[pair_slot_[e]], model.volumes()[i],
+  return contact::pair_stiffness(slot_law(pair_slot_[e]), model.volumes()[i],
                                  model.volumes()[pair_partner_[e]]);
 }
 
@@ -1180,7 +1196,7 @@ ContactModel::PairGeometry ContactModel::pair_geometry(const Model& model, const
   const auto& x = state.positions;
   const index_t j = pair_partner_[e];
   const contact::Law& law = laws_[model.node_material()[i] * material_count_ + model.node_material()[j]];
-  const real contact_radius = slot_law_[pair_slot_[e]].contact_radius;
+  const real contact_radius = slot_law(pair_slot_[e]).contact_radius;
   const vec d{x[3 * j] - x[3 * i], x[3 * j + 1] - x[3 * i + 1], x[3 * j + 2] - x[3 * i + 2]};  // as in A
   const real distance = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
   PairGeometry g;
@@ -1230,7 +1246,7 @@ vec3 ContactModel::pair_force(const Model& model, const State& state, index_t i,
 
 ContactModel::WallGeometry ContactModel::wall_geometry(const Model& model, index_t i, index_t e) const {
   // Friction acts at the deepest point: p = x_i - lever n, n from the wall towards the node.
-  const contact::PairLaw& resolved = slot_law_[wall_slot_[e]];
+  const contact::PairLaw& resolved = slot_law(wall_slot_[e]);
   const WallPoints& points = wall_points_[e];
   const WallContact& deepest = points.points[deepest_point(points.points.data(), points.count)];
   const real lever = resolved.contact_radius - 0.5 * (resolved.contact_radius - deepest.distance);
@@ -1248,7 +1264,7 @@ vec3 ContactModel::wall_force(const Model& model, const State& state, index_t i,
   const real* vi = &state.velocities[3 * i];
   const Wall& wall = walls_[wall_entry_[e][0]];
   const contact::Law& law = wall_laws_[wall_entry_[e][0] * material_count_ + model.node_material()[i]];
-  const contact::PairLaw& resolved = slot_law_[wall_slot_[e]];
+  const contact::PairLaw& resolved = slot_law(wall_slot_[e]);
   const WallPoints& points = wall_points_[e];
   const WallGeometry g = wall_geometry(model, i, e);
   vec force{0, 0, 0};
@@ -1328,7 +1344,8 @@ void ContactModel::body_loads(const Model& model, State& state) {
     }
     if (total == std::array<real, 6>{0, 0, 0, 0, 0, 0}) continue;
     const BodyMotion& motion = body_motion_[touch];
-    const vec acceleration{total[0] / motion.mass, total[1] / motion.mass, total[2] / motion.mass};
+    const real mass = body_mass_[b];
+    const vec acceleration{total[0] / mass, total[1] / mass, total[2] / mass};
     const vec turn = symmetric_times(motion.inverse_inertia, {total[3], total[4], total[5]});
     for (index_t k = body_node_offsets_[b]; k < body_node_offsets_[b + 1]; ++k) {
       const index_t i = body_nodes_[k];

@@ -25,7 +25,6 @@ struct BodyMotion {
   vec3 velocity{0, 0, 0};
   vec3 angular_velocity{0, 0, 0};
   std::array<real, 6> inverse_inertia{0, 0, 0, 0, 0, 0};
-  real mass = 0;
 };
 
 struct ContactStatistics {
@@ -229,8 +228,10 @@ class ContactModel {
   std::vector<std::array<index_t, 2>> slots_;  // particle pairs (p <= q), then (p, wall)
   std::size_t particle_slot_count_ = 0;
   std::vector<real> slot_reduced_mass_;
-  std::vector<contact::PairLaw> slot_law_;  // Rc and kn of each slot's pair of bodies
-  std::vector<real> slot_stiffness_;        // K: sum of the contact springs, last evaluation
+  std::vector<index_t> slot_law_index_;          // Rc and kn of each slot's pair of bodies:
+  std::vector<contact::PairLaw> resolved_laws_;  // an index into the laws of particle pairs
+  const contact::PairLaw& slot_law(std::size_t slot) const { return resolved_laws_[slot_law_index_[slot]]; }
+  std::vector<real> slot_stiffness_;  // K: sum of the contact springs, last evaluation
   // Collision history per pair of bodies, kept across list rebuilds: the approach x of the two
   // bodies since they touched (for the secant stiffness F / x of the dashpot).
   std::vector<real> slot_approach_;
