@@ -15,10 +15,11 @@
 //             node of the body gets rho_i (F / M + alpha x (x_i - c)), alpha = I^-1 (p - c) x F,
 //             with c, M, I the body's centre, mass and inertia tensor. The two bodies get equal
 //             and opposite forces at one point, so linear and angular momentum are conserved to
-//             round-off. dx/dt is the approach speed of the bodies' centres along m, M their
-//             reduced mass (a particle's own mass against a wall), K_s = F / x the secant stiffness
-//             of the collision (total spring force over the approach x since the bodies touched; at
-//             most the sum K of the springs). A collision lasts until x is back to 0, through the
+//             round-off. dx/dt is the bodies' approach speed at p along m (their rigid-body
+//             velocities there, rotation included), M their reduced mass (a particle's own mass
+//             against a wall), K_s = F / x the secant stiffness of the collision (total spring
+//             force over the approach x since the bodies touched; at most the sum K of the
+//             springs). A collision lasts until x is back to 0, through the
 //             gaps where chattering surface nodes part for a few steps. zeta follows from the
 //             requested coefficient of restitution of a linear spring-dashpot:
 //             zeta = -ln e / sqrt(pi^2 + ln^2 e). Acting on the bodies rather than on the contact
