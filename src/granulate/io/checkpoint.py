@@ -21,7 +21,7 @@ import numpy as np
 from granulate.errors import InputError
 from granulate.io.atomic import atomic_write
 
-FORMAT = 2  # 2: per-contact friction springs and per-node contact radii (granulate 0.2)
+FORMAT = 2  # 2: per-contact friction springs and per-node contact radii
 HEADER = "__header__"
 
 
