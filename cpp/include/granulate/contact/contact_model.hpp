@@ -85,11 +85,11 @@ class ContactModel {
   bool active() const { return any_law_ || !walls_.empty(); }
 
   /// Stable time step of the contact springs alone [s]: per particle, sqrt(2 rho / S) with the
-  /// Gershgorin bound S = 2 n max(kn V_j) of a node touching n partners (n = 4 in 2D, 6 in 3D;
-  /// a node meets about that many nodes of a partner as fine or coarser; against finer
-  /// partners, kn min(V_i, V_j)^2 summed over the more nodes it meets stays below kn V_i per
-  /// unit volume, hence kn min(V_i, V_j) there), the maximum taken over every particle and wall
-  /// it has a law with. Infinity without contact.
+  /// Gershgorin bound S = 2 n kn V_j of a node touching n partners (n = 4 in 2D, 6 in 3D) of a
+  /// particle as fine or finer (a coarse node meets more fine nodes, but each spring is
+  /// kn V_j^2, and their sum per unit volume of the node stays below that), and
+  /// S = 2 n kn min(V_i, V_j) against a coarser particle; the maximum over every particle and
+  /// wall it has a law with. Infinity without contact.
   real stable_time_step(const Model& model) const;
   const std::vector<Wall>& walls() const { return walls_; }
 
