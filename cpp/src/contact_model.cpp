@@ -154,11 +154,10 @@ void ContactModel::set_law(index_t a, index_t b, const contact::Law& law) {
   laws_[b * material_count_ + a] = law;
   law_set_[a * material_count_ + b] = law_set_[b * material_count_ + a] = 1;
   any_law_ = true;
-  const real coarsest_a = material_max_mesh_size_[a], coarsest_b = material_max_mesh_size_[b];
-  max_contact_radius_ = std::max(
-      max_contact_radius_, law.contact_radius > 0 ? law.contact_radius
-                           : law.node_pair ? law.contact_radius_factor * std::min(coarsest_a, coarsest_b)
-                                           : 0.5 * law.contact_radius_factor * (coarsest_a + coarsest_b));
+  const contact::ContactSide coarsest_a{material_max_mesh_size_[a], 0, 0};
+  const contact::ContactSide coarsest_b{material_max_mesh_size_[b], 0, 0};
+  max_contact_radius_ =
+      std::max(max_contact_radius_, contact::resolve_contact_radius(law, coarsest_a, coarsest_b));
   built_ = false;
 }
 
@@ -178,11 +177,8 @@ void ContactModel::set_wall_law(index_t wall, index_t material, const contact::L
   require_valid(law, "wall contact law");
   wall_laws_[wall * material_count_ + material] = law;
   wall_law_set_[wall * material_count_ + material] = 1;
-  const real coarsest = material_max_mesh_size_[material];
-  max_contact_radius_ =
-      std::max(max_contact_radius_, law.contact_radius > 0 ? law.contact_radius
-                                    : law.node_pair        ? law.contact_radius_factor * coarsest
-                                                           : 0.5 * law.contact_radius_factor * coarsest);
+  const contact::ContactSide coarsest{material_max_mesh_size_[material], 0, 0};
+  max_contact_radius_ = std::max(max_contact_radius_, contact::resolve_wall_contact_radius(law, coarsest));
   built_ = false;
 }
 
@@ -201,9 +197,10 @@ real ContactModel::stable_time_step(const Model& model) const {
     const index_t p = model.node_particle()[i];
     largest_volume[p] = std::max(largest_volume[p], model.volumes()[i]);
   }
-  // max over partners q of kn(p, q) V_max(q) (an upper bound of kn min(V_p, V_q) too). kn depends on q only
-  // through the finer particle's horizon, so sort each material's particles by mesh size: partners finer than
-  // p give kn(q) V(q) (a prefix maximum), coarser ones kn(p) V(q) (a suffix maximum of V).
+  // max over partners q of kn(p, q) V_max(q) for partners as fine or finer, kn(p, q)
+  // min(V_max(p), V_max(q)) for coarser ones (node-pair law: V_max(q) for all). kn depends on q only
+  // through the finer particle's horizon, so sort each material's particles by mesh size: partners
+  // finer than p give kn(q) V(q) (a prefix maximum), coarser ones kn(p) V(q) (a suffix maximum of V).
   std::vector<real> stiffness(count, 0);
   std::vector<std::vector<index_t>> by_material(material_count_);
   for (std::size_t p = 0; p < count; ++p)
@@ -243,8 +240,6 @@ real ContactModel::stable_time_step(const Model& model) const {
                              [&](index_t q, real value) { return particle_side_[q].mesh_size < value; });
         const std::size_t e = static_cast<std::size_t>(first_equal - partners_b.begin());
         const real finer = k > 0 ? prefix[k - 1] : 0.0;
-        // kn V_j (node-pair law), or kn min(V_i, V_j) (a coarse node meets many finer nodes, each
-        // with the finer volume squared: their sum per unit volume of i stays below kn V_j).
         const real coarser = e < partners_b.size()
                                  ? pair_law(p, partners_b[e]).normal_stiffness *
                                        (law.node_pair ? suffix[e] : std::min(largest_volume[p], suffix[e]))
@@ -395,28 +390,9 @@ void ContactModel::label_bodies(const Model& model, const State& state, std::uin
   for (index_t i = 0; i < n; ++i) body_nodes_[fill[node_body_[i]]++] = i;
 }
 
-void ContactModel::keep_history() {
-  // Copies of the lists (a list update edits them in place), and the entries' springs.
-  if (history_kept_) return;  // lists changed twice before finish_lists: the first kept lists stay
-  history_kept_ = true;
-  kept_pair_offsets_ = pair_offsets_;
-  kept_pair_partner_ = pair_partner_;
-  kept_pair_spring_ = std::move(pair_spring_);
-  kept_wall_offsets_ = wall_offsets_;
-  kept_wall_entry_ = wall_entry_;
-  kept_wall_spring_ = std::move(wall_spring_);
-}
-
-void ContactModel::carry_over_friction(index_t n) {
-  // After a rebuild, the springs of entries in both the kept and the new lists carry over (a
-  // merge walk per node: both lists are sorted by partner, wall entries by (wall, surface)); new
-  // entries have none.
-  if (!history_kept_) {  // a list update carried the springs over itself
-    pair_spring_.resize(pair_partner_.size(), no_spring);
-    wall_spring_.resize(wall_entry_.size(), no_spring);
-    return;
-  }
-  history_kept_ = false;
+void ContactModel::carry_over_springs(const KeptLists& kept, index_t n) {
+  // A merge walk per node: both lists are sorted by partner, wall entries by (wall, surface);
+  // new entries have no spring.
   pair_spring_.assign(pair_partner_.size(), no_spring);
   wall_spring_.assign(wall_entry_.size(), no_spring);
   auto walk = [](const auto& old_offsets, const auto& old_keys, const std::vector<index_t>& old_springs,
@@ -431,17 +407,10 @@ void ContactModel::carry_over_friction(index_t n) {
 #pragma omp parallel for schedule(static)
   for (std::int64_t ii = 0; ii < static_cast<std::int64_t>(n); ++ii) {
     const index_t i = static_cast<index_t>(ii);
-    walk(kept_pair_offsets_, kept_pair_partner_, kept_pair_spring_, pair_offsets_, pair_partner_,
-         pair_spring_, i);
-    walk(kept_wall_offsets_, kept_wall_entry_, kept_wall_spring_, wall_offsets_, wall_entry_, wall_spring_,
+    walk(kept.pair_offsets, kept.pair_partner, kept.pair_spring, pair_offsets_, pair_partner_, pair_spring_,
          i);
+    walk(kept.wall_offsets, kept.wall_entry, kept.wall_spring, wall_offsets_, wall_entry_, wall_spring_, i);
   }
-  kept_pair_offsets_ = {};
-  kept_pair_partner_ = {};
-  kept_pair_spring_ = {};
-  kept_wall_offsets_ = {};
-  kept_wall_entry_ = {};
-  kept_wall_spring_ = {};
   collect_free_springs();
 }
 
@@ -573,9 +542,9 @@ void ContactModel::finish_lists(const Model& model) {
   // Reduced masses of the bodies (particles, or fragments once bonds break): two bodies
   // m_p m_q / (m_p + m_q); unbonded nodes of one body (a crack that has not separated it),
   // about m_p / 4; a body and a rigid wall, or a body whose every node is prescribed (a held
-  // particle, a meshed wall), the moving body's mass; two such bodies, 0 (no dashpot).
-  // The laws of the slots: one per pair of particles (or particle and wall) that the slots
-  // meet, however many fragments the particles broke into.
+  // particle, a meshed wall), the moving body's mass; two such bodies, 0 (no dashpot). The laws
+  // of the slots: one per pair of particles (or particle and wall) that the slots meet, however
+  // many fragments the particles broke into.
   slot_reduced_mass_.resize(slots_.size());
   slot_law_index_.resize(slots_.size());
   resolved_laws_.clear();
@@ -614,7 +583,6 @@ void ContactModel::finish_lists(const Model& model) {
   };
   carry_over(0, particle_slots, 0, old_particle_slots);
   carry_over(particle_slots, slots_.size(), old_particle_slots, old_slots.size());
-  carry_over_friction(n);
   group_contact_nodes(model);
   pair_stiffness_.assign(pair_partner_.size(), 0);
   wall_entry_stiffness_.assign(wall_entry_.size(), 0);
@@ -624,7 +592,8 @@ void ContactModel::finish_lists(const Model& model) {
 
 void ContactModel::rebuild(const Model& model, const State& state, std::uint64_t broken_bonds, bool finish) {
   if (skin_ < 0) skin_ = 0.5 * max_contact_radius_;
-  keep_history();
+  const KeptLists kept{std::move(pair_offsets_), std::move(pair_partner_), std::move(pair_spring_),
+                       std::move(wall_offsets_), std::move(wall_entry_),   std::move(wall_spring_)};
   const auto& x = state.positions;
   const index_t n = model.node_count();
   const auto& particles = model.particles();
@@ -762,6 +731,7 @@ void ContactModel::rebuild(const Model& model, const State& state, std::uint64_t
   for (index_t i = 0; i < n; ++i)
     wall_entry_.insert(wall_entry_.end(), per_node[i].begin(), per_node[i].end());
 
+  carry_over_springs(kept, n);
   if (finish) finish_lists(model);
 
   positions_at_build_ = x;
@@ -859,7 +829,6 @@ void ContactModel::restore(const Model& model, const State& state, const Contact
     throw InputError("the checkpoint's contact data do not match this model (nodes or walls differ)");
   }
   skin_ = saved.skin;
-  history_kept_ = false;
   bodies_labelled_ = false;  // the restored bonds may differ from the current ones
   newly_broken_.clear();
   slots_ = saved.slots;
@@ -882,7 +851,6 @@ void ContactModel::restore(const Model& model, const State& state, const Contact
       pair_offsets_ = saved.pair_offsets;
       pair_partner_ = saved.pair_partners;
       statistics_.list_entries = pair_partner_.size();
-      history_kept_ = false;  // the saved springs below, not those of the lists before
       finish_lists(model);
     }
     const std::size_t pool = saved.springs.size() / 3;
@@ -1032,7 +1000,6 @@ void ContactModel::sum_slot_springs(const Model& model, const State& state) {
   // the particle) and spring-weighted contact point per slot, summed in node order.
   const auto& x = state.positions;
   const auto& volume = model.volumes();
-  const auto& node_material = model.node_material();
   for (const index_t i : contact_nodes_) {
     for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
       const index_t j = pair_partner_[e];
@@ -1040,20 +1007,12 @@ void ContactModel::sum_slot_springs(const Model& model, const State& state) {
       if (pair_stiffness_[e] == 0 || node_body_[i] == node_body_[j] || node_body_[i] != slots_[slot][0])
         continue;
       const index_t touch = slot_touch_[slot];
-      const real contact_radius = slot_law(slot).contact_radius;
-      const real distance = std::sqrt((x[3 * j] - x[3 * i]) * (x[3 * j] - x[3 * i]) +
-                                      (x[3 * j + 1] - x[3 * i + 1]) * (x[3 * j + 1] - x[3 * i + 1]) +
-                                      (x[3 * j + 2] - x[3 * i + 2]) * (x[3 * j + 2] - x[3 * i + 2]));
-      const real overlap = contact_radius - distance;
-      const real spring = contact::normal_force(entry_stiffness(model, i, e), overlap);
-      const real lever = node_radius(laws_[node_material[i] * material_count_ + node_material[j]], model, i,
-                                     j, contact_radius) -
-                         0.5 * overlap;
+      const PairGeometry g = pair_geometry(model, state, i, e);
+      const real spring = contact::normal_force(entry_stiffness(model, i, e), g.overlap);
       slot_force_[touch] += spring;
       for (int k = 0; k < 3; ++k) {
-        const real normal = (x[3 * j + k] - x[3 * i + k]) / distance;
-        slot_normal_[touch][k] += spring * normal;
-        slot_point_[touch][k] += spring * (x[3 * i + k] + lever * normal);
+        slot_normal_[touch][k] += spring * g.normal[k];
+        slot_point_[touch][k] += spring * (x[3 * i + k] + g.lever_i * g.normal[k]);
       }
     }
     for (index_t e = wall_offsets_[i]; e < wall_offsets_[i + 1]; ++e) {

@@ -134,11 +134,15 @@ inline PairLaw resolve(const Law& law, const ContactSide& a, const ContactSide& 
   return {resolve_contact_radius(law, a, b), resolve_normal_stiffness(law, a, b, dimension), law.node_pair};
 }
 
-/// Rc (node to wall surface) and kn of a law between particle a and a rigid wall: the node's own
-/// contact radius (PeriDEM's node-pair law: the pair Rc).
+/// Rc of a node of particle a against a rigid wall surface: the node's own contact radius
+/// (PeriDEM's node-pair law: the pair Rc).
+inline real resolve_wall_contact_radius(const Law& law, const ContactSide& a) {
+  return law.node_pair ? resolve_contact_radius(law, a, a) : node_contact_radius(law, a);
+}
+
+/// Rc (node to wall surface) and kn of a law between particle a and a rigid wall.
 inline PairLaw resolve_wall(const Law& law, const ContactSide& a, int dimension) {
-  return {law.node_pair ? resolve_contact_radius(law, a, a) : node_contact_radius(law, a),
-          resolve_normal_stiffness(law, a, a, dimension), law.node_pair};
+  return {resolve_wall_contact_radius(law, a), resolve_normal_stiffness(law, a, a, dimension), law.node_pair};
 }
 
 /// Spring stiffness of a node pair [N/m]: kn min(V_i, V_j)^2, so a fine particle's nodes against

@@ -133,14 +133,17 @@ class ContactModel {
   /// After bonds broke (and nothing moved half the skin): the pairs of newly_broken_ into the
   /// lists.
   void update_after_breaks(const Model& model, const State& state, std::uint64_t broken_bonds, real moved);
-  /// Slots, reduced masses, slot laws, the friction history carried over from the lists before
-  /// (keep_history) and scratch, from the lists and the bodies.
+  /// Slots, reduced masses, slot laws and scratch, from the lists and the bodies.
   void finish_lists(const Model& model);
-  /// Moves the lists and their friction springs aside before the lists change, for finish_lists.
-  void keep_history();
-  /// Friction springs of the new lists from the kept ones (entries in both keep theirs; the
+  /// The lists and their friction springs as they were before a rebuild.
+  struct KeptLists {
+    std::vector<index_t> pair_offsets, pair_partner, pair_spring, wall_offsets;
+    std::vector<std::array<index_t, 2>> wall_entry;
+    std::vector<index_t> wall_spring;
+  };
+  /// Friction springs of the rebuilt lists from the kept ones (entries in both keep theirs; the
   /// springs of entries that left the lists go back to the pool).
-  void carry_over_friction(index_t node_count);
+  void carry_over_springs(const KeptLists& kept, index_t node_count);
   /// Gives each entry in contact a spring and takes back those of entries apart (entry order).
   void assign_springs();
   /// The free list: every pool spring no entry holds, in increasing order.
@@ -240,15 +243,12 @@ class ContactModel {
   std::vector<real> slot_last_normal_;  // 3 per slot: normal of the last evaluation in contact
   // Friction springs (tangential displacement xi) of the entries in contact, in a pool: each
   // entry holds the index of its spring (no_spring when apart), given and taken back in pass B
-  // in entry order, carried over at list changes by keep_history.
+  // in entry order, carried over by list updates (in their merge) and rebuilds
+  // (carry_over_springs).
   static constexpr index_t no_spring = ~index_t{0};
   std::vector<vec3> springs_;
   std::vector<index_t> free_springs_;
   std::vector<index_t> pair_spring_, wall_spring_;
-  std::vector<index_t> kept_pair_offsets_, kept_pair_partner_, kept_wall_offsets_;
-  std::vector<std::array<index_t, 2>> kept_wall_entry_;
-  std::vector<index_t> kept_pair_spring_, kept_wall_spring_;
-  bool history_kept_ = false;
   // Nodes with entries, grouped by body: contact_nodes_[body_contact_offsets_[b] ...].
   std::vector<index_t> contact_nodes_, body_contact_offsets_;
   // Per step: the touching bodies (in a collision, or in a gap of one) and the slots in contact,
