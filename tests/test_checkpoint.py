@@ -152,8 +152,9 @@ def test_stop_criteria_end_the_run_at_a_fixed_step(tmp_path: Path) -> None:
 
 
 def test_checkpoints_of_the_earlier_contact_model_are_refused(tmp_path: Path) -> None:
-    """Format 1 (before friction springs and per-node contact radii) cannot continue the same
-    trajectory: it is refused with the reason and the fix, and the file is left alone."""
+    """Formats 1 (before friction springs and per-node contact radii) and 2 (before the damping
+    fitted to each collision's force law) cannot continue the same trajectory: they are
+    refused with the reason and the fix, and the file is left alone."""
     import json
 
     sim = tumbling_drum(tmp_path / "a")
@@ -162,14 +163,17 @@ def test_checkpoints_of_the_earlier_contact_model_are_refused(tmp_path: Path) ->
     with np.load(checkpoint) as archive:
         data = {name: archive[name] for name in archive.files}
     header = json.loads(bytes(data["__header__"]).decode())
-    header["format"] = 1
-    data["__header__"] = np.frombuffer(json.dumps(header).encode(), np.uint8)
-    old = tmp_path / "old.npz"
-    np.savez(old, **data)
-    before = old.read_bytes()
-    with pytest.raises(gr.InputError, match=r"format 1 predates.*run without --resume"):
-        tumbling_drum(tmp_path / "b").load_checkpoint(old)
-    assert old.read_bytes() == before
+    for format_ in (1, 2):
+        header["format"] = format_
+        data["__header__"] = np.frombuffer(json.dumps(header).encode(), np.uint8)
+        old = tmp_path / f"old{format_}.npz"
+        np.savez(old, **data)
+        before = old.read_bytes()
+        with pytest.raises(
+            gr.InputError, match=rf"format {format_}.*format 1 predates.*run without --resume"
+        ):
+            tumbling_drum(tmp_path / f"b{format_}").load_checkpoint(old)
+        assert old.read_bytes() == before
     state = dict(sim.core.checkpoint())
     del state["contact_pair_springs"]
     with pytest.raises(gr.InputError, match="no 'contact_pair_springs' entry"):

@@ -83,6 +83,7 @@ nb::dict checkpoint_dict(const Simulation& self) {
   d["contact_particle_slot_count"] = c.particle_slot_count;
   d["contact_slot_approach"] = copy_out(c.slot_approach);
   d["contact_slot_normal"] = copy_out(c.slot_normal);
+  d["contact_slot_work"] = copy_out(c.slot_work);
   d["contact_last_time"] = c.last_time;
   d["contact_has_last_time"] = c.has_last_time;
   d["contact_statistics"] = copy_out(
@@ -122,6 +123,7 @@ void restore_dict(Simulation& self, const nb::dict& d) {
   c.particle_slot_count = scalar<std::uint64_t>(d, "contact_particle_slot_count");
   c.slot_approach = entry<real>(d, "contact_slot_approach");
   c.slot_normal = entry<real>(d, "contact_slot_normal");
+  c.slot_work = entry<real>(d, "contact_slot_work");
   c.last_time = scalar<real>(d, "contact_last_time");
   c.has_last_time = scalar<bool>(d, "contact_has_last_time");
   const auto statistics = entry<std::uint64_t>(d, "contact_statistics");
@@ -318,6 +320,8 @@ NB_MODULE(_core, m) {
       .def_rw("peridem_friction", &contact::Law::peridem_friction)
       .def_rw("node_pair", &contact::Law::node_pair);
   m.def("damping_ratio_from_restitution", &contact::damping_ratio_from_restitution, "restitution"_a);
+  m.def("power_law_restitution", &contact::power_law_restitution, "damping_ratio"_a, "exponent"_a);
+  m.def("power_law_damping_ratio", &contact::power_law_damping_ratio, "restitution"_a, "exponent"_a);
 
   nb::enum_<WallSurface::Kind>(m, "WallSurfaceKind")
       .value("plane", WallSurface::Kind::plane)

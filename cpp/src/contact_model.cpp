@@ -124,6 +124,7 @@ bool intact_bond(const Model& model, const State& state, index_t i, index_t j) {
 void ContactModel::configure(const Model& model) {
   material_count_ = static_cast<index_t>(model.materials().size());
   laws_.assign(static_cast<std::size_t>(material_count_) * material_count_, {});
+  damping_tables_.assign(laws_.size(), {});
   law_set_.assign(laws_.size(), 0);
   dimension_ = model.dimension();
   particle_side_.clear();
@@ -152,6 +153,8 @@ void ContactModel::set_law(index_t a, index_t b, const contact::Law& law) {
   require_valid(law, "contact law");
   laws_[a * material_count_ + b] = law;
   laws_[b * material_count_ + a] = law;
+  damping_tables_[a * material_count_ + b] = damping_tables_[b * material_count_ + a] =
+      contact::DampingTable(law.damping_ratio);
   law_set_[a * material_count_ + b] = law_set_[b * material_count_ + a] = 1;
   any_law_ = true;
   const contact::ContactSide coarsest_a{material_max_mesh_size_[a], 0, 0};
@@ -165,6 +168,7 @@ index_t ContactModel::add_wall(Wall wall, int dimension) {
   wall.validate(dimension);
   walls_.push_back(std::move(wall));
   wall_laws_.resize(walls_.size() * material_count_);
+  wall_damping_tables_.resize(wall_laws_.size());
   wall_law_set_.resize(walls_.size() * material_count_, 0);
   wall_reactions_.assign(walls_.size(), {0, 0, 0, 0, 0, 0});
   built_ = false;
@@ -176,6 +180,7 @@ void ContactModel::set_wall_law(index_t wall, index_t material, const contact::L
     throw InputError("wall law names an unknown wall or material");
   require_valid(law, "wall contact law");
   wall_laws_[wall * material_count_ + material] = law;
+  wall_damping_tables_[wall * material_count_ + material] = contact::DampingTable(law.damping_ratio);
   wall_law_set_[wall * material_count_ + material] = 1;
   const contact::ContactSide coarsest{material_max_mesh_size_[material], 0, 0};
   max_contact_radius_ = std::max(max_contact_radius_, contact::resolve_wall_contact_radius(law, coarsest));
@@ -479,6 +484,8 @@ void ContactModel::finish_lists(const Model& model) {
   const std::vector<std::array<index_t, 2>> old_slots = slots_;
   const std::vector<real> old_approach = slot_approach_;
   const std::vector<real> old_normal = slot_last_normal_;
+  const std::vector<real> old_work = slot_work_;
+  const std::vector<float> old_exponent = slot_exponent_;
   const std::size_t old_particle_slots = particle_slot_count_;
   // Bucketed by the first body (a counting sort), so the sorts are per body and small, and an
   // entry finds its slot among its first body's few slots (fragments make many entries).
@@ -571,12 +578,16 @@ void ContactModel::finish_lists(const Model& model) {
   slot_stiffness_.assign(slots_.size(), 0);
   slot_approach_.assign(slots_.size(), 0);
   slot_last_normal_.assign(3 * slots_.size(), 0);
+  slot_work_.assign(slots_.size(), 0);
+  slot_exponent_.assign(slots_.size(), 1.0f);
   // Old and new slots are sorted within their two parts (particle pairs, walls): merge walks.
   auto carry_over = [&](std::size_t slot, std::size_t slot_end, std::size_t old, std::size_t old_end) {
     for (; slot < slot_end && old < old_end; ++slot) {
       while (old < old_end && old_slots[old] < slots_[slot]) ++old;
       if (old < old_end && old_slots[old] == slots_[slot]) {
         slot_approach_[slot] = old_approach[old];
+        slot_work_[slot] = old_work[old];
+        slot_exponent_[slot] = old_exponent[old];
         for (int k = 0; k < 3; ++k) slot_last_normal_[3 * slot + k] = old_normal[3 * old + k];
       }
     }
@@ -809,6 +820,10 @@ ContactCheckpoint ContactModel::checkpoint() const {
   c.particle_slot_count = particle_slot_count_;
   c.slot_approach = slot_approach_;
   c.slot_normal = slot_last_normal_;
+  for (std::size_t slot = 0; slot < slots_.size(); ++slot) {
+    c.slot_work.push_back(slot_work_[slot]);
+    c.slot_work.push_back(slot_exponent_[slot]);
+  }
   c.pair_offsets = pair_offsets_;
   c.pair_partners = pair_partner_;
   for (const vec3& spring : springs_) c.springs.insert(c.springs.end(), spring.begin(), spring.end());
@@ -823,7 +838,8 @@ ContactCheckpoint ContactModel::checkpoint() const {
 
 void ContactModel::restore(const Model& model, const State& state, const ContactCheckpoint& saved) {
   if (saved.slot_approach.size() != saved.slots.size() ||
-      saved.slot_normal.size() != 3 * saved.slots.size() || saved.particle_slot_count > saved.slots.size() ||
+      saved.slot_normal.size() != 3 * saved.slots.size() ||
+      saved.slot_work.size() != 2 * saved.slots.size() || saved.particle_slot_count > saved.slots.size() ||
       (saved.built && saved.positions_at_build.size() != 3 * static_cast<std::size_t>(model.node_count())) ||
       saved.wall_reactions.size() != walls_.size()) {
     throw InputError("the checkpoint's contact data do not match this model (nodes or walls differ)");
@@ -835,6 +851,12 @@ void ContactModel::restore(const Model& model, const State& state, const Contact
   particle_slot_count_ = saved.particle_slot_count;
   slot_approach_ = saved.slot_approach;
   slot_last_normal_ = saved.slot_normal;
+  slot_work_.resize(slots_.size());
+  slot_exponent_.resize(slots_.size());
+  for (std::size_t slot = 0; slot < slots_.size(); ++slot) {
+    slot_work_[slot] = saved.slot_work[2 * slot];
+    slot_exponent_[slot] = static_cast<float>(saved.slot_work[2 * slot + 1]);
+  }
   built_ = false;
   if (saved.built) {
     // Rebuild the lists from the positions and time they were built at: the same lists,
@@ -1064,7 +1086,7 @@ void ContactModel::slot_dashpots(const State& state, real dt) {
     const bool wall_slot = slot >= particle_slot_count_;
     const index_t p = slots_[slot][0], q = slots_[slot][1];
     if (!wall_slot && p == q) {  // fragments of one body: damped node pair by node pair
-      slot_approach_[slot] = 0;
+      end_collision(slot);
       continue;
     }
     const index_t touch = slot_touch_[slot];
@@ -1079,7 +1101,7 @@ void ContactModel::slot_dashpots(const State& state, real dt) {
     if (in_contact) {
       for (int k = 0; k < 3; ++k) last_normal[k] = sum[k] / norm;
     } else if (!(slot_approach_[slot] > 0)) {
-      slot_approach_[slot] = 0;
+      end_collision(slot);
       continue;
     }
     const vec normal{last_normal[0], last_normal[1], last_normal[2]};
@@ -1094,14 +1116,12 @@ void ContactModel::slot_dashpots(const State& state, real dt) {
                        velocity_p[2] - velocity_q[2]};
     // Closing speed along the normal (which points from p to q, or from the wall to p).
     const real approach = wall_slot ? -dot(relative, normal) : dot(relative, normal);
-    const real zeta = wall_slot
-                          ? wall_laws_[q * material_count_ + body_material_[p]].damping_ratio
-                          : laws_[body_material_[p] * material_count_ + body_material_[q]].damping_ratio;
     slot_approach_[slot] += approach * dt;
     if (!in_contact) {  // a gap within the collision: no spring, no dashpot
       slot_approach_[slot] = std::max(0.0, slot_approach_[slot]);
       continue;
     }
+    const real zeta = damping_ratio(slot, approach * dt);
     if (zeta == 0) continue;
     const real K = slot_stiffness_[slot];
     const real secant = slot_approach_[slot] > 0 ? std::min(K, slot_force_[touch] / slot_approach_[slot]) : K;
@@ -1121,6 +1141,29 @@ void ContactModel::slot_dashpots(const State& state, real dt) {
       load(q, point, {damping * normal[0], damping * normal[1], damping * normal[2]});
     }
   }
+}
+
+void ContactModel::end_collision(std::size_t slot) {
+  slot_approach_[slot] = 0;
+  slot_work_[slot] = 0;
+  slot_exponent_[slot] = 1;
+}
+
+real ContactModel::damping_ratio(std::size_t slot, real advance) {
+  // The springs' work since the bodies touched, and while they approach, the exponent of the
+  // force law it implies: W = F x / (p + 1) for F = k x^p.
+  const bool wall_slot = slot >= particle_slot_count_;
+  const index_t p = slots_[slot][0], q = slots_[slot][1];
+  const std::size_t law = wall_slot ? q * material_count_ + body_material_[p]
+                                    : body_material_[p] * material_count_ + body_material_[q];
+  const contact::Law& rule = wall_slot ? wall_laws_[law] : laws_[law];
+  if (rule.node_pair) return rule.damping_ratio;  // PeriDEM's law keeps the linear zeta
+  const real force = slot_force_[slot_touch_[slot]], approach = slot_approach_[slot];
+  slot_work_[slot] += force * advance;
+  if (advance > 0 && slot_work_[slot] > 0 && approach > 0) {
+    slot_exponent_[slot] = static_cast<float>(std::clamp(force * approach / slot_work_[slot] - 1, 1.0, 3.0));
+  }
+  return (wall_slot ? wall_damping_tables_ : damping_tables_)[law].at(slot_exponent_[slot]);
 }
 
 void ContactModel::node_forces(const Model& model, State& state, real dt) {

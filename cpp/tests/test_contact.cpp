@@ -6,6 +6,7 @@
 
 #include "check.hpp"
 #include "fixtures.hpp"
+#include "granulate/contact/power_law_damping.hpp"
 #include "granulate/simulation.hpp"
 
 using namespace granulate;
@@ -16,6 +17,29 @@ TEST_CASE("damping ratio from restitution: e = exp(-pi zeta / sqrt(1 - zeta^2))"
     CHECK_CLOSE(std::exp(-std::numbers::pi * zeta / std::sqrt(1 - zeta * zeta)), e, 1e-12);
   }
   CHECK(contact::damping_ratio_from_restitution(1.0) == 0.0);
+}
+
+TEST_CASE("power-law collisions: the linear limit, stiffer laws rebound more, the inverse") {
+  // p = 1 is the linear spring-dashpot; for p = 1.5 and 2 the references come from an
+  // independent integration of x'' = -x^p - 2 zeta x^((p-1)/2) x' (RK4, dt = 2e-4, in Python,
+  // printed to 4 digits).
+  const double e[5] = {0.1, 0.3, 0.5, 0.7, 0.9};
+  const double hertz[5] = {0.1413, 0.3460, 0.5396, 0.7272, 0.9101};
+  const double square[5] = {0.1770, 0.3830, 0.5704, 0.7478, 0.9176};
+  for (int k = 0; k < 5; ++k) {
+    const double zeta = contact::damping_ratio_from_restitution(e[k]);
+    CHECK_CLOSE(contact::power_law_restitution(zeta, 1.0), e[k], 1e-3);
+    CHECK_CLOSE(contact::power_law_restitution(zeta, 1.5), hertz[k], 1e-3);  // relative
+    CHECK_CLOSE(contact::power_law_restitution(zeta, 2.0), square[k], 1e-3);
+    const double fitted = contact::power_law_damping_ratio(e[k], 2.0);
+    CHECK(fitted > zeta);
+    CHECK_CLOSE(contact::power_law_restitution(fitted, 2.0), e[k], 1e-4);
+    const contact::DampingTable table(zeta);
+    CHECK(table.at(1.0) == zeta && table.at(0.5) == zeta);
+    CHECK_CLOSE(table.at(2.0), fitted, 1e-4);
+  }
+  CHECK(contact::power_law_restitution(0.0, 2.0) > 0.999);
+  CHECK(contact::power_law_damping_ratio(1.0, 2.0) == 0.0);
 }
 
 TEST_CASE("the friction spring sticks below mu F_n, slides at it, turns with the normal, is odd") {

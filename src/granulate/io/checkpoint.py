@@ -21,7 +21,9 @@ import numpy as np
 from granulate.errors import InputError
 from granulate.io.atomic import atomic_write
 
-FORMAT = 2  # 2: per-contact friction springs and per-node contact radii
+# 2: per-contact friction springs and per-node contact radii; 3: each collision's force-law
+# exponent (the damping that gives the requested restitution)
+FORMAT = 3
 HEADER = "__header__"
 
 
@@ -60,8 +62,8 @@ def load(path: str | Path) -> tuple[dict[str, Any], dict[str, Any]]:
         raise InputError(
             f"checkpoint {file} has format {header.get('format')!r}; this granulate reads "
             f"format {FORMAT} (format 1 predates the contact model with friction springs and "
-            "per-node contact radii, whose trajectories differ); run without --resume to start "
-            "over"
+            "per-node contact radii, format 2 the damping fitted to each collision's force law; "
+            "their trajectories differ); run without --resume to start over"
         )
     state: dict[str, Any] = {}
     for name, value in data.items():

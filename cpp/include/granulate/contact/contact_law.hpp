@@ -20,8 +20,10 @@
 //             against a wall), K_s = F / x the secant stiffness of the collision (total spring
 //             force over the approach x since the bodies touched; at most the sum K of the
 //             springs). A collision lasts until x is back to 0, through the
-//             gaps where chattering surface nodes part for a few steps. zeta follows from the
-//             requested coefficient of restitution of a linear spring-dashpot:
+//             gaps where chattering surface nodes part for a few steps. zeta gives the
+//             requested coefficient of restitution e for the collision's force law F ~ x^p,
+//             p = F x / W - 1 measured from the springs' work W while the bodies approach
+//             (power_law_damping.hpp); for linear springs (p = 1) it is
 //             zeta = -ln e / sqrt(pi^2 + ln^2 e). Acting on the bodies rather than on the contact
 //             nodes, the dashpot dissipates c (dx/dt)^2 whatever the bodies' deformation, so a
 //             collision of deformable bodies rebounds with e (checked in tests/validation).

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "granulate/contact/contact_law.hpp"
+#include "granulate/contact/power_law_damping.hpp"
 #include "granulate/model.hpp"
 #include "granulate/state.hpp"
 #include "granulate/walls.hpp"
@@ -47,7 +48,8 @@ struct ContactCheckpoint {
   std::vector<std::array<index_t, 2>> slots;
   std::uint64_t particle_slot_count = 0;
   std::vector<real> slot_approach;
-  std::vector<real> slot_normal;                     ///< 3 per slot: the collision's last contact normal
+  std::vector<real> slot_normal;  ///< 3 per slot: the collision's last contact normal
+  std::vector<real> slot_work;    ///< 2 per slot: the springs' work and the force-law exponent
   std::vector<index_t> pair_offsets, pair_partners;  ///< the lists (updated after bond breaks)
   /// Friction springs: the pool (3 per spring) and each list entry's spring (none: 2^32 - 1).
   std::vector<real> springs;
@@ -175,6 +177,11 @@ class ContactModel {
   /// Spring stiffness k of node i's list entry e in double precision (pair_stiffness_ keeps it
   /// in single precision, as the in-contact flag and for the sums of pass B).
   real entry_stiffness(const Model& model, index_t i, index_t e) const;
+  /// Forget a slot's collision (the bodies are apart).
+  void end_collision(std::size_t slot);
+  /// Damping ratio of a slot in contact that gives the requested restitution for the force law
+  /// of its collision, after adding the springs' work over `advance` (the approach this step).
+  real damping_ratio(std::size_t slot, real advance);
   /// Force on node i of its list entry e (updates the entry's friction spring).
   vec3 pair_force(const Model& model, const State& state, index_t i, index_t e, real dt);
   /// A node-wall entry in contact: the deepest point's normal (towards the node), the arm
@@ -241,6 +248,13 @@ class ContactModel {
   // bodies since they touched (for the secant stiffness F / x of the dashpot).
   std::vector<real> slot_approach_;
   std::vector<real> slot_last_normal_;  // 3 per slot: normal of the last evaluation in contact
+  // The springs' work W since the bodies touched and the collision's force-law exponent
+  // p = F x / W - 1 (exact for F = k x^p), measured while the bodies approach; p picks the
+  // damping ratio that gives the requested restitution (power_law_damping.hpp).
+  std::vector<real> slot_work_;
+  std::vector<float> slot_exponent_;
+  // Damping ratio against the exponent p, per law (as laws_ and wall_laws_).
+  std::vector<contact::DampingTable> damping_tables_, wall_damping_tables_;
   // Friction springs (tangential displacement xi) of the entries in contact, in a pool: each
   // entry holds the index of its spring (no_spring when apart), given and taken back in pass B
   // in entry order, carried over by list updates (in their merge) and rebuilds

@@ -1,0 +1,44 @@
+// Damping ratios that give the requested restitution when the contact force is a power law of
+// the approach.
+//
+// The body dashpot of ContactModel is 2 zeta sqrt(M K_s) dx/dt with K_s = F / x, the collision's
+// secant stiffness. If the spring force grows as F = k x^p, the collision is scale-free: in
+// units of the impact speed v and of the length (M v^2 / k)^(1 / (p + 1)) it reads
+//     x'' = -x^p - 2 zeta x^((p - 1) / 2) x',   x(0) = 0, x'(0) = 1,
+// and the restitution e = -x'(t) when x is back to 0 depends on zeta and p only (Tsuji, Tanaka &
+// Ishida 1992 give the same scale-freedom for Hertz's p = 3/2). For p = 1 (linear springs)
+// zeta = -ln e / sqrt(pi^2 + ln^2 e); the node springs of a curved grain engage over a contact
+// that widens with x, so a grain pressed on a plane or on another grain stiffens: p is about
+// 3/2 in 2D and 2 in 3D, and the linear zeta gives e = 0.14 and 0.18 for a requested 0.1.
+#pragma once
+
+#include <array>
+
+#include "granulate/types.hpp"
+
+namespace granulate::contact {
+
+/// Restitution of the scale-free collision above for damping ratio zeta and exponent p >= 1.
+real power_law_restitution(real zeta, real exponent);
+
+/// The damping ratio that gives restitution e (0 < e <= 1) for exponent p (bisection on
+/// power_law_restitution, to 1e-5 in zeta).
+real power_law_damping_ratio(real restitution, real exponent);
+
+/// zeta at one restitution for exponents 1, 1.1, ..., 3, interpolated linearly between them.
+class DampingTable {
+ public:
+  static constexpr int size = 21;
+  static constexpr real smallest_exponent = 1.0, exponent_step = 0.1;
+
+  DampingTable() = default;
+  /// The table of the restitution whose linear damping ratio is `linear_zeta` (zeta at p = 1).
+  explicit DampingTable(real linear_zeta);
+  /// zeta for exponent p, clamped to [1, 3].
+  real at(real exponent) const;
+
+ private:
+  std::array<real, size> zeta_{};
+};
+
+}  // namespace granulate::contact

@@ -1,0 +1,87 @@
+#include "granulate/contact/power_law_damping.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <mutex>
+#include <numbers>
+
+namespace granulate::contact {
+namespace {
+
+// x'' of the scale-free collision (zero outside contact).
+real acceleration(real x, real speed, real zeta, real exponent) {
+  if (x <= 0) return 0;
+  return -std::pow(x, exponent) - 2 * zeta * std::pow(x, 0.5 * (exponent - 1)) * speed;
+}
+
+// Restitution of the linear spring-dashpot with damping ratio zeta (the inverse of
+// damping_ratio_from_restitution).
+real linear_restitution(real zeta) {
+  if (zeta <= 0) return 1;
+  if (zeta >= 1) return 0;
+  return std::exp(-std::numbers::pi * zeta / std::sqrt(1 - zeta * zeta));
+}
+
+}  // namespace
+
+real power_law_restitution(real zeta, real exponent) {
+  // Fourth-order Runge-Kutta, 500 steps per time unit (the undamped linear collision lasts pi);
+  // the crossing of x = 0 is found by linear interpolation of the last step. A collision that
+  // has not ended after 40 time units is overdamped: it creeps back to x = 0 at no speed.
+  const real dt = 2e-3;
+  real x = 0, v = 1;
+  for (int step = 0; step < 20000; ++step) {
+    const real a1 = acceleration(x, v, zeta, exponent);
+    const real a2 = acceleration(x + 0.5 * dt * v, v + 0.5 * dt * a1, zeta, exponent);
+    const real a3 = acceleration(x + 0.5 * dt * (v + 0.5 * dt * a1), v + 0.5 * dt * a2, zeta, exponent);
+    const real a4 = acceleration(x + dt * (v + 0.5 * dt * a2), v + dt * a3, zeta, exponent);
+    const real x_next = x + dt * v + dt * dt / 6 * (a1 + a2 + a3);
+    const real v_next = v + dt / 6 * (a1 + 2 * a2 + 2 * a3 + a4);
+    if (x_next <= 0 && step > 0) {
+      const real share = x / (x - x_next);
+      return std::max(0.0, -(v + share * (v_next - v)));
+    }
+    x = x_next;
+    v = v_next;
+  }
+  return 0;
+}
+
+real power_law_damping_ratio(real restitution, real exponent) {
+  if (restitution >= 1) return 0;
+  real low = 0, high = 4;  // e falls as zeta grows
+  while (high - low > 1e-5) {
+    const real middle = 0.5 * (low + high);
+    (power_law_restitution(middle, exponent) > restitution ? low : high) = middle;
+  }
+  return 0.5 * (low + high);
+}
+
+DampingTable::DampingTable(real linear_zeta) {
+  // Tables are shared between laws of the same restitution (one per process and zeta).
+  static std::mutex mutex;
+  static std::map<real, std::array<real, size>> made;
+  const std::lock_guard<std::mutex> lock(mutex);
+  const auto found = made.find(linear_zeta);
+  if (found != made.end()) {
+    zeta_ = found->second;
+    return;
+  }
+  const real restitution = linear_restitution(linear_zeta);
+  zeta_[0] = linear_zeta;
+  for (int k = 1; k < size; ++k) {
+    zeta_[k] =
+        linear_zeta == 0 ? 0 : power_law_damping_ratio(restitution, smallest_exponent + k * exponent_step);
+  }
+  made.emplace(linear_zeta, zeta_);
+}
+
+real DampingTable::at(real exponent) const {
+  const real position = std::clamp((exponent - smallest_exponent) / exponent_step, 0.0, real(size - 1));
+  const int k = std::min(static_cast<int>(position), size - 2);
+  const real share = position - k;
+  return (1 - share) * zeta_[k] + share * zeta_[k + 1];
+}
+
+}  // namespace granulate::contact
