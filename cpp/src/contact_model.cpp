@@ -119,6 +119,27 @@ bool intact_bond(const Model& model, const State& state, index_t i, index_t j) {
   return b != bonds.count && state.bonds.intact(i, b);
 }
 
+/// Outward unit normal of the surface at node i, in the current configuration: the opposite of
+/// the influence-weighted sum of its intact bonds, sum_j w_ij (y_j - y_i), which points into
+/// the body from a surface node. Zero when that sum is under 10 % of sum_j w_ij |x_j - x_i|
+/// (reference lengths): inside the body, or a node without bonds.
+vec surface_normal(const Model& model, const State& state, index_t i) {
+  const NodeBonds bonds = model.node_bonds(i);
+  const real* y = state.positions.data();
+  vec sum{0, 0, 0};
+  real scale = 0;
+  for (index_t b = 0; b < bonds.count; ++b) {
+    if (!state.bonds.intact(i, b)) continue;
+    const index_t j = bonds.neighbor(b);
+    const real w = bonds.weight(b);
+    for (int c = 0; c < 3; ++c) sum[c] -= w * (y[3 * j + c] - y[3 * i + c]);
+    scale += w * bonds.length(b);
+  }
+  const real norm = std::sqrt(dot(sum, sum));
+  if (!(norm > 0.1 * scale)) return {0, 0, 0};
+  return {sum[0] / norm, sum[1] / norm, sum[2] / norm};
+}
+
 }  // namespace
 
 void ContactModel::configure(const Model& model) {
@@ -596,6 +617,7 @@ void ContactModel::finish_lists(const Model& model) {
   carry_over(particle_slots, slots_.size(), old_particle_slots, old_slots.size());
   group_contact_nodes(model);
   pair_stiffness_.assign(pair_partner_.size(), 0);
+  node_touching_.assign(n, 0);
   wall_entry_stiffness_.assign(wall_entry_.size(), 0);
   wall_points_.assign(wall_entry_.size(), {});
   wall_entry_reaction_.assign(wall_entry_.size(), {0, 0, 0, 0, 0, 0});
@@ -806,7 +828,10 @@ std::size_t ContactModel::memory_bytes() const {
          bytes(wall_entry_reaction_) + bytes(springs_) + bytes(free_springs_) + bytes(pair_spring_) +
          bytes(wall_spring_) + bytes(contact_nodes_) + bytes(body_contact_offsets_) + bytes(body_touch_) +
          bytes(touching_bodies_) + bytes(slot_touch_) + bytes(body_motion_) + bytes(body_load_) +
-         bytes(slot_force_) + bytes(slot_normal_) + bytes(slot_point_);
+         bytes(slot_force_) + bytes(slot_normal_) + bytes(slot_point_) + bytes(slot_work_) +
+         bytes(slot_exponent_) + bytes(damping_tables_) + bytes(wall_damping_tables_) +
+         bytes(slot_surface_normal_) + bytes(node_touching_) + bytes(touching_nodes_) +
+         bytes(touching_normals_);
 }
 
 ContactCheckpoint ContactModel::checkpoint() const {
@@ -916,6 +941,7 @@ void ContactModel::add_forces(const Model& model, State& state, std::uint64_t br
   measure_bodies(model, state);    //    rigid-body motion of the touching bodies
   sum_slot_springs(model, state);  //    spring force, normal and contact point per slot
   slot_dashpots(state, dt);        //    the body dashpots, as loads on the bodies
+  slot_redirects();                //    each collision's force turned to the surface normal
   node_forces(model, state, dt);   // C: springs, friction, fragment dashpots, per node
   body_loads(model, state);        // E: dashpots and friction couples as rigid-body loads
   sum_wall_reactions();            // D: wall reactions
@@ -940,6 +966,7 @@ void ContactModel::measure_contacts(const Model& model, const State& state) {
 #pragma omp for schedule(static)
     for (std::int64_t ii = 0; ii < n; ++ii) {
       const index_t i = static_cast<index_t>(ii);
+      bool touching = false;
       for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
         const index_t j = pair_partner_[e];
         const contact::PairLaw& law = slot_law(pair_slot_[e]);
@@ -949,7 +976,9 @@ void ContactModel::measure_contacts(const Model& model, const State& state) {
         pair_stiffness_[e] = distance < law.contact_radius && distance > 0
                                  ? static_cast<float>(contact::pair_stiffness(law, volume[i], volume[j]))
                                  : 0.0f;
+        touching = touching || (pair_stiffness_[e] > 0 && !law.node_pair && node_body_[i] != node_body_[j]);
       }
+      node_touching_[i] = touching ? 1 : 0;
       for (index_t e = wall_offsets_[i]; e < wall_offsets_[i + 1]; ++e) {
         const Wall& wall = walls_[wall_entry_[e][0]];
         const contact::PairLaw& law = slot_law(wall_slot_[e]);
@@ -1004,6 +1033,7 @@ void ContactModel::sum_slot_stiffness() {
   slot_force_.assign(in_contact, 0.0);
   slot_normal_.assign(in_contact, vec3{0, 0, 0});
   slot_point_.assign(in_contact, vec3{0, 0, 0});
+  slot_surface_normal_.assign(in_contact, vec3{0, 0, 0});
 }
 
 void ContactModel::measure_bodies(const Model& model, const State& state) {
@@ -1017,11 +1047,27 @@ void ContactModel::measure_bodies(const Model& model, const State& state) {
   }
 }
 
+void ContactModel::measure_surface_normals(const Model& model, const State& state) {
+  // The surface normal of every node in a node pair in contact between two bodies (in node
+  // order, for the look-ups of pair_surface_normal), computed in parallel.
+  touching_nodes_.clear();
+  const index_t n = model.node_count();
+  for (index_t i = 0; i < n; ++i) {
+    if (node_touching_[i]) touching_nodes_.push_back(i);
+  }
+  touching_normals_.resize(touching_nodes_.size());
+  const std::int64_t count = static_cast<std::int64_t>(touching_nodes_.size());
+#pragma omp parallel for schedule(static)
+  for (std::int64_t k = 0; k < count; ++k)
+    touching_normals_[k] = surface_normal(model, state, touching_nodes_[k]);
+}
+
 void ContactModel::sum_slot_springs(const Model& model, const State& state) {
   // Spring force, spring-weighted normal (from the first body to the second, or from the wall to
   // the particle) and spring-weighted contact point per slot, summed in node order.
   const auto& x = state.positions;
   const auto& volume = model.volumes();
+  measure_surface_normals(model, state);
   for (const index_t i : contact_nodes_) {
     for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
       const index_t j = pair_partner_[e];
@@ -1031,10 +1077,12 @@ void ContactModel::sum_slot_springs(const Model& model, const State& state) {
       const index_t touch = slot_touch_[slot];
       const PairGeometry g = pair_geometry(model, state, i, e);
       const real spring = contact::normal_force(entry_stiffness(model, i, e), g.overlap);
+      const vec surface = slot_law(slot).node_pair ? g.normal : pair_surface_normal(i, j, g.normal);
       slot_force_[touch] += spring;
       for (int k = 0; k < 3; ++k) {
         slot_normal_[touch][k] += spring * g.normal[k];
         slot_point_[touch][k] += spring * (x[3 * i + k] + g.lever_i * g.normal[k]);
+        slot_surface_normal_[touch][k] += spring * surface[k];
       }
     }
     for (index_t e = wall_offsets_[i]; e < wall_offsets_[i + 1]; ++e) {
@@ -1050,6 +1098,7 @@ void ContactModel::sum_slot_springs(const Model& model, const State& state) {
         slot_force_[touch] += spring;
         for (int c = 0; c < 3; ++c) {
           slot_normal_[touch][c] += spring * points.points[k].normal[c];
+          slot_surface_normal_[touch][c] += spring * points.points[k].normal[c];
           slot_point_[touch][c] += spring * (x[3 * i + c] - lever * points.points[k].normal[c]);
         }
       }
@@ -1066,22 +1115,8 @@ void ContactModel::slot_dashpots(const State& state, real dt) {
   // dashpot would then overdamp.
   const real t = state.time;
   std::fill(wall_damping_.begin(), wall_damping_.end(), std::array<real, 6>{0, 0, 0, 0, 0, 0});
-  auto load = [&](index_t body, const vec& point, const vec& force) {
-    const index_t touch = body_touch_[body];
-    const BodyMotion& motion = body_motion_[touch];
-    const vec torque =
-        cross({point[0] - motion.centre[0], point[1] - motion.centre[1], point[2] - motion.centre[2]}, force);
-    for (int k = 0; k < 3; ++k) {
-      body_load_[touch][k] += force[k];
-      body_load_[touch][3 + k] += torque[k];
-    }
-  };
-  auto point_velocity = [&](index_t body, const vec& point) {
-    const BodyMotion& motion = body_motion_[body_touch_[body]];
-    const vec turn = cross(motion.angular_velocity, {point[0] - motion.centre[0], point[1] - motion.centre[1],
-                                                     point[2] - motion.centre[2]});
-    return vec{motion.velocity[0] + turn[0], motion.velocity[1] + turn[1], motion.velocity[2] + turn[2]};
-  };
+  auto load = [&](index_t body, const vec& point, const vec& force) { add_body_load(body, point, force); };
+  auto point_velocity = [&](index_t body, const vec& point) { return rigid_velocity(body, point); };
   for (std::size_t slot = 0; slot < slots_.size(); ++slot) {
     const bool wall_slot = slot >= particle_slot_count_;
     const index_t p = slots_[slot][0], q = slots_[slot][1];
@@ -1090,7 +1125,7 @@ void ContactModel::slot_dashpots(const State& state, real dt) {
       continue;
     }
     const index_t touch = slot_touch_[slot];
-    const vec sum = touch == not_touching ? vec{0, 0, 0} : slot_normal_[touch];
+    const vec sum = touch == not_touching ? vec{0, 0, 0} : slot_surface_normal_[touch];
     const real norm = std::sqrt(dot(sum, sum));
     // A collision lasts until the bodies are back where they first touched (approach x = 0),
     // not while springs are in contact: the surface nodes of deformable bodies chatter (touch,
@@ -1140,6 +1175,75 @@ void ContactModel::slot_dashpots(const State& state, real dt) {
       load(p, point, {-damping * normal[0], -damping * normal[1], -damping * normal[2]});
       load(q, point, {damping * normal[0], damping * normal[1], damping * normal[2]});
     }
+  }
+}
+
+vec3 ContactModel::rigid_velocity(index_t body, const vec3& point) const {
+  const BodyMotion& motion = body_motion_[body_touch_[body]];
+  const vec turn = cross(motion.angular_velocity, {point[0] - motion.centre[0], point[1] - motion.centre[1],
+                                                   point[2] - motion.centre[2]});
+  return {motion.velocity[0] + turn[0], motion.velocity[1] + turn[1], motion.velocity[2] + turn[2]};
+}
+
+void ContactModel::add_body_load(index_t body, const vec3& point, const vec3& force) {
+  const index_t touch = body_touch_[body];
+  const BodyMotion& motion = body_motion_[touch];
+  const vec torque =
+      cross({point[0] - motion.centre[0], point[1] - motion.centre[1], point[2] - motion.centre[2]}, force);
+  for (int k = 0; k < 3; ++k) {
+    body_load_[touch][k] += force[k];
+    body_load_[touch][3 + k] += torque[k];
+  }
+}
+
+vec3 ContactModel::pair_surface_normal(index_t i, index_t j, const vec3& line) const {
+  // The mean of the two surfaces' normals, n_i - n_j (n_j points out of the other body), where
+  // both nodes lie on surfaces that face each other (|n_i - n_j| > 1, within 90 degrees of the
+  // line of the nodes); the line itself otherwise.
+  auto normal = [&](index_t node) {
+    const auto at = std::lower_bound(touching_nodes_.begin(), touching_nodes_.end(), node);
+    return touching_normals_[static_cast<std::size_t>(at - touching_nodes_.begin())];
+  };
+  const vec ni = normal(i), nj = normal(j);
+  const vec sum{ni[0] - nj[0], ni[1] - nj[1], ni[2] - nj[2]};
+  const real norm = std::sqrt(dot(sum, sum));
+  if (!(norm > 1.0) || !(dot(sum, line) > 0)) return line;
+  return {sum[0] / norm, sum[1] / norm, sum[2] / norm};
+}
+
+void ContactModel::slot_redirects() {
+  // The node springs of a collision push along the lines of their node pairs, which the node
+  // layout tilts (bumps of size h on a curved surface). Their resultant F is turned into the
+  // spring-weighted normal of the two surfaces, S: each body gets the difference D = |F| S - F
+  // (and its opposite) at the contact point p as a rigid-body load, less its part along the
+  // bodies' relative velocity at p, so that it does no work (the loads' power is D . (V_q(p) -
+  // V_p(p)), V the bodies' rigid-body velocities): turning the force cannot feed energy into a
+  // packing at rest. The nodes keep central forces, and the bodies get equal and opposite loads
+  // at one point (momentum and angular momentum conserved).
+  for (std::size_t slot = 0; slot < particle_slot_count_; ++slot) {
+    const index_t touch = slot_touch_[slot];
+    const index_t p = slots_[slot][0], q = slots_[slot][1];
+    if (touch == not_touching || p == q || slot_force_[touch] == 0) continue;
+    if (slot_law(slot).node_pair) continue;
+    const vec& resultant = slot_normal_[touch];  // the springs' force on q
+    const vec& surface = slot_surface_normal_[touch];
+    const real size = std::sqrt(dot(resultant, resultant)), surface_size = std::sqrt(dot(surface, surface));
+    // Turned only by the tilts the node layout gives (up to 30 degrees for a first touch of
+    // two node spheres); a larger angle means surfaces the normals do not describe (corners).
+    if (!(size > 0) || !(surface_size > 0) || dot(resultant, surface) < 0.7 * size * surface_size) continue;
+    const vec point{slot_point_[touch][0] / slot_force_[touch], slot_point_[touch][1] / slot_force_[touch],
+                    slot_point_[touch][2] / slot_force_[touch]};
+    vec turn;
+    for (int k = 0; k < 3; ++k) turn[k] = size * surface[k] / surface_size - resultant[k];
+    const vec vq = rigid_velocity(q, point), vp = rigid_velocity(p, point);
+    const vec relative{vq[0] - vp[0], vq[1] - vp[1], vq[2] - vp[2]};
+    const real speed2 = dot(relative, relative);
+    if (speed2 > 0) {
+      const real along = dot(turn, relative) / speed2;
+      for (int k = 0; k < 3; ++k) turn[k] -= along * relative[k];
+    }
+    add_body_load(q, point, turn);
+    add_body_load(p, point, {-turn[0], -turn[1], -turn[2]});
   }
 }
 

@@ -450,3 +450,68 @@ def test_damping_acts_on_the_fragment_in_contact_not_on_the_whole_particle() -> 
     assert np.mean(sim.velocities[left, 0]) > 0.05  # bounced
     np.testing.assert_allclose(np.mean(sim.velocities[right, 0]), 0.2, rtol=1e-12)
     assert block.node_count == len(left) + len(right)
+
+
+@pytest.mark.validation
+def test_head_on_impact_of_round_grains_throws_them_barely_sideways() -> None:
+    """Conforming discs (rings of nodes, R/h = 10) are round but bumpy at the scale of h: the
+    node springs that touch first push along lines the node layout tilts. The collision's force
+    is turned into the surfaces' normal (ContactModel::slot_redirects): measured lateral speed
+    over the approach speed 0.32 % / 0.42 % for equal discs at 0.05 m/s (e = 0.6 / 1) and
+    0.32 % / 0.42 % for a 0.5 mm disc against a 2 mm one; before, 9.9 % / 12.5 % and 9.6 % /
+    12.1 %. At 1 m/s the unequal pair still gets 1.1 % / 1.4 % (not yet the 1 % Issue 13 asks
+    for; 3.2 % / 2.9 % before)."""
+    for radius, speed, bound in ((1e-3, 0.05, 0.01), (0.5e-3, 0.05, 0.01), (0.5e-3, 1.0, 0.015)):
+        for restitution in (0.6, 1.0):
+            e, _, sim, (a, b), _ = collide(
+                2,
+                restitution,
+                radius=radius,
+                other_radius=1e-3 if radius == 1e-3 else 2e-3,
+                speed=speed,
+                discretization="conforming",
+                same_nodes_per_radius=True,
+            )
+            lateral = abs(body_velocity(sim, a)[1] - body_velocity(sim, b)[1]) / speed
+            assert lateral < bound, (radius, speed, restitution, lateral)
+            assert abs(e - restitution) < 0.05, (radius, speed, restitution, e)
+
+
+@pytest.mark.validation
+def test_turning_the_collision_force_feeds_no_energy_into_bouncing_grains() -> None:
+    """Sixteen conforming discs bounce in a box under gravity, elastic (e = 1) and frictionless:
+    kinetic + strain + potential energy, sampled when no contact spring is loaded, stays within
+    1 % of the largest kinetic energy over 0.05 s (measured: drift up to 6.8e-7 J/m against
+    7.0e-4 J/m; 2.9e-8 J/m before the force was turned). Turning the collision forces into the
+    surfaces' normal does no work (its part along the bodies' relative velocity is removed);
+    without that removal the drift reached 3.8e-3 J/m against 3.1e-3 J/m, and this test
+    failed."""
+    sim = gr.Simulation(2, gravity=(0, -9.81))
+    sim.contact = gr.Contact(restitution=1.0)
+    rng = np.random.default_rng(3)
+    for row in range(4):
+        for column in range(4):
+            x = 1.2e-3 + column * 2.3e-3 + (row % 2) * 1.1e-3 + rng.uniform(-1e-4, 1e-4)
+            centre = (x, 1.2e-3 + row * 2.3e-3)
+            sim.add_body(
+                gr.Disc(centre, 1e-3 * rng.uniform(0.8, 1.0)),
+                SOFT,
+                1e-3 / 6,
+                discretization="conforming",
+            )
+    sim.add_wall(gr.BoxContainer((0, 0), (11e-3, 30e-3)), name="box")
+    weight = sim.volumes * SOFT.density * 9.81
+
+    def energy() -> float:
+        return sim.kinetic_energy() + sim.strain_energy() + float(weight @ sim.positions[:, 1])
+
+    start = energy()
+    drift, kinetic = [], []
+    while sim.time < 0.05:
+        sim.run(200)
+        statistics = sim.core.contact_statistics
+        if statistics.node_contacts == 0 and statistics.wall_contacts == 0:  # no contact springs
+            drift.append(abs(energy() - start))
+            kinetic.append(sim.kinetic_energy())
+    assert len(drift) > 10
+    assert max(drift) < 0.01 * max(kinetic)

@@ -9,6 +9,8 @@
 //   normal:   F_n = k_ij delta on each node pair along -n, k_ij = kn min(V_i, V_j)^2 [N/m; N/m^2
 //             per unit thickness in 2D]: a fine particle's surface node meets about one node of a
 //             coarse particle, so the contact is as stiff per unit area whatever the two meshes.
+//             Per pair of bodies, the resultant of these springs is turned into the surfaces'
+//             normal by rigid-body loads that do no work (ContactModel::slot_redirects).
 //   damping:  one dashpot per pair of touching bodies, F_d = 2 zeta sqrt(M K_s) dx/dt along the
 //             mean contact normal m, acting at the collision's contact point p (the spring-weighted
 //             mean of the node pairs' contact points) on each body as a rigid-body load: every

@@ -164,6 +164,15 @@ class ContactModel {
   void measure_bodies(const Model& model, const State& state);
   void sum_slot_springs(const Model& model, const State& state);
   void slot_dashpots(const State& state, real dt);
+  void slot_redirects();
+  /// Velocity of a point moving with a touching body's rigid-body motion.
+  vec3 rigid_velocity(index_t body, const vec3& point) const;
+  /// A force at a point of a touching body, as a rigid-body load.
+  void add_body_load(index_t body, const vec3& point, const vec3& force);
+  /// The contact normal of node pair (i, j) from the two surfaces' normals (from i to j), or
+  /// `line`, the direction of the nodes, where either node has no surface normal.
+  vec3 pair_surface_normal(index_t i, index_t j, const vec3& line) const;
+  void measure_surface_normals(const Model& model, const State& state);
   void node_forces(const Model& model, State& state, real dt);
   void body_loads(const Model& model, State& state);
   void sum_wall_reactions();
@@ -275,6 +284,10 @@ class ContactModel {
   std::vector<index_t> slot_touch_;             // per slot: its index among the slots in contact
   std::vector<real> slot_force_;                // per slot in contact: spring force, and the
   std::vector<vec3> slot_normal_, slot_point_;  // spring-weighted normal and contact point sums
+  std::vector<vec3> slot_surface_normal_;       // spring-weighted sum of the surfaces' normals
+  std::vector<std::uint8_t> node_touching_;     // per node: in a pair in contact between bodies
+  std::vector<index_t> touching_nodes_;         // those nodes in order, and their surface
+  std::vector<vec3> touching_normals_;          // normals (pair_surface_normal)
   /// Angular velocity of a body (zero if it touches nothing).
   const vec3& body_spin(index_t body) const {
     static constexpr vec3 none{0, 0, 0};
