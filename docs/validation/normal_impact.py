@@ -1,15 +1,17 @@
-"""Elastic normal impact of a sphere on a rigid plane, the analogue of Chung & Ooi (2011,
-Granular Matter 13:643) test 2, against Hertz's theory: the plane's force against time from
-m d'' = -4/3 E* sqrt(R) d^1.5 (d(0) = 0, d'(0) = v; E* = E / (1 - nu^2) against a rigid plane),
-integrated here with fourth-order Runge-Kutta; its peak force and duration are
-F_max = 4/3 E* sqrt(R) d_max^1.5, d_max = (15 m v^2 / (16 E* sqrt(R)))^(2/5) and
-t_c = 2.87 (m^2 / (R E*^2 v))^(1/5).
+"""Elastic normal impacts against Hertz's theory: a sphere on a rigid plane, the analogue of Chung
+& Ooi (2011, Granular Matter 13:643) test 2, and two identical spheres head-on, their test 1.
+Hertz: m* d'' = -4/3 E* sqrt(R*) d^1.5 (d(0) = 0, d'(0) = v, the approach speed), integrated
+here with fourth-order Runge-Kutta; against a rigid plane m* = m, R* = R, E* = E / (1 - nu^2);
+between two equal spheres m* = m / 2, R* = R / 2, E* = E / (2 (1 - nu^2)). Its peak force and
+duration are F_max = 4/3 E* sqrt(R*) d_max^1.5, d_max = (15 m* v^2 / (16 E* sqrt(R*)))^(2/5)
+and t_c = 2.87 (m*^2 / (R* E*^2 v))^(1/5).
 
-The grain is a conforming peridynamic sphere (R = 1 mm, E = 30 MPa, nu = 0.25, 1200 kg/m^3) with
-the contact stiff against it (stiffness_factor 100, see ARCHITECTURE.md, "Choosing kn").
+The grains are conforming peridynamic spheres (R = 1 mm, E = 30 MPa, nu = 0.25, 1200 kg/m^3)
+with the contact stiff against them (stiffness_factor 100, see ARCHITECTURE.md, "Choosing kn").
+The force between two spheres is the rate of change of one sphere's momentum.
 
 Run: python docs/validation/normal_impact.py [--smoke]; writes docs/validation/normal_impact_3d.png
-and prints the table.
+(the plane) and docs/validation/normal_impact_pair_3d.png (two spheres) and prints the tables.
 """
 
 from __future__ import annotations
@@ -60,10 +62,60 @@ def simulate(nodes_across_radius: int, speed: float, stiffness_factor: float = 1
     }
 
 
-def hertz(mass: float, speed: float) -> dict:
-    """Hertz's force against time (RK4 on the approach), peak force and duration."""
-    k = 4 / 3 * E_STAR * np.sqrt(RADIUS)
-    duration = 2.87 * (mass**2 / (RADIUS * E_STAR**2 * speed)) ** 0.2
+def simulate_pair(nodes_across_radius: int, speed: float, stiffness_factor: float = 100.0) -> dict:
+    """Two equal spheres meeting head-on at approach speed `speed`: the force between them
+    against time (one sphere's momentum change per step), and the restitution."""
+    h = RADIUS / nodes_across_radius
+    sim = gr.Simulation(3)
+    sim.contact = gr.Contact(restitution=1.0, stiffness_factor=stiffness_factor)
+    grain = gr.Material(density=DENSITY, youngs_modulus=E, poisson_ratio=NU, fracture=False)
+    bodies = [
+        sim.add_body(
+            gr.Sphere((side * (RADIUS + 0.3 * h), 0, 0), RADIUS),
+            grain,
+            h,
+            discretization="conforming",
+            velocity=(-side * speed / 2, 0, 0),
+        )
+        for side in (-1, 1)
+    ]
+    first = bodies[0].nodes
+    masses = sim.volumes[first] * DENSITY
+
+    def momentum() -> float:
+        return float(masses @ sim.velocities[first, 0])
+
+    times, forces, touching = [], [], []
+    before = momentum()
+    while True:
+        sim.run(2)
+        now = momentum()
+        times.append(sim.time)
+        forces.append(-(now - before) / (2 * sim.dt))  # the push on the first sphere, along -x
+        before = now
+        touching.append(sim.core.contact_statistics.node_contacts > 0)
+        if any(touching) and not touching[-1]:
+            break
+    t, f, on = np.array(times), np.array(forces), np.array(touching)
+    start, end = t[on][0], t[on][-1]
+    rebound = float(np.average(sim.velocities[first, 0], weights=sim.volumes[first]))
+    return {
+        "time": t - start,
+        "force": f,
+        "duration": float(end - start),
+        "peak": float(f.max()),
+        "restitution": -2 * rebound / speed,
+        "mass": float(np.sum(masses)),
+    }
+
+
+def hertz(mass: float, speed: float, *, pair: bool = False) -> dict:
+    """Hertz's force against time (RK4 on the approach), peak force and duration; `pair`: two
+    equal spheres of mass `mass` (else one on a rigid plane)."""
+    radius, modulus = (RADIUS / 2, E_STAR / 2) if pair else (RADIUS, E_STAR)
+    mass = mass / 2 if pair else mass
+    k = 4 / 3 * modulus * np.sqrt(radius)
+    duration = 2.87 * (mass**2 / (radius * modulus**2 * speed)) ** 0.2
     dt = duration / 4000
     d, v, t = 0.0, speed, 0.0
     times, forces = [0.0], [0.0]
@@ -81,31 +133,29 @@ def hertz(mass: float, speed: float) -> dict:
         t += dt
         times.append(t)
         forces.append(k * max(d, 0.0) ** 1.5)
-    peak_approach = (15 * mass * speed**2 / (16 * E_STAR * np.sqrt(RADIUS))) ** 0.4
+    peak_approach = (15 * mass * speed**2 / (16 * modulus * np.sqrt(radius))) ** 0.4
     return {
         "time": np.array(times),
         "force": np.array(forces),
         "duration": duration,
         "peak": k * peak_approach**1.5,
-        "contact_radius": float(np.sqrt(RADIUS * peak_approach)),
+        "contact_radius": float(np.sqrt(radius * peak_approach)),
     }
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--smoke", action="store_true")
-    args = parser.parse_args()
-    speeds = [5.0] if args.smoke else [2.0, 5.0, 10.0]
+def figure(pair: bool, speeds: list[float]) -> None:
+    """One impact per speed against Hertz: print the table and write the figure."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     fig, ax = plt.subplots(figsize=(6.5, 4))
+    print("two spheres" if pair else "sphere on a plane")
     print("v [m/s]  R/h  a/h   F_max/Hertz  t_c/Hertz  e")
     for speed in speeds:
-        run = simulate(8, speed)
-        theory = hertz(run["mass"], speed)
+        run = simulate_pair(8, speed) if pair else simulate(8, speed)
+        theory = hertz(run["mass"], speed, pair=pair)
         a_over_h = theory["contact_radius"] / (RADIUS / 8)
         print(
             f"{speed:7.1f}  8  {a_over_h:5.2f}  {run['peak'] / theory['peak']:11.3f}  "
@@ -120,18 +170,30 @@ def main() -> None:
             color=line.get_color(),
             label=f"v = {speed} m/s (line: Hertz)",
         )
+    ax.set_xlim(left=-5)
     ax.set_xlabel("time since first touch [us]")
-    ax.set_ylabel("force on the plane [N]")
-    ax.set_title(
-        "Sphere on a rigid plane (Chung & Ooi test 2 analogue): R/h = 8, stiffness_factor 100",
-        fontsize=9,
+    ax.set_ylabel("force between the spheres [N]" if pair else "force on the plane [N]")
+    what = (
+        "Two equal spheres head-on (Chung & Ooi test 1 analogue)"
+        if pair
+        else "Sphere on a rigid plane (Chung & Ooi test 2 analogue)"
     )
+    ax.set_title(f"{what}: R/h = 8, stiffness_factor 100", fontsize=9)
     ax.legend(fontsize=8)
     ax.grid(alpha=0.3)
     fig.tight_layout()
-    out = Path(__file__).with_name("normal_impact_3d.png")
+    out = Path(__file__).with_name("normal_impact_pair_3d.png" if pair else "normal_impact_3d.png")
     fig.savefig(out, dpi=110)
     print(f"wrote {out}")
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--smoke", action="store_true")
+    args = parser.parse_args()
+    speeds = [5.0] if args.smoke else [2.0, 5.0, 10.0]
+    figure(False, speeds)
+    figure(True, speeds)
 
 
 if __name__ == "__main__":
