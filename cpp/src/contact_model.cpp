@@ -617,7 +617,6 @@ void ContactModel::finish_lists(const Model& model) {
   carry_over(particle_slots, slots_.size(), old_particle_slots, old_slots.size());
   group_contact_nodes(model);
   pair_stiffness_.assign(pair_partner_.size(), 0);
-  node_touching_.assign(n, 0);
   wall_entry_stiffness_.assign(wall_entry_.size(), 0);
   wall_points_.assign(wall_entry_.size(), {});
   wall_entry_reaction_.assign(wall_entry_.size(), {0, 0, 0, 0, 0, 0});
@@ -830,8 +829,7 @@ std::size_t ContactModel::memory_bytes() const {
          bytes(touching_bodies_) + bytes(slot_touch_) + bytes(body_motion_) + bytes(body_load_) +
          bytes(slot_force_) + bytes(slot_normal_) + bytes(slot_point_) + bytes(slot_work_) +
          bytes(slot_exponent_) + bytes(damping_tables_) + bytes(wall_damping_tables_) +
-         bytes(slot_surface_normal_) + bytes(node_touching_) + bytes(touching_nodes_) +
-         bytes(touching_normals_);
+         bytes(slot_surface_normal_) + bytes(touching_nodes_) + bytes(touching_normals_);
 }
 
 ContactCheckpoint ContactModel::checkpoint() const {
@@ -955,15 +953,18 @@ real ContactModel::node_radius(const contact::Law& law, const Model& model, inde
 
 void ContactModel::measure_contacts(const Model& model, const State& state) {
   // The only geometry pass: distance and spring stiffness of every pair entry in contact, and the
-  // contact points (normals in the world frame) of every wall entry. The later passes read these.
+  // contact points (normals in the world frame) of every wall entry, and the nodes in contact with
+  // another body. The later passes read these.
   const auto& x = state.positions;
   const auto& volume = model.volumes();
   const std::int64_t n = model.node_count();
   const real t = state.time;
+  touching_nodes_.clear();
 #pragma omp parallel
   {
     std::vector<WallContact> found;  // scratch of this thread
-#pragma omp for schedule(static)
+    std::vector<index_t> touching_nodes;
+#pragma omp for schedule(static) nowait
     for (std::int64_t ii = 0; ii < n; ++ii) {
       const index_t i = static_cast<index_t>(ii);
       bool touching = false;
@@ -978,7 +979,7 @@ void ContactModel::measure_contacts(const Model& model, const State& state) {
                                  : 0.0f;
         touching = touching || (pair_stiffness_[e] > 0 && !law.node_pair && node_body_[i] != node_body_[j]);
       }
-      node_touching_[i] = touching ? 1 : 0;
+      if (touching) touching_nodes.push_back(i);
       for (index_t e = wall_offsets_[i]; e < wall_offsets_[i + 1]; ++e) {
         const Wall& wall = walls_[wall_entry_[e][0]];
         const contact::PairLaw& law = slot_law(wall_slot_[e]);
@@ -994,7 +995,10 @@ void ContactModel::measure_contacts(const Model& model, const State& state) {
             static_cast<real>(points.count) * law.normal_stiffness * volume[i] * volume[i];
       }
     }
+#pragma omp critical
+    touching_nodes_.insert(touching_nodes_.end(), touching_nodes.begin(), touching_nodes.end());
   }
+  std::sort(touching_nodes_.begin(), touching_nodes_.end());  // the same for any thread count
 }
 
 void ContactModel::sum_slot_stiffness() {
@@ -1048,13 +1052,8 @@ void ContactModel::measure_bodies(const Model& model, const State& state) {
 }
 
 void ContactModel::measure_surface_normals(const Model& model, const State& state) {
-  // The surface normal of every node in a node pair in contact between two bodies (in node
-  // order, for the look-ups of pair_surface_normal), computed in parallel.
-  touching_nodes_.clear();
-  const index_t n = model.node_count();
-  for (index_t i = 0; i < n; ++i) {
-    if (node_touching_[i]) touching_nodes_.push_back(i);
-  }
+  // The surface normal of every node in a node pair in contact between two bodies (listed by
+  // measure_contacts, in node order, for the look-ups of pair_surface_normal), in parallel.
   touching_normals_.resize(touching_nodes_.size());
   const std::int64_t count = static_cast<std::int64_t>(touching_nodes_.size());
 #pragma omp parallel for schedule(static)

@@ -285,9 +285,8 @@ class ContactModel {
   std::vector<real> slot_force_;                // per slot in contact: spring force, and the
   std::vector<vec3> slot_normal_, slot_point_;  // spring-weighted normal and contact point sums
   std::vector<vec3> slot_surface_normal_;       // spring-weighted sum of the surfaces' normals
-  std::vector<std::uint8_t> node_touching_;     // per node: in a pair in contact between bodies
-  std::vector<index_t> touching_nodes_;         // those nodes in order, and their surface
-  std::vector<vec3> touching_normals_;          // normals (pair_surface_normal)
+  std::vector<index_t> touching_nodes_;         // nodes in a pair in contact between two bodies, in
+  std::vector<vec3> touching_normals_;          // order, and their surface normals (per step)
   /// Angular velocity of a body (zero if it touches nothing).
   const vec3& body_spin(index_t body) const {
     static constexpr vec3 none{0, 0, 0};
