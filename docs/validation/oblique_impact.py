@@ -15,8 +15,13 @@ v_t' = omega' R = v_t / (1 + k); an elastic contact point springs back (Maw et a
 full reversal of its tangential velocity, v_t' - omega' R = -v_t, which keeps the tangential
 and spin energy (the bound drawn dashed).
 
-Run: python docs/validation/oblique_impact.py [--dimension 2|3] [--smoke]; writes
-docs/validation/oblique_impact_<d>d.png and prints the table.
+Test 6 analogue (--test 6): the body falls straight down (v_t = 0) spinning at omega R; its
+contact point slides at u = v_t - omega R, and the same impulse theory applies with the friction
+opposing u: gross sliding while |u| > mu (1 + e) v_n (1 + 1/k), rolling below.
+
+Run: python docs/validation/oblique_impact.py [--dimension 2|3] [--test 4|6] [--smoke]; writes
+docs/validation/oblique_impact_<d>d.png (test 4) or spinning_impact_<d>d.png (test 6) and
+prints the table.
 """
 
 from __future__ import annotations
@@ -32,18 +37,26 @@ SOFT = gr.Material(density=1200, bulk_modulus=2.16e7, shear_modulus=1.296e7, fra
 RADIUS, SPEED, MU, RESTITUTION = 1e-3, 0.5, 0.3, 0.8
 
 
-def impact(dimension: int, angle: float, nodes_across_radius: int) -> dict[str, float]:
-    """One impact at `angle` degrees from the normal: incoming and rebound velocities and spin."""
+def impact(
+    dimension: int, angle: float, nodes_across_radius: int, spin: float = 0.0, speed: float = SPEED
+) -> dict[str, float]:
+    """One impact at `angle` degrees from the normal, the body turning at omega R = `spin`
+    (positive rolling forwards, towards +x): incoming and rebound velocities and spin."""
     h = RADIUS / nodes_across_radius
     sim = gr.Simulation(dimension)
     sim.contact = gr.Contact(restitution=RESTITUTION, friction=MU)
     a = np.radians(angle)
-    velocity = (SPEED * np.sin(a), -SPEED * np.cos(a), 0.0)[:dimension]
+    velocity = (speed * np.sin(a), -speed * np.cos(a), 0.0)[:dimension]
     centre = (0.0, RADIUS + 0.6 * h, 0.0)[:dimension]
     shape = gr.Disc(centre, RADIUS) if dimension == 2 else gr.Sphere(centre, RADIUS)
     body = sim.add_body(shape, SOFT, h, discretization="conforming", velocity=velocity)
     normal = (0.0, 1.0, 0.0)[:dimension]
     sim.add_wall(gr.Plane((0.0,) * dimension, normal), name="floor")
+    if spin:  # rigid rotation about z: v = v_c + omega x (x - c), omega_z = -spin / R
+        nodes = body.nodes
+        offset = sim.positions[nodes, :2] - np.asarray(centre)[:2]
+        sim.velocities[nodes, 0] += spin / RADIUS * offset[:, 1]
+        sim.velocities[nodes, 1] -= spin / RADIUS * offset[:, 0]
     touched = False
     while True:
         sim.run(10)
@@ -65,14 +78,15 @@ def impact(dimension: int, angle: float, nodes_across_radius: int) -> dict[str, 
     )
     momentum = np.sum(m[:, None] * np.cross(r, w), axis=0)
     turn = momentum / inertia[2, 2] if dimension == 2 else np.linalg.solve(inertia, momentum)
-    spin = -turn[2]
+    rate = -turn[2]  # omega', positive rolling forwards
     return {
         "angle": angle,
-        "v_n": SPEED * np.cos(a),
-        "v_t": SPEED * np.sin(a),
-        "e": vc[1] / (SPEED * np.cos(a)),
+        "v_n": speed * np.cos(a),
+        "v_t": speed * np.sin(a),
+        "spin_R_before": spin,
+        "e": vc[1] / (speed * np.cos(a)),
         "v_t_after": vc[0],
-        "spin_R": spin * RADIUS,  # omega' R, positive for rolling forwards
+        "spin_R": rate * RADIUS,  # omega' R
     }
 
 
@@ -86,6 +100,23 @@ def theory(dimension: int, v_n: float, v_t: float, e: float) -> tuple[float, flo
     return rolling, rolling
 
 
+def spinning_theory(
+    dimension: int, v_n: float, v_t: float, spin: float, e: float
+) -> tuple[float, float]:
+    """Rigid-body rebound (v_t', omega' R) of a spinning body with Coulomb friction. The contact
+    point slides at u = v_t - omega R; while it slides all through the impact
+    (|u| > mu (1 + e) v_n (1 + 1/k)) the friction impulse mu (1 + e) m v_n opposes u, else the
+    body leaves rolling (u' = 0)."""
+    k = 0.5 if dimension == 2 else 0.4
+    slip = v_t - spin
+    impulse = MU * (1 + e) * v_n
+    if abs(slip) > impulse * (1 + 1 / k):
+        change = np.sign(slip) * impulse
+    else:
+        change = k * slip / (1 + k)
+    return v_t - change, spin + change / k
+
+
 def reversal(dimension: int, v_t: float) -> tuple[float, float]:
     """Rebound (v_t', omega' R) that reverses the contact point's velocity, v_t' - omega' R =
     -v_t, with the friction impulse J: v_t' = v_t - J/m, omega' R = J/(k m)."""
@@ -94,15 +125,9 @@ def reversal(dimension: int, v_t: float) -> tuple[float, float]:
     return v_t - impulse, impulse / k
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--dimension", type=int, default=2, choices=(2, 3))
-    parser.add_argument("--smoke", action="store_true")
-    args = parser.parse_args()
-    d = args.dimension
-    angles = (
-        [5, 15, 30, 45, 60, 75] if args.smoke else [2, 5, 10, 15, 20, 25, 30, 40, 50, 60, 70, 80]
-    )
+def angle_figure(d: int, smoke: bool) -> None:
+    """Test 4: constant speed, incidence angles from 2 to 80 degrees."""
+    angles = [5, 15, 30, 45, 60, 75] if smoke else [2, 5, 10, 15, 20, 25, 30, 40, 50, 60, 70, 80]
     npr = 10 if d == 2 else 6
     rows = [impact(d, angle, npr) for angle in angles]
     print("angle  e     v_t'/v  rigid   omega'R/v  rigid  (rigid: gross sliding, or rolling)")
@@ -151,6 +176,57 @@ def main() -> None:
     out = Path(__file__).with_name(f"oblique_impact_{d}d.png")
     fig.savefig(out, dpi=110)
     print(f"wrote {out}")
+
+
+def spin_figure(d: int, smoke: bool) -> None:
+    """Test 6: a spinning body dropped straight down (v_n = SPEED, v_t = 0) at spins omega R
+    from -4 to 4 v_n."""
+    spins = [-3.0, -1.0, 1.0, 3.0] if smoke else [-4, -3, -2, -1.5, -1, -0.5, 0.5, 1, 1.5, 2, 3, 4]
+    npr = 10 if d == 2 else 6
+    rows = [impact(d, 0.0, npr, spin=float(w) * SPEED) for w in spins]
+    print("omegaR/v  e     v_t'/v  rigid    omega'R/v  rigid  (rigid: gross sliding, or rolling)")
+    for w, row in zip(spins, rows, strict=True):
+        vt, wr = spinning_theory(d, row["v_n"], 0.0, row["spin_R_before"], row["e"])
+        print(
+            f"{w:8.2f}  {row['e']:.3f} {row['v_t_after'] / SPEED:7.4f} {vt / SPEED:7.4f}  "
+            f"{row['spin_R'] / SPEED:8.4f}  {wr / SPEED:7.4f}"
+        )
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    e_mean = float(np.mean([r["e"] for r in rows]))
+    fine = np.linspace(-4.2, 4.2, 400)
+    curves = np.array([spinning_theory(d, SPEED, 0.0, w * SPEED, e_mean) for w in fine])
+    fig, axes = plt.subplots(1, 2, figsize=(9, 3.6))
+    for column, (ax, key) in enumerate(zip(axes, ("v_t_after", "spin_R"), strict=True)):
+        ax.plot(fine, curves[:, column] / SPEED, "k-", label="rigid body, Coulomb")
+        ax.plot(spins, [r[key] / SPEED for r in rows], "o", label="granulate")
+        ax.set_xlabel("spin before, omega R / v_n")
+        ax.legend()
+        ax.grid(alpha=0.3)
+    axes[0].set_ylabel("tangential rebound speed v_t' / v_n")
+    axes[1].set_ylabel("rebound spin omega' R / v_n")
+    shape = "disc" if d == 2 else "sphere"
+    fig.suptitle(
+        f"Spinning {shape} dropped on a plane (Chung & Ooi test 6 analogue): v_n = {SPEED} m/s, "
+        f"mu = {MU}, e = {RESTITUTION}, R/h = {npr}",
+        fontsize=9,
+    )
+    fig.tight_layout()
+    out = Path(__file__).with_name(f"spinning_impact_{d}d.png")
+    fig.savefig(out, dpi=110)
+    print(f"wrote {out}")
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--dimension", type=int, default=2, choices=(2, 3))
+    parser.add_argument("--test", type=int, default=4, choices=(4, 6))
+    parser.add_argument("--smoke", action="store_true")
+    args = parser.parse_args()
+    (angle_figure if args.test == 4 else spin_figure)(args.dimension, args.smoke)
 
 
 if __name__ == "__main__":
