@@ -1201,6 +1201,7 @@ vec3 ContactModel::pair_surface_normal(index_t i, index_t j, const vec3& line) c
   // line of the nodes); the line itself otherwise.
   auto normal = [&](index_t node) {
     const auto at = std::lower_bound(touching_nodes_.begin(), touching_nodes_.end(), node);
+    if (at == touching_nodes_.end() || *at != node) return vec{0, 0, 0};  // not measured: the line
     return touching_normals_[static_cast<std::size_t>(at - touching_nodes_.begin())];
   };
   const vec ni = normal(i), nj = normal(j);
