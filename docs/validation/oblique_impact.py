@@ -37,6 +37,27 @@ SOFT = gr.Material(density=1200, bulk_modulus=2.16e7, shear_modulus=1.296e7, fra
 RADIUS, SPEED, MU, RESTITUTION = 1e-3, 0.5, 0.3, 0.8
 
 
+def run_through_wall_impact(sim: gr.Simulation) -> None:
+    """Run until the body has touched the wall and left it, then 50 steps more."""
+    touched = False
+    while True:
+        sim.run(10)
+        touching = sim.core.contact_statistics.wall_contacts > 0
+        touched = touched or touching
+        if touched and not touching:
+            break
+    sim.run(50)
+
+
+def save(fig, title: str, name: str) -> None:
+    """Title the figure and write it beside this script."""
+    fig.suptitle(title, fontsize=9)
+    fig.tight_layout()
+    out = Path(__file__).with_name(name)
+    fig.savefig(out, dpi=110)
+    print(f"wrote {out}")
+
+
 def impact(
     dimension: int, angle: float, nodes_across_radius: int, spin: float = 0.0, speed: float = SPEED
 ) -> dict[str, float]:
@@ -57,14 +78,7 @@ def impact(
         offset = sim.positions[nodes, :2] - np.asarray(centre)[:2]
         sim.velocities[nodes, 0] += spin / RADIUS * offset[:, 1]
         sim.velocities[nodes, 1] -= spin / RADIUS * offset[:, 0]
-    touched = False
-    while True:
-        sim.run(10)
-        touching = sim.core.contact_statistics.wall_contacts > 0
-        touched = touched or touching
-        if touched and not touching:
-            break
-    sim.run(50)
+    run_through_wall_impact(sim)
     nodes = body.nodes
     m = sim.volumes[nodes]
     x, v = sim.positions[nodes], sim.velocities[nodes]
@@ -167,15 +181,11 @@ def angle_figure(d: int, smoke: bool) -> None:
         ax.legend()
         ax.grid(alpha=0.3)
     shape = "disc" if d == 2 else "sphere"
-    fig.suptitle(
+    title = (
         f"Oblique impact of a {shape} on a plane (Chung & Ooi test 4 analogue): v = {SPEED} m/s, "
-        f"mu = {MU}, e = {RESTITUTION}, R/h = {npr}",
-        fontsize=9,
+        f"mu = {MU}, e = {RESTITUTION}, R/h = {npr}"
     )
-    fig.tight_layout()
-    out = Path(__file__).with_name(f"oblique_impact_{d}d.png")
-    fig.savefig(out, dpi=110)
-    print(f"wrote {out}")
+    save(fig, title, f"oblique_impact_{d}d.png")
 
 
 def spin_figure(d: int, smoke: bool) -> None:
@@ -209,15 +219,11 @@ def spin_figure(d: int, smoke: bool) -> None:
     axes[0].set_ylabel("tangential rebound speed v_t' / v_n")
     axes[1].set_ylabel("rebound spin omega' R / v_n")
     shape = "disc" if d == 2 else "sphere"
-    fig.suptitle(
+    title = (
         f"Spinning {shape} dropped on a plane (Chung & Ooi test 6 analogue): v_n = {SPEED} m/s, "
-        f"mu = {MU}, e = {RESTITUTION}, R/h = {npr}",
-        fontsize=9,
+        f"mu = {MU}, e = {RESTITUTION}, R/h = {npr}"
     )
-    fig.tight_layout()
-    out = Path(__file__).with_name(f"spinning_impact_{d}d.png")
-    fig.savefig(out, dpi=110)
-    print(f"wrote {out}")
+    save(fig, title, f"spinning_impact_{d}d.png")
 
 
 def main() -> None:

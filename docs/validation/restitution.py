@@ -17,9 +17,9 @@ prints the table.
 from __future__ import annotations
 
 import argparse
-from pathlib import Path
 
 import numpy as np
+from oblique_impact import run_through_wall_impact, save
 
 import granulate as gr
 
@@ -39,14 +39,7 @@ def rebound(dimension: int, restitution: float, speed: float) -> float:
     velocity = (0.0, -speed, 0.0)[:dimension]
     body = sim.add_body(shape, SOFT, h, discretization="conforming", velocity=velocity)
     sim.add_wall(gr.Plane((0.0,) * dimension, (0.0, 1.0, 0.0)[:dimension]), name="floor")
-    touched = False
-    while True:
-        sim.run(10)
-        touching = sim.core.contact_statistics.wall_contacts > 0
-        touched = touched or touching
-        if touched and not touching:
-            break
-    sim.run(50)
+    run_through_wall_impact(sim)
     nodes = body.nodes
     return float(np.average(sim.velocities[nodes, 1], weights=sim.volumes[nodes]) / speed)
 
@@ -78,11 +71,7 @@ def main() -> None:
         ax.grid(alpha=0.3)
         ax.legend(fontsize=8)
     axes[0].set_ylabel("measured e (rebound / impact speed)")
-    fig.suptitle("Normal impact on a rigid plane (Chung & Ooi test 3 analogue)", fontsize=9)
-    fig.tight_layout()
-    out = Path(__file__).with_name("restitution.png")
-    fig.savefig(out, dpi=110)
-    print(f"wrote {out}")
+    save(fig, "Normal impact on a rigid plane (Chung & Ooi test 3 analogue)", "restitution.png")
 
 
 if __name__ == "__main__":
