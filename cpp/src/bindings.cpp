@@ -368,7 +368,8 @@ NB_MODULE(_core, m) {
       .def_ro("list_updates", &ContactStatistics::list_updates)
       .def_ro("list_entries", &ContactStatistics::list_entries)
       .def_ro("node_contacts", &ContactStatistics::node_contacts)
-      .def_ro("wall_contacts", &ContactStatistics::wall_contacts);
+      .def_ro("wall_contacts", &ContactStatistics::wall_contacts)
+      .def_ro("deepest_overlap", &ContactStatistics::deepest_overlap);
 
   nb::class_<PhaseTimes>(m, "PhaseTimes")
       .def_ro("peridynamics", &PhaseTimes::peridynamics)

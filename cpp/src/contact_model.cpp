@@ -964,6 +964,7 @@ void ContactModel::measure_contacts(const Model& model, const State& state) {
   {
     std::vector<WallContact> found;  // scratch of this thread
     std::vector<index_t> touching_nodes;
+    real deepest = 0;  // overlap / Rc
 #pragma omp for schedule(static) nowait
     for (std::int64_t ii = 0; ii < n; ++ii) {
       const index_t i = static_cast<index_t>(ii);
@@ -978,6 +979,8 @@ void ContactModel::measure_contacts(const Model& model, const State& state) {
                                  ? static_cast<float>(contact::pair_stiffness(law, volume[i], volume[j]))
                                  : 0.0f;
         touching = touching || (pair_stiffness_[e] > 0 && !law.node_pair && node_body_[i] != node_body_[j]);
+        if (pair_stiffness_[e] > 0 && !law.node_pair)
+          deepest = std::max(deepest, 1 - distance / law.contact_radius);
       }
       if (touching) touching_nodes.push_back(i);
       for (index_t e = wall_offsets_[i]; e < wall_offsets_[i + 1]; ++e) {
@@ -996,7 +999,10 @@ void ContactModel::measure_contacts(const Model& model, const State& state) {
       }
     }
 #pragma omp critical
-    touching_nodes_.insert(touching_nodes_.end(), touching_nodes.begin(), touching_nodes.end());
+    {
+      touching_nodes_.insert(touching_nodes_.end(), touching_nodes.begin(), touching_nodes.end());
+      statistics_.deepest_overlap = std::max(statistics_.deepest_overlap, deepest);
+    }
   }
   std::sort(touching_nodes_.begin(), touching_nodes_.end());  // the same for any thread count
 }

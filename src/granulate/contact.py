@@ -44,7 +44,9 @@ class Contact:
         contact_radius: absolute Rc [m] of a node pair (each node's radius Rc / 2);
             overrides the factor.
         normal_stiffness: absolute kn [N/m^7 in 3D, N/m^6 in 2D]; overrides the default.
-        stiffness_factor: multiplies the default kn.
+        stiffness_factor: multiplies the default kn. A run warns when node pairs overlap by
+            half their contact radius (the layer too soft for the impacts; nodes may pass
+            through each other): raise it then.
         tangential_stiffness_ratio: kt / kn of the friction spring of each contact (Cundall &
             Strack), in (0, 1]; default 2/7.
         friction_law: "coulomb" (default: the friction spring), or "peridem": PeriDEM's

@@ -515,3 +515,27 @@ def test_turning_the_collision_force_feeds_no_energy_into_bouncing_grains() -> N
             kinetic.append(sim.kinetic_energy())
     assert len(drift) > 10
     assert max(drift) < 0.01 * max(kinetic)
+
+
+@pytest.mark.validation
+def test_a_contact_too_soft_for_the_impact_is_reported() -> None:
+    """Two soft discs (K = 21.6 MPa, lattice, R/h = 10) meeting at 10 m/s with the default kn:
+    node pairs overlap by their whole contact radius (measured 0.996 Rc; the outermost nodes of
+    one disc pass the other's by 0.64 h), and the run warns once, naming stiffness_factor. With
+    stiffness_factor 10 the deepest overlap is 0.21 Rc and nothing is said."""
+    import warnings
+
+    for factor, deepest in ((1.0, (0.5, 1.01)), (10.0, (0.0, 0.5))):
+        sim = gr.Simulation(2)
+        sim.contact = gr.Contact(restitution=0.6, stiffness_factor=factor)
+        sim.add_body(gr.Disc((0, 0), 1e-3), SOFT, 1e-4, velocity=(5.0, 0))
+        sim.add_body(gr.Disc((2.15e-3, 0), 1e-3), SOFT, 1e-4, velocity=(-5.0, 0))
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            sim.run(until=6e-4)
+        overlap = sim.core.contact_statistics.deepest_overlap
+        assert deepest[0] < overlap < deepest[1], (factor, overlap)
+        said = [w for w in caught if "too soft" in str(w.message)]
+        assert len(said) == (1 if factor == 1.0 else 0), (factor, said)
+        if said:
+            assert "stiffness_factor" in str(said[0].message)
