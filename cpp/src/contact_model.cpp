@@ -934,15 +934,16 @@ void ContactModel::add_forces(const Model& model, State& state, std::uint64_t br
   const real dt = has_last_time_ ? state.time - last_time_ : 0.0;
   last_time_ = state.time;
   has_last_time_ = true;
-  measure_contacts(model, state);  // A: distances, springs, wall contact points
-  sum_slot_stiffness();            // B: K per pair of bodies; the touching bodies
-  measure_bodies(model, state);    //    rigid-body motion of the touching bodies
-  sum_slot_springs(model, state);  //    spring force, normal and contact point per slot
-  slot_dashpots(state, dt);        //    the body dashpots, as loads on the bodies
-  slot_redirects();                //    each collision's force turned to the surface normal
-  node_forces(model, state, dt);   // C: springs, friction, fragment dashpots, per node
-  body_loads(model, state);        // E: dashpots and friction couples as rigid-body loads
-  sum_wall_reactions();            // D: wall reactions
+  measure_contacts(model, state);         // A: distances, springs, wall contact points
+  sum_slot_stiffness();                   // B: K per pair of bodies; the touching bodies
+  measure_bodies(model, state);           //    rigid-body motion of the touching bodies
+  measure_surface_normals(model, state);  //    outward normals of the nodes in contact
+  sum_slot_springs(model, state);         //    spring force, normal and contact point per slot
+  slot_dashpots(state, dt);               //    the body dashpots, as loads on the bodies
+  slot_redirects();                       //    each collision's force turned to the surface normal
+  node_forces(model, state, dt);          // C: springs, friction, fragment dashpots, per node
+  body_loads(model, state);               // E: dashpots and friction couples as rigid-body loads
+  sum_wall_reactions();                   // D: wall reactions
 }
 
 real ContactModel::node_radius(const contact::Law& law, const Model& model, index_t i, index_t j,
@@ -1072,7 +1073,6 @@ void ContactModel::sum_slot_springs(const Model& model, const State& state) {
   // the particle) and spring-weighted contact point per slot, summed in node order.
   const auto& x = state.positions;
   const auto& volume = model.volumes();
-  measure_surface_normals(model, state);
   for (const index_t i : contact_nodes_) {
     for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
       const index_t j = pair_partner_[e];
@@ -1120,8 +1120,6 @@ void ContactModel::slot_dashpots(const State& state, real dt) {
   // dashpot would then overdamp.
   const real t = state.time;
   std::fill(wall_damping_.begin(), wall_damping_.end(), std::array<real, 6>{0, 0, 0, 0, 0, 0});
-  auto load = [&](index_t body, const vec& point, const vec& force) { add_body_load(body, point, force); };
-  auto point_velocity = [&](index_t body, const vec& point) { return rigid_velocity(body, point); };
   for (std::size_t slot = 0; slot < slots_.size(); ++slot) {
     const bool wall_slot = slot >= particle_slot_count_;
     const index_t p = slots_[slot][0], q = slots_[slot][1];
@@ -1150,8 +1148,8 @@ void ContactModel::slot_dashpots(const State& state, real dt) {
                                        slot_point_[touch][1] / slot_force_[touch],
                                        slot_point_[touch][2] / slot_force_[touch]}
                                  : body_motion_[body_touch_[p]].centre;
-    const vec velocity_p = point_velocity(p, point);
-    const vec velocity_q = wall_slot ? walls_[q].velocity_at(point.data(), t) : point_velocity(q, point);
+    const vec velocity_p = rigid_velocity(p, point);
+    const vec velocity_q = wall_slot ? walls_[q].velocity_at(point.data(), t) : rigid_velocity(q, point);
     const vec relative{velocity_p[0] - velocity_q[0], velocity_p[1] - velocity_q[1],
                        velocity_p[2] - velocity_q[2]};
     // Closing speed along the normal (which points from p to q, or from the wall to p).
@@ -1167,7 +1165,7 @@ void ContactModel::slot_dashpots(const State& state, real dt) {
     const real secant = slot_approach_[slot] > 0 ? std::min(K, slot_force_[touch] / slot_approach_[slot]) : K;
     const real damping = 2.0 * zeta * std::sqrt(slot_reduced_mass_[slot] * secant) * approach;
     if (wall_slot) {  // the wall takes the opposite force, at the contact point
-      load(p, point, {damping * normal[0], damping * normal[1], damping * normal[2]});
+      add_body_load(p, point, {damping * normal[0], damping * normal[1], damping * normal[2]});
       const vec arm{point[0] - walls_[q].center[0], point[1] - walls_[q].center[1],
                     point[2] - walls_[q].center[2]};
       const vec on_wall{-damping * normal[0], -damping * normal[1], -damping * normal[2]};
@@ -1177,8 +1175,8 @@ void ContactModel::slot_dashpots(const State& state, real dt) {
         wall_damping_[q][3 + k] += torque[k];
       }
     } else {
-      load(p, point, {-damping * normal[0], -damping * normal[1], -damping * normal[2]});
-      load(q, point, {damping * normal[0], damping * normal[1], damping * normal[2]});
+      add_body_load(p, point, {-damping * normal[0], -damping * normal[1], -damping * normal[2]});
+      add_body_load(q, point, {damping * normal[0], damping * normal[1], damping * normal[2]});
     }
   }
 }
@@ -1266,8 +1264,9 @@ real ContactModel::damping_ratio(std::size_t slot, real advance) {
   const index_t p = slots_[slot][0], q = slots_[slot][1];
   const std::size_t law = wall_slot ? q * material_count_ + body_material_[p]
                                     : body_material_[p] * material_count_ + body_material_[q];
-  const contact::Law& rule = wall_slot ? wall_laws_[law] : laws_[law];
-  if (rule.node_pair) return rule.damping_ratio;  // PeriDEM's law keeps the linear zeta
+  if (slot_law(slot).node_pair) {  // PeriDEM's law keeps the linear zeta
+    return (wall_slot ? wall_laws_ : laws_)[law].damping_ratio;
+  }
   const real force = slot_force_[slot_touch_[slot]], approach = slot_approach_[slot];
   slot_work_[slot] += force * advance;
   if (advance > 0 && slot_work_[slot] > 0 && approach > 0) {
