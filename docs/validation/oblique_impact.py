@@ -15,13 +15,16 @@ v_t' = omega' R = v_t / (1 + k); an elastic contact point springs back (Maw et a
 full reversal of its tangential velocity, v_t' - omega' R = -v_t, which keeps the tangential
 and spin energy (the bound drawn dashed).
 
+Test 5 analogue (--test 5): the same theory at a constant normal speed v_n and tangential speeds
+from 0.1 to 5 v_n.
+
 Test 6 analogue (--test 6): the body falls straight down (v_t = 0) spinning at omega R; its
 contact point slides at u = v_t - omega R, and the same impulse theory applies with the friction
 opposing u: gross sliding while |u| > mu (1 + e) v_n (1 + 1/k), rolling below.
 
-Run: python docs/validation/oblique_impact.py [--dimension 2|3] [--test 4|6] [--smoke]; writes
-docs/validation/oblique_impact_<d>d.png (test 4) or spinning_impact_<d>d.png (test 6) and
-prints the table.
+Run: python docs/validation/oblique_impact.py [--dimension 2|3] [--test 4|5|6] [--smoke]; writes
+docs/validation/oblique_impact_<d>d.png (test 4), tangential_impact_<d>d.png (test 5) or
+spinning_impact_<d>d.png (test 6) and prints the table.
 """
 
 from __future__ import annotations
@@ -37,16 +40,40 @@ SOFT = gr.Material(density=1200, bulk_modulus=2.16e7, shear_modulus=1.296e7, fra
 RADIUS, SPEED, MU, RESTITUTION = 1e-3, 0.5, 0.3, 0.8
 
 
-def run_through_wall_impact(sim: gr.Simulation) -> None:
-    """Run until the body has touched the wall and left it, then 50 steps more."""
+def run_through_impact(sim: gr.Simulation, against_wall: bool = True) -> None:
+    """Run until the bodies have touched (a body and a wall, or two bodies) and parted, then 50
+    steps more."""
     touched = False
     while True:
         sim.run(10)
-        touching = sim.core.contact_statistics.wall_contacts > 0
+        statistics = sim.core.contact_statistics
+        touching = (statistics.wall_contacts if against_wall else statistics.node_contacts) > 0
         touched = touched or touching
         if touched and not touching:
             break
     sim.run(50)
+
+
+def run_through_wall_impact(sim: gr.Simulation) -> None:
+    """Run until the body has touched the wall and left it, then 50 steps more."""
+    run_through_impact(sim, against_wall=True)
+
+
+def rigid_motion(sim: gr.Simulation, nodes: np.ndarray, dimension: int) -> tuple[np.ndarray, float]:
+    """A body's centre-of-mass velocity and its angular velocity about z (counterclockwise
+    positive), from its nodes' momentum and angular momentum (the motion is in the x-y plane)."""
+    m = sim.volumes[nodes]
+    x, v = sim.positions[nodes], sim.velocities[nodes]
+    c, vc = np.average(x, axis=0, weights=m), np.average(v, axis=0, weights=m)
+    r, w = x - c, v - vc  # 3 components in 2D too (z = 0)
+    inertia = np.einsum(
+        "n,nij->ij",
+        m,
+        np.einsum("ni,ni->n", r, r)[:, None, None] * np.eye(3) - np.einsum("ni,nj->nij", r, r),
+    )
+    momentum = np.sum(m[:, None] * np.cross(r, w), axis=0)
+    turn = momentum / inertia[2, 2] if dimension == 2 else np.linalg.solve(inertia, momentum)
+    return vc, float(turn[2])
 
 
 def save(fig, title: str, name: str) -> None:
@@ -79,20 +106,8 @@ def impact(
         sim.velocities[nodes, 0] += spin / RADIUS * offset[:, 1]
         sim.velocities[nodes, 1] -= spin / RADIUS * offset[:, 0]
     run_through_wall_impact(sim)
-    nodes = body.nodes
-    m = sim.volumes[nodes]
-    x, v = sim.positions[nodes], sim.velocities[nodes]
-    c, vc = np.average(x, axis=0, weights=m), np.average(v, axis=0, weights=m)
-    r, w = x - c, v - vc
-    # Angular velocity about z from the inertia tensor (the motion is in the x-y plane).
-    inertia = np.einsum(
-        "n,nij->ij",
-        m,
-        np.einsum("ni,ni->n", r, r)[:, None, None] * np.eye(3) - np.einsum("ni,nj->nij", r, r),
-    )
-    momentum = np.sum(m[:, None] * np.cross(r, w), axis=0)
-    turn = momentum / inertia[2, 2] if dimension == 2 else np.linalg.solve(inertia, momentum)
-    rate = -turn[2]  # omega', positive rolling forwards
+    vc, turn = rigid_motion(sim, body.nodes, dimension)
+    rate = -turn  # omega', positive rolling forwards
     return {
         "angle": angle,
         "v_n": speed * np.cos(a),
@@ -139,23 +154,61 @@ def reversal(dimension: int, v_t: float) -> tuple[float, float]:
     return v_t - impulse, impulse / k
 
 
-def angle_figure(d: int, smoke: bool) -> None:
-    """Test 4: constant speed, incidence angles from 2 to 80 degrees."""
-    angles = [5, 15, 30, 45, 60, 75] if smoke else [2, 5, 10, 15, 20, 25, 30, 40, 50, 60, 70, 80]
-    npr = 10 if d == 2 else 6
-    rows = [impact(d, angle, npr) for angle in angles]
-    print("angle  e     v_t'/v  rigid   omega'R/v  rigid  (rigid: gross sliding, or rolling)")
-    for row in rows:
-        vt, wr = theory(d, row["v_n"], row["v_t"], row["e"])
-        print(
-            f"{row['angle']:5.0f}  {row['e']:.3f} {row['v_t_after'] / SPEED:.4f} {vt / SPEED:.4f}  "
-            f"{row['spin_R'] / SPEED:.4f}    {wr / SPEED:.4f}"
-        )
+def plot_rebound(
+    measured: tuple[list[float], list[dict]],
+    theory_curves: tuple[np.ndarray, np.ndarray],
+    reversal_curves: tuple[np.ndarray, np.ndarray] | None,
+    xlabel: str,
+    unit: str = "v_n",
+):
+    """Two panels, v_t' and omega' R over SPEED (called `unit` on the axes) against x:
+    granulate's rows (points), the rigid-body theory (line) and, where given, the full reversal
+    of the contact point's velocity (dashed). Returns the figure."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    xs, rows = measured
+    fine, curves = theory_curves
+    fig, axes = plt.subplots(1, 2, figsize=(9, 3.6))
+    for column, (ax, key) in enumerate(zip(axes, ("v_t_after", "spin_R"), strict=True)):
+        if reversal_curves is not None:
+            sticking, reversed_ = reversal_curves
+            ax.plot(sticking, reversed_[:, column] / SPEED, "k--", lw=0.8, label="full reversal")
+        ax.plot(fine, curves[:, column] / SPEED, "k-", label="rigid body, Coulomb")
+        ax.plot(xs, [r[key] / SPEED for r in rows], "o", label="granulate")
+        ax.set_xlabel(xlabel)
+        ax.legend()
+        ax.grid(alpha=0.3)
+    axes[0].set_ylabel(f"tangential rebound speed v_t' / {unit}")
+    axes[1].set_ylabel(f"rebound spin omega' R / {unit}")
+    return fig
+
+
+def print_rows(label: str, xs: list[float], rows: list[dict], rigid: list, scale: float) -> None:
+    """The measured rebound against the rigid-body theory, one line per impact."""
+    print(f"{label:>8}  e     v_t'    rigid    omega'R  rigid   (over {scale} m/s)")
+    for x, row, (vt, wr) in zip(xs, rows, rigid, strict=True):
+        print(
+            f"{x:8.2f}  {row['e']:.3f} {row['v_t_after'] / scale:7.4f} {vt / scale:7.4f}  "
+            f"{row['spin_R'] / scale:7.4f} {wr / scale:7.4f}"
+        )
+
+
+def sliding_limit(d: int, e: float) -> float:
+    """v_t / v_n above which the contact point of a body without spin slides all through the
+    impact: mu (1 + e) (1 + 1/k)."""
+    return MU * (1 + e) * (1 + (2.0 if d == 2 else 2.5))
+
+
+def angle_figure(d: int, smoke: bool) -> None:
+    """Test 4: constant speed, incidence angles from 2 to 80 degrees."""
+    angles = [5, 15, 30, 45, 60, 75] if smoke else [2, 5, 10, 15, 20, 25, 30, 40, 50, 60, 70, 80]
+    npr = 10 if d == 2 else 6
+    rows = [impact(d, angle, npr) for angle in angles]
+    rigid = [theory(d, r["v_n"], r["v_t"], r["e"]) for r in rows]
+    print_rows("angle", angles, rows, rigid, SPEED)
     fine = np.linspace(0.5, 85, 200)
     e_mean = float(np.mean([r["e"] for r in rows]))
     curves = np.array(
@@ -164,22 +217,15 @@ def angle_figure(d: int, smoke: bool) -> None:
             for a in fine
         ]
     )
-    limit = np.degrees(np.arctan(MU * (1 + e_mean) * (1 + (2.0 if d == 2 else 2.5))))
-    sticking = fine[fine < limit]
+    sticking = fine[fine < np.degrees(np.arctan(sliding_limit(d, e_mean)))]
     reversed_ = np.array([reversal(d, SPEED * np.sin(np.radians(a))) for a in sticking])
-    fig, axes = plt.subplots(1, 2, figsize=(9, 3.6))
-    for column, ax in enumerate(axes):
-        ax.plot(sticking, reversed_[:, column] / SPEED, "k--", lw=0.8, label="full reversal")
-    axes[0].plot(fine, curves[:, 0] / SPEED, "k-", label="rigid body, Coulomb")
-    axes[0].plot(angles, [r["v_t_after"] / SPEED for r in rows], "o", label="granulate")
-    axes[0].set_ylabel("tangential rebound speed v_t' / v")
-    axes[1].plot(fine, curves[:, 1] / SPEED, "k-", label="rigid body, Coulomb")
-    axes[1].plot(angles, [r["spin_R"] / SPEED for r in rows], "o", label="granulate")
-    axes[1].set_ylabel("rebound spin omega' R / v")
-    for ax in axes:
-        ax.set_xlabel("incidence angle from the normal [degrees]")
-        ax.legend()
-        ax.grid(alpha=0.3)
+    fig = plot_rebound(
+        (angles, rows),
+        (fine, curves),
+        (sticking, reversed_),
+        "incidence angle from the normal [degrees]",
+        unit="v",
+    )
     shape = "disc" if d == 2 else "sphere"
     title = (
         f"Oblique impact of a {shape} on a plane (Chung & Ooi test 4 analogue): v = {SPEED} m/s, "
@@ -188,36 +234,42 @@ def angle_figure(d: int, smoke: bool) -> None:
     save(fig, title, f"oblique_impact_{d}d.png")
 
 
+def tangential_figure(d: int, smoke: bool) -> None:
+    """Test 5: constant normal speed v_n = SPEED, tangential speeds v_t from 0.1 to 5 v_n."""
+    ratios = [0.5, 2.0, 4.0] if smoke else [0.1, 0.25, 0.5, 0.75, 1, 1.5, 2, 2.5, 3, 4, 5]
+    npr = 10 if d == 2 else 6
+    rows = [
+        impact(d, float(np.degrees(np.arctan(t))), npr, speed=SPEED * float(np.hypot(1, t)))
+        for t in ratios
+    ]
+    rigid = [theory(d, r["v_n"], r["v_t"], r["e"]) for r in rows]
+    print_rows("v_t/v_n", ratios, rows, rigid, SPEED)
+    e_mean = float(np.mean([r["e"] for r in rows]))
+    fine = np.linspace(0.0, 5.2, 300)
+    curves = np.array([theory(d, SPEED, t * SPEED, e_mean) for t in fine])
+    sticking = fine[fine < sliding_limit(d, e_mean)]
+    reversed_ = np.array([reversal(d, t * SPEED) for t in sticking])
+    fig = plot_rebound((ratios, rows), (fine, curves), (sticking, reversed_), "v_t / v_n before")
+    shape = "disc" if d == 2 else "sphere"
+    title = (
+        f"Oblique impact of a {shape} on a plane (Chung & Ooi test 5 analogue): v_n = {SPEED} "
+        f"m/s, mu = {MU}, e = {RESTITUTION}, R/h = {npr}"
+    )
+    save(fig, title, f"tangential_impact_{d}d.png")
+
+
 def spin_figure(d: int, smoke: bool) -> None:
     """Test 6: a spinning body dropped straight down (v_n = SPEED, v_t = 0) at spins omega R
     from -4 to 4 v_n."""
     spins = [-3.0, -1.0, 1.0, 3.0] if smoke else [-4, -3, -2, -1.5, -1, -0.5, 0.5, 1, 1.5, 2, 3, 4]
     npr = 10 if d == 2 else 6
     rows = [impact(d, 0.0, npr, spin=float(w) * SPEED) for w in spins]
-    print("omegaR/v  e     v_t'/v  rigid    omega'R/v  rigid  (rigid: gross sliding, or rolling)")
-    for w, row in zip(spins, rows, strict=True):
-        vt, wr = spinning_theory(d, row["v_n"], 0.0, row["spin_R_before"], row["e"])
-        print(
-            f"{w:8.2f}  {row['e']:.3f} {row['v_t_after'] / SPEED:7.4f} {vt / SPEED:7.4f}  "
-            f"{row['spin_R'] / SPEED:8.4f}  {wr / SPEED:7.4f}"
-        )
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
+    rigid = [spinning_theory(d, r["v_n"], 0.0, r["spin_R_before"], r["e"]) for r in rows]
+    print_rows("omegaR/v", spins, rows, rigid, SPEED)
     e_mean = float(np.mean([r["e"] for r in rows]))
     fine = np.linspace(-4.2, 4.2, 400)
     curves = np.array([spinning_theory(d, SPEED, 0.0, w * SPEED, e_mean) for w in fine])
-    fig, axes = plt.subplots(1, 2, figsize=(9, 3.6))
-    for column, (ax, key) in enumerate(zip(axes, ("v_t_after", "spin_R"), strict=True)):
-        ax.plot(fine, curves[:, column] / SPEED, "k-", label="rigid body, Coulomb")
-        ax.plot(spins, [r[key] / SPEED for r in rows], "o", label="granulate")
-        ax.set_xlabel("spin before, omega R / v_n")
-        ax.legend()
-        ax.grid(alpha=0.3)
-    axes[0].set_ylabel("tangential rebound speed v_t' / v_n")
-    axes[1].set_ylabel("rebound spin omega' R / v_n")
+    fig = plot_rebound((spins, rows), (fine, curves), None, "spin before, omega R / v_n")
     shape = "disc" if d == 2 else "sphere"
     title = (
         f"Spinning {shape} dropped on a plane (Chung & Ooi test 6 analogue): v_n = {SPEED} m/s, "
@@ -229,10 +281,11 @@ def spin_figure(d: int, smoke: bool) -> None:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--dimension", type=int, default=2, choices=(2, 3))
-    parser.add_argument("--test", type=int, default=4, choices=(4, 6))
+    parser.add_argument("--test", type=int, default=4, choices=(4, 5, 6))
     parser.add_argument("--smoke", action="store_true")
     args = parser.parse_args()
-    (angle_figure if args.test == 4 else spin_figure)(args.dimension, args.smoke)
+    figures = {4: angle_figure, 5: tangential_figure, 6: spin_figure}
+    figures[args.test](args.dimension, args.smoke)
 
 
 if __name__ == "__main__":
