@@ -5,7 +5,10 @@ from __future__ import annotations
 
 import csv
 import json
+import os
+import stat
 import xml.etree.ElementTree as ET
+from collections.abc import Iterator
 from pathlib import Path
 
 import meshio
@@ -15,7 +18,7 @@ import pytest
 import granulate as gr
 
 
-def pulled_plate(out: Path, **output) -> gr.Simulation:
+def pulled_plate(out: Path, steps: int = 100, **output) -> gr.Simulation:
     material = gr.Material(
         density=2500, youngs_modulus=70e9, poisson_ratio=0.22, fracture_energy=8.0
     )
@@ -24,7 +27,7 @@ def pulled_plate(out: Path, **output) -> gr.Simulation:
     sim.fix(sim.select(gr.Rectangle((-1, -1), (0.0015, 1))))
     sim.prescribe_velocity(sim.select(gr.Rectangle((0.0185, -1), (1, 1))), (10.0, 0))
     sim.output(out, every=25, **output)
-    sim.run(100)
+    sim.run(steps)
     return sim
 
 
@@ -86,3 +89,80 @@ def test_bad_output_requests(tmp_path: Path) -> None:
 def test_no_temporary_files_left(tmp_path: Path) -> None:
     pulled_plate(tmp_path)
     assert not list(tmp_path.rglob("*.tmp"))
+
+
+def frame_steps(directory: Path, dt: float) -> list[int]:
+    """The steps of the frames the PVD series lists."""
+    collection = ET.parse(directory / "simulation.pvd").getroot().find("Collection")
+    return [round(float(d.get("timestep")) / dt) for d in collection.findall("DataSet")]
+
+
+def test_a_run_ending_between_output_steps_writes_its_last_step(tmp_path: Path) -> None:
+    """Outputs every 25 steps, a run of 110: the frame and history row of step 110 are written
+    (before, the outputs ended at step 100 and run.json said 100 steps and 0.0 s)."""
+    sim = pulled_plate(tmp_path, steps=110)
+    assert frame_steps(tmp_path, sim.dt) == [0, 25, 50, 75, 100, 110]
+    mesh = meshio.read(tmp_path / "frames" / "frame_000005.vtu")
+    np.testing.assert_array_equal(mesh.points, sim.positions)
+    with (tmp_path / "history.csv").open() as handle:
+        steps = [int(r["step"]) for r in csv.DictReader(handle)]
+    assert steps == [0, 25, 50, 75, 100, 110]
+    summary = json.loads((tmp_path / "run.json").read_text())
+    assert summary["steps"] == 110 and summary["steps_run"] == 110
+    assert summary["wall_seconds"] > 0
+    sim.run(15)  # continuing: outputs on the every-25 grid again, and the new last step
+    assert frame_steps(tmp_path, sim.dt) == [0, 25, 50, 75, 100, 110, 125]
+    assert json.loads((tmp_path / "run.json").read_text())["steps_run"] == 125
+
+
+def test_a_run_in_pieces_can_leave_out_the_last_step(tmp_path: Path) -> None:
+    sim = pulled_plate(tmp_path, steps=0)
+    for _ in range(11):
+        sim.run(10, write_final=False)
+    assert frame_steps(tmp_path, sim.dt) == [0, 25, 50, 75, 100]
+    assert json.loads((tmp_path / "run.json").read_text())["steps"] == 110
+
+
+@pytest.fixture
+def umask() -> Iterator[None]:
+    previous = os.umask(0o022)
+    try:
+        yield
+    finally:
+        os.umask(previous)
+
+
+def file_modes(directory: Path) -> dict[str, int]:
+    return {
+        str(p.relative_to(directory)): stat.S_IMODE(p.stat().st_mode)
+        for p in directory.rglob("*")
+        if p.is_file()
+    }
+
+
+@pytest.mark.parametrize("mask", [0o022, 0o027, 0o077], ids=["022", "027", "077"])
+def test_output_files_honour_the_umask(tmp_path: Path, umask: None, mask: int) -> None:
+    """Frames, PVD, particle tables, history, run.json and checkpoints get 0666 less the umask,
+    as open() gives (they were 0600 whatever the umask: colleagues could not read them)."""
+    os.umask(mask)
+    sim = pulled_plate(tmp_path, steps=0)
+    sim.checkpoint_every(50, path=tmp_path / "checkpoint.npz")
+    sim.run(60)
+    modes = file_modes(tmp_path)
+    assert {"simulation.pvd", "history.csv", "run.json", "checkpoint.npz"} <= set(modes)
+    assert any(name.endswith(".csv") and "particles" in name for name in modes)
+    assert set(modes.values()) == {0o666 & ~mask}, modes
+
+
+def test_an_existing_file_keeps_its_mode_when_rewritten(tmp_path: Path, umask: None) -> None:
+    pulled_plate(tmp_path, steps=25)
+    (tmp_path / "run.json").chmod(0o600)
+    sim = gr.Simulation(2)  # a second run into the same folder rewrites run.json
+    sim.add_body(
+        gr.Disc((0, 0), 1e-3),
+        gr.Material(density=1, bulk_modulus=1, shear_modulus=1, fracture=False),
+        0.5e-3,
+    )
+    sim.output(tmp_path, every=10, overwrite=True)
+    sim.run(1)
+    assert stat.S_IMODE((tmp_path / "run.json").stat().st_mode) == 0o600

@@ -202,9 +202,11 @@ def _run_case(
         sim.load_checkpoint(sim.checkpoint_path)
         print(f"resuming from step {sim.step} (t = {sim.time:.6g} s)")
     steps = case.steps(sim)
+    cut_short = False
     if limit is not None:
         if limit <= 0:
             raise InputError(f"--steps must be positive, got {limit}")
+        cut_short = limit < steps
         steps = min(steps, limit)
     stop = case.stop_criteria()
     check_every = case.spec.stop.check_every if case.spec.stop is not None else 100
@@ -215,12 +217,20 @@ def _run_case(
         )
     reporter = _Reporter(steps, quiet)
     try:
-        reason = sim.run(steps, stop=stop, check_every=check_every, progress=reporter)
+        # A run cut short by --steps is continued with --resume as if never stopped, so it
+        # ends like an interrupted one: no extra frame at its last step.
+        reason = sim.run(
+            steps,
+            stop=stop,
+            check_every=check_every,
+            progress=reporter,
+            write_final=not cut_short,
+        )
     finally:
         reporter.close()
     sim.save_checkpoint(sim.checkpoint_path)
     summary = sim.summary()
-    rate = summary["nodes"] * summary["steps"] / max(summary["wall_seconds"], 1e-9)
+    rate = summary["nodes"] * summary["steps_run"] / max(summary["wall_seconds"], 1e-9)
     ended = f"stopped: {reason}" if reason else "finished"
     print(
         f"{ended} at step {sim.step} (t = {sim.time:.6g} s) in {summary['wall_seconds']:.1f} s, "
@@ -273,7 +283,9 @@ def _main(argv: list[str] | None) -> int:
         "--overwrite", action="store_true", help="replace an earlier run in the output directory"
     )
     run.add_argument("--quiet", action="store_true", help="no progress lines")
-    run.add_argument("--steps", type=int, help="run at most this many steps (a trial run)")
+    run.add_argument(
+        "--steps", type=int, help="run at most this many steps (a trial run; --resume continues it)"
+    )
     run.add_argument("--peridem-compat", action="store_true", help=compat_help)
     run.add_argument("args", nargs="*", help="arguments passed to a script (after --)")
     bench = commands.add_parser("bench", help="run the benchmark cases (benchmarks/cases)")

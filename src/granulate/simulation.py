@@ -117,6 +117,8 @@ class _Output:
     tracked: tuple[Body, ...] = ()
     history: HistoryWriter | None = None
     frames: int = 0
+    frame_step: int = -1  # the step of the last frame written (-1: none in this process)
+    history_step: int = -1  # likewise for the last history row
 
 
 class _SignalCatcher:
@@ -211,6 +213,7 @@ class Simulation:
         self._model: _core.Model | None = None
         self._reference: NDArray[np.float64] | None = None
         self._wall_seconds = 0.0
+        self._steps_run = 0
         self._deep_contact_warned = False
         self._output_seconds = 0.0
         self._core_materials: list[Material] = []
@@ -948,6 +951,7 @@ class Simulation:
         stop: Sequence[StopCriterion] = (),
         check_every: int = 100,
         progress: Callable[[Progress], None] | None = None,
+        write_final: bool = True,
     ) -> str | None:
         """Advance ``steps`` time steps, or until simulated time ``until`` [s].
 
@@ -959,6 +963,11 @@ class Simulation:
 
         Ctrl-C or SIGTERM during a run finishes the current chunk, writes a checkpoint (when
         checkpoints or outputs are set) and raises KeyboardInterrupt; outputs stay intact.
+
+        When the run ends (its last step or a stop criterion) between output steps, the frame
+        and history row of its last step are written too (``write_final=False`` skips them at
+        the last step, for a run advanced in pieces; a stop criterion met always writes them),
+        and run.json is brought up to date.
         """
         core = self._build()
         if (steps is None) == (until is None):
@@ -977,6 +986,7 @@ class Simulation:
             core.run(0)  # the forces of step 0 (prescribed motion, contact), for the frame
             self._write_output()
         target = core.step + steps
+        first_step = int(core.step)
         start = wallclock.perf_counter()
         chunk_limit = 10
         signals = _SignalCatcher()
@@ -1025,6 +1035,9 @@ class Simulation:
                         raise KeyboardInterrupt(f"interrupted at step {core.step}{where}")
         finally:
             self._wall_seconds += wallclock.perf_counter() - start
+            self._steps_run += int(core.step) - first_step
+        if out is not None:
+            self._write_final_state(frame=write_final or reason is not None)
         return reason
 
     def _warn_deep_contact(self, core: _core.Simulation) -> None:
@@ -1344,7 +1357,9 @@ class Simulation:
         return self._model.bond_count
 
     def summary(self) -> dict[str, float | int]:
-        """Counts, time step and timings of the run so far."""
+        """Counts, time step and timings of the run so far: ``steps`` is the current step,
+        ``steps_run`` and ``wall_seconds`` the steps advanced and the wall time taken by this
+        process's runs (after a resume, only the resumed part)."""
         core = self._build()
         phases = core.phase_times
         return {
@@ -1358,6 +1373,7 @@ class Simulation:
             "steps": core.step,
             "time": core.time,
             "threads": _core.get_max_threads(),
+            "steps_run": self._steps_run,
             "wall_seconds": self._wall_seconds,
             "peridynamics_seconds": phases.peridynamics,
             "integration_seconds": phases.integration,
@@ -1401,6 +1417,22 @@ class Simulation:
         finally:
             self._output_seconds += wallclock.perf_counter() - start
 
+    def _write_final_state(self, frame: bool) -> None:
+        """The end of a run: with ``frame``, the frame and history row of the last step when
+        it was not an output step; then run.json with the counts and times of the whole run."""
+        out = self._output
+        assert out is not None
+        start = wallclock.perf_counter()
+        try:
+            step = int(self._build().step)
+            if frame and out.frame_step != step:
+                self._write_vtu_frame()
+            if frame and out.history_step != step:
+                self._write_history_row()
+            atomic_write(out.directory / "run.json", json.dumps(self.summary(), indent=2).encode())
+        finally:
+            self._output_seconds += wallclock.perf_counter() - start
+
     def _write_frame(self) -> None:
         """The frame (when the step is a frame step) and the history row (when it is a
         history step) of the current step."""
@@ -1439,6 +1471,7 @@ class Simulation:
         out.pvd.add(core.time, Path("frames") / name)
         self._write_particles(out.directory / "frames" / f"particles_{out.frames:06d}.csv", phi)
         out.frames += 1
+        out.frame_step = int(core.step)
         atomic_write(out.directory / "run.json", json.dumps(self.summary(), indent=2).encode())
 
     def _write_history_row(self) -> None:
@@ -1487,3 +1520,4 @@ class Simulation:
         if out.history is None:
             out.history = HistoryWriter(out.directory / "history.csv", list(row))
         out.history.write(row)
+        out.history_step = int(core.step)
