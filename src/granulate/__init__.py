@@ -10,7 +10,7 @@ a C++ core (OpenMP), set-up and output from Python.
     >>> body = sim.add_body(gr.Rectangle((0, 0), (0.05, 0.01)), rock, mesh_size=1e-3)
 """
 
-from granulate import _core, stopping, walls
+from granulate import _core, stopping, threads, walls
 from granulate._version import __version__
 from granulate.contact import Contact
 from granulate.errors import GranulateWarning, InputError, InstabilityError
@@ -57,6 +57,7 @@ from granulate.shapes import (
     lattice,
 )
 from granulate.simulation import FIELDS, Body, Progress, Simulation
+from granulate.threads import get_num_threads, set_num_threads
 from granulate.walls import (
     BoxContainer,
     BoxObstacle,
@@ -71,15 +72,8 @@ from granulate.walls import (
     Wall,
 )
 
-
-def set_num_threads(threads: int) -> None:
-    """Number of OpenMP threads used by the core (results are identical for any number)."""
-    _core.set_num_threads(int(threads))
-
-
-def get_num_threads() -> int:
-    """Number of OpenMP threads the core will use."""
-    return _core.get_max_threads()
+if threads.is_adaptive():  # no OMP_NUM_THREADS: as many as the CPUs this process may use
+    _core.set_num_threads(threads.available_cpus())
 
 
 __all__ = [

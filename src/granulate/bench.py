@@ -34,14 +34,16 @@ import json
 import math
 import os
 import resource
+import subprocess
+import sys
 import time
 from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
 
-from granulate import _core
 from granulate.errors import InputError
+from granulate.threads import get_num_threads, set_num_threads
 
 BOND_BUDGET, NODE_BUDGET = 16, 300
 
@@ -303,17 +305,21 @@ def _row(r: dict) -> str:
     )
 
 
-def main(
-    names: list[str] | None, quick: bool, threads: int | None, as_json: bool, out: Path
-) -> int:
-    """Run the cases; print a table or JSON lines."""
-    if threads is not None:
-        _core.set_num_threads(threads)
-    threads = _core.get_max_threads()
+def _chosen(names: list[str] | None) -> list[str]:
     chosen = names or list(CASES)
     unknown = [n for n in chosen if n not in CASES]
     if unknown:
         raise InputError(f"unknown benchmark case(s) {unknown}; choose from {', '.join(CASES)}")
+    return chosen
+
+
+def main(
+    names: list[str] | None, quick: bool, threads: int | None, as_json: bool, out: Path
+) -> int:
+    """Run the cases with a fixed thread count; print a table or JSON lines."""
+    threads = threads or get_num_threads()
+    set_num_threads(threads, adaptive=False)
+    chosen = _chosen(names)
     if not as_json:
         print(
             f"{'case':<18} {'nodes':>9} {'steps':>6} {'thr':>3} {'seconds':>8} "
@@ -322,6 +328,43 @@ def main(
     for name in chosen:
         for result in CASES[name](quick, threads, out):
             print(json.dumps(result) if as_json else _row(result), flush=True)
+    return 0
+
+
+def contended(names: list[str] | None, quick: bool, as_json: bool, out: Path) -> int:
+    """Run each case next to one busy process (a Python loop holding a core), with 1 thread,
+    with all threads fixed, and with all threads adaptive (granulate.threads); print the rates
+    and each one's ratio to the 1-thread run."""
+    most = get_num_threads()
+    chosen = _chosen(names)
+    policies = [("1 fixed", 1, False), (f"{most} fixed", most, False)]
+    policies.append((f"{most} adaptive", most, True))
+    busy = subprocess.Popen([sys.executable, "-c", "while True: pass"])
+    try:
+        time.sleep(0.2)
+        if not as_json:
+            print(f"one busy process alongside; {os.cpu_count()} CPUs")
+            print(f"{'case':<18} {'threads':<12} {'seconds':>8} {'M node-st/s':>11} {'vs 1':>6}")
+        for name in chosen:
+            single: dict[int, float] = {}  # the 1-thread rate of each row of the case
+            for label, count, adaptive in policies:
+                set_num_threads(count, adaptive=adaptive)
+                for k, result in enumerate(CASES[name](quick, count, out)):
+                    result["thread_policy"] = label
+                    rate = result["node_steps_per_s"]
+                    single.setdefault(k, rate)
+                    if as_json:
+                        print(json.dumps(result), flush=True)
+                        continue
+                    print(
+                        f"{result['case']:<18} {label:<12} {result['seconds']:8.2f} "
+                        f"{rate / 1e6:11.3f} {rate / single[k]:6.2f}",
+                        flush=True,
+                    )
+    finally:
+        busy.kill()
+        busy.wait()
+    set_num_threads(most, adaptive=False)
     return 0
 
 

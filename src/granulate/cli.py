@@ -8,7 +8,7 @@
     granulate plot DIR                         PNG plots from DIR/history.csv
     granulate render DIR [--frame N] [--gif]   PNG images (and a GIF) of the particles
     granulate schema [--json]                  the case-file reference (or its JSON Schema)
-    granulate bench [--quick] [--case NAME ...] [--threads N] [--json]
+    granulate bench [--quick] [--case NAME ...] [--threads N] [--json] [--contended]
     granulate info                             version, build options, threads
 
 Exit codes: 0 success, 2 invalid input, 1 failed run, 130 interrupted. User errors print one
@@ -25,7 +25,7 @@ import time
 import warnings
 from pathlib import Path
 
-from granulate import _core
+from granulate import _core, threads
 from granulate._version import __version__
 from granulate.errors import InputError, InstabilityError
 
@@ -42,7 +42,14 @@ def _show_warning(message, category, filename, lineno, file=None, line=None) -> 
 def _info() -> int:
     print(f"granulate {__version__}")
     print(f"core: {Path(_core.__file__).name} (C++20, OpenMP)")
-    print(f"threads: {_core.get_max_threads()} (set OMP_NUM_THREADS or --threads)")
+    policy = (
+        "adaptive: runs use fewer when that is faster, as on a busy machine"
+        if threads.is_adaptive()
+        else "fixed by OMP_NUM_THREADS, --threads or set_num_threads"
+    )
+    print(
+        f"threads: {threads.get_num_threads()} ({policy}; CPUs usable: {threads.available_cpus()})"
+    )
     print(f"python: {sys.version.split()[0]}")
     return 0
 
@@ -94,9 +101,19 @@ def _check(path: Path, compat: bool = False) -> int:
     memory = model.shared_bond_bytes() + sim.bond_count + BYTES_PER_NODE * sim.node_count
     sim.run(1)  # builds the core and the first forces and contact lists: not timed
     probe = max(1, min(50, steps))
-    start = time.perf_counter()
-    sim.run(probe)
-    rate = probe / max(time.perf_counter() - start, 1e-9)
+    most = threads.get_num_threads()
+    # A run picks the fastest thread count on a busy machine (granulate.threads): so does the
+    # estimate, from one probe per count a run would try.
+    counts = threads.candidate_counts(most) if threads.is_adaptive() else [most]
+    rates = {}
+    for count in counts:
+        threads.set_num_threads(count, adaptive=threads.is_adaptive())
+        start = time.perf_counter()
+        sim.run(probe)
+        rates[count] = probe / max(time.perf_counter() - start, 1e-9)
+    threads.set_num_threads(most, adaptive=threads.is_adaptive())
+    fastest = max(rates, key=lambda count: rates[count])
+    rate = rates[fastest]
     print(f"{path}: valid")
     print(
         f"  dimension {sim.dimension}, {len(sim.bodies)} particles, {sim.node_count} nodes, "
@@ -108,7 +125,7 @@ def _check(path: Path, compat: bool = False) -> int:
     print(f"  dt {sim.dt:.4g} s (stable estimate {sim.stable_dt:.4g} s); {steps} steps to the end")
     print(
         f"  estimated memory {memory / 1e6:.1f} MB; estimated time {_duration(steps / rate)} "
-        f"with {_core.get_max_threads()} threads"
+        f"with {fastest} of {most} threads"
     )
     return 0
 
@@ -292,6 +309,11 @@ def _main(argv: list[str] | None) -> int:
     bench.add_argument("--quick", action="store_true", help="small sizes, a smoke check")
     bench.add_argument("--case", action="append", help="a case (repeatable; default: all)")
     bench.add_argument("--json", action="store_true", help="one JSON object per case")
+    bench.add_argument(
+        "--contended",
+        action="store_true",
+        help="next to one busy process: 1 thread, all fixed, all adaptive",
+    )
     bench.add_argument("--out", type=Path, default=Path("out") / "bench", help="scratch output")
     plot = commands.add_parser("plot", help="PNG plots of a run's history.csv")
     plot.add_argument("directory", type=Path)
@@ -306,7 +328,7 @@ def _main(argv: list[str] | None) -> int:
         options.args = [*options.args, *extra]
     try:
         if options.threads is not None:
-            _core.set_num_threads(options.threads)
+            threads.set_num_threads(options.threads)
         if options.command == "info":
             return _info()
         if options.command == "schema":
@@ -332,6 +354,8 @@ def _main(argv: list[str] | None) -> int:
         if options.command == "bench":
             from granulate import bench as benchmarks
 
+            if options.contended:
+                return benchmarks.contended(options.case, options.quick, options.json, options.out)
             return benchmarks.main(options.case, options.quick, None, options.json, options.out)
         from granulate import plots
 

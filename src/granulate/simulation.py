@@ -28,7 +28,7 @@ from typing import Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from granulate import _core
+from granulate import _core, threads
 from granulate._version import __version__
 from granulate.contact import Contact
 from granulate.errors import GranulateWarning, InputError
@@ -214,6 +214,7 @@ class Simulation:
         self._reference: NDArray[np.float64] | None = None
         self._wall_seconds = 0.0
         self._steps_run = 0
+        self._tuner: threads.ThreadTuner | None = None
         self._deep_contact_warned = False
         self._output_seconds = 0.0
         self._core_materials: list[Material] = []
@@ -987,6 +988,8 @@ class Simulation:
             self._write_output()
         target = core.step + steps
         first_step = int(core.step)
+        most = threads.get_num_threads()
+        tuner = self._thread_tuner(most)
         start = wallclock.perf_counter()
         chunk_limit = 10
         signals = _SignalCatcher()
@@ -1004,10 +1007,16 @@ class Simulation:
                         every = self._checkpoint.every_steps
                         boundaries.append(every - core.step % every)
                     chunk = min(boundaries)
+                    if tuner is not None:
+                        count = tuner.threads()
+                        chunk = min(chunk, tuner.step_cap() or chunk)
+                        _core.set_num_threads(count)
                     began = wallclock.perf_counter()
                     core.run(chunk)
-                    self._warn_deep_contact(core)
                     elapsed = wallclock.perf_counter() - began
+                    if tuner is not None:
+                        tuner.record(count, chunk, elapsed)
+                    self._warn_deep_contact(core)
                     # Aim at chunks of about half a second: responsive to Ctrl-C and progress.
                     rate = chunk / max(elapsed, 1e-9)
                     chunk_limit = int(min(10_000, max(1, 0.5 * rate)))
@@ -1034,11 +1043,21 @@ class Simulation:
                         where = f"; checkpoint written to {saved}" if saved else ""
                         raise KeyboardInterrupt(f"interrupted at step {core.step}{where}")
         finally:
+            _core.set_num_threads(most)
             self._wall_seconds += wallclock.perf_counter() - start
             self._steps_run += int(core.step) - first_step
         if out is not None:
             self._write_final_state(frame=write_final or reason is not None)
         return reason
+
+    def _thread_tuner(self, most: int) -> threads.ThreadTuner | None:
+        """The run's thread-count picker (kept across runs of this simulation), or None when
+        the thread count is the user's or there is one CPU (granulate.threads)."""
+        if not threads.is_adaptive() or most == 1:
+            return None
+        if self._tuner is None or max(self._tuner.counts) != most:
+            self._tuner = threads.ThreadTuner(most)
+        return self._tuner
 
     def _warn_deep_contact(self, core: _core.Simulation) -> None:
         """Warn once when node pairs of two bodies came within half their contact distance
@@ -1372,7 +1391,8 @@ class Simulation:
             "stable_dt": core.stable_time_step,
             "steps": core.step,
             "time": core.time,
-            "threads": _core.get_max_threads(),
+            "threads": threads.get_num_threads(),
+            "threads_in_use": self._tuner.current if self._tuner is not None else None,
             "steps_run": self._steps_run,
             "wall_seconds": self._wall_seconds,
             "peridynamics_seconds": phases.peridynamics,
