@@ -577,3 +577,26 @@ def test_resume_across_an_impact_on_a_held_disc_is_bitwise(tmp_path: Path) -> No
     assert (whole / "history.csv").read_bytes() == (split / "history.csv").read_bytes()
     rows = history(whole)
     assert max(abs(r["p0_fy"]) for r in rows if r["step"] > 10_000) > 0  # impact after resume
+
+
+def test_a_deck_writes_its_output_in_the_working_directory(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """PeriDEM's Output.Path (../out/, relative to the deck) sent a run's output next to the deck
+    folder; it goes to out/<deck folder> in the working directory, and the run says so."""
+    deck = broken_deck(tmp_path / "decks", "twop_circ", lambda text: text)
+    work = tmp_path / "work"
+    work.mkdir()
+    monkeypatch.chdir(work)
+    assert main(["run", str(deck), "--steps", "5"]) == 0
+    printed = capsys.readouterr().out
+    assert "output in out/twop_circ" in printed and "Output.Path '../out/'" in printed
+    assert (work / "out" / "twop_circ" / "history.csv").is_file()
+    assert not (tmp_path / "decks" / "out").exists()
+    target = tmp_path / "cases" / "twop.yaml"
+    target.parent.mkdir()
+    assert main(["convert", str(deck), "-o", str(target)]) == 0
+    case = yaml.safe_load(target.read_text())
+    assert case["output"]["directory"] == "out/twop_circ"
+    meshes = [grain["mesh"]["file"] for grain in case["grains"].values()]
+    assert meshes and all((target.parent / m).is_file() for m in meshes)

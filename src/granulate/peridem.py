@@ -1019,7 +1019,12 @@ def _translate(path: Path, compat: bool, output: Path | None) -> Translation:
     wall_id = compressive.get("Particle_Id", compressive.get("Wall_Id"))
     if wall_id is not None and f"p{wall_id}" in named and f"p{wall_id}" not in track:
         track.append(f"p{wall_id}")
-    directory = os.path.relpath(folder / str(out.get("Path", "out")), Path.cwd())
+    directory = default_output_directory(folder)
+    if "Path" in out:
+        notes.append(
+            f"Output.Path {out['Path']!r} is PeriDEM's, relative to the deck's folder; the output "
+            f"goes to {directory} in the working directory instead (choose with --out)"
+        )
     output_spec: dict[str, Any] | None = {
         "directory": directory,
         "every": every,
@@ -1125,13 +1130,27 @@ def _youngs(spec: dict[str, Any], where: str, problems: _Problems) -> float | No
     return 9 * K * G / (3 * K + G)
 
 
+#: Folder names that say nothing about a deck (PeriDEM's examples keep decks in ``inp/``).
+_GENERIC_FOLDERS = {"inp", "input", "inputs", "deck", "decks"}
+
+
+def default_output_directory(folder: Path) -> str:
+    """Where a deck's run writes, relative to the working directory: out/<the deck's folder
+    name> (its parent's name when the folder is a generic inp/ or input/)."""
+    resolved = folder.resolve()
+    name = resolved.name
+    if name.lower() in _GENERIC_FOLDERS and resolved.parent.name:
+        name = resolved.parent.name
+    return f"out/{name or 'deck'}"
+
+
 def to_yaml(translation: Translation, compat: bool) -> str:
     """The translated case as a commented YAML case file."""
     header = [
         f"# granulate case converted from the PeriDEM deck {translation.source}",
         f"# (granulate convert{' --peridem-compat' if compat else ''}). Particles p<i> carry",
         "# PeriDEM's global particle ids; file paths are relative to this file, output.directory",
-        "# to the working directory convert ran in. What differs from PeriDEM:",
+        "# to the working directory of the run. What differs from PeriDEM:",
     ]
     header += [f"#   - {n}" for n in translation.notes]
     body = yaml.safe_dump(translation.case, sort_keys=False, default_flow_style=None, width=100)
