@@ -43,6 +43,7 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_valida
 from granulate import functions, meshes, packing, shapes, stopping, walls
 from granulate.contact import Contact
 from granulate.errors import InputError
+from granulate.input_errors import describe
 from granulate.materials import Material
 from granulate.simulation import FIELDS, Body, Simulation
 
@@ -1147,18 +1148,8 @@ def parse_case(text: str, source: Path = Path("case.yaml")) -> Case:
     try:
         spec = CaseSpec.model_validate(data)
     except ValidationError as error:
-        raise InputError(f"{source}: " + describe(error, data)) from None
+        raise InputError(f"{source}: " + describe(error, data, _ALL_SPECS)) from None
     return Case(spec, source.resolve(), text)
-
-
-def _location(loc: tuple[Any, ...]) -> str:
-    out = ""
-    for part in loc:
-        if isinstance(part, int):
-            out += f"[{part}]"
-        else:
-            out += ("." if out else "") + str(part)
-    return out or "(top level)"
 
 
 _ALL_SPECS: list[type[BaseModel]] = [
@@ -1166,105 +1157,6 @@ _ALL_SPECS: list[type[BaseModel]] = [
     for m in list(globals().values())
     if isinstance(m, type) and issubclass(m, Spec) and m is not Spec
 ] + [Material]
-
-
-def _fields_for(parent: Any) -> list[str]:
-    """Field names of the spec models that best match a mapping (for typo suggestions)."""
-    if not isinstance(parent, dict):
-        return []
-    kind = parent.get("type", parent.get("distribution"))
-    scores: list[tuple[int, list[str]]] = []
-    for model in _ALL_SPECS:
-        names = list(model.model_fields)
-        score = sum(1 for key in parent if key in names)
-        tag = model.model_fields.get("type") or model.model_fields.get("distribution")
-        if kind is not None and tag is not None and kind in getattr(tag.annotation, "__args__", ()):
-            score += 10
-        scores.append((score, names))
-    best = max(score for score, _ in scores)
-    return sorted({name for score, names in scores if score == best for name in names})
-
-
-#: Names other codes (PeriDEM) use for our shapes.
-_SYNONYMS = {
-    "circle": "disc",
-    "hexagon": "regular_polygon",
-    "triangle": "regular_polygon",
-    "square": "regular_polygon",
-    "cube": "box",
-    "cuboid": "box",
-    "rect": "rectangle",
-    "stl": "surface",
-}
-
-
-def _clean(loc: tuple[Any, ...], data: Any) -> tuple[tuple[Any, ...], Any]:
-    """The key path as the user wrote it (without pydantic's union tags), and the mapping that
-    holds its last key."""
-    path: list[Any] = []
-    current, parent = data, None
-    for part in loc:
-        if isinstance(current, list) and isinstance(part, int) and part < len(current):
-            path.append(part)
-            parent, current = current, current[part]
-        elif isinstance(current, dict) and part in current:
-            path.append(part)
-            parent, current = current, current[part]
-        elif isinstance(current, dict) and part in (
-            current.get("type"),
-            current.get("distribution"),
-        ):
-            continue  # the tag of a discriminated union
-        elif isinstance(part, str) and ("[" in part or part in ("str", "int", "float", "list")):
-            continue  # a union member's name
-        else:
-            path.append(part)
-            parent, current = current, None
-    return tuple(path), parent
-
-
-def describe(error: ValidationError, data: Any) -> str:
-    """One line per problem: key path, what was expected, what was found; a suggestion for
-    misspelt keys and kinds."""
-    problems = [(p, *_clean(p["loc"], data)) for p in error.errors()]
-    lines: list[str] = []
-    for problem, loc, parent in problems:
-        kind = problem["type"]
-        # A shape given inline that fails also fails as a shape name: keep the real reason.
-        if kind == "string_type" and isinstance(problem.get("input"), dict):
-            if any(other[1][: len(loc)] == loc and other[0] is not problem for other in problems):
-                continue
-        where = _location(loc)
-        if kind == "extra_forbidden":
-            bad = str(loc[-1])
-            suggestion = difflib.get_close_matches(bad, _fields_for(parent), n=1)
-            hint = f"; did you mean {suggestion[0]!r}?" if suggestion else ""
-            message = f"{where}: unknown key {bad!r}{hint}"
-        elif kind == "missing":
-            message = f"{where}: required key is missing"
-        elif kind in ("union_tag_invalid", "union_tag_not_found"):
-            ctx = problem.get("ctx", {})
-            expected = str(ctx.get("expected_tags", ""))
-            found = str(ctx.get("tag", problem.get("input")))
-            options = [t.strip().strip("'") for t in expected.split(",")]
-            message = f"{where}: unknown kind {found!r}; expected one of {expected}"
-            match = difflib.get_close_matches(found, options, n=1)
-            if _SYNONYMS.get(found) in options:
-                message += f"; a {found} is {_SYNONYMS[found]!r} here"
-            elif match:
-                message += f"; did you mean {match[0]!r}?"
-        else:
-            found = problem.get("input")
-            shown = "a mapping" if isinstance(found, dict) else repr(found)
-            if len(shown) > 60:
-                shown = shown[:57] + "..."
-            text = problem["msg"].removeprefix("Value error, ")
-            message = f"{where}: {text} (found {shown})"
-        if message not in lines:
-            lines.append(message)
-    if len(lines) == 1:
-        return lines[0]
-    return f"{len(lines)} problems:\n  " + "\n  ".join(lines)
 
 
 def schema() -> dict[str, Any]:

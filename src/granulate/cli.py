@@ -28,6 +28,7 @@ from pathlib import Path
 from granulate import _core, threads
 from granulate._version import __version__
 from granulate.errors import InputError, InstabilityError
+from granulate.progress import ProgressReporter, duration
 
 #: Bytes per node of state and model arrays besides bonds (positions, velocities, forces,
 #: reference positions, volumes, per-node constants, contact lists).
@@ -124,75 +125,10 @@ def _check(path: Path, compat: bool = False) -> int:
     print(f"  walls: {', '.join(name for name, _ in sim._walls) or 'none'}")
     print(f"  dt {sim.dt:.4g} s (stable estimate {sim.stable_dt:.4g} s); {steps} steps to the end")
     print(
-        f"  estimated memory {memory / 1e6:.1f} MB; estimated time {_duration(steps / rate)} "
+        f"  estimated memory {memory / 1e6:.1f} MB; estimated time {duration(steps / rate)} "
         f"with {fastest} of {most} threads"
     )
     return 0
-
-
-def _duration(seconds: float) -> str:
-    if seconds < 120:
-        return f"{seconds:.0f} s"
-    if seconds < 7200:
-        return f"{seconds / 60:.0f} min"
-    return f"{seconds / 3600:.1f} h"
-
-
-class _Reporter:
-    """A progress bar on a terminal, plain lines (every 10 % or 30 s) otherwise."""
-
-    def __init__(self, total: int, quiet: bool) -> None:
-        self.total = max(total, 1)
-        self.quiet = quiet
-        self.bar = None
-        self.last_line = time.perf_counter()
-        self.last_tenth = -1
-        if not quiet and sys.stdout.isatty():
-            from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
-
-            self.bar = Progress(
-                TextColumn("[bold]step {task.completed:>9}/{task.total}"),
-                BarColumn(),
-                TextColumn(
-                    "{task.fields[rate]} steps/s  t = {task.fields[time]} s  "
-                    "broken {task.fields[broken]}"
-                ),
-                TimeRemainingColumn(),
-            )
-            self.task = self.bar.add_task("run", total=self.total, rate="-", time="0", broken=0)
-            self.bar.start()
-        self.start_step: int | None = None
-
-    def __call__(self, p) -> None:
-        if self.quiet:
-            return
-        if self.start_step is None:
-            self.start_step = p.step
-        done = p.step - (p.target_step - self.total)
-        if self.bar is not None:
-            self.bar.update(
-                self.task,
-                completed=done,
-                rate=f"{p.steps_per_second:,.0f}",
-                time=f"{p.time:.4g}",
-                broken=p.broken_bonds,
-            )
-            return
-        tenth = int(10 * done / self.total)
-        now = time.perf_counter()
-        if tenth > self.last_tenth or now - self.last_line > 30:
-            self.last_tenth, self.last_line = tenth, now
-            remaining = (p.target_step - p.step) / max(p.steps_per_second, 1e-9)
-            print(
-                f"step {p.step} ({100 * done / self.total:.0f} %), t = {p.time:.4g} s, "
-                f"{p.steps_per_second:,.0f} steps/s, broken bonds {p.broken_bonds}, "
-                f"ETA {_duration(remaining)}",
-                flush=True,
-            )
-
-    def close(self) -> None:
-        if self.bar is not None:
-            self.bar.stop()
 
 
 def _run_case(
@@ -232,7 +168,7 @@ def _run_case(
             f"{sim.node_count} nodes, {sim.bond_count} bonds, dt {sim.dt:.4g} s, {steps} steps; "
             f"output in {directory}"
         )
-    reporter = _Reporter(steps, quiet)
+    reporter = ProgressReporter(steps, quiet)
     try:
         # A run cut short by --steps is continued with --resume as if never stopped, so it
         # ends like an interrupted one: no extra frame at its last step.

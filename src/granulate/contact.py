@@ -30,8 +30,10 @@ import math
 from dataclasses import dataclass
 
 from granulate.errors import InputError
+from granulate.input_errors import checked_arguments
 
 
+@checked_arguments
 @dataclass(frozen=True)
 class Contact:
     """Contact parameters.

@@ -17,6 +17,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from granulate import _core
+from granulate.input_errors import checked_arguments
 
 
 @dataclass(frozen=True)
@@ -38,6 +39,7 @@ class TimeFunction:
         return _core.time_function_rate(kind, a, b, t)
 
 
+@checked_arguments
 @dataclass(frozen=True)
 class Constant(TimeFunction):
     value: float = 1.0
@@ -46,6 +48,7 @@ class Constant(TimeFunction):
         return _core.TimeFunctionKind.constant, float(self.value), 0.0
 
 
+@checked_arguments
 @dataclass(frozen=True)
 class Linear(TimeFunction):
     rate: float
@@ -54,6 +57,7 @@ class Linear(TimeFunction):
         return _core.TimeFunctionKind.linear, float(self.rate), 0.0
 
 
+@checked_arguments
 @dataclass(frozen=True)
 class Quadratic(TimeFunction):
     a: float
@@ -63,6 +67,7 @@ class Quadratic(TimeFunction):
         return _core.TimeFunctionKind.quadratic, float(self.a), float(self.b)
 
 
+@checked_arguments
 @dataclass(frozen=True)
 class Sine(TimeFunction):
     amplitude: float
@@ -72,6 +77,7 @@ class Sine(TimeFunction):
         return _core.TimeFunctionKind.sine, float(self.amplitude), float(self.frequency)
 
 
+@checked_arguments
 @dataclass(frozen=True)
 class SmoothRamp(TimeFunction):
     target: float
@@ -81,6 +87,7 @@ class SmoothRamp(TimeFunction):
         return _core.TimeFunctionKind.smooth_ramp, float(self.target), float(self.duration)
 
 
+@checked_arguments
 @dataclass(frozen=True)
 class VelocityRamp(TimeFunction):
     rate: float

@@ -8,18 +8,31 @@ metres) or relative to the mesh size of each body (``horizon_factor``, default 3
 
 from __future__ import annotations
 
-from typing import Literal
+from typing import Any, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, model_validator
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
 from granulate import _core
 from granulate.errors import InputError
+from granulate.input_errors import api_error
 
 ForceModelName = Literal["lps", "pmb"]
 InfluenceName = Literal["constant", "linear", "gaussian", "inverse"]
 
 
-class Material(BaseModel):
+class _CalledFromPython(type(BaseModel)):  # type: ignore[misc]
+    """Material(...) called in Python raises InputError, told as a case file's problems are;
+    inside a case file's validation the model stays a pydantic model (its errors get key
+    paths there)."""
+
+    def __call__(cls, *args: Any, **data: Any) -> Any:
+        try:
+            return super().__call__(*args, **data)
+        except ValidationError as error:
+            raise api_error(cls.__name__, error, data, cls) from None
+
+
+class Material(BaseModel, metaclass=_CalledFromPython):
     """A peridynamic material.
 
     Attributes:
@@ -37,6 +50,13 @@ class Material(BaseModel):
     """
 
     model_config = ConfigDict(extra="forbid", frozen=True)
+
+    def __repr_args__(self) -> Any:
+        """The constants given (not the ones left out), for a readable repr."""
+        defaults = type(self).model_fields
+        for name, value in super().__repr_args__():
+            if value is not None and (name is None or value != defaults[name].default):
+                yield name, value
 
     density: float = Field(gt=0, allow_inf_nan=False)
     bulk_modulus: float | None = Field(default=None, gt=0, allow_inf_nan=False)

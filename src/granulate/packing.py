@@ -32,6 +32,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from granulate.errors import InputError
+from granulate.input_errors import checked_arguments
 from granulate.io.table import read_table
 from granulate.materials import Material
 from granulate.shapes import ReferenceShape, Shape
@@ -56,6 +57,7 @@ class SizeDistribution(ABC):
         raise InputError(f"{self!r}: almost no sizes fall within [{low}, {high}]; widen the bounds")
 
 
+@checked_arguments
 @dataclass(frozen=True)
 class Fixed(SizeDistribution):
     """Every particle has bounding radius ``radius`` [m]."""
@@ -70,6 +72,7 @@ class Fixed(SizeDistribution):
         return np.full(count, float(self.radius))
 
 
+@checked_arguments
 @dataclass(frozen=True)
 class Uniform(SizeDistribution):
     """Radius uniform in [low, high] [m]."""
@@ -85,6 +88,7 @@ class Uniform(SizeDistribution):
         return rng.uniform(self.low, self.high, count)
 
 
+@checked_arguments
 @dataclass(frozen=True)
 class Normal(SizeDistribution):
     """Radius normal with ``mean`` and ``std`` [m], truncated to [low, high] (default: mean -/+
@@ -109,6 +113,7 @@ class Normal(SizeDistribution):
         return self._bounded(lambda r, n: r.normal(self.mean, self.std, n), low, high, rng, count)
 
 
+@checked_arguments
 @dataclass(frozen=True)
 class LogNormal(SizeDistribution):
     """Radius log-normal: ln r normal about ln ``median`` with ``sigma``, truncated to [low,
@@ -132,6 +137,7 @@ class LogNormal(SizeDistribution):
         return self._bounded(draw, low, high, rng, count)
 
 
+@checked_arguments
 @dataclass(frozen=True)
 class Sieve(SizeDistribution):
     """A grading curve: ``passing[k]`` is the mass fraction of grains finer than sieve opening
@@ -170,6 +176,7 @@ class Sieve(SizeDistribution):
 
 
 # ----------------------------------------------------------------------- grains, placements
+@checked_arguments
 @dataclass(frozen=True, eq=False)
 class Grain:
     """A kind of particle: a shape (discretized once, about its ``origin``) or a ready
@@ -259,6 +266,10 @@ class Placements:
     def __len__(self) -> int:
         return len(self.radii)
 
+    def __repr__(self) -> str:
+        kinds = len(set(self.kinds.tolist()))
+        return f"Placements({len(self)} particles in {self.dimension}D, {kinds} kinds)"
+
     def write_csv(self, path: str | Path) -> None:
         """PeriDEM's format: ``i, x, y, z, r, o`` (2D) or ``i, x, y, z, r`` (3D)."""
         from granulate.io.atomic import atomic_write
@@ -339,7 +350,11 @@ class Packing(Placements):
         unit = np.array([g.measure_at_unit_radius for g in self.grains])
         return float(np.sum(unit[self.kinds] * self.radii**self.dimension) / self.container.measure)
 
+    def __repr__(self) -> str:
+        return f"Packing({self.summary()})"
+
     def summary(self) -> str:
+        """Counts per grain, sizes and packing fraction, in one line."""
         counts = np.bincount(self.kinds, minlength=len(self.grains))
         parts = ", ".join(
             f"{c} x {g.name or _label(g.shape)}" for c, g in zip(counts, self.grains, strict=True)

@@ -25,6 +25,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from granulate.errors import InputError
+from granulate.input_errors import checked_arguments
 
 
 def _points(points: ArrayLike) -> NDArray[np.float64]:
@@ -82,6 +83,7 @@ class Shape(ABC):
         return float(0.5 * np.linalg.norm((upper - lower)[:d]))
 
 
+@checked_arguments
 @dataclass(frozen=True)
 class Rectangle(Shape):
     """Axis-aligned rectangle [lower, upper] in the x-y plane [m]."""
@@ -126,6 +128,7 @@ def _box_distance(
     return outside + np.minimum(q.max(axis=1), 0.0)
 
 
+@checked_arguments
 @dataclass(frozen=True)
 class Disc(Shape):
     """Disc of a centre (x, y) and radius [m]."""
@@ -164,6 +167,7 @@ class Disc(Shape):
         return float(self.radius)
 
 
+@checked_arguments
 @dataclass(frozen=True)
 class Polygon(Shape):
     """Simple polygon (convex or concave) from its vertices in order [m]."""
@@ -268,6 +272,7 @@ class _CentredPolygon(Polygon):
         return float(getattr(self, self._extent))
 
 
+@checked_arguments
 class RegularPolygon(_CentredPolygon):
     """Regular polygon with ``sides`` vertices on a circle of ``radius`` (circumradius) about
     ``center`` [m], the first vertex at ``angle`` [rad] from the x axis (PeriDEM's triangle,
@@ -290,6 +295,7 @@ class RegularPolygon(_CentredPolygon):
         )
 
 
+@checked_arguments
 class Star(_CentredPolygon):
     """Star with ``points`` tips on a circle of ``outer_radius`` and the notches between them on
     ``inner_radius`` about ``center`` [m]; the first tip at ``angle`` [rad]."""
@@ -323,6 +329,7 @@ class Star(_CentredPolygon):
         )
 
 
+@checked_arguments
 class Drum2D(_CentredPolygon):
     """PeriDEM's drum: a hexagon of circumradius ``radius`` about ``center`` [m] whose two
     vertices on the axis (at ``angle`` [rad] from x) are pulled in to ``neck_half_width``. The
@@ -380,6 +387,7 @@ def _ellipsoid_distance(q: NDArray[np.float64], axes: NDArray[np.float64]) -> ND
     return np.where(inside, -distance, distance)
 
 
+@checked_arguments
 @dataclass(frozen=True)
 class Ellipse(Shape):
     """Ellipse of a centre (x, y), semi-axes (a, b) [m] and the angle [rad] of its a axis."""
@@ -427,6 +435,7 @@ class Ellipse(Shape):
         return float(max(self.semi_axes))
 
 
+@checked_arguments
 @dataclass(frozen=True)
 class Box(Shape):
     """Axis-aligned box [lower, upper] in 3D [m]."""
@@ -455,6 +464,7 @@ class Box(Shape):
         return _box_distance(_points(points), self.lower, self.upper)
 
 
+@checked_arguments
 @dataclass(frozen=True)
 class Sphere(Shape):
     """Sphere of a centre (x, y, z) and radius [m]."""
@@ -492,6 +502,7 @@ class Sphere(Shape):
         return float(self.radius)
 
 
+@checked_arguments
 @dataclass(frozen=True)
 class Ellipsoid(Shape):
     """Ellipsoid of a centre, semi-axes (a, b, c) [m] and a rotation of its axes (a rotation
@@ -539,6 +550,7 @@ class Ellipsoid(Shape):
         return float(max(self.semi_axes))
 
 
+@checked_arguments
 @dataclass(frozen=True)
 class Cylinder(Shape):
     """Solid cylinder of a centre (mid-point of its axis), unit ``axis`` direction, radius and
@@ -766,6 +778,7 @@ def _rings(resolution: float, dimension: int) -> tuple[NDArray[np.float64], NDAr
     return np.concatenate(points), np.concatenate(volumes)
 
 
+@checked_arguments
 @dataclass(frozen=True)
 class Union(Shape):
     """Points in any of the shapes (all of one dimension)."""
@@ -801,6 +814,7 @@ class Union(Shape):
         return np.min([shape.signed_distance(p) for shape in self.shapes], axis=0)
 
 
+@checked_arguments
 @dataclass(frozen=True)
 class Difference(Shape):
     """Points of ``base`` not in ``removed`` (notches, holes)."""

@@ -33,6 +33,7 @@ from granulate._version import __version__
 from granulate.contact import Contact
 from granulate.errors import GranulateWarning, InputError
 from granulate.functions import Constant, Linear, TimeFunction, VelocityRamp
+from granulate.input_errors import check_number
 from granulate.io import HistoryWriter, PvdSeries, atomic_write, write_vtu
 from granulate.io import checkpoint as checkpoint_file
 from granulate.materials import Material
@@ -80,6 +81,12 @@ class Body:
     mesh_size: float
     reference: ReferenceShape | None = None
     scale: float = 1.0
+
+    def __repr__(self) -> str:
+        return (
+            f"Body({self.name!r}, nodes {self.first_node}..{self.first_node + self.node_count - 1}"
+            f", mesh size {self.mesh_size:.4g} m, {self.material!r})"
+        )
 
     @property
     def nodes(self) -> NDArray[np.uint32]:
@@ -951,7 +958,7 @@ class Simulation:
         until: float | None = None,
         stop: Sequence[StopCriterion] = (),
         check_every: int = 100,
-        progress: Callable[[Progress], None] | None = None,
+        progress: Callable[[Progress], None] | bool | None = None,
         write_final: bool = True,
     ) -> str | None:
         """Advance ``steps`` time steps, or until simulated time ``until`` [s].
@@ -959,8 +966,10 @@ class Simulation:
         Writes outputs at step 0 and every ``output(every=...)`` steps, and checkpoints as set
         by ``checkpoint_every``. ``stop`` criteria (granulate.stopping) are checked every
         ``check_every`` steps; the run ends at the first one met and its reason is returned
-        (None when the run reached its last step). ``progress`` is called after each chunk of
-        steps (about every half second). Raises InstabilityError if the integration blows up.
+        (None when the run reached its last step). ``progress=True`` shows a progress bar (a
+        terminal or a Jupyter notebook; lines in a log); a callable is called with a Progress
+        after each chunk of steps (about every half second). Raises InstabilityError if the
+        integration blows up.
 
         Ctrl-C or SIGTERM during a run finishes the current chunk, writes a checkpoint (when
         checkpoints or outputs are set) and raises KeyboardInterrupt; outputs stay intact.
@@ -973,7 +982,10 @@ class Simulation:
         core = self._build()
         if (steps is None) == (until is None):
             raise InputError("give either steps or until")
+        if steps is not None:
+            check_number("run: steps", steps, integer=True)
         if until is not None:
+            check_number("run: until", until)
             if not np.isfinite(until):
                 raise InputError(f"until must be a finite time, got {until}")
             steps = max(0, int(np.ceil((until - core.time) / core.time_step - 1e-9)))
@@ -982,6 +994,25 @@ class Simulation:
             raise InputError(f"steps must be non-negative, got {steps}")
         if not (isinstance(check_every, int) and check_every > 0):
             raise InputError(f"check_every must be a positive number of steps, got {check_every}")
+        if progress is True:
+            from granulate.progress import ProgressReporter
+
+            reporter = ProgressReporter(steps)
+            try:
+                return self.run(
+                    steps,
+                    stop=stop,
+                    check_every=check_every,
+                    progress=reporter,
+                    write_final=write_final,
+                )
+            finally:
+                reporter.close()
+        if not (progress is None or progress is False or callable(progress)):
+            raise InputError(
+                f"progress must be True, False or a function of a Progress, got {progress!r}"
+            )
+        progress = progress or None
         out = self._output
         if out is not None and out.frames == 0:
             core.run(0)  # the forces of step 0 (prescribed motion, contact), for the frame
@@ -1076,6 +1107,25 @@ class Simulation:
             GranulateWarning,
             stacklevel=3,
         )
+
+    def __repr__(self) -> str:
+        """What the simulation holds and where it stands, without building it."""
+        parts = [f"{self.dimension}D", f"{len(self.bodies)} bodies", f"{self.node_count:,} nodes"]
+        if self._core is None:
+            parts.append("not built yet (built by the first run)")
+        else:
+            core = self._core
+            parts += [
+                f"{self.bond_count:,} bonds",
+                f"step {core.step:,}",
+                f"t = {core.time:.6g} s",
+                f"dt = {core.time_step:.4g} s",
+            ]
+        if self._walls:
+            parts.append(f"walls: {', '.join(name for name, _ in self._walls)}")
+        if self._output is not None:
+            parts.append(f"output: {self._output.directory} every {self._output.every} steps")
+        return f"Simulation({'; '.join(parts)})"
 
     @property
     def output_directory(self) -> Path | None:

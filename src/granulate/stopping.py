@@ -21,6 +21,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from granulate.errors import InputError
+from granulate.input_errors import checked_arguments
 
 if TYPE_CHECKING:
     from granulate.simulation import Simulation
@@ -34,8 +35,14 @@ class StopCriterion(ABC):
         """The reason to stop, or None."""
 
 
+@checked_arguments
 @dataclass(frozen=True)
 class KineticEnergyBelow(StopCriterion):
+    """Stop when the kinetic energy [J; J/m in 2D] is below ``energy``, from simulated time
+    ``after`` [s] on. A run that starts at rest is below any threshold at its first check:
+    give ``after`` (say, the time a grain takes to fall onto the pile) so that it stops when
+    the grains have settled, not before they move."""
+
     energy: float
     after: float = 0.0
 
@@ -52,6 +59,7 @@ class KineticEnergyBelow(StopCriterion):
         )
 
 
+@checked_arguments
 @dataclass(frozen=True)
 class WallDisplacement(StopCriterion):
     wall: str
@@ -68,6 +76,7 @@ class WallDisplacement(StopCriterion):
         return None
 
 
+@checked_arguments
 @dataclass(frozen=True)
 class ParticlesBroken(StopCriterion):
     count: int
@@ -83,6 +92,7 @@ class ParticlesBroken(StopCriterion):
         return None
 
 
+@checked_arguments
 @dataclass(frozen=True)
 class BrokenBonds(StopCriterion):
     count: int
@@ -96,6 +106,7 @@ class BrokenBonds(StopCriterion):
         return f"{broken} bonds broken (limit {self.count})" if broken >= self.count else None
 
 
+@checked_arguments
 @dataclass(frozen=True)
 class NodeDistance(StopCriterion):
     """A node is farther than ``distance`` [m] from the origin (a particle escaped the domain;

@@ -38,6 +38,7 @@ from granulate import _core
 from granulate.contact import Contact
 from granulate.errors import InputError
 from granulate.functions import Constant, Linear, TimeFunction
+from granulate.input_errors import checked_arguments
 from granulate.meshes import SurfaceMesh, read_file
 from granulate.shapes import Box, Disc, Ellipse, Polygon, Rectangle, Shape
 
@@ -56,6 +57,7 @@ class Surface:
         raise TypeError(f"{type(self).__name__} is not a concrete surface")
 
 
+@checked_arguments
 @dataclass(frozen=True)
 class Plane(Surface):
     point: ArrayLike
@@ -83,11 +85,13 @@ class _Box(Surface):
         return s
 
 
+@checked_arguments
 @dataclass(frozen=True)
 class BoxContainer(_Box):
     """Particles inside the box [lower, upper]."""
 
 
+@checked_arguments
 @dataclass(frozen=True)
 class BoxObstacle(_Box):
     """Particles outside the box [lower, upper]."""
@@ -114,11 +118,13 @@ class _Circle(Surface):
         return s
 
 
+@checked_arguments
 @dataclass(frozen=True)
 class CircleContainer(_Circle):
     """Particles inside a circle (2D) or an infinite cylinder along ``axis`` (3D)."""
 
 
+@checked_arguments
 @dataclass(frozen=True)
 class CircleObstacle(_Circle):
     """Particles outside a circle (2D) or an infinite cylinder along ``axis`` (3D)."""
@@ -142,11 +148,13 @@ class _Polygon(Surface):
         return s
 
 
+@checked_arguments
 @dataclass(frozen=True)
 class PolygonContainer(_Polygon):
     """Particles inside a 2D polygon."""
 
 
+@checked_arguments
 @dataclass(frozen=True)
 class PolygonObstacle(_Polygon):
     """Particles outside a 2D polygon."""
@@ -154,6 +162,7 @@ class PolygonObstacle(_Polygon):
     inside: bool = field(default=False, init=False)
 
 
+@checked_arguments
 @dataclass(frozen=True, eq=False)
 class TriangleMesh(Surface):
     """A triangle surface (3D). ``vertices`` (n, 3) [m], ``triangles`` (m, 3) vertex indices.
@@ -197,6 +206,7 @@ class TriangleMesh(Surface):
         return s
 
 
+@checked_arguments
 @dataclass(frozen=True)
 class Translation:
     """x = X + function(t) * direction (direction normalised)."""
@@ -205,6 +215,7 @@ class Translation:
     function: TimeFunction
 
 
+@checked_arguments
 @dataclass(frozen=True)
 class Rotation:
     """Rotation by angle(t) [rad] about ``axis`` through ``center`` (z in 2D)."""
@@ -223,6 +234,7 @@ class Rotation:
         return Rotation(Linear(angular_velocity), center, axis)
 
 
+@checked_arguments
 @dataclass(frozen=True)
 class Wall:
     """Surfaces moving together, with an optional motion and contact parameters.

@@ -1,0 +1,102 @@
+"""The Python API's habits: every mistake in a call is an InputError naming the argument (with a
+suggestion for a misspelt one), as in case files; progress bars; readable reprs."""
+
+from __future__ import annotations
+
+import pytest
+
+import granulate as gr
+
+ROCK = {"density": 2500, "youngs_modulus": 5e9, "poisson_ratio": 0.25, "fracture": False}
+
+
+@pytest.mark.parametrize(
+    ("call", "message"),
+    [
+        (lambda: gr.Material(**{**ROCK, "young_modulus": 1}), "did you mean 'youngs_modulus'"),
+        (lambda: gr.Material(**{**ROCK, "youngs_modulus": "50 GPa"}), "youngs_modulus"),
+        (lambda: gr.Material(**{**ROCK, "density": -1}), "density"),
+        (lambda: gr.Material(density=1, youngs_modulus=1e9, fracture=False), "exactly two"),
+        (lambda: gr.Disc((0, 0), radus=1e-3), "Disc: unknown argument 'radus'; did you mean"),
+        (lambda: gr.Disc((0, 0)), "Disc: the argument 'radius' is missing"),
+        (lambda: gr.Disc((0, 0), "1e-3"), "radius must be a number (without quotes)"),
+        (lambda: gr.Disc((0, 0), 1e-3, 2), "too many positional arguments"),
+        (lambda: gr.Contact(restitutio=0.5), "did you mean 'restitution'"),
+        (lambda: gr.Contact(friction="0.3"), "friction must be a number"),
+        (lambda: gr.Contact(friction=True), "friction must be a number"),
+        (lambda: gr.Sphere((0, 0, 0), radius=None), "radius must be a number"),
+        (lambda: gr.Plane((0, 0), normall=(0, 1)), "did you mean 'normal'"),
+        (lambda: gr.Linear(slope=2.0), "unknown argument 'slope'"),
+        (lambda: gr.Uniform(0.1, hi=0.2), "unknown argument 'hi'"),
+        (lambda: gr.stopping.KineticEnergyBelow(1e-6, afer=0.1), "did you mean 'after'"),
+        (lambda: gr.RegularPolygon((0, 0), 1e-3, sides=6, angel=0.1), "did you mean 'angle'"),
+        (lambda: gr.set_num_threads(0), "positive integer"),
+    ],
+)
+def test_mistakes_in_api_calls_are_input_errors(call, message: str) -> None:
+    """Before: pydantic's ValidationError (not an InputError) or a TypeError from Python."""
+    with pytest.raises(gr.InputError) as caught:
+        call()
+    assert message in str(caught.value)
+    assert "Traceback" not in str(caught.value)
+
+
+def disc_simulation() -> gr.Simulation:
+    sim = gr.Simulation(2)
+    sim.add_body(gr.Disc((0, 0), 1e-3), gr.Material(**ROCK), 2e-4)
+    return sim
+
+
+@pytest.mark.parametrize(
+    ("arguments", "message"),
+    [
+        ({"steps": 2.5}, "steps must be an integer, got 2.5"),
+        ({"steps": "10"}, "steps must be an integer (without quotes)"),
+        ({"steps": True}, "steps must be an integer"),
+        ({"until": "1e-3"}, "until must be a number"),
+        ({"steps": 5, "progress": "yes"}, "progress must be True, False or a function"),
+    ],
+)
+def test_bad_run_arguments_are_input_errors(arguments: dict, message: str) -> None:
+    sim = disc_simulation()
+    with pytest.raises(gr.InputError, match=message.replace("(", r"\(").replace(")", r"\)")):
+        sim.run(**arguments)
+    assert sim.step == 0
+
+
+def test_progress_true_reports_the_run(capsys: pytest.CaptureFixture[str]) -> None:
+    """progress=True draws a bar in a terminal or notebook; in a captured stream, lines."""
+    sim = disc_simulation()
+    sim.run(50, progress=True)
+    printed = capsys.readouterr().out
+    assert "step 50 (100 %)" in printed
+    assert sim.step == 50
+
+
+def test_reprs_say_what_objects_hold() -> None:
+    sim = disc_simulation()
+    sim.add_wall(gr.Plane((0, -2e-3), (0, 1)), name="floor")
+    unbuilt = "not built yet (built by the first run); walls: floor)"
+    assert repr(sim) == f"Simulation(2D; 1 bodies; 80 nodes; {unbuilt}"
+    sim.run(3)
+    assert "step 3;" in repr(sim) and "bonds" in repr(sim)
+    material = gr.Material(**ROCK)
+    assert repr(material) == (
+        "Material(density=2500.0, youngs_modulus=5000000000.0, poisson_ratio=0.25, fracture=False)"
+    )
+    assert repr(sim.bodies[0]).startswith("Body('body0', nodes 0..79, mesh size 0.0002 m")
+    grain = gr.Grain(gr.Disc((0, 0), 1e-3), material, 2e-4, gr.Uniform(0.5e-3, 1e-3))
+    packing = gr.pack(gr.Rectangle((0, 0), (0.01, 0.01)), [grain], 10, seed=1)
+    assert repr(packing).startswith("Packing(10 particles (10 x Disc); radius")
+
+
+def test_a_settling_criterion_waits_for_its_start_time() -> None:
+    """A body at rest is below any kinetic energy at the first check: with ``after`` the run
+    goes on to that time (the README's example)."""
+    sim = disc_simulation()
+    sim.gravity = (0.0, -9.81)
+    dt = sim.dt
+    reason = sim.run(
+        400, stop=[gr.stopping.KineticEnergyBelow(1.0, after=300 * dt)], check_every=50
+    )
+    assert reason is not None and 300 <= sim.step <= 350
