@@ -43,13 +43,40 @@ def test_large_user_dt_warns_when_the_model_is_built() -> None:
         plate(dt=1.0)  # setting the initial velocities builds the model
 
 
-def test_blow_up_message_names_step_and_dt() -> None:
+def test_a_time_step_far_above_the_estimate_is_refused_before_running() -> None:
+    """dt = 1e-3 s (thousands of times the estimate): an InputError when the run starts,
+    before anything moves (it was accepted with a warning, and the run died in the core)."""
     with pytest.warns(gr.GranulateWarning):
         sim = plate(dt=1e-3)
-    with pytest.raises(gr.InstabilityError) as error:
+    with pytest.raises(gr.InputError, match="times the stable estimate"):
         sim.run(500)
+    assert sim.step == 0
+    with pytest.raises(gr.InputError, match="dt must be a number"):
+        sim.dt = "1e-6"  # type: ignore[assignment]
+
+
+def test_a_blow_up_is_caught_on_the_step_it_happens() -> None:
+    """dt at 5 times the estimate (the most a run accepts): the run stops with an
+    InstabilityError naming the step, the node and its speed. The check ran every 64 steps, so
+    a 20-step run ended "finished" with an exploded state; it now runs every step (measured:
+    stopped at step 4)."""
+    probe = plate()
+    sim = plate(dt=5 * probe.stable_dt)
+    with pytest.raises(gr.InstabilityError) as error:
+        sim.run(20)
     message = str(error.value)
     assert "unstable at step" in message and "stable estimate" in message
+    assert "m/s, more than its mesh size" in message
+    assert sim.step < 20
+
+
+def test_a_non_finite_velocity_stops_the_run_at_once() -> None:
+    """An initial velocity of 1e308 m/s: an InstabilityError at step 1 (a 60-step run ended
+    "finished" with NaN energies)."""
+    sim = plate()
+    sim.velocities[:, 0] = 1e308
+    with pytest.raises(gr.InstabilityError, match=r"at step 1 .*non-finite"):
+        sim.run(60)
 
 
 @pytest.mark.parametrize("bad", [0.0, -1e-6, float("nan"), float("inf")])

@@ -242,6 +242,7 @@ class Simulation:
     # ------------------------------------------------------------------ building
     @staticmethod
     def _check_dt(dt: float) -> float:
+        check_number("time step dt", dt)
         if not (np.isfinite(dt) and dt > 0):
             raise InputError(f"time step dt must be a positive number of seconds, got {dt!r}")
         return float(dt)
@@ -980,6 +981,7 @@ class Simulation:
         and run.json is brought up to date.
         """
         core = self._build()
+        self.validate_time_step()
         if (steps is None) == (until is None):
             raise InputError("give either steps or until")
         if steps is not None:
