@@ -5,6 +5,7 @@ criteria end runs cleanly."""
 from __future__ import annotations
 
 import filecmp
+import json
 import os
 import signal
 from pathlib import Path
@@ -117,6 +118,62 @@ def test_mismatched_and_corrupted_checkpoints_are_refused(tmp_path: Path) -> Non
         tumbling_drum(tmp_path / "d").load_checkpoint(tmp_path / "text.npz")
     with pytest.raises(gr.InputError, match="does not exist"):
         tumbling_drum(tmp_path / "e").load_checkpoint(tmp_path / "missing.npz")
+
+
+def edited(checkpoint: Path, target: Path, edit, checksum: bool) -> Path:
+    """A copy of a checkpoint with one array changed by ``edit(arrays)``, its checksum
+    recomputed (a deliberate edit) or left as it was."""
+    from granulate.io import checkpoint as checkpoint_file
+
+    with np.load(checkpoint) as archive:
+        arrays = {name: archive[name].copy() for name in archive.files}
+    header = json.loads(bytes(arrays.pop("__header__")).decode())
+    edit(arrays)
+    if checksum:
+        header["checksum"] = checkpoint_file.content_checksum(arrays)
+    arrays["__header__"] = np.frombuffer(json.dumps(header).encode(), np.uint8)
+    np.savez(target, **arrays)
+    return target
+
+
+@pytest.mark.parametrize(
+    ("array", "change", "message"),
+    [
+        (
+            "contact_pair_partners",
+            lambda a: a.__setitem__(0, 10**6),
+            "partners past the node count",
+        ),
+        ("contact_pair_offsets", lambda a: a.__setitem__(1, a[-1] + 5), "partners past"),
+        ("contact_slots", lambda a: a.__setitem__(0, 10**6), "slots are out of range"),
+        ("contact_slots", lambda a: a.__setitem__(slice(None, 4), a[[2, 3, 0, 1]]), "out of order"),
+        ("contact_slot_approach", lambda a: a.__setitem__(0, np.nan), "non-finite"),
+        ("positions", lambda a: a.__setitem__(5, np.inf), "non-finite"),
+        ("contact_positions_at_build", lambda a: a.__setitem__(0, np.nan), "non-finite"),
+    ],
+)
+def test_checkpoints_edited_out_of_range_are_refused(
+    tmp_path: Path, array: str, change, message: str
+) -> None:
+    """Arrays well formed but out of range (contact partners past the node count) crashed the
+    core; edited slots were accepted. Now: the checksum refuses any edit, and the core refuses
+    arrays out of range even with a matching checksum, before anything is replaced."""
+    sim = tumbling_drum(tmp_path / "a")
+    sim.run(1000)
+    original = tmp_path / "a" / "checkpoint.npz"
+
+    def edit(arrays: dict) -> None:
+        change(arrays[array])
+
+    with pytest.raises(gr.InputError, match="changed after it was written"):
+        tumbling_drum(tmp_path / "b").load_checkpoint(
+            edited(original, tmp_path / "same.npz", edit, checksum=False)
+        )
+    target = tumbling_drum(tmp_path / "c")
+    before = target.positions.copy()
+    with pytest.raises(gr.InputError, match=message):
+        target.load_checkpoint(edited(original, tmp_path / "resummed.npz", edit, checksum=True))
+    np.testing.assert_array_equal(target.positions, before)
 
 
 def test_stop_criteria_end_the_run_at_a_fixed_step(tmp_path: Path) -> None:

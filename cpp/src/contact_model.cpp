@@ -859,14 +859,57 @@ ContactCheckpoint ContactModel::checkpoint() const {
   return c;
 }
 
-void ContactModel::restore(const Model& model, const State& state, const ContactCheckpoint& saved) {
-  if (saved.slot_approach.size() != saved.slots.size() ||
-      saved.slot_normal.size() != 3 * saved.slots.size() ||
-      saved.slot_work.size() != 2 * saved.slots.size() || saved.particle_slot_count > saved.slots.size() ||
-      (saved.built && saved.positions_at_build.size() != 3 * static_cast<std::size_t>(model.node_count())) ||
+namespace {
+
+bool all_finite(const std::vector<real>& values) {
+  return std::all_of(values.begin(), values.end(), [](real v) { return std::isfinite(v); });
+}
+
+/// CSR lists over n nodes: offsets from 0, never decreasing, ending at the partner count;
+/// partners are other nodes.
+bool valid_lists(const std::vector<index_t>& offsets, const std::vector<index_t>& partners, index_t n) {
+  if (offsets.size() != static_cast<std::size_t>(n) + 1 || offsets.front() != 0 ||
+      offsets.back() != partners.size())
+    return false;
+  for (index_t i = 0; i < n; ++i) {
+    if (offsets[i + 1] < offsets[i]) return false;
+    for (index_t e = offsets[i]; e < offsets[i + 1]; ++e)
+      if (partners[e] >= n || partners[e] == i) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+void ContactModel::check_checkpoint(const Model& model, const ContactCheckpoint& saved) const {
+  const index_t n = model.node_count();
+  const std::size_t slots = saved.slots.size();
+  if (saved.slot_approach.size() != slots || saved.slot_normal.size() != 3 * slots ||
+      saved.slot_work.size() != 2 * slots || saved.particle_slot_count > slots ||
+      (saved.built && saved.positions_at_build.size() != 3 * static_cast<std::size_t>(n)) ||
       saved.wall_reactions.size() != walls_.size()) {
     throw InputError("the checkpoint's contact data do not match this model (nodes or walls differ)");
   }
+  // Bodies are numbered below the node count; a wall slot's second entry is a wall. Slots are
+  // kept sorted (particle slots, then wall slots), which the merge at list builds relies on.
+  for (std::size_t k = 0; k < slots; ++k) {
+    const bool wall = k >= saved.particle_slot_count;
+    const auto& slot = saved.slots[k];
+    const bool sorted = k == 0 || k == saved.particle_slot_count || saved.slots[k - 1] < slot;
+    if (slot[0] >= n || slot[1] >= (wall ? walls_.size() : n) || !sorted)
+      throw InputError("the checkpoint's contact slots are out of range or out of order");
+  }
+  const bool finite = all_finite(saved.positions_at_build) && all_finite(saved.slot_approach) &&
+                      all_finite(saved.slot_normal) && all_finite(saved.slot_work) &&
+                      all_finite(saved.springs) && std::isfinite(saved.skin) &&
+                      std::isfinite(saved.time_at_build) && std::isfinite(saved.last_time);
+  if (!finite) throw InputError("the checkpoint's contact data hold non-finite values");
+  if (!saved.pair_offsets.empty() && !valid_lists(saved.pair_offsets, saved.pair_partners, n))
+    throw InputError("the checkpoint's contact lists are out of range (partners past the node count)");
+}
+
+void ContactModel::restore(const Model& model, const State& state, const ContactCheckpoint& saved) {
+  check_checkpoint(model, saved);
   skin_ = saved.skin;
   bodies_labelled_ = false;  // the restored bonds may differ from the current ones
   newly_broken_.clear();

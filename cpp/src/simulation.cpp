@@ -461,6 +461,14 @@ void Simulation::restore(const State& state, const ContactCheckpoint& contact) {
       state.dilatation.size() != model_->node_count()) {
     throw InputError("the checkpoint's state does not match this model (nodes or bonds differ)");
   }
+  auto finite = [](const std::vector<real>& v) {
+    return std::all_of(v.begin(), v.end(), [](real x) { return std::isfinite(x); });
+  };
+  if (!finite(state.positions) || !finite(state.velocities) || !finite(state.forces) ||
+      !finite(state.dilatation) || !std::isfinite(state.time)) {
+    throw InputError("the checkpoint's state holds non-finite values");
+  }
+  contact_.check_checkpoint(*model_, contact);  // before anything is replaced
   state_ = state;
   update_kinematic_nodes();  // the contact lists are rebuilt below with the held bodies known
   broken_bond_copies_ = state_.bonds.broken(model_->bond_offsets(), 0, model_->node_count());

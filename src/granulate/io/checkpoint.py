@@ -2,8 +2,9 @@
 
 A checkpoint is a NumPy .npz archive (zip, CRC-checked members) written atomically, holding
 the core's state and contact history (``_core.Simulation.checkpoint()``) and a JSON header:
-format version, granulate version, the model fingerprint, step, time, and the state of the
-outputs (frames written, PVD entries). A checkpoint is only loaded into a simulation with the
+format version, granulate version, the model fingerprint, step, time, the state of the
+outputs (frames written, PVD entries) and a SHA-256 checksum of the arrays (a file edited or
+damaged after it was written is refused; the core also checks every array's size and range). A checkpoint is only loaded into a simulation with the
 same fingerprint (same nodes, volumes, bonds, time step, loading and walls).
 """
 
@@ -27,10 +28,22 @@ FORMAT = 3
 HEADER = "__header__"
 
 
+def content_checksum(arrays: dict[str, np.ndarray]) -> str:
+    """SHA-256 of the arrays' names, kinds, shapes and bytes, in name order."""
+    digest = hashlib.sha256()
+    for name in sorted(arrays):
+        value = np.ascontiguousarray(arrays[name])
+        digest.update(f"{name}:{value.dtype.str}:{value.shape}".encode())
+        digest.update(value.tobytes())
+    return digest.hexdigest()
+
+
 def save(path: str | Path, state: dict[str, Any], header: dict[str, Any]) -> None:
-    """Write the core's checkpoint dict and a JSON header to ``path`` atomically."""
+    """Write the core's checkpoint dict and a JSON header (with the checksum of the arrays) to
+    ``path`` atomically."""
     arrays = {k: np.asarray(v) for k, v in state.items()}
-    arrays[HEADER] = np.frombuffer(json.dumps({"format": FORMAT, **header}).encode(), np.uint8)
+    header = {"format": FORMAT, **header, "checksum": content_checksum(arrays)}
+    arrays[HEADER] = np.frombuffer(json.dumps(header).encode(), np.uint8)
     buffer = io.BytesIO()
     np.savez(buffer, **arrays)
     atomic_write(Path(path), buffer.getvalue())
@@ -64,6 +77,12 @@ def load(path: str | Path) -> tuple[dict[str, Any], dict[str, Any]]:
             f"format {FORMAT} (format 1 predates the contact model with friction springs and "
             "per-node contact radii, format 2 the damping fitted to each collision's force law; "
             "their trajectories differ); run without --resume to start over"
+        )
+    checksum = header.get("checksum")
+    if checksum is not None and checksum != content_checksum(data):
+        raise InputError(
+            f"checkpoint {file} was changed after it was written (its arrays do not match the "
+            "checksum in its header); remove it and run without --resume"
         )
     state: dict[str, Any] = {}
     for name, value in data.items():

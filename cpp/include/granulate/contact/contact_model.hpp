@@ -128,6 +128,9 @@ class ContactModel {
   /// Restores a checkpoint taken with the same model, laws and walls; `state` is the restored
   /// state (its bond states are those the lists were built with).
   void restore(const Model& model, const State& state, const ContactCheckpoint& saved);
+  /// InputError unless every array of a checkpoint has the size and range this model and its
+  /// walls allow (a file edited or damaged by hand must not crash the core); changes nothing.
+  void check_checkpoint(const Model& model, const ContactCheckpoint& saved) const;
 
  private:
   real largest_displacement(const Model& model, const State& state) const;  ///< since the build [m]
