@@ -28,6 +28,7 @@ from pathlib import Path
 from granulate import _core, threads
 from granulate._version import __version__
 from granulate.errors import InputError, InstabilityError
+from granulate.io.run_folder import check_writable
 from granulate.progress import ProgressReporter, duration
 
 #: Bytes per node of state and model arrays besides bonds (positions, velocities, forces,
@@ -97,6 +98,8 @@ def _check(path: Path, compat: bool = False) -> int:
     _notes(case)
     sim = case.build(outputs=False)
     case.stop_criteria()  # names of walls in stop criteria
+    spec = case.spec.output
+    check_writable(Path(spec.directory) if spec is not None else Path("out") / path.stem)
     steps = case.steps(sim)
     model = sim.model
     memory = model.shared_bond_bytes() + sim.bond_count + BYTES_PER_NODE * sim.node_count
@@ -315,3 +318,13 @@ def _main(argv: list[str] | None) -> int:
     except KeyboardInterrupt as error:
         print(f"granulate: {error or 'interrupted'}", file=sys.stderr)
         return 130
+    except OSError as error:  # a full disk, a file system gone read-only, a lost mount
+        if options.debug:
+            raise
+        where = f" {error.filename}" if error.filename else ""
+        print(
+            f"granulate: run failed: could not write{where}: {error.strerror or error}; the "
+            "outputs written before are intact (free space or fix the folder, then --resume)",
+            file=sys.stderr,
+        )
+        return 1

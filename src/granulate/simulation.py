@@ -36,6 +36,7 @@ from granulate.functions import Constant, Linear, TimeFunction, VelocityRamp
 from granulate.input_errors import check_number
 from granulate.io import HistoryWriter, PvdSeries, atomic_write, write_vtu
 from granulate.io import checkpoint as checkpoint_file
+from granulate.io.run_folder import RunFolder
 from granulate.materials import Material
 from granulate.packing import Grain, Packing, Placements, grains_by_kind
 from granulate.shapes import ReferenceShape, Shape, rotation_matrix
@@ -121,6 +122,7 @@ class _Output:
     fields: tuple[str, ...]
     pvd: PvdSeries
     history_every: int
+    folder: RunFolder
     tracked: tuple[Body, ...] = ()
     history: HistoryWriter | None = None
     frames: int = 0
@@ -221,6 +223,7 @@ class Simulation:
         self._reference: NDArray[np.float64] | None = None
         self._wall_seconds = 0.0
         self._steps_run = 0
+        self._status = "not run"
         self._tuner: threads.ThreadTuner | None = None
         self._deep_contact_warned = False
         self._output_seconds = 0.0
@@ -743,9 +746,12 @@ class Simulation:
         [m]. For a body whose nodes are all prescribed (a meshed wall, a loading platen) the
         force is the reaction a load cell would measure.
 
-        A directory that already holds a run is refused unless ``overwrite`` is true (its
-        frames are then deleted) or ``resume`` is true (it is kept for ``load_checkpoint``,
-        which must follow).
+        A directory that already holds a run (simulation.pvd or frames) is refused unless
+        ``overwrite`` is true (the old run is deleted when the new one starts writing, so an
+        error found before leaves it intact) or ``resume`` is true (it is kept for
+        ``load_checkpoint``, which must follow; temporaries of interrupted writes are removed).
+        A file, or a directory you cannot write, is refused at once; while a run writes, the
+        directory is locked (.granulate.lock) against a second run.
         """
         if not (isinstance(every, int) and every > 0):
             raise InputError(f"output interval must be a positive number of steps, got {every!r}")
@@ -759,21 +765,15 @@ class Simulation:
         if unknown:
             raise InputError(f"unknown output fields {unknown}; choose from {', '.join(FIELDS)}")
         path = Path(directory)
-        if overwrite and resume:
-            raise InputError("overwrite and resume exclude each other")
-        if (path / "simulation.pvd").exists() and not (overwrite or resume):
-            raise InputError(
-                f"{path} already holds a run (simulation.pvd); choose another directory, replace "
-                "it (overwrite=True; granulate run --overwrite) or continue it (granulate run "
-                "--resume)"
-            )
-        (path / "frames").mkdir(parents=True, exist_ok=True)
-        if overwrite:
-            for pattern in ("frame_*.vtu", "particles_*.csv"):
-                for old in (path / "frames").glob(pattern):
-                    old.unlink()
+        folder = RunFolder(path, overwrite=overwrite, resume=resume)
         self._output = _Output(
-            path, every, tuple(fields), PvdSeries(path / "simulation.pvd"), history_every, tracked
+            path,
+            every,
+            tuple(fields),
+            PvdSeries(path / "simulation.pvd"),
+            history_every,
+            folder,
+            tracked,
         )
 
     def _body(self, body: Body | str) -> Body:
@@ -981,21 +981,7 @@ class Simulation:
         and run.json is brought up to date.
         """
         core = self._build()
-        self.validate_time_step()
-        if (steps is None) == (until is None):
-            raise InputError("give either steps or until")
-        if steps is not None:
-            check_number("run: steps", steps, integer=True)
-        if until is not None:
-            check_number("run: until", until)
-            if not np.isfinite(until):
-                raise InputError(f"until must be a finite time, got {until}")
-            steps = max(0, int(np.ceil((until - core.time) / core.time_step - 1e-9)))
-        assert steps is not None
-        if steps < 0:
-            raise InputError(f"steps must be non-negative, got {steps}")
-        if not (isinstance(check_every, int) and check_every > 0):
-            raise InputError(f"check_every must be a positive number of steps, got {check_every}")
+        steps = self._run_steps(core, steps, until, check_every)
         if progress is True:
             from granulate.progress import ProgressReporter
 
@@ -1014,7 +1000,61 @@ class Simulation:
             raise InputError(
                 f"progress must be True, False or a function of a Progress, got {progress!r}"
             )
-        progress = progress or None
+        out = self._output
+        if out is None:
+            return self._advance(core, steps, stop, check_every, progress or None, write_final)
+        out.folder.start_writing()
+        self._status = "running"
+        try:
+            reason = self._advance(core, steps, stop, check_every, progress or None, write_final)
+            self._status = f"stopped: {reason}" if reason else "finished"
+            return reason
+        except KeyboardInterrupt:
+            self._status = "interrupted"
+            raise
+        except BaseException as error:
+            self._status = f"failed: {error}"
+            raise
+        finally:
+            try:
+                self._write_run_json()
+            except OSError:
+                pass  # a full disk: the error that stopped the run is the one to report
+            out.folder.stop_writing()
+
+    def _run_steps(
+        self, core: _core.Simulation, steps: int | None, until: float | None, check_every: int
+    ) -> int:
+        """The number of steps a run(steps, until=...) takes; InputError for bad arguments or a
+        time step far above the stable estimate."""
+        self.validate_time_step()
+        if (steps is None) == (until is None):
+            raise InputError("give either steps or until")
+        if steps is not None:
+            check_number("run: steps", steps, integer=True)
+        if until is not None:
+            check_number("run: until", until)
+            if not np.isfinite(until):
+                raise InputError(f"until must be a finite time, got {until}")
+            steps = max(0, int(np.ceil((until - core.time) / core.time_step - 1e-9)))
+        assert steps is not None
+        if steps < 0:
+            raise InputError(f"steps must be non-negative, got {steps}")
+        if not (isinstance(check_every, int) and check_every > 0):
+            raise InputError(f"check_every must be a positive number of steps, got {check_every}")
+        return int(steps)
+
+    def _advance(
+        self,
+        core: _core.Simulation,
+        steps: int,
+        stop: Sequence[StopCriterion],
+        check_every: int,
+        progress: Callable[[Progress], None] | None,
+        write_final: bool,
+    ) -> str | None:
+        """The time loop of run(): chunks of steps between outputs, stop checks and
+        checkpoints, with the thread count the tuner picks."""
         out = self._output
         if out is not None and out.frames == 0:
             core.run(0)  # the forces of step 0 (prescribed motion, contact), for the frame
@@ -1445,6 +1485,7 @@ class Simulation:
             "time": core.time,
             "threads": threads.get_num_threads(),
             "threads_in_use": self._tuner.current if self._tuner is not None else None,
+            "status": self._status,
             "steps_run": self._steps_run,
             "wall_seconds": self._wall_seconds,
             "peridynamics_seconds": phases.peridynamics,
@@ -1489,9 +1530,14 @@ class Simulation:
         finally:
             self._output_seconds += wallclock.perf_counter() - start
 
+    def _write_run_json(self) -> None:
+        out = self._output
+        assert out is not None
+        atomic_write(out.directory / "run.json", json.dumps(self.summary(), indent=2).encode())
+
     def _write_final_state(self, frame: bool) -> None:
         """The end of a run: with ``frame``, the frame and history row of the last step when
-        it was not an output step; then run.json with the counts and times of the whole run."""
+        it was not an output step (run() then writes run.json with the run's status)."""
         out = self._output
         assert out is not None
         start = wallclock.perf_counter()
@@ -1501,7 +1547,6 @@ class Simulation:
                 self._write_vtu_frame()
             if frame and out.history_step != step:
                 self._write_history_row()
-            atomic_write(out.directory / "run.json", json.dumps(self.summary(), indent=2).encode())
         finally:
             self._output_seconds += wallclock.perf_counter() - start
 
@@ -1544,7 +1589,7 @@ class Simulation:
         self._write_particles(out.directory / "frames" / f"particles_{out.frames:06d}.csv", phi)
         out.frames += 1
         out.frame_step = int(core.step)
-        atomic_write(out.directory / "run.json", json.dumps(self.summary(), indent=2).encode())
+        self._write_run_json()
 
     def _write_history_row(self) -> None:
         out = self._output

@@ -2,10 +2,11 @@
 
 A checkpoint is a NumPy .npz archive (zip, CRC-checked members) written atomically, holding
 the core's state and contact history (``_core.Simulation.checkpoint()``) and a JSON header:
-format version, granulate version, the model fingerprint, step, time, the state of the
-outputs (frames written, PVD entries) and a SHA-256 checksum of the arrays (a file edited or
-damaged after it was written is refused; the core also checks every array's size and range). A checkpoint is only loaded into a simulation with the
-same fingerprint (same nodes, volumes, bonds, time step, loading and walls).
+format version, granulate version, the model fingerprint, step, time, the state of the outputs
+(frames written, PVD entries) and a SHA-256 checksum of the arrays (a file changed after it was
+written is refused; the core also checks every array's size and range). A checkpoint is only
+loaded into a simulation with the same fingerprint (same nodes, volumes, bonds, time step,
+loading and walls).
 """
 
 from __future__ import annotations

@@ -1,0 +1,148 @@
+"""Faults around the output directory: a full disk, --overwrite followed by an input error, two
+runs into one folder, leftovers of interrupted writes, folders that cannot hold a run."""
+
+from __future__ import annotations
+
+import errno
+import json
+import os
+import socket
+import subprocess
+import sys
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import meshio
+import pytest
+
+import granulate as gr
+from granulate.cli import main
+from granulate.io import vtu
+
+BASE = Path(__file__).parent / "cases" / "base.yaml"
+
+
+def listed_frames(directory: Path) -> list[str]:
+    collection = ET.parse(directory / "simulation.pvd").getroot().find("Collection")
+    return [d.get("file") for d in collection.findall("DataSet")]
+
+
+def test_a_full_disk_is_one_message_and_run_json_says_failed(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The fourth frame meets a full disk: exit 1, one line naming the file and the cause, no
+    traceback; run.json says failed; the frames written before are intact and listed."""
+    written = vtu.atomic_write
+    calls = {"frames": 0}
+
+    def filling(path, data) -> None:
+        if Path(path).name.startswith("frame_"):
+            calls["frames"] += 1
+            if calls["frames"] == 4:
+                raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC), str(path))
+        written(path, data)
+
+    monkeypatch.setattr(vtu, "atomic_write", filling)
+    out = tmp_path / "run"
+    assert main(["run", str(BASE), "--out", str(out), "--quiet"]) == 1
+    error = capsys.readouterr().err
+    assert error.count("\n") == 1 and "Traceback" not in error
+    assert "could not write" in error and "No space left on device" in error
+    assert "frame_000003.vtu" in error
+    summary = json.loads((out / "run.json").read_text())
+    assert summary["status"].startswith("failed: ") and "No space left" in summary["status"]
+    frames = listed_frames(out)
+    assert frames == [f"frames/frame_{k:06d}.vtu" for k in range(3)]
+    for frame in frames:
+        assert len(meshio.read(out / frame).points) > 0
+    assert not (out / ".granulate.lock").exists()
+
+
+def test_overwrite_followed_by_an_input_error_keeps_the_old_run(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """--overwrite deleted the old frames at once, so an error found after (here --steps 0)
+    left a PVD listing frames that no longer existed. The old run is now replaced only when the
+    new one starts writing."""
+    out = tmp_path / "run"
+    assert main(["run", str(BASE), "--out", str(out), "--quiet"]) == 0
+    before = {p.name: p.read_bytes() for p in (out / "frames").iterdir()}
+    pvd = (out / "simulation.pvd").read_bytes()
+    assert (
+        main(["run", str(BASE), "--out", str(out), "--quiet", "--overwrite", "--steps", "0"]) == 2
+    )
+    assert "--steps must be positive" in capsys.readouterr().err
+    assert {p.name: p.read_bytes() for p in (out / "frames").iterdir()} == before
+    assert (out / "simulation.pvd").read_bytes() == pvd
+    assert (
+        main(["run", str(BASE), "--out", str(out), "--quiet", "--overwrite", "--steps", "30"]) == 0
+    )
+    assert len(listed_frames(out)) < len(before) // 2  # replaced by the shorter run
+
+
+def plate(out: Path, **output) -> gr.Simulation:
+    sim = gr.Simulation(2)
+    material = gr.Material(density=2500, youngs_modulus=7e10, poisson_ratio=0.22, fracture=False)
+    sim.add_body(gr.Rectangle((0, 0), (0.01, 0.005)), material, 0.5e-3)
+    sim.output(out, every=10, **output)
+    return sim
+
+
+def test_a_second_run_into_a_locked_folder_is_refused(tmp_path: Path) -> None:
+    """Two runs into one folder interleaved their rows and frames and both exited 0. A run
+    holds .granulate.lock while it writes; another live process's lock refuses the run, a lock
+    left by a process that is gone is taken over, and the lock goes when the run ends."""
+    out = tmp_path / "run"
+    sim = plate(out)
+    lock = out / ".granulate.lock"
+    out.mkdir()
+    other = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(30)"])
+    try:
+        lock.write_text(json.dumps({"pid": other.pid, "host": socket.gethostname()}))
+        with pytest.raises(gr.InputError, match="another run is writing into"):
+            sim.run(20)
+        assert not (out / "simulation.pvd").exists()
+    finally:
+        other.kill()
+        other.wait()
+    sim.run(20)  # the holder is gone: its lock is stale
+    assert not lock.exists() and len(listed_frames(out)) == 3
+
+
+def test_frames_without_a_pvd_are_a_run_too(tmp_path: Path) -> None:
+    out = tmp_path / "run"
+    (out / "frames").mkdir(parents=True)
+    (out / "frames" / "frame_000000.vtu").write_text("<VTKFile/>")
+    with pytest.raises(gr.InputError, match="already holds a run"):
+        plate(out)
+
+
+def test_resuming_removes_the_temporaries_of_interrupted_writes(tmp_path: Path) -> None:
+    out = tmp_path / "run"
+    plate(out).run(20)
+    leftovers = [out / ".checkpoint.npz.x1y2.tmp", out / "frames" / ".frame_000009.vtu.ab.tmp"]
+    for leftover in leftovers:
+        leftover.write_bytes(b"partial")
+    plate(out, resume=True)
+    assert not any(leftover.exists() for leftover in leftovers)
+    assert (out / "simulation.pvd").exists()
+
+
+@pytest.mark.parametrize("kind", ["file", "under a file"])
+def test_folders_that_cannot_hold_a_run_are_refused_by_check_and_run(
+    tmp_path: Path, kind: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """check said valid and run gave a NotADirectoryError traceback."""
+    blocker = tmp_path / "blocker"
+    blocker.write_text("a file")
+    target = blocker if kind == "file" else blocker / "out"
+    case = tmp_path / "case.yaml"
+    case.write_text(
+        BASE.read_text().replace(
+            "output: {every: 20}", f"output: {{directory: {target}, every: 20}}"
+        )
+    )
+    assert main(["check", str(case)]) == 2
+    assert main(["run", str(case), "--quiet"]) == 2
+    errors = capsys.readouterr().err
+    assert errors.count(f"output directory {target}") == 2 and "Traceback" not in errors
