@@ -100,3 +100,28 @@ def test_a_settling_criterion_waits_for_its_start_time() -> None:
         400, stop=[gr.stopping.KineticEnergyBelow(1.0, after=300 * dt)], check_every=50
     )
     assert reason is not None and 300 <= sim.step <= 350
+
+
+def test_add_body_names_swapped_or_mistyped_arguments() -> None:
+    sim = gr.Simulation(2)
+    material = gr.Material(**ROCK)
+    with pytest.raises(gr.InputError, match="the order is shape, material, mesh_size"):
+        sim.add_body(material, gr.Disc((0, 0), 1e-3), 2e-4)  # type: ignore[arg-type]
+    with pytest.raises(gr.InputError, match=r"mesh_size must be a number \(without quotes\)"):
+        sim.add_body(gr.Disc((0, 0), 1e-3), material, "2.5e-4")  # type: ignore[arg-type]
+    with pytest.raises(gr.InputError, match=r"material must be a granulate\.Material"):
+        sim.add_body(gr.Disc((0, 0), 1e-3), {"density": 1}, 2e-4)  # type: ignore[arg-type]
+    assert not sim.bodies
+
+
+def test_arrays_users_must_not_change_are_read_only() -> None:
+    """volumes[:] = 0 or reference_positions *= 2 went through and the run went on with
+    nonsense; positions and velocities stay writable (documented)."""
+    sim = disc_simulation()
+    for name in ("volumes", "reference_positions", "forces"):
+        with pytest.raises(ValueError, match="read-only"):
+            getattr(sim, name)[:] = 0
+    sim.velocities[:, 0] = 1.0
+    sim.positions[:, 1] += 1e-6
+    sim.run(2)
+    assert sim.velocities[0, 0] == pytest.approx(1.0, rel=1e-3)

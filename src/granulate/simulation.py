@@ -130,6 +130,13 @@ class _Output:
     history_step: int = -1  # likewise for the last history row
 
 
+def _read_only(array: NDArray) -> NDArray:
+    """A view of `array` that cannot be written (the core keeps writing the original)."""
+    view = array.view()
+    view.flags.writeable = False
+    return view
+
+
 class _SignalCatcher:
     """During a run, Ctrl-C (SIGINT) and SIGTERM only set ``caught``: the run finishes its
     chunk of steps and stops cleanly. A second signal interrupts at once. Outside the main
@@ -277,6 +284,19 @@ class Simulation:
         ``angular_velocity`` [rad/s; a scalar about z in 2D, a vector in 3D, about the body's
         centroid] set the initial motion.
         """
+        if not isinstance(shape, Shape):
+            order = (
+                " (the order is shape, material, mesh_size)" if isinstance(shape, Material) else ""
+            )
+            raise InputError(
+                f"add_body: shape must be a shape (Disc, Rectangle, Sphere, ...), got "
+                f"{type(shape).__name__}{order}"
+            )
+        if not isinstance(material, Material):
+            raise InputError(
+                f"add_body: material must be a granulate.Material, got {type(material).__name__}"
+            )
+        check_number("add_body: mesh_size", mesh_size)
         if shape.dimension != self.dimension:
             raise InputError(
                 f"{type(shape).__name__} is a {shape.dimension}D shape but the simulation is "
@@ -401,6 +421,7 @@ class Simulation:
         v = np.asarray(volumes, dtype=np.float64).reshape(-1)
         if len(v) != len(p):
             raise InputError(f"{len(p)} positions but {len(v)} volumes")
+        check_number("add_body_from_nodes: mesh_size", mesh_size)
         if not (np.isfinite(mesh_size) and mesh_size > 0):
             raise InputError(f"mesh size must be positive, got {mesh_size}")
         return self._add(p, v, material, mesh_size, velocity, angular_velocity, name, None, 1.0)
@@ -460,9 +481,9 @@ class Simulation:
 
     @property
     def reference_positions(self) -> NDArray[np.float64]:
-        """(n, 3) reference positions X of all nodes [m]."""
+        """(n, 3) reference positions X of all nodes [m], read-only."""
         if self._model is not None:
-            return self._model.reference_positions
+            return _read_only(self._model.reference_positions)
         if not self._positions:
             return np.zeros((0, 3))
         return np.concatenate(self._positions)
@@ -1341,18 +1362,22 @@ class Simulation:
     # ------------------------------------------------------------------ results
     @property
     def positions(self) -> NDArray[np.float64]:
-        """(n, 3) current positions x [m] (a live view)."""
+        """(n, 3) current positions x [m]: a live, writable view. Writing moves nodes before
+        or between runs (bonds stretch accordingly; contact lists follow); the forces are
+        recomputed at the next step."""
         return self._build().positions
 
     @property
     def velocities(self) -> NDArray[np.float64]:
-        """(n, 3) velocities v [m/s] (a live, writable view)."""
+        """(n, 3) velocities v [m/s]: a live, writable view (set initial or changed velocities
+        before or between runs; prescribed nodes keep their prescribed motion)."""
         return self._build().velocities
 
     @property
     def forces(self) -> NDArray[np.float64]:
-        """(n, 3) net force densities f [N/m^3] of the last step (a live view)."""
-        return self._build().forces
+        """(n, 3) net force densities f [N/m^3] of the last step: a live, read-only view (the
+        next step starts from them)."""
+        return _read_only(self._build().forces)
 
     @property
     def displacements(self) -> NDArray[np.float64]:
@@ -1362,10 +1387,10 @@ class Simulation:
 
     @property
     def volumes(self) -> NDArray[np.float64]:
-        """(n,) nodal volumes [m^3; m^2 in 2D]."""
+        """(n,) nodal volumes [m^3; m^2 in 2D], read-only."""
         self._build()
         assert self._model is not None
-        return self._model.volumes
+        return _read_only(self._model.volumes)
 
     @property
     def damage(self) -> NDArray[np.float64]:
