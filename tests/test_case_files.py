@@ -211,3 +211,51 @@ def test_fuzzed_cases_raise_input_error_or_build(data: dict) -> None:
         case.build(outputs=False)
     except InputError:
         pass
+
+
+@pytest.mark.parametrize("with_contact", [True, False])
+def test_precracks_in_a_case_file_break_bonds(tmp_path: Path, with_contact: bool) -> None:
+    """Any precracks entry stopped the run ("cannot change contact after the simulation has
+    started"): precrack built the simulation before contact and walls were set. It is kept
+    until the build now; here it cuts the first particle in two."""
+    text = BASE.read_text() + (
+        "precracks:\n  - {point: [0.005, 0.005], normal: [1, 0], "
+        "region: {type: rectangle, lower: [0.004, 0.003], upper: [0.006, 0.007]}}\n"
+    )
+    if not with_contact:  # a body-only case: one plate, no grains, walls or packings
+        text = (
+            "dimension: 2\nmaterials:\n  rock: {density: 2600, youngs_modulus: 5.0e+7, "
+            "poisson_ratio: 0.25, fracture_energy: 20}\nbodies:\n  - {name: plate, material: "
+            "rock, mesh_size: 2.5e-4, shape: {type: rectangle, lower: [0, 0], upper: [0.01, "
+            "0.01]}}\ntime: {end: 1.0e-5}\n"
+            "precracks:\n  - {point: [0.005, 0.005], normal: [1, 0]}\n"
+        )
+    case = tmp_path / "cracked.yaml"
+    case.write_text(text)
+    assert main(["check", str(case)]) == 0
+    out = tmp_path / "out"
+    assert main(["run", str(case), "--out", str(out), "--quiet"]) == 0
+    history = (out / "history.csv").read_text().splitlines()
+    header = history[0].split(",")
+    first = dict(zip(header, history[1].split(","), strict=True))
+    assert int(first["broken_bonds"]) > 0
+
+
+def test_a_packing_in_a_union_container_checks_and_runs(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    case = tmp_path / "union.yaml"
+    case.write_text(
+        BASE.read_text()
+        .replace(
+            "packings:\n  - {container: {type: rectangle, lower: [0, 0], upper: [0.01, 0.004]}",
+            "shapes:\n  bin: {type: union, shapes: [{type: rectangle, lower: [0, 0], upper: "
+            "[0.01, 0.004]}, {type: rectangle, lower: [0.003, 0.004], upper: [0.007, 0.008]}]}\n"
+            "packings:\n  - {container: bin",
+        )
+        .replace("particles:\n  - {grain: pebble, position: [0.005, 0.005]}\n", "")
+    )
+    assert "container: bin" in case.read_text()
+    assert main(["check", str(case)]) == 0
+    assert "packing fraction" in capsys.readouterr().out
+    assert main(["run", str(case), "--out", str(tmp_path / "out"), "--quiet", "--steps", "5"]) == 0

@@ -230,6 +230,7 @@ class Simulation:
         self._reference: NDArray[np.float64] | None = None
         self._wall_seconds = 0.0
         self._steps_run = 0
+        self._precracks: list[tuple[NDArray[np.float64], NDArray[np.float64], Shape | None]] = []
         self._status = "not run"
         self._tuner: threads.ThreadTuner | None = None
         self._deep_contact_warned = False
@@ -883,6 +884,8 @@ class Simulation:
         self._model = model
         self._core = core
         self._reference = model.reference_positions
+        for crack in self._precracks:
+            self._break_crossing_bonds(*crack)
         return core
 
     def _check_start(self, model: _core.Model, core: _core.Simulation) -> None:
@@ -1443,14 +1446,30 @@ class Simulation:
                 count += 1
         return count
 
-    def precrack(self, point: ArrayLike, normal: ArrayLike, *, region: Shape | None = None) -> int:
+    def precrack(
+        self, point: ArrayLike, normal: ArrayLike, *, region: Shape | None = None
+    ) -> int | None:
         """Break the bonds that cross the plane through ``point`` with ``normal`` (in the reference
         configuration), only those whose midpoint lies in ``region`` if given: a pre-crack or a
-        notch without removing material. Returns the number of bonds broken."""
+        notch without removing material. Before the simulation is built (the first run, or the
+        first look at its state) the pre-crack is kept and applied when it is, and None is
+        returned, so contact, walls and loading can still be set; after, the bonds break at
+        once and their number is returned."""
+        crack = (self._vector(point, "point"), self._vector(normal, "normal"), region)
+        if region is not None and not isinstance(region, Shape):
+            raise InputError(f"precrack: region must be a shape, got {type(region).__name__}")
+        if self._core is None:
+            self._precracks.append(crack)
+            return None
+        return self._break_crossing_bonds(*crack)
+
+    def _break_crossing_bonds(
+        self, point: NDArray[np.float64], normal: NDArray[np.float64], region: Shape | None
+    ) -> int:
         core = self._build()
         assert self._model is not None
         X = self._model.reference_positions
-        side = (X - self._vector(point, "point")) @ self._vector(normal, "normal")
+        side = (X - point) @ normal
         offsets = self._model.bond_offsets
         owner = np.repeat(
             np.arange(len(offsets) - 1, dtype=np.uint32), np.diff(offsets).astype(np.int64)
