@@ -9,8 +9,9 @@ import granulate as gr
 
 
 def plate(model: str = "lps", **kwargs) -> gr.Simulation:
+    shear = 2e9 if model == "lps" else 1.8e9  # PMB's Poisson ratio is 1/4: G = 0.6 K
     material = gr.Material(
-        density=1500, bulk_modulus=3e9, shear_modulus=2e9, fracture=False, model=model
+        density=1500, bulk_modulus=3e9, shear_modulus=shear, fracture=False, model=model
     )
     sim = gr.Simulation(2, **kwargs)
     sim.add_body(gr.Rectangle((0, 0), (0.02, 0.02)), material, 1e-3)

@@ -37,20 +37,20 @@ from pathlib import Path
 from typing import Annotated, Any, Literal
 
 import numpy as np
-import yaml
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
 from granulate import functions, meshes, packing, shapes, stopping, walls
 from granulate.contact import Contact
 from granulate.errors import InputError
-from granulate.input_errors import describe
+from granulate.input_errors import NOT_BOOL, describe
 from granulate.materials import Material
 from granulate.simulation import FIELDS, Body, Simulation
+from granulate.yaml_input import load_yaml
 
-Vector = list[float]
-Positive = Annotated[float, Field(gt=0, allow_inf_nan=False)]
-NonNegative = Annotated[float, Field(ge=0, allow_inf_nan=False)]
-Finite = Annotated[float, Field(allow_inf_nan=False)]
+Vector = list[Annotated[float, NOT_BOOL]]
+Positive = Annotated[float, Field(gt=0, allow_inf_nan=False), NOT_BOOL]
+NonNegative = Annotated[float, Field(ge=0, allow_inf_nan=False), NOT_BOOL]
+Finite = Annotated[float, Field(allow_inf_nan=False), NOT_BOOL]
 
 
 class Spec(BaseModel):
@@ -111,7 +111,7 @@ class RegularPolygonSpec(Spec):
     type: Literal["regular_polygon"]
     center: Annotated[list[Finite], Field(min_length=2, max_length=2, description="[m]")] = [0, 0]
     radius: Positive = Field(description="circumradius [m]")
-    sides: Annotated[int, Field(ge=3)]
+    sides: Annotated[int, Field(ge=3), NOT_BOOL]
     angle: Finite = Field(0.0, description="of the first vertex from x [rad]")
 
     def make(self, case: CaseContext) -> shapes.Shape:
@@ -125,7 +125,7 @@ class StarSpec(Spec):
     center: Annotated[list[Finite], Field(min_length=2, max_length=2, description="[m]")] = [0, 0]
     outer_radius: Positive = Field(description="tips [m]")
     inner_radius: Positive = Field(description="notches [m]")
-    points: Annotated[int, Field(ge=3)] = 5
+    points: Annotated[int, Field(ge=3), NOT_BOOL] = 5
     angle: Finite = Field(0.0, description="[rad]")
 
     def make(self, case: CaseContext) -> shapes.Shape:
@@ -403,8 +403,8 @@ class BodySpec(Spec):
     material: str
     mesh_size: Positive = Field(description="[m]")
     discretization: Literal["lattice", "conforming", "grid"] = "lattice"
-    jitter: Annotated[float, Field(ge=0, lt=0.5)] = 0.0
-    seed: Annotated[int, Field(ge=0)] = 0
+    jitter: Annotated[float, Field(ge=0, lt=0.5), NOT_BOOL] = 0.0
+    seed: Annotated[int, Field(ge=0), NOT_BOOL] = 0
     velocity: list[Finite] | None = Field(None, description="[m/s]")
     angular_velocity: Finite | list[Finite] | None = Field(None, description="[rad/s]")
 
@@ -429,12 +429,12 @@ class PackingSpec(Spec):
 
     container: ShapeRef
     grains: Annotated[list[str], Field(min_length=1)]
-    count: Annotated[int, Field(gt=0)]
+    count: Annotated[int, Field(gt=0), NOT_BOOL]
     by: Literal["number", "volume"] = "number"
     method: Literal["random", "lattice"] = "random"
     gap: NonNegative = Field(0.0, description="[m]")
-    seed: Annotated[int, Field(ge=0)] = 0
-    attempts: Annotated[int, Field(gt=0)] = 2000
+    seed: Annotated[int, Field(ge=0), NOT_BOOL] = 0
+    attempts: Annotated[int, Field(gt=0), NOT_BOOL] = 2000
     velocity: list[Finite] | None = Field(None, description="[m/s]")
 
 
@@ -443,7 +443,7 @@ class PlacementSpec(Spec):
 
     file: str = Field(description="path, relative to the case file")
     zones: dict[int, str] = Field(description="zone id -> grain name")
-    seed: Annotated[int, Field(ge=0)] = 0
+    seed: Annotated[int, Field(ge=0), NOT_BOOL] = 0
     velocity: list[Finite] | None = Field(None, description="[m/s]")
 
 
@@ -457,7 +457,7 @@ class PrecrackSpec(Spec):
 class ContactSpec(Spec):
     """Contact parameters (see granulate.Contact)."""
 
-    restitution: Annotated[float, Field(gt=0, le=1)] = 1.0
+    restitution: Annotated[float, Field(gt=0, le=1), NOT_BOOL] = 1.0
     friction: NonNegative = 0.0
     contact_radius_factor: Positive = Field(
         0.95, description="each node's contact radius is factor x h / 2 of its particle"
@@ -465,7 +465,7 @@ class ContactSpec(Spec):
     contact_radius: Positive | None = Field(None, description="absolute Rc [m]")
     normal_stiffness: Positive | None = Field(None, description="absolute kn")
     stiffness_factor: Positive = 1.0
-    tangential_stiffness_ratio: Annotated[float, Field(gt=0, le=1)] = Field(
+    tangential_stiffness_ratio: Annotated[float, Field(gt=0, le=1), NOT_BOOL] = Field(
         2.0 / 7.0, description="kt / kn of the friction spring"
     )
     friction_law: Literal["coulomb", "peridem"] = Field(
@@ -488,7 +488,7 @@ class PairContactSpec(Spec):
 
 class PeridemDampingPairSpec(Spec):
     materials: Annotated[list[str], Field(min_length=2, max_length=2)]
-    epsilon: Annotated[float, Field(gt=0, le=1)] = Field(description="PeriDEM's Epsilon")
+    epsilon: Annotated[float, Field(gt=0, le=1), NOT_BOOL] = Field(description="PeriDEM's Epsilon")
     beta_factor: NonNegative = Field(1.0, description="PeriDEM's Beta_n_Factor")
 
 
@@ -590,7 +590,7 @@ class SelectSpec(Spec):
     region: ShapeRef | None = None
     body: str | list[str] | None = Field(None, description="a body name, or a list (any of them)")
     exclude: list[str] = Field([], description="bodies whose nodes are left out")
-    ids: list[Annotated[int, Field(ge=0)]] | None = None
+    ids: list[Annotated[int, Field(ge=0), NOT_BOOL]] | None = None
 
 
 class FixSpec(Spec):
@@ -641,9 +641,9 @@ class TimeSpec(Spec):
     """Time stepping: dt (default: dt_safety x the stable estimate) and the run length."""
 
     dt: Positive | None = Field(None, description="[s]")
-    dt_safety: Annotated[float, Field(gt=0, le=1)] = 0.8
+    dt_safety: Annotated[float, Field(gt=0, le=1), NOT_BOOL] = 0.8
     end: Positive | None = Field(None, description="simulated time to reach [s]")
-    steps: Annotated[int, Field(gt=0)] | None = None
+    steps: Annotated[int, Field(gt=0), NOT_BOOL] | None = None
 
     @model_validator(mode="after")
     def _length(self) -> TimeSpec:
@@ -654,9 +654,9 @@ class TimeSpec(Spec):
 
 class OutputSpec(Spec):
     directory: str = Field("out", description="relative to the working directory")
-    every: Annotated[int, Field(gt=0)] = Field(1000, description="steps between frames")
+    every: Annotated[int, Field(gt=0), NOT_BOOL] = Field(1000, description="steps between frames")
     fields: list[Literal[FIELDS]] = list(FIELDS)  # type: ignore[valid-type]
-    history_every: Annotated[int, Field(gt=0)] | None = Field(
+    history_every: Annotated[int, Field(gt=0), NOT_BOOL] | None = Field(
         None, description="steps between history.csv rows (default: every)"
     )
     track: list[str] = Field(
@@ -670,11 +670,13 @@ class RestartSpec(Spec):
     does not hold their states; granulate's checkpoints do, see --resume)."""
 
     file: str = Field(description="VTU file with Displacement and Velocity, relative to the case")
-    step: Annotated[int, Field(ge=0)] = Field(description="the step the frame was written at")
+    step: Annotated[int, Field(ge=0), NOT_BOOL] = Field(
+        description="the step the frame was written at"
+    )
 
 
 class CheckpointSpec(Spec):
-    every_steps: Annotated[int, Field(gt=0)] | None = None
+    every_steps: Annotated[int, Field(gt=0), NOT_BOOL] | None = None
     every_minutes: Positive | None = None
 
 
@@ -693,14 +695,14 @@ class StopSpec(Spec):
 
     kinetic_energy_below: KineticEnergyStopSpec | None = None
     wall_displacement: WallDisplacementStopSpec | None = None
-    particles_broken: Annotated[int, Field(gt=0)] | None = Field(
+    particles_broken: Annotated[int, Field(gt=0), NOT_BOOL] | None = Field(
         None, description="particles with every bond broken"
     )
-    broken_bonds: Annotated[int, Field(gt=0)] | None = None
+    broken_bonds: Annotated[int, Field(gt=0), NOT_BOOL] | None = None
     node_distance: Positive | None = Field(
         None, description="a node farther than this from the origin [m]"
     )
-    check_every: Annotated[int, Field(gt=0)] = 100
+    check_every: Annotated[int, Field(gt=0), NOT_BOOL] = 100
 
 
 class CaseSpec(Spec):
@@ -737,6 +739,28 @@ class CaseSpec(Spec):
         if not (self.bodies or self.particles or self.packings or self.placements):
             raise ValueError(
                 "the case has no particles: add bodies, particles, packings or placements"
+            )
+        return self
+
+    @model_validator(mode="after")
+    def _names_once(self) -> CaseSpec:
+        """A name says one thing: bodies and particles, walls, and material pairs of contact
+        laws each once; tracked bodies not named like walls (history.csv columns)."""
+        bodies = [b.name for b in [*self.bodies, *self.particles] if b.name is not None]
+        walls = [w.name for w in self.walls if w.name is not None]
+        pairs = [tuple(sorted(pair.materials)) for pair in self.contact_pairs]
+        for what, names in (("bodies and particles", bodies), ("walls", walls)):
+            twice = sorted({n for n in names if names.count(n) > 1})
+            if twice:
+                raise ValueError(f"{what} named {twice} more than once; give each its own name")
+        twice_pairs = sorted({p for p in pairs if pairs.count(p) > 1})
+        if twice_pairs:
+            raise ValueError(f"contact_pairs give the material pairs {twice_pairs} twice; keep one")
+        tracked = set(self.output.track) if self.output is not None else set()
+        if tracked & set(walls):
+            raise ValueError(
+                f"output.track names {sorted(tracked & set(walls))}, which are walls too; their "
+                "history.csv columns would overwrite each other: rename them"
             )
         return self
 
@@ -941,6 +965,9 @@ class Case:
         for warning in caught:
             warnings.warn(warning.message, warning.category, stacklevel=2)
         if not outputs:
+            if spec.output is not None:  # what check can say about the outputs
+                for t in spec.output.track:
+                    _named(t, named, "output.track")
             return sim
         if spec.output is not None or output is not None:
             o = spec.output or OutputSpec()
@@ -985,11 +1012,23 @@ class Case:
             criteria.append(stopping.NodeDistance(s.node_distance))
         return criteria
 
+    #: The most steps a case may ask for: a year at 10^5 steps per second.
+    MOST_STEPS = 3 * 10**12
+
     def steps(self, sim: Simulation) -> int:
-        """Steps from the current state to the end of the case."""
+        """Steps from the current state to the end of the case; InputError past MOST_STEPS
+        (an end time in the wrong unit: 1e300 s, or a step count beyond any run)."""
         if self.spec.time.steps is not None:
-            return max(0, self.spec.time.steps - sim.step)
-        return max(0, int(np.ceil((self.spec.time.end - sim.time) / sim.dt - 1e-9)))  # type: ignore[operator]
+            count = float(self.spec.time.steps - sim.step)
+        else:
+            count = np.ceil((self.spec.time.end - sim.time) / sim.dt - 1e-9)  # type: ignore[operator]
+        if not count <= self.MOST_STEPS:
+            raise InputError(
+                f"time: the run would take {count:.3g} steps of dt = {sim.dt:.4g} s (at most "
+                f"{self.MOST_STEPS:.0e}, a year at 100,000 steps per second); check time.end or "
+                "time.steps"
+            )
+        return max(0, int(count))
 
 
 def _vector(values: list[float], dimension: int, name: str) -> list[float]:
@@ -1110,10 +1149,7 @@ def load_case(path: str | Path, *, peridem_compat: bool = False) -> Case:
         text = source.read_text()
     except (OSError, UnicodeDecodeError) as error:
         raise InputError(f"cannot read case file {source}: {error}") from None
-    try:
-        data = yaml.safe_load(text)
-    except yaml.YAMLError:
-        data = None  # parse_case reports it
+    data = load_yaml(text, source)
     from granulate import peridem
 
     if peridem.is_deck(data):
@@ -1131,15 +1167,7 @@ def load_case(path: str | Path, *, peridem_compat: bool = False) -> Case:
 
 
 def parse_case(text: str, source: Path = Path("case.yaml")) -> Case:
-    try:
-        data = yaml.safe_load(text)
-    except yaml.YAMLError as error:
-        where = ""
-        mark = getattr(error, "problem_mark", None)
-        if mark is not None:
-            where = f" at line {mark.line + 1}, column {mark.column + 1}"
-        problem = getattr(error, "problem", None) or str(error).splitlines()[0]
-        raise InputError(f"{source}: not valid YAML{where}: {problem}") from None
+    data = load_yaml(text, source)
     if not isinstance(data, dict):
         raise InputError(
             f"{source}: a case file is a mapping of keys (dimension, materials, ...), got "

@@ -12,7 +12,7 @@ import numbers
 from collections.abc import Sequence
 from typing import Any, TypeVar
 
-from pydantic import BaseModel, ValidationError
+from pydantic import BaseModel, BeforeValidator, ValidationError
 
 from granulate.errors import InputError
 
@@ -118,7 +118,11 @@ def describe(error: ValidationError, data: Any, models: Sequence[type[BaseModel]
             if len(shown) > 60:
                 shown = shown[:57] + "..."
             text = problem["msg"].removeprefix("Value error, ")
-            message = f"{where}: {text} (found {shown})"
+            if isinstance(found, dict) and problem["type"] == "value_error":
+                # A check of a whole mapping (which names, which combination): no value to show.
+                message = text if not loc else f"{where}: {text}"
+            else:
+                message = f"{where}: {text} (found {shown})"
         if message not in lines:
             lines.append(message)
     if len(lines) == 1:
@@ -205,5 +209,15 @@ def api_error(
 ) -> InputError:
     """The InputError of an API object's validation error, told as a case file's is."""
     text = describe(error, data, [model]).replace(": unknown key ", ": unknown argument ")
-    text = text.replace("(top level): ", "").replace(" (found a mapping)", "")
     return InputError(f"{where}: {text}")
+
+
+def _refuse_bool(value: Any) -> Any:
+    if isinstance(value, bool):
+        raise ValueError("a number is expected, not a yes/no (true/false) value")
+    return value
+
+
+#: Marks a number field of a pydantic model: YAML's yes/no/true/false (Python's bools) are
+#: refused instead of read as 1 and 0.
+NOT_BOOL = BeforeValidator(_refuse_bool)

@@ -8,15 +8,16 @@ metres) or relative to the mesh size of each body (``horizon_factor``, default 3
 
 from __future__ import annotations
 
-from typing import Any, Literal
+from typing import Annotated, Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
 from granulate import _core
 from granulate.errors import InputError
-from granulate.input_errors import api_error
+from granulate.input_errors import NOT_BOOL, api_error
 
 ForceModelName = Literal["lps", "pmb"]
+_Number = Annotated[float | None, NOT_BOOL]  # a number or None, never a yes/no
 InfluenceName = Literal["constant", "linear", "gaussian", "inverse"]
 
 
@@ -58,14 +59,14 @@ class Material(BaseModel, metaclass=_CalledFromPython):
             if value is not None and (name is None or value != defaults[name].default):
                 yield name, value
 
-    density: float = Field(gt=0, allow_inf_nan=False)
-    bulk_modulus: float | None = Field(default=None, gt=0, allow_inf_nan=False)
-    shear_modulus: float | None = Field(default=None, gt=0, allow_inf_nan=False)
-    youngs_modulus: float | None = Field(default=None, gt=0, allow_inf_nan=False)
-    poisson_ratio: float | None = Field(default=None, gt=-1, lt=0.5, allow_inf_nan=False)
-    fracture_energy: float | None = Field(default=None, gt=0, allow_inf_nan=False)
-    horizon: float | None = Field(default=None, gt=0, allow_inf_nan=False)
-    horizon_factor: float | None = Field(default=None, ge=1, allow_inf_nan=False)
+    density: Annotated[float, NOT_BOOL] = Field(gt=0, allow_inf_nan=False)
+    bulk_modulus: _Number = Field(default=None, gt=0, allow_inf_nan=False)
+    shear_modulus: _Number = Field(default=None, gt=0, allow_inf_nan=False)
+    youngs_modulus: _Number = Field(default=None, gt=0, allow_inf_nan=False)
+    poisson_ratio: _Number = Field(default=None, gt=-1, lt=0.5, allow_inf_nan=False)
+    fracture_energy: _Number = Field(default=None, gt=0, allow_inf_nan=False)
+    horizon: _Number = Field(default=None, gt=0, allow_inf_nan=False)
+    horizon_factor: _Number = Field(default=None, ge=1, allow_inf_nan=False)
     model: ForceModelName = "lps"
     influence: InfluenceName = "linear"
     fracture: bool = True

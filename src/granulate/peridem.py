@@ -43,6 +43,7 @@ import numpy as np
 import yaml
 
 from granulate.errors import InputError
+from granulate.yaml_input import load_yaml
 
 #: Sections of a deck and the keys granulate reads in each (Zone_<k> / Set_<s> blocks apart).
 SECTIONS = (
@@ -178,13 +179,10 @@ def read_deck(path: str | Path) -> dict[str, Any]:
     if not source.is_file():
         raise InputError(f"deck {source} does not exist")
     try:
-        data = yaml.safe_load(source.read_text())
+        text = source.read_text()
     except (OSError, UnicodeDecodeError) as error:
         raise InputError(f"cannot read deck {source}: {error}") from None
-    except yaml.YAMLError as error:
-        mark = getattr(error, "problem_mark", None)
-        where = f" at line {mark.line + 1}" if mark is not None else ""
-        raise InputError(f"{source}: not valid YAML{where}: {error}") from None
+    data = load_yaml(text, source)
     if not is_deck(data):
         raise InputError(f"{source} is not a PeriDEM deck (it has no Model block)")
     return data

@@ -446,6 +446,8 @@ class Simulation:
             )
         index = len(self.bodies)
         first = sum(b.node_count for b in self.bodies)
+        if name is not None and any(b.name == name for b in self.bodies):
+            raise InputError(f"a body named {name!r} exists already; give each body its own name")
         body = Body(
             index,
             name or f"body{index}",
@@ -532,7 +534,7 @@ class Simulation:
     def fix(self, nodes: ArrayLike, components: Components = "xyz") -> None:
         """Hold the given components of the nodes at their reference position."""
         components = components[: self.dimension] if components == "xyz" else components
-        self.prescribe_displacement(nodes, (0, 0, 0), Constant(0.0), components=components)
+        self._prescribe(nodes, np.zeros(3), Constant(0.0), components)
 
     def prescribe_displacement(
         self,
@@ -545,15 +547,26 @@ class Simulation:
         """Impose x = X + f(t) * direction on the given components (default: all).
 
         Example: ``prescribe_displacement(ids, (1, 0), Linear(0.01))`` pulls at 0.01 m/s in x.
+        A zero direction would hold the nodes still: use ``fix`` for that.
         """
+        vector = self._vector(direction, "direction")
+        if not np.any(vector):
+            raise InputError(
+                "prescribe_displacement: the direction is zero, so the nodes would be held still; "
+                "give the direction of the motion (or fix the nodes with fix / a fix entry)"
+            )
+        self._prescribe(nodes, vector, function, components)
+
+    def _prescribe(
+        self,
+        nodes: ArrayLike,
+        vector: NDArray[np.float64],
+        function: TimeFunction,
+        components: Components | None,
+    ) -> None:
         self._require_building("add loading")
         mask = _component_mask(components or "xyz"[: self.dimension], self.dimension)
-        self._loads.append(
-            (
-                "displacement",
-                (self._nodes(nodes), mask, self._vector(direction, "direction"), function),
-            )
-        )
+        self._loads.append(("displacement", (self._nodes(nodes), mask, vector, function)))
 
     def prescribe_velocity(
         self,
@@ -783,6 +796,13 @@ class Simulation:
                 f"history interval must be a positive number of steps, got {history_every!r}"
             )
         tracked = tuple(self._body(b) for b in track)
+        walls = {name for name, _ in self._walls}
+        clashing = sorted({b.name for b in tracked} & walls)
+        if clashing:
+            raise InputError(
+                f"tracked bodies {clashing} are named like walls: their history.csv columns "
+                "(<name>_fx, ...) would overwrite each other; rename them"
+            )
         unknown = [f for f in fields if f not in FIELDS]
         if unknown:
             raise InputError(f"unknown output fields {unknown}; choose from {', '.join(FIELDS)}")
@@ -828,6 +848,7 @@ class Simulation:
             self.bodies, self._positions, self._volumes, strict=True
         ):
             horizon = body.material.resolved_horizon(body.mesh_size)
+            self._check_material_for(body, horizon)
             key = id(body.material)
             if key not in material_ids:
                 material_ids[key] = model.add_material(body.material.core_params(body.mesh_size))
@@ -1146,6 +1167,34 @@ class Simulation:
         if out is not None:
             self._write_final_state(frame=write_final or reason is not None)
         return reason
+
+    #: The most horizon / mesh size accepted: peridynamic horizons are 3-4 mesh sizes; at 20
+    #: a node has about 1,300 bonds in 2D and 34,000 in 3D.
+    MOST_HORIZON_FACTOR = 20.0
+
+    def _check_material_for(self, body: Body, horizon: float) -> None:
+        """InputError for a material a body cannot use as given: a horizon far beyond its mesh
+        size (an absolute horizon in the wrong unit bonds every node to every other), or PMB
+        with a Poisson ratio it cannot have (1/4; 1/3 in plane stress)."""
+        ratio = horizon / body.mesh_size
+        if ratio > self.MOST_HORIZON_FACTOR:
+            raise InputError(
+                f"body {body.name!r}: the horizon {horizon:.4g} m is {ratio:.0f} times its mesh "
+                f"size {body.mesh_size:.4g} m (at most {self.MOST_HORIZON_FACTOR:.0f}; usually "
+                "3-4): give horizon_factor, or the horizon in metres"
+            )
+        material = body.material
+        if material.model != "pmb":
+            return
+        K, G = material.elastic_moduli()
+        nu = (3 * K - 2 * G) / (2 * (3 * K + G))
+        allowed = 1 / 3 if (self.dimension == 2 and self.plane == "stress") else 0.25
+        if abs(nu - allowed) > 1e-3:
+            raise InputError(
+                f"body {body.name!r}: model 'pmb' has Poisson ratio {allowed:.4g} here, but the "
+                f"material's constants give {nu:.4g}; use model 'lps', or constants with "
+                f"poisson_ratio {allowed:.4g}"
+            )
 
     def _thread_tuner(self, most: int) -> threads.ThreadTuner | None:
         """The run's thread-count picker (kept across runs of this simulation), or None when

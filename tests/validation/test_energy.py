@@ -11,8 +11,9 @@ import granulate as gr
 
 
 def vibrating_body(dimension: int, model: str, dt_safety: float = 0.8) -> gr.Simulation:
+    nu = 0.3 if model == "lps" else 0.25  # PMB's Poisson ratio is 1/4
     material = gr.Material(
-        density=2000, youngs_modulus=5e9, poisson_ratio=0.3, fracture=False, model=model
+        density=2000, youngs_modulus=5e9, poisson_ratio=nu, fracture=False, model=model
     )
     sim = gr.Simulation(dimension, dt_safety=dt_safety)
     h = 1e-3
