@@ -31,6 +31,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from granulate import resources
 from granulate.errors import InputError
 from granulate.input_errors import checked_arguments
 from granulate.io.table import read_table
@@ -426,6 +427,12 @@ def pack(
             raise InputError("every Grain of a packing needs sizes (e.g. Uniform(0.9e-3, 1.1e-3))")
     if not (isinstance(count, int | np.integer) and count > 0):
         raise InputError(f"count must be a positive number of particles, got {count!r}")
+    nodes = max(len(g.reference.volumes) for g in grains)
+    resources.require_memory(
+        float(count) * (64 + resources.BYTES_PER_NODE * nodes),
+        f"a packing of {count:,} grains of up to {nodes:,} nodes each",
+        "pack fewer grains, or mesh them more coarsely",
+    )
     if not (gap >= 0 and np.isfinite(gap)):
         raise InputError(f"gap must be a non-negative distance, got {gap}")
     rng = _generator(seed)

@@ -25,6 +25,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from granulate import resources
 from granulate.errors import InputError
 from granulate.input_errors import checked_arguments
 
@@ -283,8 +284,11 @@ class RegularPolygon(_CentredPolygon):
         self, center: tuple[float, float], radius: float, sides: int, angle: float = 0.0
     ) -> None:
         _vector(center, 2, "RegularPolygon center")
-        if not (isinstance(sides, int | np.integer) and sides >= 3):
-            raise InputError(f"RegularPolygon needs an integer number of sides >= 3, got {sides!r}")
+        if not (isinstance(sides, int | np.integer) and 3 <= sides <= MOST_VERTICES):
+            raise InputError(
+                f"RegularPolygon needs an integer number of sides from 3 to {MOST_VERTICES:,}, "
+                f"got {sides!r} (a Disc is a polygon of very many sides)"
+            )
         if not (radius > 0 and np.isfinite(radius)):
             raise InputError(f"RegularPolygon radius must be positive, got {radius}")
         super().__init__(_regular_vertices(center, radius, int(sides), angle))
@@ -312,8 +316,11 @@ class Star(_CentredPolygon):
         angle: float = 0.0,
     ) -> None:
         _vector(center, 2, "Star center")
-        if not (isinstance(points, int | np.integer) and points >= 3):
-            raise InputError(f"Star needs an integer number of points >= 3, got {points!r}")
+        if not (isinstance(points, int | np.integer) and 3 <= points <= MOST_VERTICES // 2):
+            raise InputError(
+                f"Star needs an integer number of points from 3 to {MOST_VERTICES // 2:,}, got "
+                f"{points!r}"
+            )
         if not (0 < inner_radius < outer_radius and np.isfinite(outer_radius)):
             raise InputError(
                 f"Star needs 0 < inner_radius < outer_radius, got {inner_radius}, {outer_radius}"
@@ -612,6 +619,22 @@ class Cylinder(Shape):
         return float(np.hypot(self.radius, 0.5 * self.length))
 
 
+#: The most vertices of a polygon built from a count (RegularPolygon, Star): every contains()
+#: and signed_distance() call visits each edge.
+MOST_VERTICES = 100_000
+
+
+def _require_nodes(cells: float, nodes: float, mesh_size: float, kind: str) -> None:
+    """InputError before a discretisation of `cells` candidate points and about `nodes` nodes
+    is generated, when it (or the simulation of those nodes) would not fit in memory."""
+    needed = max(80.0 * cells, resources.BYTES_PER_NODE * nodes)
+    resources.require_memory(
+        needed,
+        f"a {kind} of about {nodes:.3g} nodes (mesh size {mesh_size:.4g} m)",
+        "use a larger mesh size",
+    )
+
+
 def lattice(
     shape: Shape, mesh_size: float, *, jitter: float = 0.0, seed: int = 0
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
@@ -639,10 +662,9 @@ def lattice(
     counts = np.maximum(1, np.round((upper[:d] - lower[:d]) / mesh_size).astype(np.int64))
     # Centre the lattice in the bounding box so that a box of whole cells is filled exactly.
     origin = 0.5 * (lower[:d] + upper[:d]) - 0.5 * counts * mesh_size
-    if np.prod(counts.astype(float)) > 2e8:
-        raise InputError(
-            f"mesh size {mesh_size} gives over 200 million lattice cells; use a larger mesh size"
-        )
+    _require_nodes(
+        float(np.prod(counts.astype(float))), shape.measure / mesh_size**d, mesh_size, "lattice"
+    )
     axes = [origin[k] + (np.arange(counts[k]) + 0.5) * mesh_size for k in range(d)]
     grid = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, d)
     points = np.zeros((len(grid), 3))
@@ -679,10 +701,8 @@ def grid(shape: Shape, mesh_size: float) -> tuple[NDArray[np.float64], NDArray[n
     lower = np.asarray(shape.lower, dtype=float)[:d]
     upper = np.asarray(shape.upper, dtype=float)[:d]
     cells = np.maximum(1, np.round((upper - lower) / mesh_size).astype(np.int64))
-    if np.prod((cells + 1).astype(float)) > 2e8:
-        raise InputError(
-            f"mesh size {mesh_size} gives over 200 million grid nodes; use a larger mesh size"
-        )
+    nodes = float(np.prod((cells + 1).astype(float)))
+    _require_nodes(nodes, nodes, mesh_size, "grid")
     axes = [np.linspace(lower[k], upper[k], cells[k] + 1) for k in range(d)]
     spacing = (upper - lower) / cells
     shares = []
@@ -714,11 +734,12 @@ def conforming(shape: Shape, mesh_size: float) -> tuple[NDArray[np.float64], NDA
     """
     if not (mesh_size > 0 and np.isfinite(mesh_size)):
         raise InputError(f"mesh size must be positive, got {mesh_size}")
-    rings = shape.bounding_radius / mesh_size if hasattr(shape, "bounding_radius") else 0.0
-    if rings**shape.dimension > 2e8:
-        raise InputError(
-            f"mesh size {mesh_size} gives over 200 million nodes; use a larger mesh size"
-        )
+    nodes = (
+        shape.measure / mesh_size**shape.dimension
+        if isinstance(shape, Disc | Ellipse | Sphere | Ellipsoid)
+        else 0.0
+    )
+    _require_nodes(nodes, nodes, mesh_size, "conforming discretisation")
     if isinstance(shape, Disc | Ellipse):
         axes = (
             np.array([shape.radius, shape.radius])

@@ -28,7 +28,7 @@ from typing import Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from granulate import _core, threads
+from granulate import _core, resources, threads
 from granulate._version import __version__
 from granulate.contact import Contact
 from granulate.errors import GranulateWarning, InputError
@@ -839,6 +839,7 @@ class Simulation:
         if not self.bodies:
             raise InputError("the simulation has no body; add one with add_body")
         model = _core.Model(self.dimension, getattr(_core.PlaneMode, self.plane))
+        self._require_memory_for_model()
         # One core material per Material; each particle carries its own horizon (absolute, or
         # horizon_factor times its mesh size), so particles of any size share one material.
         material_ids: dict[int, int] = {}
@@ -848,7 +849,6 @@ class Simulation:
             self.bodies, self._positions, self._volumes, strict=True
         ):
             horizon = body.material.resolved_horizon(body.mesh_size)
-            self._check_material_for(body, horizon)
             key = id(body.material)
             if key not in material_ids:
                 material_ids[key] = model.add_material(body.material.core_params(body.mesh_size))
@@ -1167,6 +1167,24 @@ class Simulation:
         if out is not None:
             self._write_final_state(frame=write_final or reason is not None)
         return reason
+
+    def _require_memory_for_model(self) -> None:
+        """InputError before the bonds are built when the model would not fit in memory:
+        every node's state, and one bond family per reference shape and horizon ratio
+        (particles placed from one shape share it) or per body."""
+        families: dict[tuple[int, float], float] = {}
+        for body in self.bodies:
+            for_body = body.material.resolved_horizon(body.mesh_size) / body.mesh_size
+            self._check_material_for(body, for_body * body.mesh_size)
+            key = (id(body.reference) if body.reference is not None else -1 - body.index, for_body)
+            family = body.node_count * resources.bonds_per_node(self.dimension, for_body)
+            families[key] = family
+        nodes, bonds = float(self.node_count), float(sum(families.values()))
+        resources.require_memory(
+            resources.simulation_bytes(nodes, bonds),
+            f"the model ({nodes:,.0f} nodes, about {bonds:,.0f} bonds)",
+            "use fewer or coarser particles, or a smaller horizon_factor",
+        )
 
     #: The most horizon / mesh size accepted: peridynamic horizons are 3-4 mesh sizes; at 20
     #: a node has about 1,300 bonds in 2D and 34,000 in 3D.
