@@ -259,3 +259,30 @@ def test_a_packing_in_a_union_container_checks_and_runs(
     assert main(["check", str(case)]) == 0
     assert "packing fraction" in capsys.readouterr().out
     assert main(["run", str(case), "--out", str(tmp_path / "out"), "--quiet", "--steps", "5"]) == 0
+
+
+def test_files_that_are_not_what_they_should_be_get_one_message(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A UTF-16 case file, a loop of symbolic links as a mesh, and a gmsh header declaring
+    9e11 nodes (meshio would allocate them) are refused with one line each, no traceback."""
+    utf16 = tmp_path / "utf16.yaml"
+    utf16.write_bytes(BASE.read_text().encode("utf-16"))
+    (tmp_path / "loop_a").symlink_to(tmp_path / "loop_b")
+    (tmp_path / "loop_b").symlink_to(tmp_path / "loop_a")
+    huge = tmp_path / "huge.msh"
+    huge.write_text("$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n900000000000\n1 0 0 0\n")
+    mesh_case = BASE.read_text().replace(
+        "    shape: {type: disc, radius: 1.0e-3}\n", "    mesh: {file: MESH}\n"
+    )
+    cases = {
+        utf16: "is not UTF-8 text",
+        tmp_path / "looped.yaml": "cannot be resolved",
+        tmp_path / "huge.yaml": "900,000,000,000 nodes declared",
+    }
+    (tmp_path / "looped.yaml").write_text(mesh_case.replace("MESH", "loop_a"))
+    (tmp_path / "huge.yaml").write_text(mesh_case.replace("MESH", "huge.msh"))
+    for path, message in cases.items():
+        assert main(["check", str(path)]) == 2
+        error = capsys.readouterr().err
+        assert message in error and error.count("\n") == 1 and "Traceback" not in error, error

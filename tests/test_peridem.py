@@ -294,6 +294,12 @@ def broken_deck(tmp_path: Path, name: str, edit) -> Path:
         (lambda t: t + "Restart:\n  File: a.vtu\n  Step: 10\n", "restart file"),
         (lambda t: t + "Restart:\n  File: a.vtu\n", "Restart: give File"),
         (lambda t: t.replace("Particle_List: [1]", "Particle_List: [7]"), "IC.Constant_Velocity"),
+        (
+            # one problem, told as it is: not wrapped as 'an unexpected kind', and without the
+            # particles the broken zone would have had reported missing as well
+            lambda t: t.replace("mesh_cir_1_0.msh", "input_0.yaml"),
+            "1 problem(s) in the PeriDEM deck:\n  - Mesh.Zone_1.File: cannot read mesh file",
+        ),
         (lambda t: t.replace("Particle_List: [0]", "Particle_List: [5]"), "0 .. 1"),
         (lambda t: t.replace("  Zone_12:\n", "  Zone_21:\n"), "Contact.Zone_12: missing"),
         (lambda t: t.replace("- Theta", "- Thetta"), "unknown tags ['Thetta']"),

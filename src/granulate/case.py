@@ -44,6 +44,7 @@ from granulate.contact import Contact
 from granulate.errors import InputError
 from granulate.input_errors import NOT_BOOL, describe
 from granulate.materials import Material
+from granulate.meshes import existing_file
 from granulate.simulation import FIELDS, Body, Simulation
 from granulate.yaml_input import load_yaml
 
@@ -779,16 +780,28 @@ class CaseContext:
     folder: Path
     _shapes: dict[str, shapes.Shape] = field(default_factory=dict)
     _grains: dict[str, packing.Grain] = field(default_factory=dict)
+    _resolving: list[str] = field(default_factory=list)  # named shapes being made
 
     def path(self, name: str) -> Path:
-        return (self.folder / name).resolve()
+        """A file the case names, relative to the case file's folder."""
+        try:
+            return (self.folder / name).resolve()
+        except (RuntimeError, OSError) as error:  # a loop of symbolic links, a bad name
+            raise InputError(f"the file {name!r} cannot be resolved: {error}") from None
 
     def shape(self, ref: ShapeRef) -> shapes.Shape:  # type: ignore[valid-type]
         if isinstance(ref, str):
             if ref not in self.spec.shapes:
                 raise InputError(f"unknown shape {ref!r}{_closest(ref, self.spec.shapes)}")
+            if ref in self._resolving:  # a named shape made of itself, through others or not
+                cycle = " -> ".join([*self._resolving[self._resolving.index(ref) :], ref])
+                raise InputError(f"shapes refer to each other in a cycle: {cycle}")
             if ref not in self._shapes:
-                self._shapes[ref] = self.spec.shapes[ref].make(self)  # type: ignore[union-attr]
+                self._resolving.append(ref)
+                try:
+                    self._shapes[ref] = self.spec.shapes[ref].make(self)  # type: ignore[union-attr]
+                finally:
+                    self._resolving.pop()
             return self._shapes[ref]
         return ref.make(self)  # type: ignore[union-attr]
 
@@ -879,17 +892,20 @@ class Case:
         named: dict[str, Body] = {}
         for k, b in enumerate(spec.bodies):
             shape = case.shape(b.shape)
-            body = sim.add_body(
-                shape,
-                case.material(b.material),
-                b.mesh_size,
-                discretization=b.discretization,
-                jitter=b.jitter,
-                seed=b.seed,
-                velocity=b.velocity,
-                angular_velocity=b.angular_velocity,
-                name=b.name or f"body{k}",
-            )
+            try:
+                body = sim.add_body(
+                    shape,
+                    case.material(b.material),
+                    b.mesh_size,
+                    discretization=b.discretization,
+                    jitter=b.jitter,
+                    seed=b.seed,
+                    velocity=b.velocity,
+                    angular_velocity=b.angular_velocity,
+                    name=b.name or f"body{k}",
+                )
+            except InputError as error:
+                raise InputError(f"bodies[{k}] ({b.name or f'body{k}'}): {error}") from None
             named[body.name] = body
         for p in spec.particles:
             g = case.grain(p.grain)
@@ -1142,13 +1158,15 @@ def load_case(path: str | Path, *, peridem_compat: bool = False) -> Case:
     """Read and validate a YAML case file (InputError with every problem found). A PeriDEM
     input deck is recognised and translated (granulate.peridem); ``peridem_compat`` selects
     PeriDEM's formulas where granulate has them. It is refused for a native case."""
-    source = Path(path)
-    if not source.is_file():
-        raise InputError(f"case file {source} does not exist")
+    source = existing_file(path, "case file")
     try:
         text = source.read_text()
-    except (OSError, UnicodeDecodeError) as error:
-        raise InputError(f"cannot read case file {source}: {error}") from None
+    except UnicodeDecodeError:
+        raise InputError(
+            f"case file {source} is not UTF-8 text (a binary file, or UTF-16? save it as UTF-8)"
+        ) from None
+    except OSError as error:
+        raise InputError(f"cannot read case file {source}: {error.strerror or error}") from None
     data = load_yaml(text, source)
     from granulate import peridem
 

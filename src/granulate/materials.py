@@ -18,6 +18,7 @@ from granulate.input_errors import NOT_BOOL, api_error
 
 ForceModelName = Literal["lps", "pmb"]
 _Number = Annotated[float | None, NOT_BOOL]  # a number or None, never a yes/no
+MOST_MODULUS = 1e14  # Pa: 200 times diamond's bulk modulus
 InfluenceName = Literal["constant", "linear", "gaussian", "inverse"]
 
 
@@ -90,7 +91,13 @@ class Material(BaseModel, metaclass=_CalledFromPython):
             raise ValueError(
                 "give horizon (absolute) or horizon_factor (times mesh size), not both"
             )
-        self.elastic_moduli()  # raises for E outside what K or G allow (nu outside (-1, 0.5))
+        moduli = self.elastic_moduli()  # raises for E outside what K or G allow
+        if not max(moduli) <= MOST_MODULUS:
+            raise ValueError(
+                f"the elastic constants give moduli (K, G) = ({moduli[0]:.3g}, {moduli[1]:.3g}) "
+                f"Pa, beyond any solid (diamond: K about 4.4e11 Pa; at most {MOST_MODULUS:.0e}); "
+                "give them in Pa"
+            )
         return self
 
     def elastic_moduli(self) -> tuple[float, float]:

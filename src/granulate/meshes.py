@@ -20,6 +20,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from granulate import resources
 from granulate.errors import InputError
 from granulate.io.table import read_table
 from granulate.shapes import Shape, _points
@@ -43,13 +44,48 @@ class NodalMesh:
     source: str = field(default="")
 
 
+def existing_file(path: str | Path, what: str) -> Path:
+    """`path` when it is a readable file; else InputError saying what it is instead (missing,
+    a folder, a symlink that leads nowhere or in a loop)."""
+    file = Path(path)
+    try:
+        if file.is_file():
+            return file
+        if file.is_dir():
+            raise InputError(f"{what} {file} is a folder, not a file")
+        if file.is_symlink():
+            raise InputError(f"{what} {file} is a symbolic link that leads nowhere (or in a loop)")
+    except OSError as error:  # a loop of links, a name too long
+        raise InputError(f"{what} {file} cannot be opened: {error.strerror or error}") from None
+    raise InputError(f"{what} {file} does not exist")
+
+
+def _require_declared_nodes(file: Path) -> None:
+    """InputError before reading a gmsh file whose header declares more nodes than memory can
+    hold (meshio would allocate them)."""
+    if file.suffix.lower() != ".msh":
+        return
+    with file.open("rb") as handle:
+        head = handle.read(1 << 20).split(b"\n")
+    for k, line in enumerate(head[:-1]):
+        if line.strip() == b"$Nodes" and k + 1 < len(head):
+            fields = head[k + 1].split()
+            try:  # v2: the count; v4: blocks, count, min tag, max tag
+                declared = int(fields[1] if len(fields) == 4 else fields[0])
+            except (ValueError, IndexError):
+                return  # meshio reports the malformed header
+            resources.require_memory(
+                64.0 * declared, f"mesh file {file} ({declared:,} nodes declared)", "check the file"
+            )
+            return
+
+
 def read_file(path: str | Path):  # -> meshio.Mesh
     """meshio.read with one clear InputError for a missing, unreadable or malformed file."""
     import meshio
 
-    file = Path(path)
-    if not file.is_file():
-        raise InputError(f"mesh file {file} does not exist")
+    file = existing_file(path, "mesh file")
+    _require_declared_nodes(file)
     try:
         # meshio reports some failures by printing and calling sys.exit: keep both quiet.
         with (

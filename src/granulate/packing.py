@@ -221,9 +221,16 @@ class Grain:
                 self._cache["reference"] = self.shape
             else:
                 assert self.mesh_size is not None
-                self._cache["reference"] = ReferenceShape.from_shape(
-                    self.shape, self.mesh_size, discretization=self.discretization, centered=True
-                )
+                try:
+                    self._cache["reference"] = ReferenceShape.from_shape(
+                        self.shape,
+                        self.mesh_size,
+                        discretization=self.discretization,
+                        centered=True,
+                    )
+                except InputError as error:
+                    label = f"grain {self.name!r}" if self.name else f"a {_label(self.shape)} grain"
+                    raise InputError(f"{label}: {error}") from None
         return self._cache["reference"]
 
     @property

@@ -332,6 +332,8 @@ def translate(path: str | Path, *, compat: bool = False, output: Path | None = N
     relative to (default: the deck's folder)."""
     try:
         return _translate(Path(path), compat, output)
+    except InputError:
+        raise  # already says what is wrong (InputError is a ValueError too)
     except (AttributeError, TypeError, ValueError, KeyError, IndexError) as error:
         # A value of a kind no check above expected (a list where a block belongs, ...).
         raise InputError(
@@ -660,6 +662,9 @@ def _translate(path: Path, compat: bool, output: Path | None) -> Translation:
             }
             particles.append(entry)
             zone_of.append(z)
+    # A zone whose mesh failed has no particles, so later particle ids do not resolve: those
+    # are consequences of the reported problem, not problems of their own.
+    numbered = all(f"zone_{z}" in grains or z in deck_bodies for z in zones)
     if rows is not None:
         unknown = sorted({int(v) + 1 for v in rows[:, 0]} - set(placed_zones))
         if unknown:
@@ -823,10 +828,11 @@ def _translate(path: Path, compat: bool, output: Path | None) -> Translation:
         ids = info.get("Particle_List")
         if ids is not None:
             if not isinstance(ids, list) or any(f"p{i}" not in named for i in ids):
-                problems.add(
-                    f"{where}.Particle_List: {ids!r} names particles that do not exist (ids are "
-                    f"0-based, 0 .. {len(zone_of) - 1})"
-                )
+                if numbered or not isinstance(ids, list):
+                    problems.add(
+                        f"{where}.Particle_List: {ids!r} names particles that do not exist (ids "
+                        f"are 0-based, 0 .. {len(zone_of) - 1})"
+                    )
                 return None
             out["body"] = [f"p{i}" for i in ids]
         excluded = info.get("Particle_Exclude_List")
@@ -972,7 +978,8 @@ def _translate(path: Path, compat: bool, output: Path | None) -> Translation:
             target = next((p for p in particles if p["name"] == f"p{i}"), None)
             body = next((b for b in deck_bodies.values() if b["name"] == f"p{i}"), None)
             if target is None and body is None:
-                problems.add(f"IC.Constant_Velocity.Particle_List: no particle {i}")
+                if numbered:
+                    problems.add(f"IC.Constant_Velocity.Particle_List: no particle {i}")
             else:
                 (target or body)["velocity"] = v[:dimension]  # type: ignore[index]
 

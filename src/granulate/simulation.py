@@ -748,9 +748,33 @@ class Simulation:
             raise InputError(f"a wall named {label!r} exists already; give each wall its own name")
         if not label.replace("_", "").isalnum():
             raise InputError(f"wall name {label!r} must be letters, digits and underscores")
+        self._check_wall_vectors(wall, label)
         wall.core(label)  # checks the description now rather than at the first run
         self._walls.append((label, wall))
         return label
+
+    #: The vectors of wall surfaces and motions (points, normals, corners, centres, axes).
+    WALL_VECTORS = ("point", "normal", "lower", "upper", "center", "axis", "direction")
+
+    def _check_wall_vectors(self, wall: Wall, label: str) -> None:
+        """InputError for a vector of a wall with the wrong number of components: 3 in 3D (two
+        were read with z = 0), 2 or 3 with z = 0 in 2D (an axis may be z itself)."""
+        parts = [*wall.surfaces, *([wall.motion] if wall.motion is not None else [])]
+        for part in parts:
+            for name in self.WALL_VECTORS:
+                value = getattr(part, name, None)
+                if value is None or callable(value):
+                    continue
+                try:
+                    array = np.asarray(value, dtype=float).reshape(-1)
+                except (TypeError, ValueError):
+                    continue  # not numbers: the wall's own checks name it
+                where = f"wall {label!r}: {type(part).__name__} {name} {array.tolist()}"
+                if self.dimension == 3 and len(array) != 3:
+                    raise InputError(f"{where} needs 3 components in a 3D simulation")
+                z_axis = name == "axis" and len(array) == 3 and not np.any(array[:2])
+                if self.dimension == 2 and len(array) == 3 and array[2] != 0 and not z_axis:
+                    raise InputError(f"{where} has a z component in a 2D simulation")
 
     def wall_reactions(self) -> dict[str, NDArray[np.float64]]:
         """Per wall: (fx, fy, fz, tx, ty, tz), the force and torque the particles exert on it
