@@ -163,6 +163,17 @@ NB_MODULE(_core, m) {
     omp_set_num_threads(n);
   });
   m.def("get_max_threads", [] { return omp_get_max_threads(); });
+  m.def("build_info", [] {
+    nb::dict d;
+    d["build_type"] = GRANULATE_BUILD_TYPE;
+    d["compiler"] = GRANULATE_COMPILER;
+    d["cpu_tuning"] = GRANULATE_CPU_TUNING;
+    d["openmp"] = _OPENMP;  // the specification date the compiler implements (yyyymm)
+    d["warnings_as_errors"] = static_cast<bool>(GRANULATE_WARNINGS_AS_ERRORS);
+    d["precision"] = sizeof(real) == 8 ? "double" : "single";
+    d["index_bits"] = 8 * static_cast<int>(sizeof(index_t));
+    return d;
+  });
 
   nb::enum_<PlaneMode>(m, "PlaneMode")
       .value("strain", PlaneMode::strain)

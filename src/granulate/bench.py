@@ -23,8 +23,8 @@ evaluated in the same passes as node pairs, so their time is part of contact_for
 ``walls`` is null) and memory (the core's bytes per bond and per node, against the budget of 16
 bytes per bond plus 300 per node).
 
-The case files live in ``benchmarks/cases`` of the source tree (found from the working
-directory, the package's checkout, or GRANULATE_BENCH_CASES).
+The case files are installed with the package (granulate/bench_cases; GRANULATE_BENCH_CASES
+points elsewhere), so ``granulate bench`` runs from any folder.
 """
 
 from __future__ import annotations
@@ -49,18 +49,16 @@ BOND_BUDGET, NODE_BUDGET = 16, 300
 
 
 def cases_folder() -> Path:
-    candidates = [
-        os.environ.get("GRANULATE_BENCH_CASES"),
-        Path.cwd() / "benchmarks" / "cases",
-        Path(__file__).resolve().parents[2] / "benchmarks" / "cases",
-    ]
-    for candidate in candidates:
-        if candidate and (Path(candidate) / "compression_502.yaml").is_file():
-            return Path(candidate)
-    raise InputError(
-        "benchmark case files not found; run granulate bench from the source tree (it reads "
-        "benchmarks/cases) or set GRANULATE_BENCH_CASES"
-    )
+    """The benchmark case files: GRANULATE_BENCH_CASES if set, else the ones shipped in the
+    package (granulate/bench_cases)."""
+    chosen = os.environ.get("GRANULATE_BENCH_CASES")
+    folder = Path(chosen) if chosen else Path(__file__).with_name("bench_cases")
+    if not (folder / "compression_502.yaml").is_file():
+        raise InputError(
+            f"benchmark case files not found in {folder} (compression_502.yaml); unset "
+            "GRANULATE_BENCH_CASES to use the ones installed with granulate"
+        )
+    return folder
 
 
 def _timed(sim, steps: int, case: str, threads: int, extra: dict | None = None) -> dict:

@@ -112,7 +112,7 @@ class RegularPolygonSpec(Spec):
     type: Literal["regular_polygon"]
     center: Annotated[list[Finite], Field(min_length=2, max_length=2, description="[m]")] = [0, 0]
     radius: Positive = Field(description="circumradius [m]")
-    sides: Annotated[int, Field(ge=3), NOT_BOOL]
+    sides: Annotated[int, Field(ge=3), NOT_BOOL] = Field(description="[-]")
     angle: Finite = Field(0.0, description="of the first vertex from x [rad]")
 
     def make(self, case: CaseContext) -> shapes.Shape:
@@ -126,7 +126,7 @@ class StarSpec(Spec):
     center: Annotated[list[Finite], Field(min_length=2, max_length=2, description="[m]")] = [0, 0]
     outer_radius: Positive = Field(description="tips [m]")
     inner_radius: Positive = Field(description="notches [m]")
-    points: Annotated[int, Field(ge=3), NOT_BOOL] = 5
+    points: Annotated[int, Field(ge=3), NOT_BOOL] = Field(5, description="[-]")
     angle: Finite = Field(0.0, description="[rad]")
 
     def make(self, case: CaseContext) -> shapes.Shape:
@@ -189,7 +189,7 @@ class EllipsoidSpec(Spec):
             list[Finite], Field(min_length=3, max_length=3, description="rotation vector [rad]")
         ]
         | None
-    ) = None
+    ) = Field(None, description="rotation vector [rad]")
 
     def make(self, case: CaseContext) -> shapes.Shape:
         return shapes.Ellipsoid(tuple(self.center), tuple(self.semi_axes), self.rotation)  # type: ignore[arg-type]
@@ -204,7 +204,9 @@ class CylinderSpec(Spec):
     ] = [0, 0, 0]
     radius: Positive = Field(description="[m]")
     length: Positive = Field(description="[m]")
-    axis: Annotated[list[Finite], Field(min_length=3, max_length=3)] = [0, 0, 1]
+    axis: Annotated[list[Finite], Field(min_length=3, max_length=3)] = Field(
+        [0, 0, 1], description="direction [-]"
+    )
 
     def make(self, case: CaseContext) -> shapes.Shape:
         return shapes.Cylinder(tuple(self.center), self.radius, self.length, tuple(self.axis))  # type: ignore[arg-type]
@@ -266,7 +268,7 @@ ShapeRef = ShapeSpec | str
 # ------------------------------------------------------------------------ time functions
 class ConstantSpec(Spec):
     type: Literal["constant"]
-    value: Finite = 1.0
+    value: Finite = Field(1.0, description="[the loading's unit: m, m/s, rad, or a factor]")
 
 
 class LinearSpec(Spec):
@@ -277,18 +279,18 @@ class LinearSpec(Spec):
 class QuadraticSpec(Spec):
     type: Literal["quadratic"]
     a: Finite = Field(description="f = a t + b t^2")
-    b: Finite
+    b: Finite = Field(description="[the loading's unit / s^2]")
 
 
 class SineSpec(Spec):
     type: Literal["sine"]
-    amplitude: Finite
+    amplitude: Finite = Field(description="[the loading's unit]")
     frequency: Positive = Field(description="[Hz]")
 
 
 class SmoothRampSpec(Spec):
     type: Literal["smooth_ramp"]
-    target: Finite
+    target: Finite = Field(description="[the loading's unit]")
     duration: Positive = Field(description="[s]")
 
 
@@ -333,16 +335,16 @@ class NormalSizeSpec(Spec):
     distribution: Literal["normal"]
     mean: Positive = Field(description="[m]")
     std: NonNegative = Field(description="[m]")
-    low: Positive | None = None
-    high: Positive | None = None
+    low: Positive | None = Field(None, description="[m]")
+    high: Positive | None = Field(None, description="[m]")
 
 
 class LogNormalSizeSpec(Spec):
     distribution: Literal["lognormal"]
     median: Positive = Field(description="[m]")
     sigma: NonNegative = Field(description="of ln r")
-    low: Positive | None = None
-    high: Positive | None = None
+    low: Positive | None = Field(None, description="[m]")
+    high: Positive | None = Field(None, description="[m]")
 
 
 class SieveSizeSpec(Spec):
@@ -404,8 +406,8 @@ class BodySpec(Spec):
     material: str
     mesh_size: Positive = Field(description="[m]")
     discretization: Literal["lattice", "conforming", "grid"] = "lattice"
-    jitter: Annotated[float, Field(ge=0, lt=0.5), NOT_BOOL] = 0.0
-    seed: Annotated[int, Field(ge=0), NOT_BOOL] = 0
+    jitter: Annotated[float, Field(ge=0, lt=0.5), NOT_BOOL] = Field(0.0, description="[mesh sizes]")
+    seed: Annotated[int, Field(ge=0), NOT_BOOL] = Field(0, description="random seed of the jitter")
     velocity: list[Finite] | None = Field(None, description="[m/s]")
     angular_velocity: Finite | list[Finite] | None = Field(None, description="[rad/s]")
 
@@ -419,7 +421,7 @@ class ParticleSpec(Spec):
     rotation: Finite | list[Finite] | None = Field(
         None, description="angle or rotation vector [rad]"
     )
-    scale: Positive | None = None
+    scale: Positive | None = Field(None, description="[-] times the grain's reference size")
     radius: Positive | None = Field(None, description="bounding radius [m] (instead of scale)")
     velocity: list[Finite] | None = Field(None, description="[m/s]")
     angular_velocity: Finite | list[Finite] | None = Field(None, description="[rad/s]")
@@ -430,12 +432,14 @@ class PackingSpec(Spec):
 
     container: ShapeRef
     grains: Annotated[list[str], Field(min_length=1)]
-    count: Annotated[int, Field(gt=0), NOT_BOOL]
+    count: Annotated[int, Field(gt=0), NOT_BOOL] = Field(description="[particles]")
     by: Literal["number", "volume"] = "number"
     method: Literal["random", "lattice"] = "random"
     gap: NonNegative = Field(0.0, description="[m]")
-    seed: Annotated[int, Field(ge=0), NOT_BOOL] = 0
-    attempts: Annotated[int, Field(gt=0), NOT_BOOL] = 2000
+    seed: Annotated[int, Field(ge=0), NOT_BOOL] = Field(0, description="random seed")
+    attempts: Annotated[int, Field(gt=0), NOT_BOOL] = Field(
+        2000, description="placement attempts per particle"
+    )
     velocity: list[Finite] | None = Field(None, description="[m/s]")
 
 
@@ -444,13 +448,15 @@ class PlacementSpec(Spec):
 
     file: str = Field(description="path, relative to the case file")
     zones: dict[int, str] = Field(description="zone id -> grain name")
-    seed: Annotated[int, Field(ge=0), NOT_BOOL] = 0
+    seed: Annotated[int, Field(ge=0), NOT_BOOL] = Field(
+        0, description="random seed of the orientations"
+    )
     velocity: list[Finite] | None = Field(None, description="[m/s]")
 
 
 class PrecrackSpec(Spec):
     point: list[Finite] = Field(description="[m]")
-    normal: list[Finite]
+    normal: list[Finite] = Field(description="[-]")
     region: ShapeRef | None = None
 
 
@@ -458,14 +464,16 @@ class PrecrackSpec(Spec):
 class ContactSpec(Spec):
     """Contact parameters (see granulate.Contact)."""
 
-    restitution: Annotated[float, Field(gt=0, le=1), NOT_BOOL] = 1.0
-    friction: NonNegative = 0.0
+    restitution: Annotated[float, Field(gt=0, le=1), NOT_BOOL] = Field(
+        1.0, description="e [-] of a head-on collision"
+    )
+    friction: NonNegative = Field(0.0, description="Coulomb mu [-]")
     contact_radius_factor: Positive = Field(
         0.95, description="each node's contact radius is factor x h / 2 of its particle"
     )
     contact_radius: Positive | None = Field(None, description="absolute Rc [m]")
     normal_stiffness: Positive | None = Field(None, description="absolute kn")
-    stiffness_factor: Positive = 1.0
+    stiffness_factor: Positive = Field(1.0, description="times the default kn [-]")
     tangential_stiffness_ratio: Annotated[float, Field(gt=0, le=1), NOT_BOOL] = Field(
         2.0 / 7.0, description="kt / kn of the friction spring"
     )
@@ -529,7 +537,7 @@ class MeshSurfaceSpec(Spec):
     type: Literal["triangle_mesh"]
     file: str = Field(description="STL/OBJ/PLY, relative to the case file")
     inside: bool = True
-    scale: Positive = 1.0
+    scale: Positive = Field(1.0, description="[-]")
 
 
 class ShapeSurfaceSpec(Spec):
@@ -550,7 +558,7 @@ SurfaceSpecs = Annotated[
 
 class TranslationSpec(Spec):
     type: Literal["translation"]
-    direction: list[Finite]
+    direction: list[Finite] = Field(description="[-]")
     function: FunctionSpec = Field(description="distance [m] along direction")
 
 
@@ -558,14 +566,14 @@ class RotationSpec(Spec):
     type: Literal["rotation"]
     angle: FunctionSpec = Field(description="[rad]")
     center: list[Finite] = Field([0, 0, 0], description="[m]")
-    axis: list[Finite] = [0, 0, 1]
+    axis: list[Finite] = Field([0, 0, 1], description="[-]")
 
 
 class SteadyRotationSpec(Spec):
     type: Literal["steady_rotation"]
     angular_velocity: Finite = Field(description="[rad/s]")
     center: list[Finite] = Field([0, 0, 0], description="[m]")
-    axis: list[Finite] = [0, 0, 1]
+    axis: list[Finite] = Field([0, 0, 1], description="[-]")
 
 
 MotionSpec = Annotated[
@@ -591,7 +599,7 @@ class SelectSpec(Spec):
     region: ShapeRef | None = None
     body: str | list[str] | None = Field(None, description="a body name, or a list (any of them)")
     exclude: list[str] = Field([], description="bodies whose nodes are left out")
-    ids: list[Annotated[int, Field(ge=0), NOT_BOOL]] | None = None
+    ids: list[Annotated[int, Field(ge=0), NOT_BOOL]] | None = Field(None, description="node ids")
 
 
 class FixSpec(Spec):
@@ -603,7 +611,7 @@ class FixSpec(Spec):
 class DisplacementSpec(Spec):
     type: Literal["displacement"]
     nodes: SelectSpec
-    direction: list[Finite]
+    direction: list[Finite] = Field(description="[-], times the function's value [m]")
     function: FunctionSpec = Field(description="displacement [m] along direction")
     components: str | None = None
 
@@ -621,7 +629,7 @@ class RotationLoadSpec(Spec):
     nodes: SelectSpec
     center: list[Finite] = Field(description="[m]")
     angle: FunctionSpec = Field(description="[rad]")
-    axis: list[Finite] = [0, 0, 1]
+    axis: list[Finite] = Field([0, 0, 1], description="[-]")
 
 
 class ForceDensitySpec(Spec):
@@ -642,9 +650,11 @@ class TimeSpec(Spec):
     """Time stepping: dt (default: dt_safety x the stable estimate) and the run length."""
 
     dt: Positive | None = Field(None, description="[s]")
-    dt_safety: Annotated[float, Field(gt=0, le=1), NOT_BOOL] = 0.8
+    dt_safety: Annotated[float, Field(gt=0, le=1), NOT_BOOL] = Field(
+        0.8, description="dt / stable estimate [-]"
+    )
     end: Positive | None = Field(None, description="simulated time to reach [s]")
-    steps: Annotated[int, Field(gt=0), NOT_BOOL] | None = None
+    steps: Annotated[int, Field(gt=0), NOT_BOOL] | None = Field(None, description="[steps]")
 
     @model_validator(mode="after")
     def _length(self) -> TimeSpec:
@@ -677,8 +687,8 @@ class RestartSpec(Spec):
 
 
 class CheckpointSpec(Spec):
-    every_steps: Annotated[int, Field(gt=0), NOT_BOOL] | None = None
-    every_minutes: Positive | None = None
+    every_steps: Annotated[int, Field(gt=0), NOT_BOOL] | None = Field(None, description="[steps]")
+    every_minutes: Positive | None = Field(None, description="[minutes of wall time]")
 
 
 class KineticEnergyStopSpec(Spec):
@@ -694,7 +704,7 @@ class WallDisplacementStopSpec(Spec):
 class StopSpec(Spec):
     """Criteria that end the run early (checked every check_every steps)."""
 
-    kinetic_energy_below: KineticEnergyStopSpec | None = None
+    kinetic_energy_below: KineticEnergyStopSpec | None = Field(None, description="[J; J/m in 2D]")
     wall_displacement: WallDisplacementStopSpec | None = None
     particles_broken: Annotated[int, Field(gt=0), NOT_BOOL] | None = Field(
         None, description="particles with every bond broken"
@@ -703,7 +713,7 @@ class StopSpec(Spec):
     node_distance: Positive | None = Field(
         None, description="a node farther than this from the origin [m]"
     )
-    check_every: Annotated[int, Field(gt=0), NOT_BOOL] = 100
+    check_every: Annotated[int, Field(gt=0), NOT_BOOL] = Field(100, description="[steps]")
 
 
 class CaseSpec(Spec):

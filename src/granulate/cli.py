@@ -43,7 +43,13 @@ def _show_warning(message, category, filename, lineno, file=None, line=None) -> 
 
 def _info() -> int:
     print(f"granulate {__version__}")
-    print(f"core: {Path(_core.__file__).name} (C++20, OpenMP)")
+    build = _core.build_info()
+    print(
+        f"core: {Path(_core.__file__).name} (C++20; {build['compiler']}, {build['build_type']}, "
+        f"{build['cpu_tuning']}; OpenMP {build['openmp']}; {build['precision']} precision, "
+        f"{build['index_bits']}-bit indices; warnings as errors: "
+        f"{'yes' if build['warnings_as_errors'] else 'no'})"
+    )
     policy = (
         "adaptive: runs use fewer when that is faster, as on a busy machine"
         if threads.is_adaptive()
@@ -244,7 +250,7 @@ def _main(argv: list[str] | None) -> int:
     )
     run.add_argument("--peridem-compat", action="store_true", help=compat_help)
     run.add_argument("args", nargs="*", help="arguments passed to a script (after --)")
-    bench = commands.add_parser("bench", help="run the benchmark cases (benchmarks/cases)")
+    bench = commands.add_parser("bench", help="run the benchmark cases (shipped with granulate)")
     bench.add_argument("--quick", action="store_true", help="small sizes, a smoke check")
     bench.add_argument("--case", action="append", help="a case (repeatable; default: all)")
     bench.add_argument("--json", action="store_true", help="one JSON object per case")

@@ -60,18 +60,24 @@ class Material(BaseModel, metaclass=_CalledFromPython):
             if value is not None and (name is None or value != defaults[name].default):
                 yield name, value
 
-    density: Annotated[float, NOT_BOOL] = Field(gt=0, allow_inf_nan=False)
-    bulk_modulus: _Number = Field(default=None, gt=0, allow_inf_nan=False)
-    shear_modulus: _Number = Field(default=None, gt=0, allow_inf_nan=False)
-    youngs_modulus: _Number = Field(default=None, gt=0, allow_inf_nan=False)
-    poisson_ratio: _Number = Field(default=None, gt=-1, lt=0.5, allow_inf_nan=False)
-    fracture_energy: _Number = Field(default=None, gt=0, allow_inf_nan=False)
-    horizon: _Number = Field(default=None, gt=0, allow_inf_nan=False)
-    horizon_factor: _Number = Field(default=None, ge=1, allow_inf_nan=False)
-    model: ForceModelName = "lps"
-    influence: InfluenceName = "linear"
-    fracture: bool = True
-    break_in_compression: bool = False
+    density: Annotated[float, NOT_BOOL] = Field(gt=0, allow_inf_nan=False, description="[kg/m^3]")
+    bulk_modulus: _Number = Field(default=None, gt=0, allow_inf_nan=False, description="K [Pa]")
+    shear_modulus: _Number = Field(default=None, gt=0, allow_inf_nan=False, description="G [Pa]")
+    youngs_modulus: _Number = Field(default=None, gt=0, allow_inf_nan=False, description="E [Pa]")
+    poisson_ratio: _Number = Field(
+        default=None, gt=-1, lt=0.5, allow_inf_nan=False, description="nu [-]"
+    )
+    fracture_energy: _Number = Field(
+        default=None, gt=0, allow_inf_nan=False, description="Gc [J/m^2]"
+    )
+    horizon: _Number = Field(default=None, gt=0, allow_inf_nan=False, description="delta [m]")
+    horizon_factor: _Number = Field(
+        default=None, ge=1, allow_inf_nan=False, description="delta / mesh size [-] (default 3)"
+    )
+    model: ForceModelName = Field("lps", description="lps (state-based) or pmb (bond-based)")
+    influence: InfluenceName = Field("linear", description="J(r / delta)")
+    fracture: bool = Field(True, description="false: bonds never break")
+    break_in_compression: bool = Field(False, description="bonds also break below -s0")
 
     @model_validator(mode="after")
     def _check(self) -> Material:
