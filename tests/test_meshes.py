@@ -12,7 +12,9 @@ import pytest
 import granulate as gr
 
 # Copies of a PeriDEM deck's files (made by PeriDEM's set-up scripts), kept with the benchmarks.
-DECK = Path(__file__).resolve().parents[1] / "src" / "granulate" / "bench_cases" / "compression_small"
+DECK = (
+    Path(__file__).resolve().parents[1] / "src" / "granulate" / "bench_cases" / "compression_small"
+)
 
 
 def structured(dimension: int, kind: str, n: int = 4, size: float = 2e-3) -> meshio.Mesh:

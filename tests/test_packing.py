@@ -12,7 +12,9 @@ import granulate as gr
 
 ROCK = gr.Material(density=2600, bulk_modulus=2.16e7, shear_modulus=1.296e7, fracture_energy=50)
 # Copies of a PeriDEM deck's files (made by PeriDEM's set-up scripts), kept with the benchmarks.
-DECK = Path(__file__).resolve().parents[1] / "src" / "granulate" / "bench_cases" / "compression_small"
+DECK = (
+    Path(__file__).resolve().parents[1] / "src" / "granulate" / "bench_cases" / "compression_small"
+)
 
 
 def grain(shape: gr.Shape, sizes: gr.SizeDistribution, fraction: float = 1.0) -> gr.Grain:

@@ -146,3 +146,30 @@ def test_folders_that_cannot_hold_a_run_are_refused_by_check_and_run(
     assert main(["run", str(case), "--quiet"]) == 2
     errors = capsys.readouterr().err
     assert errors.count(f"output directory {target}") == 2 and "Traceback" not in errors
+
+
+@pytest.mark.parametrize(
+    ("directory", "message"),
+    [
+        ("nul\0name", "holds a NUL character"),
+        ("x" * 300, "longer than 255 bytes"),
+        ("/dev/null/out", "is under the file /dev/null"),
+        ("/proc/granulate_out", "cannot be made"),
+    ],
+)
+def test_output_paths_the_system_rejects_are_input_errors(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, directory: str, message: str
+) -> None:
+    """They gave ValueError, OSError or NotADirectoryError tracebacks."""
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(gr.InputError, match=message):
+        plate(Path(directory)).run(5)
+
+
+def test_an_output_interval_that_would_fill_the_disk_is_refused(tmp_path: Path) -> None:
+    """Frames every 10 steps of a 10^12-step run (about 5 PB): refused before anything is
+    written, with the size and the free space."""
+    sim = plate(tmp_path / "run")
+    with pytest.raises(gr.InputError, match="would write 100,000,000,001 frames"):
+        sim.run(10**12)
+    assert not (tmp_path / "run" / "simulation.pvd").exists()

@@ -1072,6 +1072,8 @@ class Simulation:
         out = self._output
         if out is None:
             return self._advance(core, steps, stop, check_every, progress or None, write_final)
+        frames = steps // out.every + 2 if out.frames else steps // out.every + 1
+        out.folder.require_space(frames, self.node_count * (12 + 8 * 3 * len(out.fields)))
         out.folder.start_writing()
         self._status = "running"
         try:

@@ -6,10 +6,12 @@ from __future__ import annotations
 
 import json
 import os
+import shutil
 import socket
 from pathlib import Path
 
 from granulate.errors import InputError
+from granulate.resources import size_text
 
 LOCK = ".granulate.lock"
 #: What a run writes (replaced together with --overwrite).
@@ -24,8 +26,21 @@ def _holds_run(path: Path) -> bool:
     )
 
 
+#: The longest name of one folder or file most file systems take.
+LONGEST_NAME = 255
+
+
 def check_writable(path: Path) -> None:
     """InputError if `path` cannot become a directory this process writes into."""
+    text = str(path)
+    if "\0" in text:
+        raise InputError(f"output directory {text!r} holds a NUL character; choose another name")
+    long = [part for part in path.parts if len(part.encode()) > LONGEST_NAME]
+    if long:
+        raise InputError(
+            f"output directory {path}: the name {long[0][:40]}... is longer than "
+            f"{LONGEST_NAME} bytes; choose a shorter one"
+        )
     for parent in [path, *path.parents]:
         if parent.exists():
             if not parent.is_dir():
@@ -37,6 +52,13 @@ def check_writable(path: Path) -> None:
                     "directory"
                 )
             return
+
+
+def _existing_parent(path: Path) -> Path:
+    for parent in [path, *path.parents]:
+        if parent.exists():
+            return parent
+    return Path.cwd()
 
 
 def _alive(pid: int) -> bool:
@@ -71,11 +93,30 @@ class RunFolder:
         if resume:
             self.clean_temporaries()
 
+    def require_space(self, frames: int, bytes_per_frame: float) -> None:
+        """InputError when `frames` frames of about `bytes_per_frame` would not fit on the
+        disk (an output interval far too small for the run)."""
+        usage = shutil.disk_usage(_existing_parent(self.path))
+        if usage.total == 0:
+            return  # not a disk (/proc, /sys): making the folder will say what is wrong
+        free, needed = usage.free, frames * bytes_per_frame
+        if needed > free:
+            raise InputError(
+                f"the run would write {frames:,} frames, about {size_text(needed)}, to "
+                f"{self.path}, and the disk has {size_text(free)} free; write frames less often "
+                "(output every)"
+            )
+
     def start_writing(self) -> None:
         """Before a run writes: take the lock (InputError if another live process holds it),
         replace the old run if asked (only now, so an input error found earlier leaves it
         intact), and make frames/."""
-        (self.path / "frames").mkdir(parents=True, exist_ok=True)
+        try:
+            (self.path / "frames").mkdir(parents=True, exist_ok=True)
+        except OSError as error:  # a read-only or device tree, a full disk
+            raise InputError(
+                f"output directory {self.path} cannot be made: {error.strerror or error}"
+            ) from None
         self._lock()
         if self._replace:
             self._replace = False
