@@ -1072,7 +1072,9 @@ class Simulation:
         out = self._output
         if out is None:
             return self._advance(core, steps, stop, check_every, progress or None, write_final)
-        frames = steps // out.every + 2 if out.frames else steps // out.every + 1
+        # The frames this run writes: one every `every` steps, the last step's, and step 0's
+        # when none is written yet; each about 8 bytes per component of its fields per node.
+        frames = steps // out.every + (1 if out.frames else 2)
         out.folder.require_space(frames, self.node_count * (12 + 8 * 3 * len(out.fields)))
         out.folder.start_writing()
         self._status = "running"
@@ -1200,10 +1202,10 @@ class Simulation:
         (particles placed from one shape share it) or per body."""
         families: dict[tuple[int, float], float] = {}
         for body in self.bodies:
-            for_body = body.material.resolved_horizon(body.mesh_size) / body.mesh_size
-            self._check_material_for(body, for_body * body.mesh_size)
-            key = (id(body.reference) if body.reference is not None else -1 - body.index, for_body)
-            family = body.node_count * resources.bonds_per_node(self.dimension, for_body)
+            ratio = body.material.resolved_horizon(body.mesh_size) / body.mesh_size
+            self._check_material_for(body, ratio * body.mesh_size)
+            key = (id(body.reference) if body.reference is not None else -1 - body.index, ratio)
+            family = body.node_count * resources.bonds_per_node(self.dimension, ratio)
             families[key] = family
         nodes, bonds = float(self.node_count), float(sum(families.values()))
         resources.require_memory(
