@@ -1072,9 +1072,10 @@ class Simulation:
         out = self._output
         if out is None:
             return self._advance(core, steps, stop, check_every, progress or None, write_final)
-        # The frames this run writes: one every `every` steps, the last step's, and step 0's
-        # when none is written yet; each about 8 bytes per component of its fields per node.
-        frames = steps // out.every + (1 if out.frames else 2)
+        # The frames this run writes: one every `every` steps, the last step's when it falls
+        # between, and step 0's when none is written yet; each about 8 bytes per component of
+        # its fields per node.
+        frames = steps // out.every + (steps % out.every > 0) + (out.frames == 0)
         out.folder.require_space(frames, self.node_count * (12 + 8 * 3 * len(out.fields)))
         out.folder.start_writing()
         self._status = "running"
