@@ -111,17 +111,17 @@ def _check(path: Path, compat: bool = False) -> int:
     memory = model.shared_bond_bytes() + sim.bond_count + BYTES_PER_NODE * sim.node_count
     sim.run(1)  # builds the core and the first forces and contact lists: not timed
     probe = max(1, min(50, steps))
-    most = threads.get_num_threads()
+    most, adaptive = threads.get_num_threads(), threads.is_adaptive()
     # A run picks the fastest thread count on a busy machine (granulate.threads): so does the
-    # estimate, from one probe per count a run would try.
-    counts = threads.candidate_counts(most) if threads.is_adaptive() else [most]
+    # estimate, from one probe at each count a run would try (each at that count only).
+    counts = threads.candidate_counts(most) if adaptive else [most]
     rates = {}
     for count in counts:
-        threads.set_num_threads(count, adaptive=threads.is_adaptive())
+        threads.set_num_threads(count, adaptive=False)
         start = time.perf_counter()
         sim.run(probe)
         rates[count] = probe / max(time.perf_counter() - start, 1e-9)
-    threads.set_num_threads(most, adaptive=threads.is_adaptive())
+    threads.set_num_threads(most, adaptive=adaptive)
     fastest = max(rates, key=lambda count: rates[count])
     rate = rates[fastest]
     print(f"{path}: valid")
