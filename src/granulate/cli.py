@@ -25,15 +25,11 @@ import time
 import warnings
 from pathlib import Path
 
-from granulate import _core, threads
+from granulate import _core, resources, threads
 from granulate._version import __version__
 from granulate.errors import InputError, InstabilityError
 from granulate.io.run_folder import check_writable
 from granulate.progress import ProgressReporter, duration
-
-#: Bytes per node of state and model arrays besides bonds (positions, velocities, forces,
-#: reference positions, volumes, per-node constants, contact lists).
-BYTES_PER_NODE = 300
 
 
 def _show_warning(message, category, filename, lineno, file=None, line=None) -> None:
@@ -108,7 +104,7 @@ def _check(path: Path, compat: bool = False) -> int:
     check_writable(Path(spec.directory) if spec is not None else Path("out") / path.stem)
     steps = case.steps(sim)
     model = sim.model
-    memory = model.shared_bond_bytes() + sim.bond_count + BYTES_PER_NODE * sim.node_count
+    memory = model.shared_bond_bytes() + sim.bond_count + resources.BYTES_PER_NODE * sim.node_count
     sim.run(1)  # builds the core and the first forces and contact lists: not timed
     probe = max(1, min(50, steps))
     most, adaptive = threads.get_num_threads(), threads.is_adaptive()
