@@ -173,3 +173,14 @@ def test_an_output_interval_that_would_fill_the_disk_is_refused(tmp_path: Path) 
     with pytest.raises(gr.InputError, match="would write 100,000,000,001 frames"):
         sim.run(10**12)
     assert not (tmp_path / "run" / "simulation.pvd").exists()
+
+
+def test_checkpoints_every_step_of_a_huge_run_are_refused(tmp_path: Path) -> None:
+    """A checkpoint every step of a 10^12-step run would make the run mostly writing."""
+    sim = plate(tmp_path / "run")
+    sim.checkpoint_every(1)
+    with pytest.raises(gr.InputError, match="checkpoints every 1 steps would write"):
+        sim.run(10**12)
+    sim.checkpoint_every(100)
+    sim.run(200)  # an ordinary interval runs
+    assert (tmp_path / "run" / "checkpoint.npz").exists()

@@ -1051,6 +1051,7 @@ class Simulation:
         """
         core = self._build()
         steps = self._run_steps(core, steps, until, check_every)
+        self._require_checkpoint_budget(steps)
         if progress is True:
             from granulate.progress import ProgressReporter
 
@@ -1334,6 +1335,25 @@ class Simulation:
         self._checkpoint = _Checkpointing(
             Path(path), steps, None if minutes is None else 60.0 * minutes, wallclock.perf_counter()
         )
+
+    #: The most bytes a run's checkpoints may write in all: at 1 GB/s, 20 minutes of writing.
+    MOST_CHECKPOINT_BYTES = 1.2e12
+
+    def _require_checkpoint_budget(self, steps: int) -> None:
+        """InputError when checkpoints every few steps would make the run mostly writing: each
+        holds the state (about 100 bytes per node and a bit per bond) and replaces the last."""
+        plan = self._checkpoint
+        if plan is None or not plan.every_steps:
+            return
+        count = steps // plan.every_steps
+        size = 100.0 * self.node_count + self.bond_count / 8
+        if count * size > self.MOST_CHECKPOINT_BYTES:
+            raise InputError(
+                f"checkpoints every {plan.every_steps} steps would write {count:,} checkpoints of "
+                f"about {resources.size_text(size)} over this run ("
+                f"{resources.size_text(count * size)}); checkpoint less often (every_steps), or "
+                "every few minutes (every_minutes)"
+            )
 
     def _checkpoint_if_due(self) -> None:
         plan = self._checkpoint
