@@ -662,9 +662,10 @@ def lattice(
     counts = np.maximum(1, np.round((upper[:d] - lower[:d]) / mesh_size).astype(np.int64))
     # Centre the lattice in the bounding box so that a box of whole cells is filled exactly.
     origin = 0.5 * (lower[:d] + upper[:d]) - 0.5 * counts * mesh_size
-    _require_nodes(
-        float(np.prod(counts.astype(float))), shape.measure / mesh_size**d, mesh_size, "lattice"
-    )
+    # The nodes are at most the cells (the measure would do better, but a union's costs a
+    # count on a grid).
+    cells = float(np.prod(counts.astype(float)))
+    _require_nodes(cells, cells, mesh_size, "lattice")
     axes = [origin[k] + (np.arange(counts[k]) + 0.5) * mesh_size for k in range(d)]
     grid = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, d)
     points = np.zeros((len(grid), 3))
