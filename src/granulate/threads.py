@@ -135,8 +135,11 @@ class ThreadTuner:
         self._confirm: tuple[int, float] | None = None  # after a switch: the old count, rate
         self._low_windows = 0  # consecutive windows below DROP x usual
         self._run_seconds = 0.0
-        self._next_trial = FIRST_TRIAL_SECONDS
-        self._wait = FIRST_TRIAL_SECONDS
+        # Started below the ceiling because other processes run: trust that for a second
+        # before trying more threads (a trial at the slower count is what a short run pays).
+        first = FIRST_TRIAL_SECONDS if self.current == most else FIRST_WAIT_SECONDS
+        self._next_trial = first
+        self._wait = first
         self._last_trial = 0.0  # run time at the end of the last trial
         self._direction = -1  # trials go to fewer threads first
 
