@@ -10,7 +10,8 @@ chunks of steps without changing a bit of its output. That is what makes this po
   itself: the steps per second of each thread count it uses, in windows of at least
   MEASURE_SECONDS. Now and then (sooner when its rate drops by 40 %) it tries a neighbouring
   count for a short window between two windows at its own, and keeps the faster by
-  SWITCH_MARGIN, confirmed by the next full window. Failed trials back off to one a minute.
+  SWITCH_MARGIN, confirmed by the next full window. Failed trials back off to one a minute;
+  a run that started below the ceiling (others busy) first tries more threads after a second.
 - Why: when another process holds a core, a thread waiting at the core's barriers for a
   descheduled sibling costs far more than the work it shares. Next to one busy process on 2
   CPUs, 2 fixed threads ran PeriDEM's small compression deck 2.5 times slower than 1 thread,
