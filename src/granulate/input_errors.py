@@ -131,7 +131,7 @@ def describe(error: ValidationError, data: Any, models: Sequence[type[BaseModel]
 
 
 def unknown_name(name: str, options: Sequence[str]) -> str:
-    """ "; did you mean 'x'?" for the closest of `options`, or the options themselves."""
+    """A hint for a misspelt name: did you mean the closest of `options`, or the list."""
     match = difflib.get_close_matches(name, list(options), n=1)
     if match:
         return f"; did you mean {match[0]!r}?"
@@ -165,7 +165,7 @@ def checked_arguments(cls: C) -> C:
     parameter annotated as a plain number."""
     init = cls.__init__
     signature = inspect.signature(init)
-    numeric = _numeric_parameters(cls, signature)
+    numeric = _numeric_parameters(signature)
 
     @functools.wraps(init)
     def __init__(self: Any, *args: Any, **kwargs: Any) -> None:
@@ -174,10 +174,10 @@ def checked_arguments(cls: C) -> C:
         except TypeError:
             problem = call_problem(cls.__name__, signature, (self, *args), kwargs)
             raise InputError(problem) from None
-        for name, optional in numeric.items():
+        for name, (integer, optional) in numeric.items():
             value = bound.arguments.get(name)
             if name in bound.arguments and not (optional and value is None):
-                check_number(f"{cls.__name__}: {name}", value)
+                check_number(f"{cls.__name__}: {name}", value, integer=integer)
         init(self, *args, **kwargs)
 
     cls.__init__ = __init__  # type: ignore[misc]
@@ -194,13 +194,13 @@ def check_number(what: str, value: Any, integer: bool = False) -> None:
         raise InputError(f"{what} must be {expected}{hint}, got {value!r}")
 
 
-def _numeric_parameters(cls: type, signature: inspect.Signature) -> dict[str, bool]:
-    """Parameters annotated as a plain float or int, each with whether None is allowed."""
+def _numeric_parameters(signature: inspect.Signature) -> dict[str, tuple[bool, bool]]:
+    """Parameters annotated as a plain float or int: (is it an int, may it be None)."""
     out = {}
     for name, parameter in signature.parameters.items():
         annotation = str(parameter.annotation).replace(" ", "")
         if annotation in ("float", "int", "float|None", "int|None"):
-            out[name] = annotation.endswith("|None")
+            out[name] = (annotation.startswith("int"), annotation.endswith("|None"))
     return out
 
 
