@@ -59,21 +59,30 @@ def run_through_wall_impact(sim: gr.Simulation) -> None:
     run_through_impact(sim, against_wall=True)
 
 
-def rigid_motion(sim: gr.Simulation, nodes: np.ndarray, dimension: int) -> tuple[np.ndarray, float]:
-    """A body's centre-of-mass velocity and its angular velocity about z (counterclockwise
-    positive), from its nodes' momentum and angular momentum (the motion is in the x-y plane)."""
-    m = sim.volumes[nodes]
+def rigid_motion(sim: gr.Simulation, body: gr.Body) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A body's centre of mass, its velocity and its angular velocity (about z in 2D, a vector
+    in 3D), from its nodes' momentum and angular momentum (also used by the friction tests)."""
+    nodes = body.nodes
+    mass = sim.volumes[nodes] * body.material.density
     x, v = sim.positions[nodes], sim.velocities[nodes]
-    c, vc = np.average(x, axis=0, weights=m), np.average(v, axis=0, weights=m)
-    r, w = x - c, v - vc  # 3 components in 2D too (z = 0)
-    inertia = np.einsum(
-        "n,nij->ij",
-        m,
-        np.einsum("ni,ni->n", r, r)[:, None, None] * np.eye(3) - np.einsum("ni,nj->nij", r, r),
+    centre = np.average(x, axis=0, weights=mass)
+    velocity = np.average(v, axis=0, weights=mass)
+    r = x - centre  # 3 components in 2D too (z = 0)
+    momentum = np.sum(mass[:, None] * np.cross(r, v - velocity), axis=0)
+    terms = np.einsum("ni,ni->n", r, r)[:, None, None] * np.eye(3) - np.einsum("ni,nj->nij", r, r)
+    inertia = np.einsum("n,nij->ij", mass, terms)
+    if sim.dimension == 2:
+        return centre, velocity, np.array([0.0, 0.0, momentum[2] / inertia[2, 2]])
+    return centre, velocity, np.linalg.solve(inertia, momentum)
+
+
+def save_test_figure(fig, test: int, heading: str, speed: str, resolution: str, name: str) -> None:
+    """Title a Chung & Ooi test figure (what it shows, then its parameters) and save it."""
+    title = (
+        f"{heading} (Chung & Ooi test {test} analogue)\n"
+        f"{speed} = {SPEED} m/s, mu = {MU}, e = {RESTITUTION}, {resolution}"
     )
-    momentum = np.sum(m[:, None] * np.cross(r, w), axis=0)
-    turn = momentum / inertia[2, 2] if dimension == 2 else np.linalg.solve(inertia, momentum)
-    return vc, float(turn[2])
+    save(fig, title, name)
 
 
 def save(fig, title: str, name: str) -> None:
@@ -106,8 +115,8 @@ def impact(
         sim.velocities[nodes, 0] += spin / RADIUS * offset[:, 1]
         sim.velocities[nodes, 1] -= spin / RADIUS * offset[:, 0]
     run_through_wall_impact(sim)
-    vc, turn = rigid_motion(sim, body.nodes, dimension)
-    rate = -turn  # omega', positive rolling forwards
+    _, vc, omega = rigid_motion(sim, body)
+    rate = -omega[2]  # omega', positive rolling forwards
     return {
         "angle": angle,
         "v_n": speed * np.cos(a),
@@ -226,12 +235,8 @@ def angle_figure(d: int, smoke: bool) -> None:
         "incidence angle from the normal [degrees]",
         unit="v",
     )
-    shape = "disc" if d == 2 else "sphere"
-    title = (
-        f"Oblique impact of a {shape} on a plane (Chung & Ooi test 4 analogue): v = {SPEED} m/s, "
-        f"mu = {MU}, e = {RESTITUTION}, R/h = {npr}"
-    )
-    save(fig, title, f"oblique_impact_{d}d.png")
+    heading = f"Oblique impact of a {'disc' if d == 2 else 'sphere'} on a plane"
+    save_test_figure(fig, 4, heading, "v", f"R/h = {npr}", f"oblique_impact_{d}d.png")
 
 
 def tangential_figure(d: int, smoke: bool) -> None:
@@ -250,12 +255,8 @@ def tangential_figure(d: int, smoke: bool) -> None:
     sticking = fine[fine < sliding_limit(d, e_mean)]
     reversed_ = np.array([reversal(d, t * SPEED) for t in sticking])
     fig = plot_rebound((ratios, rows), (fine, curves), (sticking, reversed_), "v_t / v_n before")
-    shape = "disc" if d == 2 else "sphere"
-    title = (
-        f"Oblique impact of a {shape} on a plane (Chung & Ooi test 5 analogue): v_n = {SPEED} "
-        f"m/s, mu = {MU}, e = {RESTITUTION}, R/h = {npr}"
-    )
-    save(fig, title, f"tangential_impact_{d}d.png")
+    heading = f"Oblique impact of a {'disc' if d == 2 else 'sphere'} on a plane"
+    save_test_figure(fig, 5, heading, "v_n", f"R/h = {npr}", f"tangential_impact_{d}d.png")
 
 
 def spin_figure(d: int, smoke: bool) -> None:
@@ -270,12 +271,8 @@ def spin_figure(d: int, smoke: bool) -> None:
     fine = np.linspace(-4.2, 4.2, 400)
     curves = np.array([spinning_theory(d, SPEED, 0.0, w * SPEED, e_mean) for w in fine])
     fig = plot_rebound((spins, rows), (fine, curves), None, "spin before, omega R / v_n")
-    shape = "disc" if d == 2 else "sphere"
-    title = (
-        f"Spinning {shape} dropped on a plane (Chung & Ooi test 6 analogue): v_n = {SPEED} m/s, "
-        f"mu = {MU}, e = {RESTITUTION}, R/h = {npr}"
-    )
-    save(fig, title, f"spinning_impact_{d}d.png")
+    heading = f"Spinning {'disc' if d == 2 else 'sphere'} dropped on a plane"
+    save_test_figure(fig, 6, heading, "v_n", f"R/h = {npr}", f"spinning_impact_{d}d.png")
 
 
 def main() -> None:

@@ -44,7 +44,7 @@ from oblique_impact import (
     SOFT,
     SPEED,
     rigid_motion,
-    save,
+    save_test_figure,
 )
 
 import granulate as gr
@@ -102,7 +102,7 @@ def pair_impact(
         sim.velocities[body.nodes, 0] = -spin / radius * offset[:, 1]
         sim.velocities[body.nodes, 1] = share * SPEED + spin / radius * offset[:, 0]
     run_until_apart(sim, bodies, radii)
-    after = [rigid_motion(sim, b.nodes, dimension) for b in bodies]
+    after = [rigid_motion(sim, b)[1:] for b in bodies]
     return {
         "masses": masses,
         "friction": friction,
@@ -110,7 +110,7 @@ def pair_impact(
         "spins": spins,
         "e": (after[1][0][1] - after[0][0][1]) / SPEED,
         "v_t_after": [float(v[0]) for v, _ in after],
-        "spin_after": [w * r for (_, w), r in zip(after, radii, strict=True)],
+        "spin_after": [w[2] * r for (_, w), r in zip(after, radii, strict=True)],
     }
 
 
@@ -191,11 +191,8 @@ def figure(dimension: int, test: int, rows: list[dict], rates: list[float], npr:
         if test == 7
         else f"a spinning {shape} and one {LARGE:g} times larger at rest"
     )
-    title = (
-        f"Head-on impact of {what} (Chung & Ooi test {test} analogue)\n"
-        f"v_n = {SPEED} m/s, mu = {MU}, e = {RESTITUTION}, R/h = {npr} each"
-    )
-    save(fig, title, f"pair_impact_test{test}_{dimension}d.png")
+    name = f"pair_impact_test{test}_{dimension}d.png"
+    save_test_figure(fig, test, f"Head-on impact of {what}", "v_n", f"R/h = {npr} each", name)
 
 
 def main() -> None:

@@ -43,8 +43,8 @@ from granulate import functions, meshes, packing, shapes, stopping, walls
 from granulate.contact import Contact
 from granulate.errors import InputError
 from granulate.input_errors import NOT_BOOL, describe
+from granulate.io.files import existing_file, read_text
 from granulate.materials import Material
-from granulate.meshes import existing_file
 from granulate.simulation import FIELDS, Body, Simulation
 from granulate.yaml_input import load_yaml
 
@@ -1103,8 +1103,7 @@ def _restart(sim: Simulation, path: Path, step: int) -> None:
     """Positions and velocities of a VTU frame, at ``step`` (see RestartSpec)."""
     from granulate.io.vtu import read_vtu_point_data
 
-    if not path.is_file():
-        raise InputError(f"restart file {path} does not exist")
+    existing_file(path, "restart file")
     _, data = read_vtu_point_data(path)
     missing = [name for name in ("Displacement", "Velocity") if name not in data]
     if missing:
@@ -1168,15 +1167,8 @@ def load_case(path: str | Path, *, peridem_compat: bool = False) -> Case:
     """Read and validate a YAML case file (InputError with every problem found). A PeriDEM
     input deck is recognised and translated (granulate.peridem); ``peridem_compat`` selects
     PeriDEM's formulas where granulate has them. It is refused for a native case."""
-    source = existing_file(path, "case file")
-    try:
-        text = source.read_text()
-    except UnicodeDecodeError:
-        raise InputError(
-            f"case file {source} is not UTF-8 text (a binary file, or UTF-16? save it as UTF-8)"
-        ) from None
-    except OSError as error:
-        raise InputError(f"cannot read case file {source}: {error.strerror or error}") from None
+    source = Path(path)
+    text = read_text(source, "case file")
     data = load_yaml(text, source)
     from granulate import peridem
 

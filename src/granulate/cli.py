@@ -28,6 +28,7 @@ from pathlib import Path
 from granulate import _core, resources, threads
 from granulate._version import __version__
 from granulate.errors import InputError, InstabilityError
+from granulate.io.files import existing_file
 from granulate.io.run_folder import check_writable
 from granulate.progress import ProgressReporter, duration
 
@@ -198,8 +199,7 @@ def _run_case(
 
 
 def _run_script(script: Path, args: list[str]) -> int:
-    if not script.is_file():
-        raise InputError(f"script {script} does not exist")
+    existing_file(script, "script")
     sys.argv = [str(script), *args]
     runpy.run_path(str(script), run_name="__main__")
     return 0

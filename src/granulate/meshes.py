@@ -22,6 +22,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from granulate import resources
 from granulate.errors import InputError
+from granulate.io.files import existing_file
 from granulate.io.table import read_table
 from granulate.shapes import Shape, _points
 
@@ -42,22 +43,6 @@ class NodalMesh:
     mesh_size: float
     dimension: int
     source: str = field(default="")
-
-
-def existing_file(path: str | Path, what: str) -> Path:
-    """`path` when it is a readable file; else InputError saying what it is instead (missing,
-    a folder, a symlink that leads nowhere or in a loop)."""
-    file = Path(path)
-    try:
-        if file.is_file():
-            return file
-        if file.is_dir():
-            raise InputError(f"{what} {file} is a folder, not a file")
-        if file.is_symlink():
-            raise InputError(f"{what} {file} is a symbolic link that leads nowhere (or in a loop)")
-    except OSError as error:  # a loop of links, a name too long
-        raise InputError(f"{what} {file} cannot be opened: {error.strerror or error}") from None
-    raise InputError(f"{what} {file} does not exist")
 
 
 def _require_declared_nodes(file: Path) -> None:

@@ -43,6 +43,7 @@ import numpy as np
 import yaml
 
 from granulate.errors import InputError
+from granulate.io.files import read_text
 from granulate.yaml_input import load_yaml
 
 #: Sections of a deck and the keys granulate reads in each (Zone_<k> / Set_<s> blocks apart).
@@ -176,13 +177,7 @@ def is_deck(data: Any) -> bool:
 
 def read_deck(path: str | Path) -> dict[str, Any]:
     source = Path(path)
-    if not source.is_file():
-        raise InputError(f"deck {source} does not exist")
-    try:
-        text = source.read_text()
-    except (OSError, UnicodeDecodeError) as error:
-        raise InputError(f"cannot read deck {source}: {error}") from None
-    data = load_yaml(text, source)
+    data = load_yaml(read_text(source, "deck"), source)
     if not is_deck(data):
         raise InputError(f"{source} is not a PeriDEM deck (it has no Model block)")
     return data

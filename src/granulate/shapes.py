@@ -624,12 +624,11 @@ class Cylinder(Shape):
 MOST_VERTICES = 100_000
 
 
-def _require_nodes(cells: float, nodes: float, mesh_size: float, kind: str) -> None:
-    """InputError before a discretisation of `cells` candidate points and about `nodes` nodes
-    is generated, when it (or the simulation of those nodes) would not fit in memory."""
-    needed = max(80.0 * cells, resources.BYTES_PER_NODE * nodes)
+def _require_nodes(nodes: float, mesh_size: float, kind: str) -> None:
+    """InputError before a discretisation of about `nodes` nodes (or candidate points) is
+    generated, when the simulation of those nodes would not fit in memory."""
     resources.require_memory(
-        needed,
+        resources.BYTES_PER_NODE * nodes,
         f"a {kind} of about {nodes:.3g} nodes (mesh size {mesh_size:.4g} m)",
         "use a larger mesh size",
     )
@@ -664,8 +663,7 @@ def lattice(
     origin = 0.5 * (lower[:d] + upper[:d]) - 0.5 * counts * mesh_size
     # The nodes are at most the cells (the measure would do better, but a union's costs a
     # count on a grid).
-    cells = float(np.prod(counts.astype(float)))
-    _require_nodes(cells, cells, mesh_size, "lattice")
+    _require_nodes(float(np.prod(counts.astype(float))), mesh_size, "lattice")
     axes = [origin[k] + (np.arange(counts[k]) + 0.5) * mesh_size for k in range(d)]
     grid = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, d)
     points = np.zeros((len(grid), 3))
@@ -703,7 +701,7 @@ def grid(shape: Shape, mesh_size: float) -> tuple[NDArray[np.float64], NDArray[n
     upper = np.asarray(shape.upper, dtype=float)[:d]
     cells = np.maximum(1, np.round((upper - lower) / mesh_size).astype(np.int64))
     nodes = float(np.prod((cells + 1).astype(float)))
-    _require_nodes(nodes, nodes, mesh_size, "grid")
+    _require_nodes(nodes, mesh_size, "grid")
     axes = [np.linspace(lower[k], upper[k], cells[k] + 1) for k in range(d)]
     spacing = (upper - lower) / cells
     shares = []
@@ -740,7 +738,7 @@ def conforming(shape: Shape, mesh_size: float) -> tuple[NDArray[np.float64], NDA
         if isinstance(shape, Disc | Ellipse | Sphere | Ellipsoid)
         else 0.0
     )
-    _require_nodes(nodes, nodes, mesh_size, "conforming discretisation")
+    _require_nodes(nodes, mesh_size, "conforming discretisation")
     if isinstance(shape, Disc | Ellipse):
         axes = (
             np.array([shape.radius, shape.radius])

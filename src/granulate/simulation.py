@@ -21,7 +21,7 @@ import threading
 import time as wallclock
 import warnings
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Literal
 
@@ -128,6 +128,17 @@ class _Output:
     frames: int = 0
     frame_step: int = -1  # the step of the last frame written (-1: none in this process)
     history_step: int = -1  # likewise for the last history row
+
+
+@dataclass(frozen=True)
+class _RunPlan:
+    """What one run() call asked for, checked."""
+
+    steps: int
+    stop: Sequence[StopCriterion]
+    check_every: int
+    progress: Callable[[Progress], None] | None
+    write_final: bool
 
 
 def _read_only(array: NDArray) -> NDArray:
@@ -748,33 +759,9 @@ class Simulation:
             raise InputError(f"a wall named {label!r} exists already; give each wall its own name")
         if not label.replace("_", "").isalnum():
             raise InputError(f"wall name {label!r} must be letters, digits and underscores")
-        self._check_wall_vectors(wall, label)
-        wall.core(label)  # checks the description now rather than at the first run
+        wall.core(label, self.dimension)  # checks the description now, not at the first run
         self._walls.append((label, wall))
         return label
-
-    #: The vectors of wall surfaces and motions (points, normals, corners, centres, axes).
-    WALL_VECTORS = ("point", "normal", "lower", "upper", "center", "axis", "direction")
-
-    def _check_wall_vectors(self, wall: Wall, label: str) -> None:
-        """InputError for a vector of a wall with the wrong number of components: 3 in 3D (two
-        were read with z = 0), 2 or 3 with z = 0 in 2D (an axis may be z itself)."""
-        parts = [*wall.surfaces, *([wall.motion] if wall.motion is not None else [])]
-        for part in parts:
-            for name in self.WALL_VECTORS:
-                value = getattr(part, name, None)
-                if value is None or callable(value):
-                    continue
-                try:
-                    array = np.asarray(value, dtype=float).reshape(-1)
-                except (TypeError, ValueError):
-                    continue  # not numbers: the wall's own checks name it
-                where = f"wall {label!r}: {type(part).__name__} {name} {array.tolist()}"
-                if self.dimension == 3 and len(array) != 3:
-                    raise InputError(f"{where} needs 3 components in a 3D simulation")
-                z_axis = name == "axis" and len(array) == 3 and not np.any(array[:2])
-                if self.dimension == 2 and len(array) == 3 and array[2] != 0 and not z_axis:
-                    raise InputError(f"{where} has a z component in a 2D simulation")
 
     def wall_reactions(self) -> dict[str, NDArray[np.float64]]:
         """Per wall: (fx, fy, fz, tx, ty, tz), the force and torque the particles exert on it
@@ -979,7 +966,7 @@ class Simulation:
                 if contact is not None:
                     core.set_contact_law(a, b, self._law(contact))
         for name, wall in self._walls:
-            index = core.add_wall(wall.core(name))
+            index = core.add_wall(wall.core(name, self.dimension))
             contact = wall.contact or self._contact or Contact()
             for a in range(len(materials)):
                 core.set_wall_law(index, a, self._law(contact))
@@ -1052,36 +1039,38 @@ class Simulation:
         core = self._build()
         steps = self._run_steps(core, steps, until, check_every)
         self._require_checkpoint_budget(steps)
-        if progress is True:
-            from granulate.progress import ProgressReporter
-
-            reporter = ProgressReporter(steps)
-            try:
-                return self.run(
-                    steps,
-                    stop=stop,
-                    check_every=check_every,
-                    progress=reporter,
-                    write_final=write_final,
-                )
-            finally:
-                reporter.close()
-        if not (progress is None or progress is False or callable(progress)):
+        if not (progress is None or isinstance(progress, bool) or callable(progress)):
             raise InputError(
                 f"progress must be True, False or a function of a Progress, got {progress!r}"
             )
+        callback = None if isinstance(progress, bool) else progress
+        plan = _RunPlan(steps, tuple(stop), check_every, callback, write_final)
+        if progress is not True:
+            return self._run_with_outputs(core, plan)
+        from granulate.progress import ProgressReporter
+
+        reporter = ProgressReporter(steps)
+        try:
+            return self._run_with_outputs(core, replace(plan, progress=reporter))
+        finally:
+            reporter.close()
+
+    def _run_with_outputs(self, core: _core.Simulation, plan: _RunPlan) -> str | None:
+        """The run, in its output folder when outputs are set: its space checked, its lock held
+        while it writes, and run.json with its status at the end, whatever ends it."""
         out = self._output
         if out is None:
-            return self._advance(core, steps, stop, check_every, progress or None, write_final)
+            return self._advance(core, plan)
         # The frames this run writes: one every `every` steps, the last step's when it falls
         # between, and step 0's when none is written yet; each about 8 bytes per component of
         # its fields per node.
+        steps = plan.steps
         frames = steps // out.every + (steps % out.every > 0) + (out.frames == 0)
         out.folder.require_space(frames, self.node_count * (12 + 8 * 3 * len(out.fields)))
         out.folder.start_writing()
         self._status = "running"
         try:
-            reason = self._advance(core, steps, stop, check_every, progress or None, write_final)
+            reason = self._advance(core, plan)
             self._status = f"stopped: {reason}" if reason else "finished"
             return reason
         except KeyboardInterrupt:
@@ -1119,22 +1108,30 @@ class Simulation:
             raise InputError(f"check_every must be a positive number of steps, got {check_every}")
         return int(steps)
 
-    def _advance(
-        self,
-        core: _core.Simulation,
-        steps: int,
-        stop: Sequence[StopCriterion],
-        check_every: int,
-        progress: Callable[[Progress], None] | None,
-        write_final: bool,
-    ) -> str | None:
+    def _chunk_end(self, core: _core.Simulation, plan: _RunPlan, target: int, limit: int) -> int:
+        """Steps to the next place the loop must stop at: the run's end, an output or history
+        step, a stop check, a checkpoint, or `limit` (about half a second)."""
+        step, out, check_every = core.step, self._output, plan.check_every
+        boundaries = [target - step, limit]
+        if out is not None:
+            boundaries.append(out.every - step % out.every)
+            boundaries.append(out.history_every - step % out.history_every)
+        if plan.stop:
+            boundaries.append(check_every - step % check_every)
+        if self._checkpoint is not None and self._checkpoint.every_steps:
+            every = self._checkpoint.every_steps
+            boundaries.append(every - step % every)
+        return min(boundaries)
+
+    def _advance(self, core: _core.Simulation, plan: _RunPlan) -> str | None:
         """The time loop of run(): chunks of steps between outputs, stop checks and
         checkpoints, with the thread count the tuner picks."""
+        stop, check_every, progress = plan.stop, plan.check_every, plan.progress
         out = self._output
         if out is not None and out.frames == 0:
             core.run(0)  # the forces of step 0 (prescribed motion, contact), for the frame
             self._write_output()
-        target = core.step + steps
+        target = core.step + plan.steps
         first_step = int(core.step)
         most = threads.get_num_threads()
         tuner = self._thread_tuner(most)
@@ -1145,16 +1142,7 @@ class Simulation:
         try:
             with signals:
                 while core.step < target and reason is None:
-                    boundaries = [target - core.step, chunk_limit]
-                    if out is not None:
-                        boundaries.append(out.every - core.step % out.every)
-                        boundaries.append(out.history_every - core.step % out.history_every)
-                    if stop:
-                        boundaries.append(check_every - core.step % check_every)
-                    if self._checkpoint is not None and self._checkpoint.every_steps:
-                        every = self._checkpoint.every_steps
-                        boundaries.append(every - core.step % every)
-                    chunk = min(boundaries)
+                    chunk = self._chunk_end(core, plan, target, chunk_limit)
                     if tuner is not None:
                         count = tuner.threads()
                         chunk = min(chunk, tuner.step_cap() or chunk)
@@ -1195,7 +1183,7 @@ class Simulation:
             self._wall_seconds += wallclock.perf_counter() - start
             self._steps_run += int(core.step) - first_step
         if out is not None:
-            self._write_final_state(frame=write_final or reason is not None)
+            self._write_final_state(frame=plan.write_final or reason is not None)
         return reason
 
     def _require_memory_for_model(self) -> None:

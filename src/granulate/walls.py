@@ -43,17 +43,26 @@ from granulate.meshes import SurfaceMesh, read_file
 from granulate.shapes import Box, Disc, Ellipse, Polygon, Rectangle, Shape
 
 
-def _vec3(value: ArrayLike, name: str) -> tuple[float, float, float]:
+def _vec3(
+    value: ArrayLike, name: str, dimension: int, axis: bool = False
+) -> tuple[float, float, float]:
+    """A point or direction of a wall as three numbers: 3 given in 3D; 2, or 3 with z = 0, in
+    2D (an axis may be z itself)."""
     array = np.asarray(value, dtype=float).reshape(-1)
     if array.shape not in ((2,), (3,)) or not np.all(np.isfinite(array)):
         raise InputError(f"{name} must be 2 or 3 finite numbers, got {value!r}")
+    if dimension == 3 and len(array) != 3:
+        raise InputError(f"{name} {array.tolist()} needs 3 components in a 3D simulation")
+    z_axis = axis and len(array) == 3 and not np.any(array[:2])
+    if dimension == 2 and len(array) == 3 and array[2] != 0 and not z_axis:
+        raise InputError(f"{name} {array.tolist()} has a z component in a 2D simulation")
     return (float(array[0]), float(array[1]), float(array[2]) if len(array) == 3 else 0.0)
 
 
 class Surface:
     """Base class of wall surfaces."""
 
-    def core(self) -> _core.WallSurface:
+    def core(self, dimension: int) -> _core.WallSurface:
         raise TypeError(f"{type(self).__name__} is not a concrete surface")
 
 
@@ -63,10 +72,13 @@ class Plane(Surface):
     point: ArrayLike
     normal: ArrayLike
 
-    def core(self) -> _core.WallSurface:
+    def core(self, dimension: int) -> _core.WallSurface:
         s = _core.WallSurface()
         s.kind = _core.WallSurfaceKind.plane
-        s.point, s.normal = _vec3(self.point, "plane point"), _vec3(self.normal, "plane normal")
+        s.point, s.normal = (
+            _vec3(self.point, "plane point", dimension),
+            _vec3(self.normal, "plane normal", dimension),
+        )
         return s
 
 
@@ -76,12 +88,15 @@ class _Box(Surface):
     upper: ArrayLike
     inside: bool = field(default=True, init=False)
 
-    def core(self) -> _core.WallSurface:
+    def core(self, dimension: int) -> _core.WallSurface:
         s = _core.WallSurface()
         s.kind = (
             _core.WallSurfaceKind.box_inside if self.inside else _core.WallSurfaceKind.box_outside
         )
-        s.lower, s.upper = _vec3(self.lower, "box lower"), _vec3(self.upper, "box upper")
+        s.lower, s.upper = (
+            _vec3(self.lower, "box lower", dimension),
+            _vec3(self.upper, "box upper", dimension),
+        )
         return s
 
 
@@ -106,14 +121,17 @@ class _Circle(Surface):
     axis: ArrayLike = (0.0, 0.0, 1.0)
     inside: bool = field(default=True, init=False)
 
-    def core(self) -> _core.WallSurface:
+    def core(self, dimension: int) -> _core.WallSurface:
         s = _core.WallSurface()
         s.kind = (
             _core.WallSurfaceKind.circle_inside
             if self.inside
             else _core.WallSurfaceKind.circle_outside
         )
-        s.point, s.normal = _vec3(self.center, "circle center"), _vec3(self.axis, "cylinder axis")
+        s.point, s.normal = (
+            _vec3(self.center, "circle center", dimension),
+            _vec3(self.axis, "cylinder axis", dimension, axis=True),
+        )
         s.radius = float(self.radius)
         return s
 
@@ -137,7 +155,7 @@ class _Polygon(Surface):
     vertices: ArrayLike
     inside: bool = field(default=True, init=False)
 
-    def core(self) -> _core.WallSurface:
+    def core(self, dimension: int) -> _core.WallSurface:
         v = np.asarray(self.vertices, dtype=float)
         if v.ndim != 2 or v.shape[1] != 2 or len(v) < 3 or not np.all(np.isfinite(v)):
             raise InputError("a polygon wall needs at least 3 finite (x, y) vertices")
@@ -187,7 +205,7 @@ class TriangleMesh(Surface):
             np.asarray(mesh.points, dtype=float) * scale, np.concatenate(triangles), inside
         )
 
-    def core(self) -> _core.WallSurface:
+    def core(self, dimension: int) -> _core.WallSurface:
         vertices = np.asarray(self.vertices, dtype=float)
         triangles = np.asarray(self.triangles)
         if vertices.ndim != 2 or vertices.shape[1] != 3 or not np.all(np.isfinite(vertices)):
@@ -249,21 +267,27 @@ class Wall:
     contact: Contact | None = None
     center: ArrayLike = (0.0, 0.0, 0.0)
 
-    def core(self, name: str) -> _core.Wall:
+    def core(self, name: str, dimension: int) -> _core.Wall:
+        try:
+            return self._core(name, dimension)
+        except InputError as error:
+            raise InputError(f"wall {name!r}: {error}") from None
+
+    def _core(self, name: str, dimension: int) -> _core.Wall:
         wall = _core.Wall()
         wall.name = name
         if not self.surfaces:
-            raise InputError(f"wall {name!r} has no surface")
-        wall.surfaces = [s.core() for s in self.surfaces]
-        wall.center = _vec3(self.center, "wall center")
+            raise InputError("it has no surface")
+        wall.surfaces = [s.core(dimension) for s in self.surfaces]
+        wall.center = _vec3(self.center, "wall center", dimension)
         if isinstance(self.motion, Translation):
             wall.motion = _core.WallMotion.translation
-            wall.direction = _vec3(self.motion.direction, "translation direction")
+            wall.direction = _vec3(self.motion.direction, "translation direction", dimension)
             wall.set_function(*self.motion.function.core())
         elif isinstance(self.motion, Rotation):
             wall.motion = _core.WallMotion.rotation
-            wall.center = _vec3(self.motion.center, "rotation center")
-            wall.axis = _vec3(self.motion.axis, "rotation axis")
+            wall.center = _vec3(self.motion.center, "rotation center", dimension)
+            wall.axis = _vec3(self.motion.axis, "rotation axis", dimension, axis=True)
             wall.set_function(*self.motion.angle.core())
         elif self.motion is None:
             wall.set_function(*Constant(0.0).core())

@@ -5,32 +5,19 @@ speed (Cundall-Strack springs acting at the surface, see contact_law.hpp)."""
 
 from __future__ import annotations
 
+import sys
+from pathlib import Path
+
 import numpy as np
 import pytest
 
 import granulate as gr
 
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "docs" / "validation"))
+from oblique_impact import rigid_motion
+
 RUBBER = gr.Material(density=1000, youngs_modulus=5e6, poisson_ratio=0.25, fracture=False)
 SOFT = gr.Material(density=1200, bulk_modulus=2.16e7, shear_modulus=1.296e7, fracture=False)
-
-
-def rigid_motion(sim: gr.Simulation, body: gr.Body) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Centre, velocity and angular velocity (about z in 2D, a vector in 3D) of a body."""
-    nodes = slice(body.first_node, body.first_node + body.node_count)
-    mass = sim.volumes[nodes] * body.material.density
-    x, v = sim.positions[nodes], sim.velocities[nodes]
-    centre = np.average(x, axis=0, weights=mass)
-    velocity = np.average(v, axis=0, weights=mass)
-    r = x - centre
-    momentum = np.sum(mass[:, None] * np.cross(r, v - velocity), axis=0)
-    inertia = np.einsum("n,nij->ij", mass, _inertia_terms(r))
-    if sim.dimension == 2:
-        return centre, velocity, np.array([0.0, 0.0, momentum[2] / inertia[2, 2]])
-    return centre, velocity, np.linalg.solve(inertia, momentum)
-
-
-def _inertia_terms(r: np.ndarray) -> np.ndarray:
-    return np.einsum("ni,ni->n", r, r)[:, None, None] * np.eye(3) - np.einsum("ni,nj->nij", r, r)
 
 
 def block_on_incline(dimension: int, angle: float, mu: float) -> tuple[gr.Simulation, gr.Body]:

@@ -9,6 +9,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from granulate.errors import InputError
+from granulate.io.files import existing_file
 
 
 def read_table(
@@ -17,9 +18,7 @@ def read_table(
     """Rows of numbers from a CSV file: an optional header line, ``#`` comments and blank lines
     skipped; every row has one of ``widths`` values, the same on every line (``columns`` names
     them in messages). ``what`` names the file's content (``"points"``)."""
-    file = Path(path)
-    if not file.is_file():
-        raise InputError(f"{what} file {file} does not exist")
+    file = existing_file(path, f"{what} file")
     rows: list[list[float]] = []
     with file.open(newline="") as handle:
         for number, row in enumerate(csv.reader(handle), start=1):
