@@ -204,3 +204,44 @@ def test_a_meshed_particle_runs(tmp_path: Path) -> None:
     vb = np.average(sim.velocities[b.nodes, 0], weights=sim.volumes[b.nodes])
     assert va < 0 < vb
     assert (vb - va) / 1.0 == pytest.approx(0.8, abs=0.05)
+
+
+def test_surface_offsets_reach_every_face_at_a_node() -> None:
+    """ReferenceShape.surface: o with n . o = 1 for each boundary face normal n at a node, zero
+    inside. PeriDEM's hexagon: |o| = 1 on its sides and 1 / sin(60 deg) at its corners (two
+    sides at 120 degrees); its triangle: 2 = 1 / sin(30 deg) at the corners; the gmsh disc: 1
+    radially outward within 0.5 % (its 32 sides meet at 169 degrees); a grid: +-1 along each
+    axis whose face a node lies on."""
+    hexagon = gr.ReferenceShape.from_mesh(str(DECK / "mesh_hex_small_0.msh"))
+    o, x = hexagon.surface, hexagon.positions
+    length = np.linalg.norm(o, axis=1)
+    corners = np.isclose(np.linalg.norm(x, axis=1), 1e-3, rtol=1e-9)
+    assert corners.sum() == 6
+    np.testing.assert_allclose(length[corners], 1 / np.sin(np.pi / 3), rtol=1e-9)
+    on_sides = (length > 0) & ~corners
+    np.testing.assert_allclose(length[on_sides], 1.0, rtol=1e-9)
+    assert np.all(np.einsum("ij,ij->i", o[on_sides], x[on_sides]) > 0)  # outward
+    assert np.all(length[np.linalg.norm(x, axis=1) < 0.8e-3] == 0)
+    triangle = gr.ReferenceShape.from_mesh(str(DECK / "mesh_tri_small_0.msh"))
+    assert np.max(np.linalg.norm(triangle.surface, axis=1)) == pytest.approx(2.0, rel=1e-9)
+    disc = gr.ReferenceShape.from_mesh(str(DECK / "mesh_cir_small_0.msh"))
+    rim = np.linalg.norm(disc.surface, axis=1) > 0
+    radial = disc.positions[rim] / np.linalg.norm(disc.positions[rim], axis=1)[:, None]
+    np.testing.assert_allclose(disc.surface[rim], radial, atol=5e-3)
+    box = gr.ReferenceShape.from_shape(gr.Box((0, 0, 0), (1, 2, 3)), 0.5, discretization="grid")
+    np.testing.assert_array_equal(np.unique(box.surface), [-1.0, 0.0, 1.0])
+    corner = np.flatnonzero(np.all(box.positions == 0, axis=1))[0]
+    np.testing.assert_array_equal(box.surface[corner], [-1.0, -1.0, -1.0])
+    assert gr.ReferenceShape.from_shape(gr.Disc((0, 0), 1), 0.1).surface is None
+
+
+def test_surface_offsets_of_the_wrong_size_are_refused() -> None:
+    from granulate import _core
+
+    model = _core.Model(2)
+    positions, volumes = np.zeros((2, 3)), np.ones(2)
+    positions[1, 0] = 1.0
+    with pytest.raises(gr.InputError, match="1 surface offsets for 2 nodes"):
+        model.add_shape(positions, volumes, 1.0, np.zeros(3))
+    with pytest.raises(gr.InputError, match="not finite"):
+        model.add_shape(positions, volumes, 1.0, np.array([0, 0, 0, np.nan, 0, 0]))

@@ -94,8 +94,10 @@ def test_two_discs_fall_and_rebound_as_in_peridem(tmp_path: Path) -> None:
     steps. In free fall (first three frames) the schemes differ by g dt t / 2 (Verlet against
     semi-implicit Euler): within 1e-8 m. With --peridem-compat (PeriDEM's centre damping,
     Epsilon 0.9, Beta_n_Factor 100) the rebound follows PeriDEM's within 10 um (measured 7.1 um,
-    apex 0.191 mm against 0.197 mm). granulate's own damping gives the e = 0.9 asked for and
-    rebounds higher (apex 0.223 mm, measured 29 um above PeriDEM's at the end)."""
+    apex 0.191 mm against 0.197 mm). granulate's own physics touches at the discs' surfaces
+    (PeriDEM's contact spheres reach Rc = 0.13 mm beyond them), so its disc falls further, and
+    its damping gives the e = 0.9 asked for: it rebounds higher, from the lowest frame to the
+    highest 0.711 mm against PeriDEM's 0.636 mm."""
     ref = reference("twop_circ")
     top = ref[ref[:, 3] == 1]
     compat = run_deck("twop_circ", tmp_path / "compat", 60_000, "--peridem-compat")
@@ -109,7 +111,8 @@ def test_two_discs_fall_and_rebound_as_in_peridem(tmp_path: Path) -> None:
         np.testing.assert_allclose(uy[:3], top[:3, 9], rtol=0, atol=1e-8)
         assert uy[10:].max() - uy[2:5].min() > 5e-4  # it bounced
     np.testing.assert_allclose(ours["compat"], top[:, 9], rtol=0, atol=1e-5)
-    assert ours["default"][8:].max() > top[8:, 9].max() + 1e-5
+    rebound = ours["default"].max() - ours["default"].min()
+    assert rebound > top[:, 9].max() - top[:, 9].min() + 5e-5
     # Damage onset at the impact (frame 3, step 15,000) in both codes, of the same order.
     damage = [frame(compat, k).point_data["Damage_Z"].max() for k in (2, 3)]
     assert damage[0] < 1e-9 and top[2, 12] == 0  # round-off before the impact
@@ -205,17 +208,21 @@ def test_pulled_rectangle_matches_peridem(tmp_path: Path) -> None:
 
 def test_compression_deck_settles_like_peridem(tmp_path: Path) -> None:
     """compression_small_set, all 20,000 steps: the grains settle under gravity while the top
-    wall comes down 3 mm, reaching the settled pile only at the end. The mean grain centroid
-    height at the last frame agrees within 0.1 mm (grain radius 1 mm; measured 26 um) and no
-    bond breaks. The
-    walls' reactions are those of the grains (PeriDEM's summed force on its walls is their
-    weight alone: it does not report the grains' push, the "one-way walls" of the notes)."""
+    wall comes down 3 mm, reaching the settled pile only at the end, and no bond breaks.
+    PeriDEM's contact spheres sit on the mesh's surface nodes and reach Rc = 0.95 h (0.16 mm)
+    beyond each grain; granulate's reach the surfaces themselves. So the settled pile (grain
+    radius 1 mm, one to three layers) is lower than PeriDEM's by up to Rc per contact below a
+    grain, three contacts at most: the mean grain centroid height at the last frame is
+    0.02-0.5 mm below PeriDEM's (measured 0.243 mm; 26 um above it while granulate's spheres
+    also stood proud of the mesh's surface). The walls' reactions are those of the grains
+    (PeriDEM's summed force on its walls is their weight alone: it does not report the grains'
+    push, the "one-way walls" of the notes)."""
     out = run_deck("compression_small_set", tmp_path / "out", None)
     ref = reference("compression_small_set")
     last = ref[ref[:, 0] == 10]
     ours = centroids(frame(out, 10), 17)
     grains = slice(0, 15)
-    assert abs(ours[grains, 1].mean() - last[grains, 7].mean()) < 1e-4  # measured 26 um
+    assert 2e-5 < last[grains, 7].mean() - ours[grains, 1].mean() < 5e-4
     rows = history(out)
     assert rows[-1]["broken_bonds"] == 0
     assert rows[-1]["p16_uy"] == pytest.approx(-3e-3, rel=1e-9)
@@ -228,7 +235,10 @@ def test_compression_deck_settles_like_peridem(tmp_path: Path) -> None:
 
 def test_attrition_drum_turns_as_in_peridem(tmp_path: Path) -> None:
     """attrition_mix_particles_small_set: the meshed drum turns about (x0, y0) = (-3, 3) mm at
-    -125.66 rad/s; its centroid follows PeriDEM's to 1e-9 m, and no grain leaves the drum."""
+    -125.66 rad/s; its centroid follows PeriDEM's to 1e-9 m, and no grain leaves the drum: no
+    grain node passes the drum's inner surface (radius 15 mm) by half a grain's mesh size
+    (0.17 mm), where it would slip between the drum's nodes. Grain surfaces touch the drum's
+    (measured: 15.025 mm, the contact layer's overlap under the drum's 24 g)."""
     out = run_deck("attrition_mix_particles_small_set", tmp_path / "out", 4000)
     ref = reference("attrition_mix_particles_small_set")
     for k in range(5):
@@ -240,7 +250,7 @@ def test_attrition_drum_turns_as_in_peridem(tmp_path: Path) -> None:
         pivot = np.array([-3e-3, 3e-3])
         turn = np.array([[math.cos(angle), -math.sin(angle)], [math.sin(angle), math.cos(angle)]])
         centre = pivot + turn @ (np.zeros(2) - pivot)  # the drum's axis, carried round the pivot
-        assert np.hypot(*(mesh.points[grains, :2] - centre).T).max() < 15.0e-3
+        assert np.hypot(*(mesh.points[grains, :2] - centre).T).max() < 15.0e-3 + 0.5 * 0.17e-3
 
 
 def test_converted_case_runs_the_same_bits(tmp_path: Path) -> None:

@@ -19,6 +19,7 @@ namespace {
 
 using Points = nb::ndarray<const double, nb::shape<-1, 3>, nb::c_contig, nb::device::cpu>;
 using Scalars = nb::ndarray<const double, nb::ndim<1>, nb::c_contig, nb::device::cpu>;
+
 using Indices = nb::ndarray<const std::uint32_t, nb::ndim<1>, nb::c_contig, nb::device::cpu>;
 
 template <class T>
@@ -243,11 +244,12 @@ NB_MODULE(_core, m) {
           "positions"_a, "volumes"_a, "material"_a, "mesh_size"_a, "horizon"_a = 0.0)
       .def(
           "add_shape",
-          [](Model& self, Points positions, Scalars volumes, real mesh_size) {
+          [](Model& self, Points positions, Scalars volumes, real mesh_size, Scalars surface_offsets) {
             return self.add_shape({positions.data(), positions.shape(0) * 3},
-                                  {volumes.data(), volumes.shape(0)}, mesh_size);
+                                  {volumes.data(), volumes.shape(0)}, mesh_size,
+                                  {surface_offsets.data(), surface_offsets.shape(0)});
           },
-          "positions"_a, "volumes"_a, "mesh_size"_a)
+          "positions"_a, "volumes"_a, "mesh_size"_a, "surface_offsets"_a)
       .def(
           "place_shape",
           [](Model& self, index_t shape, index_t material, Points positions, real scale, real horizon) {

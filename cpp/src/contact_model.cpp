@@ -157,6 +157,110 @@ void ContactModel::configure(const Model& model) {
     material_max_mesh_size_[p.material] = std::max(material_max_mesh_size_[p.material], p.mesh_size);
   }
   built_ = false;
+  centres_found_ = false;
+}
+
+bool ContactModel::centres_particle(const Model& model, index_t p) const {
+  const Particle& particle = model.particles()[p];
+  if (model.shapes()[particle.shape].anchors.anchors.empty()) return false;
+  const index_t m = particle.material;
+  for (index_t b = 0; b < material_count_; ++b) {
+    if (law_set_[m * material_count_ + b] && laws_[m * material_count_ + b].node_pair) return false;
+  }
+  for (std::size_t w = 0; w < walls_.size(); ++w) {
+    if (wall_law_set_[w * material_count_ + m] && wall_laws_[w * material_count_ + m].node_pair) return false;
+  }
+  return true;
+}
+
+void ContactModel::find_centred_particles(const Model& model, const State& state) {
+  centres_found_ = true;
+  const index_t count = static_cast<index_t>(model.particles().size());
+  particle_centred_.assign(count, 0);
+  detached_.clear();
+  any_centred_ = false;
+  for (index_t p = 0; p < count; ++p) {
+    particle_centred_[p] = centres_particle(model, p) ? 1 : 0;
+    any_centred_ = any_centred_ || particle_centred_[p];
+  }
+  if (!any_centred_ || state.bonds.broken(model.bond_offsets(), 0, model.node_count()) == 0) return;
+  for (index_t i = 0; i < model.node_count(); ++i) {
+    const SurfaceAnchor* anchor = centred_anchor(model, i);
+    if (anchor == nullptr) continue;
+    const index_t first = model.particles()[model.node_particle()[i]].first_node;
+    const NodeBonds bonds = model.node_bonds(i);
+    for (const index_t k : anchor->nodes) {
+      const index_t b = k == SurfaceAnchor::no_anchor ? bonds.count : bonds.find(first + k);
+      if (b != bonds.count && !state.bonds.intact(i, b)) detach(model, i);  // the bond broke
+    }
+  }
+}
+
+void ContactModel::detach(const Model& model, index_t i) {
+  if (detached_.empty()) detached_.assign(model.node_count(), 0);
+  detached_[i] = 1;
+}
+
+void ContactModel::detach_anchored(const Model& model, std::span<const std::array<index_t, 2>> pairs) {
+  if (!centres_found_ || !any_centred_) return;
+  for (const auto& [i, j] : pairs) {
+    for (const auto& [node, other] : {std::array<index_t, 2>{i, j}, std::array<index_t, 2>{j, i}}) {
+      const SurfaceAnchor* anchor = centred_anchor(model, node);
+      if (anchor == nullptr) continue;
+      const index_t local = other - model.particles()[model.node_particle()[node]].first_node;
+      if (std::find(anchor->nodes.begin(), anchor->nodes.end(), local) != anchor->nodes.end())
+        detach(model, node);
+    }
+  }
+}
+
+const SurfaceAnchor* ContactModel::centred_anchor(const Model& model, index_t i) const {
+  if (!any_centred_ || !particle_centred_[model.node_particle()[i]]) return nullptr;
+  if (!detached_.empty() && detached_[i]) return nullptr;
+  return model.surface_anchor(i);
+}
+
+vec3 ContactModel::contact_position(const Model& model, const State& state, index_t i) const {
+  const real* y = state.positions.data();
+  vec3 c{y[3 * i], y[3 * i + 1], y[3 * i + 2]};
+  const SurfaceAnchor* anchor = centred_anchor(model, i);
+  if (anchor == nullptr) return c;
+  const index_t first = model.particles()[model.node_particle()[i]].first_node;
+  for (std::size_t k = 0; k < anchor->nodes.size() && anchor->nodes[k] != SurfaceAnchor::no_anchor; ++k) {
+    const index_t j = first + anchor->nodes[k];
+    const real w = anchor->weights[k];
+    for (int d = 0; d < 3; ++d) c[d] -= w * (y[3 * j + d] - y[3 * i + d]);
+  }
+  return c;
+}
+
+vec3 ContactModel::contact_velocity(const Model& model, const State& state, index_t i) const {
+  const real* v = state.velocities.data();
+  vec3 u{v[3 * i], v[3 * i + 1], v[3 * i + 2]};
+  const SurfaceAnchor* anchor = centred_anchor(model, i);
+  if (anchor == nullptr) return u;
+  const index_t first = model.particles()[model.node_particle()[i]].first_node;
+  for (std::size_t k = 0; k < anchor->nodes.size() && anchor->nodes[k] != SurfaceAnchor::no_anchor; ++k) {
+    const index_t j = first + anchor->nodes[k];
+    const real w = anchor->weights[k];
+    for (int d = 0; d < 3; ++d) u[d] -= w * (v[3 * j + d] - v[3 * i + d]);
+  }
+  return u;
+}
+
+void ContactModel::fill_contact_positions(const Model& model, const State& state,
+                                          std::vector<real>& x) const {
+  if (!any_centred_) {
+    x = state.positions;
+    return;
+  }
+  x.resize(state.positions.size());
+  const std::int64_t n = model.node_count();
+#pragma omp parallel for schedule(static)
+  for (std::int64_t i = 0; i < n; ++i) {
+    const vec3 c = contact_position(model, state, static_cast<index_t>(i));
+    for (int k = 0; k < 3; ++k) x[3 * i + k] = c[k];
+  }
 }
 
 contact::PairLaw ContactModel::pair_law(index_t p, index_t q) const {
@@ -183,6 +287,7 @@ void ContactModel::set_law(index_t a, index_t b, const contact::Law& law) {
   max_contact_radius_ =
       std::max(max_contact_radius_, contact::resolve_contact_radius(law, coarsest_a, coarsest_b));
   built_ = false;
+  centres_found_ = false;
 }
 
 index_t ContactModel::add_wall(Wall wall, int dimension) {
@@ -206,6 +311,7 @@ void ContactModel::set_wall_law(index_t wall, index_t material, const contact::L
   const contact::ContactSide coarsest{material_max_mesh_size_[material], 0, 0};
   max_contact_radius_ = std::max(max_contact_radius_, contact::resolve_wall_contact_radius(law, coarsest));
   built_ = false;
+  centres_found_ = false;
 }
 
 void ContactModel::set_skin(real skin) {
@@ -292,14 +398,14 @@ real ContactModel::stable_time_step(const Model& model) const {
 }
 
 real ContactModel::largest_displacement(const Model& model, const State& state) const {
-  const auto& x = state.positions;
   const std::int64_t n = model.node_count();
   real worst = 0;
 #pragma omp parallel for schedule(static) reduction(max : worst)
   for (std::int64_t i = 0; i < n; ++i) {
+    const vec3 x = contact_position(model, state, static_cast<index_t>(i));
     real d2 = 0;
     for (int k = 0; k < 3; ++k) {
-      const real d = x[3 * i + k] - positions_at_build_[3 * i + k];
+      const real d = x[k] - positions_at_build_[3 * i + k];
       d2 += d * d;
     }
     worst = std::max(worst, d2);
@@ -328,7 +434,6 @@ void ContactModel::update_after_breaks(const Model& model, const State& state, s
   // candidates. Then the bodies are labelled again.
   label_bodies(model, state, broken_bonds);
   const index_t n = model.node_count();
-  const auto& x = state.positions;
   const auto& node_particle = model.node_particle();
   const auto& node_material = model.node_material();
   const real extra = skin_ + 2 * moved;
@@ -340,7 +445,8 @@ void ContactModel::update_after_breaks(const Model& model, const State& state, s
         contact::resolve_contact_radius(laws_[m * material_count_ + m], particle_side_[node_particle[i]],
                                         particle_side_[node_particle[i]]) +
         extra;
-    const real dx = x[3 * j] - x[3 * i], dy = x[3 * j + 1] - x[3 * i + 1], dz = x[3 * j + 2] - x[3 * i + 2];
+    const vec3 xi = contact_position(model, state, i), xj = contact_position(model, state, j);
+    const real dx = xj[0] - xi[0], dy = xj[1] - xi[1], dz = xj[2] - xi[2];
     if (dx * dx + dy * dy + dz * dz > limit * limit) continue;
     const index_t* listed = pair_partner_.data();
     if (std::binary_search(listed + pair_offsets_[i], listed + pair_offsets_[i + 1], j)) continue;
@@ -622,11 +728,11 @@ void ContactModel::finish_lists(const Model& model) {
   wall_entry_reaction_.assign(wall_entry_.size(), {0, 0, 0, 0, 0, 0});
 }
 
-void ContactModel::rebuild(const Model& model, const State& state, std::uint64_t broken_bonds, bool finish) {
+void ContactModel::rebuild(const Model& model, const State& state, const std::vector<real>& x,
+                           std::uint64_t broken_bonds, bool finish) {
   if (skin_ < 0) skin_ = 0.5 * max_contact_radius_;
   const KeptLists kept{std::move(pair_offsets_), std::move(pair_partner_), std::move(pair_spring_),
                        std::move(wall_offsets_), std::move(wall_entry_),   std::move(wall_spring_)};
-  const auto& x = state.positions;
   const index_t n = model.node_count();
   const auto& particles = model.particles();
   const auto& node_particle = model.node_particle();
@@ -766,7 +872,7 @@ void ContactModel::rebuild(const Model& model, const State& state, std::uint64_t
   carry_over_springs(kept, n);
   if (finish) finish_lists(model);
 
-  positions_at_build_ = x;
+  if (&x != &positions_at_build_) positions_at_build_ = x;
   time_at_build_ = state.time;
   broken_at_build_ = broken_bonds;
   built_ = true;
@@ -829,7 +935,8 @@ std::size_t ContactModel::memory_bytes() const {
          bytes(touching_bodies_) + bytes(slot_touch_) + bytes(body_motion_) + bytes(body_load_) +
          bytes(slot_force_) + bytes(slot_normal_) + bytes(slot_point_) + bytes(slot_work_) +
          bytes(slot_exponent_) + bytes(damping_tables_) + bytes(wall_damping_tables_) +
-         bytes(slot_surface_normal_) + bytes(touching_nodes_) + bytes(touching_normals_);
+         bytes(slot_surface_normal_) + bytes(touching_nodes_) + bytes(touching_normals_) +
+         bytes(particle_centred_) + bytes(detached_) + bytes(centre_forces_);
 }
 
 ContactCheckpoint ContactModel::checkpoint() const {
@@ -912,6 +1019,7 @@ void ContactModel::restore(const Model& model, const State& state, const Contact
   check_checkpoint(model, saved);
   skin_ = saved.skin;
   bodies_labelled_ = false;  // the restored bonds may differ from the current ones
+  centres_found_ = false;    // and so may the detached surface nodes
   newly_broken_.clear();
   slots_ = saved.slots;
   particle_slot_count_ = saved.particle_slot_count;
@@ -934,7 +1042,7 @@ void ContactModel::restore(const Model& model, const State& state, const Contact
     // checkpoint without them predates these updates, and a search gives them again).
     const bool saved_lists = saved.pair_offsets.size() == static_cast<std::size_t>(model.node_count()) + 1 &&
                              saved.pair_offsets.back() == saved.pair_partners.size();
-    rebuild(model, at_build, saved.broken_at_build, !saved_lists);
+    rebuild(model, at_build, saved.positions_at_build, saved.broken_at_build, !saved_lists);
     if (saved_lists) {
       pair_offsets_ = saved.pair_offsets;
       pair_partner_ = saved.pair_partners;
@@ -967,9 +1075,11 @@ void ContactModel::restore(const Model& model, const State& state, const Contact
 void ContactModel::add_forces(const Model& model, State& state, std::uint64_t broken_bonds) {
   if (!active()) return;
   const auto search_start = std::chrono::steady_clock::now();
+  if (!centres_found_) find_centred_particles(model, state);
   real moved = 0;  // largest node displacement since the build
   if (needs_rebuild(model, state, moved)) {
-    rebuild(model, state, broken_bonds);
+    fill_contact_positions(model, state, positions_at_build_);
+    rebuild(model, state, positions_at_build_, broken_bonds);
   } else if (broken_bonds != broken_at_build_) {
     update_after_breaks(model, state, broken_bonds, moved);
   }
@@ -999,7 +1109,6 @@ void ContactModel::measure_contacts(const Model& model, const State& state) {
   // The only geometry pass: distance and spring stiffness of every pair entry in contact, and the
   // contact points (normals in the world frame) of every wall entry, and the nodes in contact with
   // another body. The later passes read these.
-  const auto& x = state.positions;
   const auto& volume = model.volumes();
   const std::int64_t n = model.node_count();
   const real t = state.time;
@@ -1012,12 +1121,14 @@ void ContactModel::measure_contacts(const Model& model, const State& state) {
 #pragma omp for schedule(static) nowait
     for (std::int64_t ii = 0; ii < n; ++ii) {
       const index_t i = static_cast<index_t>(ii);
+      if (pair_offsets_[i] == pair_offsets_[i + 1] && wall_offsets_[i] == wall_offsets_[i + 1]) continue;
+      const vec3 xi = contact_position(model, state, i);
       bool touching = false;
       for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
         const index_t j = pair_partner_[e];
         const contact::PairLaw& law = slot_law(pair_slot_[e]);
-        const real dx = x[3 * j] - x[3 * i], dy = x[3 * j + 1] - x[3 * i + 1],
-                   dz = x[3 * j + 2] - x[3 * i + 2];
+        const vec3 xj = contact_position(model, state, j);
+        const real dx = xj[0] - xi[0], dy = xj[1] - xi[1], dz = xj[2] - xi[2];
         const real distance = std::sqrt(dx * dx + dy * dy + dz * dz);
         pair_stiffness_[e] = distance < law.contact_radius && distance > 0
                                  ? static_cast<float>(contact::pair_stiffness(law, volume[i], volume[j]))
@@ -1031,7 +1142,7 @@ void ContactModel::measure_contacts(const Model& model, const State& state) {
         const Wall& wall = walls_[wall_entry_[e][0]];
         const contact::PairLaw& law = slot_law(wall_slot_[e]);
         found.clear();
-        wall.contacts(wall_entry_[e][1], wall.to_reference(&x[3 * i], t), law.contact_radius, dimension_,
+        wall.contacts(wall_entry_[e][1], wall.to_reference(xi.data(), t), law.contact_radius, dimension_,
                       found);
         WallPoints& points = wall_points_[e];
         points.count = static_cast<std::uint8_t>(std::min(found.size(), points.points.size()));
@@ -1114,9 +1225,9 @@ void ContactModel::measure_surface_normals(const Model& model, const State& stat
 void ContactModel::sum_slot_springs(const Model& model, const State& state) {
   // Spring force, spring-weighted normal (from the first body to the second, or from the wall to
   // the particle) and spring-weighted contact point per slot, summed in node order.
-  const auto& x = state.positions;
   const auto& volume = model.volumes();
   for (const index_t i : contact_nodes_) {
+    const vec3 xi = contact_position(model, state, i);
     for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
       const index_t j = pair_partner_[e];
       const std::size_t slot = pair_slot_[e];
@@ -1129,7 +1240,7 @@ void ContactModel::sum_slot_springs(const Model& model, const State& state) {
       slot_force_[touch] += spring;
       for (int k = 0; k < 3; ++k) {
         slot_normal_[touch][k] += spring * g.normal[k];
-        slot_point_[touch][k] += spring * (x[3 * i + k] + g.lever_i * g.normal[k]);
+        slot_point_[touch][k] += spring * (xi[k] + g.lever_i * g.normal[k]);
         slot_surface_normal_[touch][k] += spring * surface[k];
       }
     }
@@ -1147,7 +1258,7 @@ void ContactModel::sum_slot_springs(const Model& model, const State& state) {
         for (int c = 0; c < 3; ++c) {
           slot_normal_[touch][c] += spring * points.points[k].normal[c];
           slot_surface_normal_[touch][c] += spring * points.points[k].normal[c];
-          slot_point_[touch][c] += spring * (x[3 * i + c] - lever * points.points[k].normal[c]);
+          slot_point_[touch][c] += spring * (xi[c] - lever * points.points[k].normal[c]);
         }
       }
     }
@@ -1319,8 +1430,11 @@ real ContactModel::damping_ratio(std::size_t slot, real advance) {
 }
 
 void ContactModel::node_forces(const Model& model, State& state, real dt) {
-  // Each node gathers its own contact forces and updates its own friction springs.
+  // Each node gathers its own contact forces and updates its own friction springs. A centred
+  // node's forces act on its contact centre: (1 + W) of them go to the node here, -w_k to its
+  // anchors after (in node order, so the sums are the same for any thread count).
   const std::int64_t count = static_cast<std::int64_t>(contact_nodes_.size());
+  if (any_centred_) centre_forces_.assign(contact_nodes_.size(), vec3{0, 0, 0});
 #pragma omp parallel for schedule(static)
   for (std::int64_t k = 0; k < count; ++k) {
     const index_t i = contact_nodes_[k];
@@ -1336,7 +1450,27 @@ void ContactModel::node_forces(const Model& model, State& state, real dt) {
       const vec force = wall_force(model, state, i, e, dt);
       for (int c = 0; c < 3; ++c) total[c] += force[c];
     }
+    const SurfaceAnchor* anchor = centred_anchor(model, i);
+    if (anchor != nullptr) {
+      centre_forces_[k] = total;
+      real own = 1;
+      for (std::size_t a = 0; a < anchor->nodes.size() && anchor->nodes[a] != SurfaceAnchor::no_anchor; ++a)
+        own += anchor->weights[a];
+      for (real& c : total) c *= own;
+    }
     for (int c = 0; c < 3; ++c) state.forces[3 * i + c] += total[c] / model.volumes()[i];
+  }
+  if (!any_centred_) return;
+  for (std::int64_t k = 0; k < count; ++k) {
+    const index_t i = contact_nodes_[k];
+    const SurfaceAnchor* anchor = centred_anchor(model, i);
+    if (anchor == nullptr) continue;
+    const index_t first = model.particles()[model.node_particle()[i]].first_node;
+    for (std::size_t a = 0; a < anchor->nodes.size() && anchor->nodes[a] != SurfaceAnchor::no_anchor; ++a) {
+      const index_t j = first + anchor->nodes[a];
+      for (int c = 0; c < 3; ++c)
+        state.forces[3 * j + c] -= anchor->weights[a] * centre_forces_[k][c] / model.volumes()[j];
+    }
   }
 }
 
@@ -1347,11 +1481,11 @@ real ContactModel::entry_stiffness(const Model& model, index_t i, index_t e) con
 
 ContactModel::PairGeometry ContactModel::pair_geometry(const Model& model, const State& state, index_t i,
                                                        index_t e) const {
-  const auto& x = state.positions;
   const index_t j = pair_partner_[e];
   const contact::Law& law = laws_[model.node_material()[i] * material_count_ + model.node_material()[j]];
   const real contact_radius = slot_law(pair_slot_[e]).contact_radius;
-  const vec d{x[3 * j] - x[3 * i], x[3 * j + 1] - x[3 * i + 1], x[3 * j + 2] - x[3 * i + 2]};  // as in A
+  const vec3 xi = contact_position(model, state, i), xj = contact_position(model, state, j);
+  const vec d{xj[0] - xi[0], xj[1] - xi[1], xj[2] - xi[2]};  // as in A
   const real distance = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
   PairGeometry g;
   g.normal = {d[0] / distance, d[1] / distance, d[2] / distance};
@@ -1362,15 +1496,15 @@ ContactModel::PairGeometry ContactModel::pair_geometry(const Model& model, const
 }
 
 vec3 ContactModel::pair_force(const Model& model, const State& state, index_t i, index_t e, real dt) {
-  // Spring along the line of the nodes, the fragment dashpot, and friction at the contact point
-  // p = x_i + lever_i n, whose slip adds each body's rotation about its node to the nodes'
-  // velocities (the node lies inside its particle, p on the surface).
-  const auto& v = state.velocities;
+  // Spring along the line of the contact centres, the fragment dashpot, and friction at the
+  // contact point p = c_i + lever_i n, whose slip adds each body's rotation about the centre to
+  // the centres' velocities (the centre lies inside its particle, p on the surface).
   const index_t j = pair_partner_[e];
   const contact::Law& law = laws_[model.node_material()[i] * material_count_ + model.node_material()[j]];
   const PairGeometry g = pair_geometry(model, state, i, e);
   const vec& n = g.normal;  // from i to j
-  const vec relative{v[3 * i] - v[3 * j], v[3 * i + 1] - v[3 * j + 1], v[3 * i + 2] - v[3 * j + 2]};
+  const vec vi = contact_velocity(model, state, i), vj = contact_velocity(model, state, j);
+  const vec relative{vi[0] - vj[0], vi[1] - vj[1], vi[2] - vj[2]};
   const real approach = dot(relative, n);
   const real k = entry_stiffness(model, i, e);
   real push = contact::normal_force(k, g.overlap);
@@ -1389,9 +1523,9 @@ vec3 ContactModel::pair_force(const Model& model, const State& state, index_t i,
         cross(body_spin(node_body_[i]), {g.lever_i * n[0], g.lever_i * n[1], g.lever_i * n[2]});
     const vec turn_j =
         cross(body_spin(node_body_[j]), {-g.lever_j * n[0], -g.lever_j * n[1], -g.lever_j * n[2]});
-    const real slip[3] = {(v[3 * i] + turn_i[0]) - (v[3 * j] + turn_j[0]),
-                          (v[3 * i + 1] + turn_i[1]) - (v[3 * j + 1] + turn_j[1]),
-                          (v[3 * i + 2] + turn_i[2]) - (v[3 * j + 2] + turn_j[2])};
+    const real slip[3] = {(vi[0] + turn_i[0]) - (vj[0] + turn_j[0]),
+                          (vi[1] + turn_i[1]) - (vj[1] + turn_j[1]),
+                          (vi[2] + turn_i[2]) - (vj[2] + turn_j[2])};
     contact::tangential_force(law.tangential_stiffness_ratio * k, law.friction, push, n.data(), slip, dt,
                               springs_[pair_spring_[e]].data(), friction);
   }
@@ -1399,7 +1533,7 @@ vec3 ContactModel::pair_force(const Model& model, const State& state, index_t i,
 }
 
 ContactModel::WallGeometry ContactModel::wall_geometry(const Model& model, index_t i, index_t e) const {
-  // Friction acts at the deepest point: p = x_i - lever n, n from the wall towards the node.
+  // Friction acts at the deepest point: p = c_i - lever n, n from the wall towards the node.
   const contact::PairLaw& resolved = slot_law(wall_slot_[e]);
   const WallPoints& points = wall_points_[e];
   const WallContact& deepest = points.points[deepest_point(points.points.data(), points.count)];
@@ -1414,8 +1548,7 @@ ContactModel::WallGeometry ContactModel::wall_geometry(const Model& model, index
 vec3 ContactModel::wall_force(const Model& model, const State& state, index_t i, index_t e, real dt) {
   // Springs at every contact point of the entry, friction at the deepest; the wall takes the
   // opposite force at the contact point.
-  const real* xi = &state.positions[3 * i];
-  const real* vi = &state.velocities[3 * i];
+  const vec xi = contact_position(model, state, i), vi = contact_velocity(model, state, i);
   const Wall& wall = walls_[wall_entry_[e][0]];
   const contact::Law& law = wall_laws_[wall_entry_[e][0] * material_count_ + model.node_material()[i]];
   const contact::PairLaw& resolved = slot_law(wall_slot_[e]);

@@ -48,7 +48,8 @@ index_t Model::add_material(const MaterialParams& params) {
   return static_cast<index_t>(materials_.size() - 1);
 }
 
-index_t Model::add_shape(std::span<const real> positions, std::span<const real> volumes, real mesh_size) {
+index_t Model::add_shape(std::span<const real> positions, std::span<const real> volumes, real mesh_size,
+                         std::span<const real> surface_offsets) {
   require_not_finalized("add a shape");
   const std::size_t n = volumes.size();
   const std::string name = "shape " + std::to_string(shapes_.size());
@@ -72,7 +73,15 @@ index_t Model::add_shape(std::span<const real> positions, std::span<const real> 
       throw InputError(name + ": node " + std::to_string(a) + " has z != 0 in a 2D model");
     }
   }
+  if (!surface_offsets.empty() && surface_offsets.size() != 3 * n) {
+    throw InputError(name + ": " + std::to_string(surface_offsets.size() / 3) + " surface offsets for " +
+                     std::to_string(n) + " nodes");
+  }
+  if (!std::all_of(surface_offsets.begin(), surface_offsets.end(), [](real o) { return std::isfinite(o); }))
+    throw InputError(name + ": a surface offset is not finite");
   Shape shape;
+  if (std::any_of(surface_offsets.begin(), surface_offsets.end(), [](real o) { return o != 0; }))
+    shape.surface_offsets.assign(surface_offsets.begin(), surface_offsets.end());
   shape.positions.assign(positions.begin(), positions.end());
   shape.volumes.assign(volumes.begin(), volumes.end());
   shape.mesh_size = mesh_size;
@@ -165,9 +174,16 @@ void Model::finalize() {
   if (particles_.empty()) throw InputError("the model has no particles; add at least one body");
   build_bonds();
   build_bond_schedule();
-  // The shapes' node positions were only needed to build the bond families (a body used once
-  // would otherwise hold its nodes twice).
-  for (Shape& shape : shapes_) std::vector<real>().swap(shape.positions);
+  // The shapes' node positions and surface offsets were only needed to build the bond families
+  // and the surface anchors (a body used once would otherwise hold its nodes twice).
+  for (Shape& shape : shapes_) {
+    if (!shape.surface_offsets.empty()) {
+      shape.anchors =
+          build_surface_anchors(shape.positions, shape.surface_offsets, shape.mesh_size, dimension_);
+    }
+    std::vector<real>().swap(shape.positions);
+    std::vector<real>().swap(shape.surface_offsets);
+  }
   finalized_ = true;
 }
 

@@ -330,7 +330,7 @@ void Simulation::compute_forces() {
     BondStates::clear(intact.node(j), bonds.find(i));
   }
   const std::uint64_t newly_broken = 2 * broken.size();
-  contact_.bonds_broke(broken);
+  contact_.bonds_broke(m, broken);
 
   // Dilatation and pressure of LPS nodes; body forces and damping start each node's sum.
 #pragma omp parallel for schedule(static)
@@ -451,7 +451,7 @@ std::array<std::size_t, 2> Simulation::memory_bytes() const {
                       contact_.memory_bytes();
   for (const BondFamilies& f : m.families()) other += bytes(f.offsets) + bytes(f.forward);
   other += m.bond_schedule().memory_bytes();
-  for (const Shape& s : m.shapes()) other += bytes(s.positions) + bytes(s.volumes);
+  for (const Shape& s : m.shapes()) other += bytes(s.positions) + bytes(s.volumes) + s.anchors.memory_bytes();
   return {bonds, other};
 }
 
@@ -584,7 +584,7 @@ void Simulation::break_bonds(const std::vector<std::array<index_t, 2>>& pairs) {
       BondStates::clear(state_.bonds.node(backward[0]), backward[1]);
       broken_bond_copies_ += 2;
       const std::array<index_t, 2> pair{i, j};
-      contact_.bonds_broke({&pair, 1});
+      contact_.bonds_broke(*model_, {&pair, 1});
     }
   }
   forces_current_ = false;

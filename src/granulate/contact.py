@@ -1,17 +1,18 @@
 """Contact parameters between particles, and between particles and walls.
 
 Every node is a contact sphere of radius rho_i = contact_radius_factor x h_i / 2 (h_i: its
-particle's mesh size), reaching the particle's surface. Two nodes interact when they are closer
-than Rc = rho_i + rho_j and no intact bond joins them (nodes of different particles, or of
-fragments of one particle); a node touches a wall closer than rho_i. The pair force is a spring
-kn (Rc - R) min(V_i, V_j)^2, a dashpot sized so that two bodies colliding head-on rebound with
-the requested coefficient of restitution (acting on both bodies at the contact point; its
-damping ratio is fitted to each collision's force-approach law, which stiffens as a curved
-grain's contact widens), and
-Coulomb friction with stick: a tangential spring per contact (Cundall & Strack), capped at
-mu F_n, acting on the particles' surfaces (see cpp/include/granulate/contact/contact_law.hpp
-for the formulas). Particles of different sizes meshed with the same nodes per radius collide
-like equal ones; a particle at rest sits at its radius.
+particle's mesh size), reaching the particle's surface (a node that lies on the surface, a
+mesh's or grid's boundary vertex, has its sphere centred h/2 inside it). Two nodes interact
+when they are closer than Rc = rho_i + rho_j and no intact bond joins them (nodes of different
+particles, or of fragments of one particle); a node touches a wall closer than rho_i. The
+pair force is a spring kn (Rc - R) min(V_i, V_j)^2, a dashpot sized so that two bodies
+colliding head-on rebound with the requested coefficient of restitution (acting on both bodies
+at the contact point; its damping ratio is fitted to each collision's force-approach law,
+which stiffens as a curved grain's contact widens), and Coulomb friction with stick: a
+tangential spring per contact (Cundall & Strack), capped at mu F_n, acting on the particles'
+surfaces (see cpp/include/granulate/contact/contact_law.hpp for the formulas). Particles of
+different sizes meshed with the same nodes per radius collide like equal ones; a particle at
+rest sits at its radius.
 
 Defaults: contact_radius_factor 0.95; kn = c / delta, the stiffness of a peridynamic bond one
 horizon long (PMB micromodulus c, constant influence) for the harmonic mean of the two moduli:

@@ -36,13 +36,16 @@ VOLUME_FIELDS = ("volume", "Volume", "Nodal_Volume", "nodal_volume")
 
 @dataclass(frozen=True)
 class NodalMesh:
-    """Nodes with volumes read from a file: positions (n, 3) [m], volumes (n,) [m^d]."""
+    """Nodes with volumes read from a file: positions (n, 3) [m], volumes (n,) [m^d], and the
+    offsets of the nodes on the boundary (``surface``, (n, 3), see ``boundary_offsets``; None
+    when the file has no elements to tell)."""
 
     positions: NDArray[np.float64]
     volumes: NDArray[np.float64]
     mesh_size: float
     dimension: int
     source: str = field(default="")
+    surface: NDArray[np.float64] | None = None
 
 
 def _require_declared_nodes(file: Path) -> None:
@@ -136,6 +139,68 @@ def element_measures(
     raise InputError(f"element kind {kind!r} is not supported")
 
 
+#: The facets of each element kind (local vertex numbers): edges in 2D, faces in 3D.
+_FACETS = {
+    "triangle": ((0, 1), (1, 2), (2, 0)),
+    "quad": ((0, 1), (1, 2), (2, 3), (3, 0)),
+    "tetra": ((0, 1, 2), (0, 1, 3), (0, 2, 3), (1, 2, 3)),
+    "hexahedron": (
+        (0, 1, 2, 3),
+        (4, 5, 6, 7),
+        (0, 1, 5, 4),
+        (1, 2, 6, 5),
+        (2, 3, 7, 6),
+        (3, 0, 4, 7),
+    ),
+}
+
+
+def boundary_offsets(
+    blocks: list[tuple[str, NDArray[np.int64]]], points: NDArray[np.float64], dimension: int
+) -> NDArray[np.float64]:
+    """Per node (n, 3): zero inside the mesh; on its boundary, the vector o with n_k . o = 1 for
+    the outward unit normal n_k of every boundary facet (edge in 2D, face in 3D; a facet of one
+    element only) at the node, in the least-squares sense: o = M^+ sum_k n_k with M = sum_k n_k
+    n_k^T, directions whose eigenvalue is under 5 % of the largest left out. On a face o is its
+    normal; at an edge or corner it reaches every face at once (two faces meeting at an angle a
+    give |o| = 1 / sin(a / 2)); on a curved surface, the mean normal. Contact puts a surface
+    node's sphere at depth h/2 below its faces, at x - (h / 2) o (see granulate.contact)."""
+    facets, owners = [], []
+    for kind, cells in blocks:
+        for local in _FACETS[kind]:
+            facets.append(np.sort(cells[:, local], axis=1))
+            owners.append(cells)
+    offsets = np.zeros((len(points), 3))
+    for width in {f.shape[1] for f in facets}:
+        same = np.concatenate([f for f in facets if f.shape[1] == width])
+        cells = [c for f, c in zip(facets, owners, strict=True) if f.shape[1] == width]
+        centroids = np.concatenate([points[c].mean(axis=1) for c in cells])
+        _, index, counts = np.unique(same, axis=0, return_index=True, return_counts=True)
+        single = index[counts == 1]
+        faces, inside = same[single], centroids[single]
+        x = points[faces]
+        if dimension == 2:
+            edge = x[:, 1] - x[:, 0]
+            normals = np.column_stack([edge[:, 1], -edge[:, 0], np.zeros(len(edge))])
+        else:
+            normals = np.cross(x[:, 1] - x[:, 0], x[:, 2] - x[:, 0])
+        normals /= np.linalg.norm(normals, axis=1)[:, None]
+        outward = np.einsum("ij,ij->i", normals, x.mean(axis=1) - inside) > 0
+        normals[~outward] *= -1
+        moments = np.zeros((len(points), 3, 3))
+        sums = np.zeros((len(points), 3))
+        for k in range(width):
+            np.add.at(moments, faces[:, k], normals[:, :, None] * normals[:, None, :])
+            np.add.at(sums, faces[:, k], normals)
+        on_surface = np.flatnonzero(np.any(sums != 0, axis=1))
+        values, vectors = np.linalg.eigh(moments[on_surface])
+        kept = values > 0.05 * values[:, -1:]
+        inverse = np.where(kept, 1 / np.where(kept, values, 1), 0)
+        local = np.einsum("nji,nj->ni", vectors, sums[on_surface]) * inverse
+        offsets[on_surface] += np.einsum("nij,nj->ni", vectors, local)
+    return offsets
+
+
 #: c of the element size (c |e|)^(1/d): the measure of a right-angled element of unit edge.
 _SIZE_FACTOR = {"triangle": 2.0, "quad": 1.0, "tetra": 6.0, "hexahedron": 1.0}
 
@@ -188,8 +253,11 @@ def nodal_mesh(mesh, *, dimension: int | None = None, source: str = "mesh") -> N
             np.add.at(volumes, cells.reshape(-1), np.repeat(measures / wanted[kind], wanted[kind]))
             sizes.append((_SIZE_FACTOR[kind] * measures) ** (1.0 / dimension))
             used[cells.reshape(-1)] = True
+    surface = boundary_offsets(blocks, points, dimension) if volume_field is None else None
     # Nodes of no element (gmsh geometry points, boundary-only nodes) carry no volume: drop them.
     positions, volumes = points[used], volumes[used]
+    if surface is not None:
+        surface = surface[used]
     if len(volumes) == 0:
         raise InputError(f"{source}: the mesh has no nodes")
     bad = np.flatnonzero(~(volumes > 0) | ~np.isfinite(volumes))
@@ -202,7 +270,9 @@ def nodal_mesh(mesh, *, dimension: int | None = None, source: str = "mesh") -> N
         mesh_size = float(np.median(np.concatenate(sizes)))
     else:
         mesh_size = float(np.median(volumes) ** (1.0 / dimension))
-    return NodalMesh(np.ascontiguousarray(positions), volumes, mesh_size, dimension, source)
+    return NodalMesh(
+        np.ascontiguousarray(positions), volumes, mesh_size, dimension, source, surface
+    )
 
 
 def read_mesh(path: str | Path, *, dimension: int | None = None) -> NodalMesh:

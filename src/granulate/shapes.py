@@ -717,6 +717,21 @@ def grid(shape: Shape, mesh_size: float) -> tuple[NDArray[np.float64], NDArray[n
     return points, volumes.reshape(-1)
 
 
+def grid_surface(shape: Rectangle | Box, positions: NDArray[np.float64]) -> NDArray[np.float64]:
+    """The surface offsets of ``grid(shape, h)``'s nodes (see ReferenceShape.surface): -1 or +1
+    along each axis where a node lies on the lower or upper face, zero inside."""
+    d = shape.dimension
+    lower = np.asarray(shape.lower, dtype=float)[:d]
+    upper = np.asarray(shape.upper, dtype=float)[:d]
+    tolerance = 1e-9 * float(np.max(upper - lower))
+    offsets = np.zeros((len(positions), 3))
+    p = positions[:, :d]
+    offsets[:, :d] = (np.abs(p - upper) <= tolerance).astype(float) - (
+        np.abs(p - lower) <= tolerance
+    ).astype(float)
+    return offsets
+
+
 def conforming(shape: Shape, mesh_size: float) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Nodes on rings (2D) or shells (3D) that follow the surface of a Disc, Ellipse, Sphere or
     Ellipsoid, so the particle's surface is smooth instead of a lattice staircase (this matters
@@ -914,6 +929,11 @@ class ReferenceShape:
     volumes: NDArray[np.float64]  # (n,) [m^d]
     mesh_size: float  # [m]
     dimension: int
+    #: (n, 3) the offsets o of the nodes on the surface (a mesh's boundary vertices, a grid's
+    #: boundary; n . o = 1 for each face normal n at the node, zero inside), or None where no
+    #: node lies on it (the lattice and conforming rings keep theirs h/2 inside). Contact centres
+    #: the spheres of these nodes at x - (h/2) o, so that they reach the surface.
+    surface: NDArray[np.float64] | None = None
 
     @staticmethod
     def from_shape(
@@ -930,6 +950,7 @@ class ReferenceShape:
         or "grid" (grid vertices with finite-element volumes: Rectangle, Box).
         ``centered``: move the shape's ``origin`` (centre or centroid) to (0, 0, 0), so that
         rotations and scales act about it."""
+        surface = None
         if discretization == "lattice":
             positions, volumes = lattice(shape, mesh_size, jitter=jitter, seed=seed)
         elif discretization in ("conforming", "grid"):
@@ -937,6 +958,8 @@ class ReferenceShape:
                 raise InputError("jitter applies to the lattice discretization only")
             make = conforming if discretization == "conforming" else grid
             positions, volumes = make(shape, mesh_size)
+            if discretization == "grid":
+                surface = grid_surface(shape, positions)
         else:
             raise InputError(
                 f"unknown discretization {discretization!r}; choose 'lattice', 'conforming' or "
@@ -944,7 +967,7 @@ class ReferenceShape:
             )
         if centered:
             positions = positions - shape.origin
-        return ReferenceShape(positions, volumes, float(mesh_size), shape.dimension)
+        return ReferenceShape(positions, volumes, float(mesh_size), shape.dimension, surface)
 
     @staticmethod
     def from_mesh(
@@ -971,7 +994,9 @@ class ReferenceShape:
         h = mesh.mesh_size if mesh_size is None else float(mesh_size)
         if not (h > 0 and np.isfinite(h)):
             raise InputError(f"mesh size must be positive, got {mesh_size}")
-        return ReferenceShape(np.ascontiguousarray(positions), mesh.volumes, h, mesh.dimension)
+        return ReferenceShape(
+            np.ascontiguousarray(positions), mesh.volumes, h, mesh.dimension, mesh.surface
+        )
 
     @staticmethod
     def from_nodes(

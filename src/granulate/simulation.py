@@ -225,6 +225,8 @@ class Simulation:
         self.bodies: list[Body] = []
         self._positions: list[NDArray[np.float64]] = []
         self._volumes: list[NDArray[np.float64]] = []
+        # Per body without a reference shape: its surface offsets (a grid), or None.
+        self._surfaces: list[NDArray[np.float64] | None] = []
         self._initial_velocities: list[
             tuple[Body, NDArray[np.float64], float | NDArray[np.float64]]
         ] = []
@@ -317,16 +319,17 @@ class Simulation:
         reference = ReferenceShape.from_shape(
             shape, mesh_size, discretization=discretization, jitter=jitter, seed=seed
         )
-        positions, volumes = reference.positions, reference.volumes
-        return self.add_body_from_nodes(
-            positions,
-            volumes,
+        body = self.add_body_from_nodes(
+            reference.positions,
+            reference.volumes,
             material,
             mesh_size,
             velocity=velocity,
             angular_velocity=angular_velocity,
             name=name,
         )
+        self._surfaces[body.index] = reference.surface
+        return body
 
     def add_particle(
         self,
@@ -472,6 +475,7 @@ class Simulation:
         self.bodies.append(body)
         self._positions.append(np.ascontiguousarray(p))
         self._volumes.append(np.ascontiguousarray(v))
+        self._surfaces.append(None)
         if velocity is not None or angular_velocity is not None:
             linear = np.zeros(3) if velocity is None else self._vector(velocity, "velocity")
             spin: float | NDArray[np.float64] = 0.0
@@ -856,8 +860,8 @@ class Simulation:
         material_ids: dict[int, int] = {}
         core_materials: list[Material] = []
         shape_ids: dict[int, int] = {}
-        for body, positions, volumes in zip(
-            self.bodies, self._positions, self._volumes, strict=True
+        for body, positions, volumes, surface in zip(
+            self.bodies, self._positions, self._volumes, self._surfaces, strict=True
         ):
             horizon = body.material.resolved_horizon(body.mesh_size)
             key = id(body.material)
@@ -865,12 +869,18 @@ class Simulation:
                 material_ids[key] = model.add_material(body.material.core_params(body.mesh_size))
                 core_materials.append(body.material)
             if body.reference is None:
-                model.add_particle(positions, volumes, material_ids[key], body.mesh_size, horizon)
+                shape = model.add_shape(
+                    positions, volumes, body.mesh_size, _surface_offsets(surface)
+                )
+                model.place_shape(shape, material_ids[key], positions, 1.0, horizon)
                 continue
             reference = body.reference
             if id(reference) not in shape_ids:
                 shape_ids[id(reference)] = model.add_shape(
-                    reference.positions, reference.volumes, reference.mesh_size
+                    reference.positions,
+                    reference.volumes,
+                    reference.mesh_size,
+                    _surface_offsets(reference.surface),
                 )
             model.place_shape(
                 shape_ids[id(reference)], material_ids[key], positions, body.scale, horizon
@@ -1786,3 +1796,10 @@ class Simulation:
             out.history = HistoryWriter(out.directory / "history.csv", list(row))
         out.history.write(row)
         out.history_step = int(core.step)
+
+
+def _surface_offsets(surface: NDArray[np.float64] | None) -> NDArray[np.float64]:
+    """Surface offsets for the core, flat (3 per node), or none (an empty array)."""
+    if surface is None:
+        return np.zeros(0)
+    return np.ascontiguousarray(surface, dtype=np.float64).reshape(-1)

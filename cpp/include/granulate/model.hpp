@@ -10,6 +10,7 @@
 #include "granulate/material.hpp"
 #include "granulate/peridynamics/lps.hpp"
 #include "granulate/state.hpp"
+#include "granulate/surface_anchors.hpp"
 #include "granulate/types.hpp"
 
 namespace granulate {
@@ -20,6 +21,13 @@ struct Shape {
   std::vector<real> positions;  ///< n x 3 [m], local frame (released by Model::finalize)
   std::vector<real> volumes;    ///< n [m^d]
   real mesh_size = 0;           ///< h [m] of the reference discretisation
+  /// Nodes on the shape's surface (the vertices on an imported mesh's or a grid's boundary),
+  /// n x 3 in the shape's frame: o_a with n_k . o_a = 1 for the outward normal n_k of every
+  /// boundary face at the node, zero inside; empty when no node lies on the surface (lattices
+  /// and conforming discretisations keep their outer nodes h/2 inside it). Turned into
+  /// `anchors` and released by Model::finalize.
+  std::vector<real> surface_offsets;
+  SurfaceAnchors anchors;  ///< where contact centres the surface nodes' spheres
   index_t node_count() const { return static_cast<index_t>(volumes.size()); }
 };
 
@@ -107,8 +115,10 @@ class Model {
   index_t add_material(const MaterialParams& params);
 
   /// Adds a reference shape: positions n x 3 row-major [m] (z = 0 in 2D), volumes n [m^3, or
-  /// m^2 per unit thickness in 2D], its mesh size h [m]. Returns the shape index.
-  index_t add_shape(std::span<const real> positions, std::span<const real> volumes, real mesh_size);
+  /// m^2 per unit thickness in 2D], its mesh size h [m], and optionally the offsets of the
+  /// nodes on its surface (n x 3, see Shape::surface_offsets). Returns the shape index.
+  index_t add_shape(std::span<const real> positions, std::span<const real> volumes, real mesh_size,
+                    std::span<const real> surface_offsets = {});
 
   /// Places a shape as a particle: `positions` (n x 3) are the shape's nodes after scaling by
   /// `scale`, rotating and translating (the caller places them; they are checked to be a rigid
@@ -143,6 +153,12 @@ class Model {
   const std::vector<index_t>& node_material() const { return node_material_; }
   const std::vector<real>& node_density() const { return node_density_; }
   const std::vector<Shape>& shapes() const { return shapes_; }
+  /// The anchors of node i if it lies on its shape's surface (see surface_anchors.hpp), else
+  /// null; their nodes are local to the particle (add its first node). Valid after finalize().
+  const SurfaceAnchor* surface_anchor(index_t i) const {
+    const Particle& p = particles_[node_particle_[i]];
+    return shapes_[p.shape].anchors.of(i - p.first_node);
+  }
   const std::vector<BondFamilies>& families() const { return families_; }
   /// Global bond numbering: the bonds of node i are bond_offsets()[i] .. bond_offsets()[i+1]-1.
   const std::vector<std::size_t>& bond_offsets() const { return bond_offsets_; }

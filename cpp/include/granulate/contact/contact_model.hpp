@@ -104,8 +104,10 @@ class ContactModel {
   /// Bonds (i, j) that broke since the last evaluation: the candidates the next list update
   /// inserts (a pair broken earlier and not inserted then cannot reach its Rc before the next
   /// rebuild; see update_after_breaks).
-  void bonds_broke(std::span<const std::array<index_t, 2>> pairs) {
-    if (active()) newly_broken_.insert(newly_broken_.end(), pairs.begin(), pairs.end());
+  void bonds_broke(const Model& model, std::span<const std::array<index_t, 2>> pairs) {
+    if (!active()) return;
+    newly_broken_.insert(newly_broken_.end(), pairs.begin(), pairs.end());
+    detach_anchored(model, pairs);
   }
 
   /// Per wall: force (x, y, z) and torque about its centre (x, y, z) exerted by the particles
@@ -137,8 +139,10 @@ class ContactModel {
   /// Whether the lists must be searched again; `moved`: the largest node displacement since the
   /// build (0 when not computed).
   bool needs_rebuild(const Model& model, const State& state, real& moved) const;
-  /// A grid search at the current positions; `finish`: then finish_lists.
-  void rebuild(const Model& model, const State& state, std::uint64_t broken_bonds, bool finish = true);
+  /// A grid search at the contact positions x (see contact_positions) of `state`; `finish`: then
+  /// finish_lists.
+  void rebuild(const Model& model, const State& state, const std::vector<real>& x, std::uint64_t broken_bonds,
+               bool finish = true);
   /// After bonds broke (and nothing moved half the skin): the pairs of newly_broken_ into the
   /// lists.
   void update_after_breaks(const Model& model, const State& state, std::uint64_t broken_bonds, real moved);
@@ -157,6 +161,37 @@ class ContactModel {
   void assign_springs();
   /// The free list: every pool spring no entry holds, in increasing order.
   void collect_free_springs();
+  // Surface nodes (the vertices on an imported mesh's or a grid's boundary) lie on the
+  // surface, where a lattice's outer nodes lie h/2 inside it: contact centres their spheres at
+  // c_i = (1 + W) y_i - sum_k w_k y_k (W = sum_k w_k) over their anchors (surface_anchors.hpp),
+  // h/2 below every face at the node, following the particle as it turns and deforms. c_i is a
+  // virtual node: it moves at (1 + W) v_i - sum_k w_k v_k, and a force F on it goes as (1 + W) F
+  // to node i and -w_k F to anchor k (node_forces), which is F at c_i in force, moment and work:
+  // momentum, angular momentum and the springs' energy are kept. A node whose bond to an anchor
+  // broke is detached: its sphere is centred on itself from then on. Not with PeriDEM's law.
+  /// Whether particle p's surface nodes are centred (its shape has anchors and no law of its
+  /// material is PeriDEM's node-pair law).
+  bool centres_particle(const Model& model, index_t p) const;
+  /// The particles whose surface nodes are centred, and the detached nodes, from the laws and
+  /// the bond states (at the first evaluation, and after a restore).
+  void find_centred_particles(const Model& model, const State& state);
+  void detach(const Model& model, index_t i);
+  /// Detaches the nodes whose bond to one of their anchors is among `pairs` (bonds that broke).
+  void detach_anchored(const Model& model, std::span<const std::array<index_t, 2>> pairs);
+  /// The anchors of node i if its sphere is centred, else null.
+  const SurfaceAnchor* centred_anchor(const Model& model, index_t i) const;
+  /// Where contact sees node i: its contact centre c_i, or y_i.
+  vec3 contact_position(const Model& model, const State& state, index_t i) const;
+  /// The velocity of node i's contact centre (see contact_position).
+  vec3 contact_velocity(const Model& model, const State& state, index_t i) const;
+  /// Every node's contact position, into x (n x 3).
+  void fill_contact_positions(const Model& model, const State& state, std::vector<real>& x) const;
+  bool centres_found_ = false;
+  bool any_centred_ = false;
+  std::vector<std::uint8_t> particle_centred_;
+  std::vector<std::uint8_t> detached_;  // per node once a centred node is detached
+  std::vector<vec3> centre_forces_;     // per contact node: the force on its centre (per step)
+
   /// Nodes with list entries, grouped by body (each group in node order), and the per-step
   /// scratch of bodies and slots.
   void group_contact_nodes(const Model& model);
@@ -209,7 +244,7 @@ class ContactModel {
   WallGeometry wall_geometry(const Model& model, index_t i, index_t e) const;
   /// Force on node i of its wall entry e (updates the spring; sets the entry's reaction).
   vec3 wall_force(const Model& model, const State& state, index_t i, index_t e, real dt);
-  /// Sum of (p - x_i) x F_t over node i's friction forces, from the springs.
+  /// Sum of (p - c_i) x F_t over node i's friction forces, from the springs.
   vec3 friction_couple(const Model& model, const State& state, index_t i) const;
   /// Contact radius of node i in a contact of law `law` with node j (its share of the pair's Rc).
   real node_radius(const contact::Law& law, const Model& model, index_t i, index_t j,

@@ -1,0 +1,117 @@
+#include "granulate/surface_anchors.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
+#include "granulate/cell_grid.hpp"
+#include "granulate/types.hpp"
+
+namespace granulate {
+namespace {
+
+using vec = std::array<real, 3>;
+
+real det3(const vec& a, const vec& b, const vec& c) {
+  return a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
+         a[2] * (b[0] * c[1] - b[1] * c[0]);
+}
+
+/// |det| of the unit vectors along the columns: 1 when they are orthogonal, 0 when they do not
+/// span. In 2D the third column is (0, 0, 1).
+real spread(const std::array<vec, 3>& columns, int dimension) {
+  std::array<vec, 3> unit = columns;
+  for (int k = 0; k < dimension; ++k) {
+    const real length =
+        std::sqrt(unit[k][0] * unit[k][0] + unit[k][1] * unit[k][1] + unit[k][2] * unit[k][2]);
+    for (real& c : unit[k]) c /= length;
+  }
+  if (dimension == 2) unit[2] = {0, 0, 1};
+  return std::abs(det3(unit[0], unit[1], unit[2]));
+}
+
+/// w with sum_k w_k columns_k = target (Cramer's rule; in 2D the third column is (0, 0, 1)).
+std::array<real, 3> solve(std::array<vec, 3> columns, const vec& target, int dimension) {
+  if (dimension == 2) columns[2] = {0, 0, 1};
+  const real det = det3(columns[0], columns[1], columns[2]);
+  std::array<real, 3> w{0, 0, 0};
+  for (int k = 0; k < dimension; ++k) {
+    std::array<vec, 3> replaced = columns;
+    replaced[k] = target;
+    w[k] = det3(replaced[0], replaced[1], replaced[2]) / det;
+  }
+  return w;
+}
+
+/// The nodes within `radius` of node a, nearest first (ties by index), at most `count`.
+std::vector<index_t> nearest(const CellGrid& grid, const std::vector<real>& x, index_t a, real radius,
+                             int dimension, std::size_t count) {
+  std::vector<std::pair<real, index_t>> near;
+  grid.for_each_within(x, a, radius, dimension, [&](index_t j, real r2) { near.push_back({r2, j}); });
+  std::sort(near.begin(), near.end());
+  std::vector<index_t> nodes;
+  for (std::size_t k = 0; k < near.size() && k < count; ++k) nodes.push_back(near[k].second);
+  return nodes;
+}
+
+/// The d candidates whose bond vectors from a span best (largest spread; the first such in
+/// nearest-first order); empty if none spreads over 0.2.
+std::vector<index_t> best_span(const std::vector<real>& x, index_t a, const std::vector<index_t>& candidates,
+                               int dimension) {
+  auto bond = [&](index_t j) {
+    return vec{x[3 * j] - x[3 * a], x[3 * j + 1] - x[3 * a + 1], x[3 * j + 2] - x[3 * a + 2]};
+  };
+  real best = 0.2;
+  std::vector<index_t> chosen;
+  const std::size_t n = candidates.size();
+  for (std::size_t p = 0; p < n; ++p) {
+    for (std::size_t q = p + 1; q < n; ++q) {
+      if (dimension == 2) {
+        const real s = spread({bond(candidates[p]), bond(candidates[q]), vec{}}, 2);
+        if (s > best) best = s, chosen = {candidates[p], candidates[q]};
+        continue;
+      }
+      for (std::size_t r = q + 1; r < n; ++r) {
+        const real s = spread({bond(candidates[p]), bond(candidates[q]), bond(candidates[r])}, 3);
+        if (s > best) best = s, chosen = {candidates[p], candidates[q], candidates[r]};
+      }
+    }
+  }
+  return chosen;
+}
+
+}  // namespace
+
+SurfaceAnchors build_surface_anchors(std::span<const real> positions, std::span<const real> offsets,
+                                     real mesh_size, int dimension) {
+  const index_t n = static_cast<index_t>(positions.size() / 3);
+  SurfaceAnchors result;
+  const std::vector<real> x(positions.begin(), positions.end());
+  const real radius = 1.75 * mesh_size;
+  const CellGrid grid = CellGrid::build(x, 0, n, radius);
+  const std::size_t candidates = dimension == 2 ? 12 : 18;
+  result.slot.assign(n, SurfaceAnchors::none);
+  for (index_t a = 0; a < n; ++a) {
+    const vec o{offsets[3 * a], offsets[3 * a + 1], offsets[3 * a + 2]};
+    if (o[0] == 0 && o[1] == 0 && o[2] == 0) continue;
+    const std::vector<index_t> chosen =
+        best_span(x, a, nearest(grid, x, a, radius, dimension, candidates), dimension);
+    if (chosen.empty()) continue;
+    std::array<vec, 3> columns{};
+    for (std::size_t k = 0; k < chosen.size(); ++k) {
+      for (int c = 0; c < 3; ++c) columns[k][c] = x[3 * chosen[k] + c] - x[3 * a + c];
+    }
+    const vec target{0.5 * mesh_size * o[0], 0.5 * mesh_size * o[1], 0.5 * mesh_size * o[2]};
+    const std::array<real, 3> w = solve(columns, target, dimension);
+    SurfaceAnchor anchor;
+    for (std::size_t k = 0; k < chosen.size(); ++k) {
+      anchor.nodes[k] = chosen[k];
+      anchor.weights[k] = static_cast<float>(w[k]);
+    }
+    result.slot[a] = static_cast<index_t>(result.anchors.size());
+    result.anchors.push_back(anchor);
+  }
+  return result;
+}
+
+}  // namespace granulate
