@@ -271,9 +271,15 @@ void Model::build_bonds() {
   }
   for (index_t i = 0; i < nodes; ++i) bond_offsets_[i + 1] += bond_offsets_[i];
 
+  // Each force model's constants only where some particle uses it (8 and 24 bytes per node).
+  bool any_lps = false, any_pmb = false;
+  for (const Particle& p : particles_) {
+    any_lps = any_lps || materials_[p.material].params.model == ForceModel::lps;
+    any_pmb = any_pmb || materials_[p.material].params.model == ForceModel::pmb;
+  }
   weighted_volume_.assign(nodes, 0);
-  lps_coefficients_.assign(nodes, {});
-  pmb_stiffness_.assign(nodes, 0);
+  lps_coefficients_.assign(any_lps ? nodes : 0, {});
+  pmb_stiffness_.assign(any_pmb ? nodes : 0, 0);
   std::vector<index_t> isolated;
 #pragma omp parallel for schedule(static)
   for (std::int64_t ii = 0; ii < static_cast<std::int64_t>(nodes); ++ii) {
@@ -294,7 +300,7 @@ void Model::build_bonds() {
     if (material.params.model == ForceModel::pmb && first_moment > 0) {
       pmb_stiffness_[i] = dimension_ * dimension_ * material.dilatation_modulus / first_moment;
     }
-    if (m > 0) {
+    if (material.params.model == ForceModel::lps && m > 0) {
       const real d = lps_dimension();
       const real a = material.deviatoric_factor;
       const real G = material.params.shear_modulus;

@@ -32,10 +32,6 @@ Simulation::Simulation(std::shared_ptr<Model> model) : model_(std::move(model)) 
   state_.bonds.reset(m.bond_offsets());
   state_.dilatation.assign(n, 0);
   pressure_.assign(n, 0);
-  mesh_size_.resize(n);
-  for (const Particle& p : m.particles()) {
-    std::fill_n(mesh_size_.begin() + p.first_node, p.node_count, p.mesh_size);
-  }
   contact_.configure(m);
   stable_time_step_ = m.stable_time_step();
   time_step_ = 0.8 * stable_time_step_;
@@ -388,6 +384,8 @@ void Simulation::compute_forces() {
 void Simulation::run(std::uint64_t steps) {
   const Model& m = *model_;
   const auto& density = m.node_density();
+  const auto& particles = m.particles();
+  const auto& node_particle = m.node_particle();
   const std::int64_t n3 = 3 * static_cast<std::int64_t>(m.node_count());
   auto& x = state_.positions;
   auto& v = state_.velocities;
@@ -427,7 +425,7 @@ void Simulation::run(std::uint64_t steps) {
         v[k] += 0.5 * dt * f[k] / density[i];
         speed2 += v[k] * v[k];
       }
-      const real limit = mesh_size_[i] / dt;
+      const real limit = particles[node_particle[i]].mesh_size / dt;
       if (!(speed2 <= limit * limit)) first_unstable = std::min(first_unstable, i);
     }
     apply_prescribed_motion(false);
@@ -444,7 +442,7 @@ std::array<std::size_t, 2> Simulation::memory_bytes() const {
   for (const BondFamilies& f : m.families())
     bonds += bytes(f.neighbors) + bytes(f.weights) + bytes(f.lengths);
   std::size_t other = state_.bonds.offset_bytes() + bytes(state_.positions) + bytes(state_.velocities) +
-                      bytes(state_.forces) + bytes(state_.dilatation) + bytes(pressure_) + bytes(mesh_size_) +
+                      bytes(state_.forces) + bytes(state_.dilatation) + bytes(pressure_) +
                       bytes(m.reference_positions()) + bytes(m.volumes()) + bytes(m.node_particle()) +
                       bytes(m.node_material()) + bytes(m.node_density()) + bytes(m.bond_offsets()) +
                       bytes(m.weighted_volume()) + bytes(m.lps_coefficients()) + bytes(m.pmb_stiffness()) +
@@ -484,12 +482,13 @@ void Simulation::check_stability() const {
     const real speed2 = v[3 * i] * v[3 * i] + v[3 * i + 1] * v[3 * i + 1] + v[3 * i + 2] * v[3 * i + 2];
     const bool finite = std::isfinite(speed2) && std::isfinite(x[3 * i]) && std::isfinite(x[3 * i + 1]) &&
                         std::isfinite(x[3 * i + 2]);
-    if (!finite || std::sqrt(speed2) * time_step_ > mesh_size_[i]) {
+    const real mesh_size = model_->particles()[model_->node_particle()[i]].mesh_size;
+    if (!finite || std::sqrt(speed2) * time_step_ > mesh_size) {
       std::ostringstream msg;
       msg << "the simulation became unstable at step " << state_.step << " (t = " << state_.time
           << " s): node " << i << " of particle " << model_->node_particle()[i];
       if (finite)
-        msg << " moves at " << std::sqrt(speed2) << " m/s, more than its mesh size " << mesh_size_[i]
+        msg << " moves at " << std::sqrt(speed2) << " m/s, more than its mesh size " << mesh_size
             << " m per step";
       else
         msg << " has a non-finite position or velocity";

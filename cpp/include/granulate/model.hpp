@@ -182,8 +182,10 @@ class Model {
   }
   const BondSchedule& bond_schedule() const { return bond_schedule_; }
   const std::vector<real>& weighted_volume() const { return weighted_volume_; }
+  /// Per node, for LPS nodes (zero for others; empty when no particle uses LPS).
   const std::vector<lps::NodeCoefficients>& lps_coefficients() const { return lps_coefficients_; }
-  /// k_i = d^2 kappa_d / sum_j w_ij r_ij of PMB nodes (0 for LPS nodes), see pmb.hpp.
+  /// k_i = d^2 kappa_d / sum_j w_ij r_ij of PMB nodes (0 for LPS nodes; empty when no particle
+  /// uses PMB), see pmb.hpp.
   const std::vector<real>& pmb_stiffness() const { return pmb_stiffness_; }
 
   /// Fragments: connected components of the graph of intact bonds. Writes each node's label,

@@ -103,7 +103,6 @@ class Simulation {
   std::vector<PrescribedMotion> motions_;
   std::vector<NodalForce> nodal_forces_;
   std::vector<real> pressure_;            // A_i theta_i of LPS nodes
-  std::vector<real> mesh_size_;           // per node, for the stability check
   std::uint64_t broken_bond_copies_ = 0;  // both copies of a broken bond count
   ContactModel contact_;
   contact::PeridemDamping peridem_damping_;
