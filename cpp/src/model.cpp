@@ -174,14 +174,16 @@ void Model::finalize() {
   if (particles_.empty()) throw InputError("the model has no particles; add at least one body");
   build_bonds();
   build_bond_schedule();
-  // The shapes' node positions and surface offsets were only needed to build the bond families
-  // and the surface anchors (a body used once would otherwise hold its nodes twice).
+  // The shapes' node positions, volumes and surface offsets were only needed to place the
+  // particles and build the bond families and the surface anchors (a body used once would
+  // otherwise hold its nodes twice).
   for (Shape& shape : shapes_) {
     if (!shape.surface_offsets.empty()) {
       shape.anchors =
           build_surface_anchors(shape.positions, shape.surface_offsets, shape.mesh_size, dimension_);
     }
     std::vector<real>().swap(shape.positions);
+    std::vector<real>().swap(shape.volumes);
     std::vector<real>().swap(shape.surface_offsets);
   }
   finalized_ = true;

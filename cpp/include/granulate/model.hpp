@@ -19,7 +19,7 @@ namespace granulate {
 /// many particles as wanted (translated, rotated, scaled); its bond families are shared.
 struct Shape {
   std::vector<real> positions;  ///< n x 3 [m], local frame (released by Model::finalize)
-  std::vector<real> volumes;    ///< n [m^d]
+  std::vector<real> volumes;    ///< n [m^d] (released by Model::finalize)
   real mesh_size = 0;           ///< h [m] of the reference discretisation
   /// Nodes on the shape's surface (the vertices on an imported mesh's or a grid's boundary),
   /// n x 3 in the shape's frame: o_a with n_k . o_a = 1 for the outward normal n_k of every
@@ -28,7 +28,7 @@ struct Shape {
   /// `anchors` and released by Model::finalize.
   std::vector<real> surface_offsets;
   SurfaceAnchors anchors;  ///< where contact centres the surface nodes' spheres
-  index_t node_count() const { return static_cast<index_t>(volumes.size()); }
+  index_t node_count() const { return static_cast<index_t>(volumes.size()); }  ///< before finalize
 };
 
 /// A particle is a contiguous range of nodes: a shape placed with a scale, one material.
