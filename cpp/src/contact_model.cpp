@@ -176,12 +176,12 @@ bool ContactModel::centres_particle(const Model& model, index_t p) const {
 void ContactModel::find_centred_particles(const Model& model, const State& state) {
   centres_found_ = true;
   const index_t count = static_cast<index_t>(model.particles().size());
-  particle_centred_.assign(count, 0);
+  particle_depth_.assign(count, 0);
   detached_.clear();
   any_centred_ = false;
   for (index_t p = 0; p < count; ++p) {
-    particle_centred_[p] = centres_particle(model, p) ? 1 : 0;
-    any_centred_ = any_centred_ || particle_centred_[p];
+    if (centres_particle(model, p)) particle_depth_[p] = centring_depth(p);
+    any_centred_ = any_centred_ || particle_depth_[p] > 0;
   }
   if (!any_centred_ || state.bonds.broken(model.bond_offsets(), 0, model.node_count()) == 0) return;
   for (index_t i = 0; i < model.node_count(); ++i) {
@@ -214,8 +214,23 @@ void ContactModel::detach_anchored(const Model& model, std::span<const std::arra
   }
 }
 
+real ContactModel::centring_depth(index_t p) const {
+  // The node's contact radius over h/2, from its material's law with itself, or else its first
+  // law with another material or a wall.
+  const index_t m = particle_material_[p];
+  const contact::Law* law = law_set_[m * material_count_ + m] ? &laws_[m * material_count_ + m] : nullptr;
+  for (index_t b = 0; law == nullptr && b < material_count_; ++b) {
+    if (law_set_[m * material_count_ + b]) law = &laws_[m * material_count_ + b];
+  }
+  for (std::size_t w = 0; law == nullptr && w < walls_.size(); ++w) {
+    if (wall_law_set_[w * material_count_ + m]) law = &wall_laws_[w * material_count_ + m];
+  }
+  if (law == nullptr) return 0;
+  return contact::node_contact_radius(*law, particle_side_[p]) / (0.5 * particle_side_[p].mesh_size);
+}
+
 const SurfaceAnchor* ContactModel::centred_anchor(const Model& model, index_t i) const {
-  if (!any_centred_ || !particle_centred_[model.node_particle()[i]]) return nullptr;
+  if (!any_centred_ || !(particle_depth_[model.node_particle()[i]] > 0)) return nullptr;
   if (!detached_.empty() && detached_[i]) return nullptr;
   return model.surface_anchor(i);
 }
@@ -225,10 +240,11 @@ vec3 ContactModel::contact_position(const Model& model, const State& state, inde
   vec3 c{y[3 * i], y[3 * i + 1], y[3 * i + 2]};
   const SurfaceAnchor* anchor = centred_anchor(model, i);
   if (anchor == nullptr) return c;
-  const index_t first = model.particles()[model.node_particle()[i]].first_node;
+  const index_t p = model.node_particle()[i];
+  const index_t first = model.particles()[p].first_node;
   for (std::size_t k = 0; k < anchor->nodes.size() && anchor->nodes[k] != SurfaceAnchor::no_anchor; ++k) {
     const index_t j = first + anchor->nodes[k];
-    const real w = anchor->weights[k];
+    const real w = particle_depth_[p] * anchor->weights[k];
     for (int d = 0; d < 3; ++d) c[d] -= w * (y[3 * j + d] - y[3 * i + d]);
   }
   return c;
@@ -239,10 +255,11 @@ vec3 ContactModel::contact_velocity(const Model& model, const State& state, inde
   vec3 u{v[3 * i], v[3 * i + 1], v[3 * i + 2]};
   const SurfaceAnchor* anchor = centred_anchor(model, i);
   if (anchor == nullptr) return u;
-  const index_t first = model.particles()[model.node_particle()[i]].first_node;
+  const index_t p = model.node_particle()[i];
+  const index_t first = model.particles()[p].first_node;
   for (std::size_t k = 0; k < anchor->nodes.size() && anchor->nodes[k] != SurfaceAnchor::no_anchor; ++k) {
     const index_t j = first + anchor->nodes[k];
-    const real w = anchor->weights[k];
+    const real w = particle_depth_[p] * anchor->weights[k];
     for (int d = 0; d < 3; ++d) u[d] -= w * (v[3 * j + d] - v[3 * i + d]);
   }
   return u;
@@ -936,7 +953,7 @@ std::size_t ContactModel::memory_bytes() const {
          bytes(slot_force_) + bytes(slot_normal_) + bytes(slot_point_) + bytes(slot_work_) +
          bytes(slot_exponent_) + bytes(damping_tables_) + bytes(wall_damping_tables_) +
          bytes(slot_surface_normal_) + bytes(touching_nodes_) + bytes(touching_normals_) +
-         bytes(particle_centred_) + bytes(detached_) + bytes(centre_forces_);
+         bytes(particle_depth_) + bytes(detached_) + bytes(centre_forces_);
 }
 
 ContactCheckpoint ContactModel::checkpoint() const {
@@ -1453,9 +1470,10 @@ void ContactModel::node_forces(const Model& model, State& state, real dt) {
     const SurfaceAnchor* anchor = centred_anchor(model, i);
     if (anchor != nullptr) {
       centre_forces_[k] = total;
+      const real depth = particle_depth_[model.node_particle()[i]];
       real own = 1;
       for (std::size_t a = 0; a < anchor->nodes.size() && anchor->nodes[a] != SurfaceAnchor::no_anchor; ++a)
-        own += anchor->weights[a];
+        own += depth * anchor->weights[a];
       for (real& c : total) c *= own;
     }
     for (int c = 0; c < 3; ++c) state.forces[3 * i + c] += total[c] / model.volumes()[i];
@@ -1465,11 +1483,12 @@ void ContactModel::node_forces(const Model& model, State& state, real dt) {
     const index_t i = contact_nodes_[k];
     const SurfaceAnchor* anchor = centred_anchor(model, i);
     if (anchor == nullptr) continue;
-    const index_t first = model.particles()[model.node_particle()[i]].first_node;
+    const index_t p = model.node_particle()[i];
+    const index_t first = model.particles()[p].first_node;
     for (std::size_t a = 0; a < anchor->nodes.size() && anchor->nodes[a] != SurfaceAnchor::no_anchor; ++a) {
       const index_t j = first + anchor->nodes[a];
-      for (int c = 0; c < 3; ++c)
-        state.forces[3 * j + c] -= anchor->weights[a] * centre_forces_[k][c] / model.volumes()[j];
+      const real w = particle_depth_[p] * anchor->weights[a];
+      for (int c = 0; c < 3; ++c) state.forces[3 * j + c] -= w * centre_forces_[k][c] / model.volumes()[j];
     }
   }
 }

@@ -2,7 +2,7 @@
 
 Every node is a contact sphere of radius rho_i = contact_radius_factor x h_i / 2 (h_i: its
 particle's mesh size), reaching the particle's surface (a node that lies on the surface, a
-mesh's or grid's boundary vertex, has its sphere centred h/2 inside it). Two nodes interact
+mesh's or grid's boundary vertex, has its sphere centred rho_i inside it). Two nodes interact
 when they are closer than Rc = rho_i + rho_j and no intact bond joins them (nodes of different
 particles, or of fragments of one particle); a node touches a wall closer than rho_i. The
 pair force is a spring kn (Rc - R) min(V_i, V_j)^2, a dashpot sized so that two bodies

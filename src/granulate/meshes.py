@@ -164,7 +164,7 @@ def boundary_offsets(
     n_k^T, directions whose eigenvalue is under 5 % of the largest left out. On a face o is its
     normal; at an edge or corner it reaches every face at once (two faces meeting at an angle a
     give |o| = 1 / sin(a / 2)); on a curved surface, the mean normal. Contact puts a surface
-    node's sphere at depth h/2 below its faces, at x - (h / 2) o (see granulate.contact)."""
+    node's sphere one contact radius rho below its faces, at x - rho o (see granulate.contact)."""
     facets, owners = [], []
     for kind, cells in blocks:
         for local in _FACETS[kind]:

@@ -932,7 +932,8 @@ class ReferenceShape:
     #: (n, 3) the offsets o of the nodes on the surface (a mesh's boundary vertices, a grid's
     #: boundary; n . o = 1 for each face normal n at the node, zero inside), or None where no
     #: node lies on it (the lattice and conforming rings keep theirs h/2 inside). Contact centres
-    #: the spheres of these nodes at x - (h/2) o, so that they reach the surface.
+    #: the spheres of these nodes at x - rho o (rho: their contact radius), so that they reach
+    #: the surface.
     surface: NDArray[np.float64] | None = None
 
     @staticmethod

@@ -281,7 +281,7 @@ def test_collisions_of_meshed_particles_conserve_angular_momentum(
         sim.contact = gr.Contact(restitution=restitution, friction=friction)
         a = sim.add_particle(reference, SOFT, position=(0, 0, *zero))
         b = sim.add_particle(
-            reference, SOFT, position=(2e-3 + 1.5 * reference.mesh_size, offset, *zero)
+            reference, SOFT, position=(2e-3 + 0.6 * reference.mesh_size, offset, *zero)
         )
         sim.velocities[a.nodes, 0] = 0.1
         sim.velocities[b.nodes, 0] = -0.1

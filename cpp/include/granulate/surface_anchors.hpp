@@ -3,9 +3,10 @@
 //
 // A lattice's or conforming discretisation's outer nodes lie h/2 inside the surface, so a contact
 // sphere of radius about h/2 centred on each node reaches the surface. A boundary vertex lies on
-// the surface itself; its sphere is centred where a lattice would put the node, at depth h/2
-// below every boundary face at the vertex: c = y - (h/2) o in the shape's frame, o the surface
-// offset (n . o = 1 for each face normal n at the node; see granulate.meshes.boundary_offsets).
+// the surface itself; its sphere is centred inside, h/2 below every boundary face at the vertex
+// (contact scales that to the node's contact radius, so the sphere just reaches the faces):
+// c = y - (h/2) o in the shape's frame, o the surface offset (n . o = 1 for each face normal n
+// at the node; see granulate.meshes.boundary_offsets).
 // To follow the particle as it moves, turns and deforms, (h/2) o is written as a combination of
 // d bond vectors to nearby nodes of the same particle (its anchors, d = the dimension):
 //   (h/2) o = sum_k w_k (X_k - X_a)   in the shape's frame, so at any time

@@ -3,7 +3,7 @@
 // Each node i has a contact radius rho_i = factor h_i / 2 (h_i: its particle's mesh size), so its
 // contact sphere reaches the particle's surface (a lattice's or ring discretisation's outer nodes
 // lie h/2 inside it; a node that lies on the surface, a mesh's or grid's boundary vertex, has
-// its sphere centred h/2 below it, see surface_anchors.hpp). Two nodes i, j interact when
+// its sphere centred rho_i below it, see surface_anchors.hpp). Two nodes i, j interact when
 // R = |x_j - x_i| < Rc = rho_i + rho_j and no intact bond joins them; a node touches a wall when
 // its distance D to the surface is < rho_i.
 // With n = (x_j - x_i)/R and the overlap delta = Rc - R, the contact is the sum of three

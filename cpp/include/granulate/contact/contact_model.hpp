@@ -163,8 +163,9 @@ class ContactModel {
   void collect_free_springs();
   // Surface nodes (the vertices on an imported mesh's or a grid's boundary) lie on the
   // surface, where a lattice's outer nodes lie h/2 inside it: contact centres their spheres at
-  // c_i = (1 + W) y_i - sum_k w_k y_k (W = sum_k w_k) over their anchors (surface_anchors.hpp),
-  // h/2 below every face at the node, following the particle as it turns and deforms. c_i is a
+  // c_i = (1 + W) y_i - sum_k w_k y_k (W = sum_k w_k) over their anchors (surface_anchors.hpp,
+  // the weights scaled from h/2 to the node's contact radius), one contact radius below every
+  // face at the node, following the particle as it turns and deforms. c_i is a
   // virtual node: it moves at (1 + W) v_i - sum_k w_k v_k, and a force F on it goes as (1 + W) F
   // to node i and -w_k F to anchor k (node_forces), which is F at c_i in force, moment and work:
   // momentum, angular momentum and the springs' energy are kept. A node whose bond to an anchor
@@ -188,7 +189,10 @@ class ContactModel {
   void fill_contact_positions(const Model& model, const State& state, std::vector<real>& x) const;
   bool centres_found_ = false;
   bool any_centred_ = false;
-  std::vector<std::uint8_t> particle_centred_;
+  /// Per particle: how deep its surface nodes' spheres are centred, over h/2 (0: not centred).
+  /// One contact radius deep, so that the sphere reaches the surface (the anchors give h/2).
+  std::vector<real> particle_depth_;
+  real centring_depth(index_t p) const;
   std::vector<std::uint8_t> detached_;  // per node once a centred node is detached
   std::vector<vec3> centre_forces_;     // per contact node: the force on its centre (per step)
 
