@@ -617,3 +617,52 @@ def test_a_deck_writes_its_output_in_the_working_directory(
     meshes = [grain["mesh"]["file"] for grain in case["grains"].values()]
     assert meshes and all((target.parent / m).is_file() for m in meshes)
 
+
+def older_format(text: str, time_steps: int | None = None) -> str:
+    """compression_small_set written in PeriDEM's older deck format (its paper's decks): the two
+    wall zones under Zone (Is_Wall, Type, Parameters) with a Wall block, the displacement sets
+    by Wall_List, the loaded wall by Compressive_Test.Wall_Id, and the Contact_Data tag."""
+    data = yaml.safe_load(text)
+    walls = {}
+    for zone in ("Zone_9", "Zone_10"):
+        particle = data["Particle"].pop(zone)
+        data["Zone"][zone] = {k: particle[k] for k in ("Is_Wall", "Type", "Parameters")}
+        walls[zone] = {
+            "Type": "flexible",
+            "All_Dofs_Constrained": particle["All_Dofs_Constrained"],
+            "Mesh": True,
+        }
+    data["Wall"] = walls
+    data["Particle"]["Compressive_Test"] = {"Wall_Id": 1, "Wall_Force_Direction": 2}
+    for s, wall in (("Set_1", 0), ("Set_2", 1)):
+        del data["Displacement_BC"][s]["Particle_List"]
+        data["Displacement_BC"][s]["Wall_List"] = [wall]
+    data["Output"]["Tags"] = [*data["Output"].get("Tags", ["Displacement"]), "Contact_Data"]
+    if time_steps is not None:
+        data["Model"]["Time_Steps"] = time_steps
+    return yaml.safe_dump(data)
+
+
+def test_decks_in_peridems_older_format_translate_as_the_current_ones(tmp_path: Path) -> None:
+    """PeriDEM's paper decks (decks/n500_circ_hex) use an older format: wall zones under Zone
+    with a Wall block, Wall_List, Compressive_Test.Wall_Id. compression_small_set rewritten in
+    it translates to the same case as the original (walls 0 and 1 are its particles 15 and 16),
+    except the notes; its Time_Steps: 1 slip (fewer steps than one output interval) runs to
+    Final_Time at granulate's own time step, and says so."""
+    new = peridem.translate(DECKS / "compression_small_set" / "input_0.yaml")
+    old = peridem.translate(broken_deck(tmp_path / "a", "compression_small_set", older_format))
+    assert old.case == new.case
+    assert any("Contact_Data" in note for note in old.notes)
+    slip = broken_deck(tmp_path / "b", "compression_small_set", lambda t: older_format(t, 1))
+    translated = peridem.translate(slip)
+    assert translated.case["time"] == {"end": new.case["time"]["dt"] * new.case["time"]["steps"]}
+    assert any("Time_Steps: 1 is fewer than Output.Output_Interval" in n for n in translated.notes)
+    wrong = broken_deck(
+        tmp_path / "c",
+        "compression_small_set",
+        lambda t: older_format(t).replace("Wall_List:\n    - 1", "Wall_List:\n    - 2"),
+    )
+    with pytest.raises(
+        InputError, match=r"\[2\] names walls that do not exist \(walls are numbered 0 .. 1"
+    ):
+        peridem.translate(wrong)

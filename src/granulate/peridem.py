@@ -11,7 +11,10 @@ schema of granulate.case), so a deck runs through exactly the code path of a cas
   ``Parameters[0]``) and a material ``zone_<k>``; particles are placed from the CSV (scale
   r / Parameters[0], rotation o about z) and named ``p<i>`` with PeriDEM's global particle id i
   (zone by zone, CSV row order within a zone; a wall zone is one particle);
-- walls are particles with every node constrained, as in PeriDEM;
+- walls are particles with every node constrained, as in PeriDEM; PeriDEM's older deck format
+  (its paper's decks) says the same with a wall zone (``Zone.Zone_k.Is_Wall`` with ``Type`` and
+  ``Parameters``) meshed by a ``Wall.Zone_k`` block, ``Displacement_BC`` sets that select walls by
+  ``Wall_List`` (walls numbered 0, 1, ... in zone order) and ``Compressive_Test.Wall_Id``;
 - contact is set per zone pair: Rc = Contact_Radius, or Contact_Radius_Factor x the smallest
   node spacing over all particles; kn = Kn x Kn_Factor; e = Epsilon when Damping_On; mu =
   Friction_Coeff when Friction_On; no contact between two walls (PeriDEM skips wall pairs);
@@ -61,9 +64,10 @@ SECTIONS = (
     "IC",
     "Output",
     "Restart",
+    "Wall",
 )
 #: Top-level keys PeriDEM does not read (or that only describe the set-up).
-IGNORED_SECTIONS = ("HPX", "Policy", "Wall", "Container", "State_Potential")
+IGNORED_SECTIONS = ("HPX", "Policy", "Container", "State_Potential")
 
 _MODEL_KEYS = {
     "Dimension",
@@ -115,6 +119,7 @@ _CONTACT_KEYS = {
 }
 _SET_KEYS = {
     "Particle_List",
+    "Wall_List",
     "Particle_Exclude_List",
     "Region",
     "Direction",
@@ -150,6 +155,7 @@ TAGS = {
 }
 #: Tags granulate does not write (reported, the run goes on).
 UNWRITTEN_TAGS = (
+    "Contact_Data",
     "Zone_ID",
     "Force_Fixity",
     "Contact_Nodes",
@@ -390,6 +396,7 @@ def _translate(path: Path, compat: bool, output: Path | None) -> Translation:
     # ---------------------------------------------------------------- zones
     zone_block = _block(deck, "Zone", "deck", problems)
     particle_block = _block(deck, "Particle", "deck", problems)
+    wall_block = _block(deck, "Wall", "deck", problems)
     mesh_block = _block(deck, "Mesh", "deck", problems)
     material_block = _block(deck, "Material", "deck", problems)
     count = zone_block.get("Zones", 1)
@@ -421,6 +428,8 @@ def _translate(path: Path, compat: bool, output: Path | None) -> Translation:
         zk = f"Zone_{z}"
         zinfo = _block(zone_block, zk, "Zone", problems)
         pinfo = _block(particle_block, zk, "Particle", problems)
+        if zk in wall_block:
+            pinfo = _older_wall_zone(zk, zinfo, pinfo, wall_block, problems)
         problems.unknown(f"Zone.{zk}", zinfo, {"Is_Wall", "Type", "Parameters"})
         problems.unknown(f"Particle.{zk}", pinfo, _PARTICLE_ZONE_KEYS)
         if zinfo.get("Is_Wall", pinfo.get("Is_Wall", False)):
@@ -818,9 +827,28 @@ def _translate(path: Path, compat: bool, output: Path | None) -> Translation:
     loading: list[dict[str, Any]] = []
     named = {f"p{k}" for k in range(len(zone_of))}
 
+    # Walls by number (the older format's Wall_List, Wall_Id): 0, 1, ... in zone order.
+    wall_particles = [k for k, z in enumerate(zone_of) if z in walls]
+
+    def wall_ids(value: Any, where: str) -> list[int] | None:
+        if not isinstance(value, list) or any(
+            not isinstance(w, int) or not 0 <= w < len(wall_particles) for w in value
+        ):
+            problems.add(
+                f"{where}: {value!r} names walls that do not exist (walls are numbered 0 .. "
+                f"{len(wall_particles) - 1} in zone order)"
+            )
+            return None
+        return [wall_particles[w] for w in value]
+
     def select(info: dict[str, Any], where: str) -> dict[str, Any] | None:
         out: dict[str, Any] = {}
         ids = info.get("Particle_List")
+        if "Wall_List" in info:
+            by_wall = wall_ids(info["Wall_List"], f"{where}.Wall_List")
+            if by_wall is None:
+                return None
+            ids = [*(ids if isinstance(ids, list) else []), *by_wall]
         if ids is not None:
             if not isinstance(ids, list) or any(f"p{i}" not in named for i in ids):
                 if numbered or not isinstance(ids, list):
@@ -1016,7 +1044,10 @@ def _translate(path: Path, compat: bool, output: Path | None) -> Translation:
     if "two_particle" in test:
         track = [f"p{k}" for k in range(len(zone_of))]
     compressive = particle_block.get("Compressive_Test") or {}
-    wall_id = compressive.get("Particle_Id", compressive.get("Wall_Id"))
+    wall_id = compressive.get("Particle_Id")
+    if "Wall_Id" in compressive:
+        by_wall = wall_ids([compressive["Wall_Id"]], "Particle.Compressive_Test.Wall_Id")
+        wall_id = by_wall[0] if by_wall else None
     if wall_id is not None and f"p{wall_id}" in named and f"p{wall_id}" not in track:
         track.append(f"p{wall_id}")
     directory = default_output_directory(folder)
@@ -1073,7 +1104,16 @@ def _translate(path: Path, compat: bool, output: Path | None) -> Translation:
         case["loading"] = loading
     if gravity is not None and any(gravity):
         case["gravity"] = gravity
-    case["time"] = {"dt": final_time / steps, "steps": steps}
+    if steps < every:
+        # PeriDEM's paper decks say Time_Steps: 1, a run shorter than one output interval.
+        notes.append(
+            f"Model.Time_Steps: {steps} is fewer than Output.Output_Interval ({every}), which no "
+            "run means (PeriDEM's paper decks carry this slip): granulate runs to Final_Time at "
+            "its default time step; the output intervals count its steps"
+        )
+        case["time"] = {"end": final_time}
+    else:
+        case["time"] = {"dt": final_time / steps, "steps": steps}
     if output_spec is not None:
         case["output"] = output_spec
     if stop is not None:
@@ -1155,3 +1195,31 @@ def to_yaml(translation: Translation, compat: bool) -> str:
     header += [f"#   - {n}" for n in translation.notes]
     body = yaml.safe_dump(translation.case, sort_keys=False, default_flow_style=None, width=100)
     return "\n".join(header) + "\n" + body
+
+
+def _older_wall_zone(
+    zk: str,
+    zinfo: dict[str, Any],
+    pinfo: dict[str, Any],
+    wall_block: dict[str, Any],
+    problems: _Problems,
+) -> dict[str, Any]:
+    """The Particle.Zone_k entry that PeriDEM's older format's wall zone means (KEYS.md): the
+    zone's mesh is one wall placed as meshed, every node fixed if All_Dofs_Constrained."""
+    winfo = _block(wall_block, zk, "Wall", problems)
+    problems.unknown(f"Wall.{zk}", winfo, {"Type", "All_Dofs_Constrained", "Mesh"})
+    if not zinfo.get("Is_Wall", False):
+        problems.add(f"Wall.{zk}: zone {zk} is not a wall (Zone.{zk}.Is_Wall is not true)")
+    if winfo.get("Type", "flexible") != "flexible" or winfo.get("Mesh", True) is not True:
+        problems.add(
+            f"Wall.{zk}: granulate reads meshed (Type: flexible, Mesh: true) walls, got "
+            f"Type {winfo.get('Type')!r}, Mesh {winfo.get('Mesh')!r}"
+        )
+    if pinfo:
+        problems.add(f"Particle.{zk}: a wall zone of the older format has no Particle entry")
+    return {
+        "Type": zinfo.get("Type", ""),
+        "Parameters": zinfo.get("Parameters", []),
+        "All_Dofs_Constrained": bool(winfo.get("All_Dofs_Constrained", False)),
+        "Create_Particle_Using_ParticleZone_GeomObject": True,
+    }
