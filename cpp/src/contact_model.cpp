@@ -235,9 +235,10 @@ const SurfaceAnchor* ContactModel::centred_anchor(const Model& model, index_t i)
   return model.surface_anchor(i);
 }
 
-vec3 ContactModel::contact_position(const Model& model, const State& state, index_t i) const {
-  const real* y = state.positions.data();
-  vec3 c{y[3 * i], y[3 * i + 1], y[3 * i + 2]};
+vec3 ContactModel::at_centre(const Model& model, const std::vector<real>& field, index_t i) const {
+  // f_i - sum_k w_k (f_k - f_i) over node i's anchors (the weights scaled to its depth).
+  const real* f = field.data();
+  vec3 c{f[3 * i], f[3 * i + 1], f[3 * i + 2]};
   const SurfaceAnchor* anchor = centred_anchor(model, i);
   if (anchor == nullptr) return c;
   const index_t p = model.node_particle()[i];
@@ -245,24 +246,17 @@ vec3 ContactModel::contact_position(const Model& model, const State& state, inde
   for (std::size_t k = 0; k < anchor->nodes.size() && anchor->nodes[k] != SurfaceAnchor::no_anchor; ++k) {
     const index_t j = first + anchor->nodes[k];
     const real w = particle_depth_[p] * anchor->weights[k];
-    for (int d = 0; d < 3; ++d) c[d] -= w * (y[3 * j + d] - y[3 * i + d]);
+    for (int d = 0; d < 3; ++d) c[d] -= w * (f[3 * j + d] - f[3 * i + d]);
   }
   return c;
 }
 
+vec3 ContactModel::contact_position(const Model& model, const State& state, index_t i) const {
+  return at_centre(model, state.positions, i);
+}
+
 vec3 ContactModel::contact_velocity(const Model& model, const State& state, index_t i) const {
-  const real* v = state.velocities.data();
-  vec3 u{v[3 * i], v[3 * i + 1], v[3 * i + 2]};
-  const SurfaceAnchor* anchor = centred_anchor(model, i);
-  if (anchor == nullptr) return u;
-  const index_t p = model.node_particle()[i];
-  const index_t first = model.particles()[p].first_node;
-  for (std::size_t k = 0; k < anchor->nodes.size() && anchor->nodes[k] != SurfaceAnchor::no_anchor; ++k) {
-    const index_t j = first + anchor->nodes[k];
-    const real w = particle_depth_[p] * anchor->weights[k];
-    for (int d = 0; d < 3; ++d) u[d] -= w * (v[3 * j + d] - v[3 * i + d]);
-  }
-  return u;
+  return at_centre(model, state.velocities, i);
 }
 
 void ContactModel::fill_contact_positions(const Model& model, const State& state,

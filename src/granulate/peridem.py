@@ -783,6 +783,13 @@ def _translate(path: Path, compat: bool, output: Path | None) -> Translation:
             f"contact radius: Contact_Radius_Factor x the smallest node spacing of all particles "
             f"({h_min:.6g} m)"
         )
+        if not compat:
+            notes.append(
+                "contact surface: a mesh vertex on a particle's surface has its contact sphere "
+                "centred Rc/2 inside it, so particles touch where their meshes' surfaces meet "
+                "(PeriDEM centres it on the vertex, so its particles touch Rc apart; "
+                "--peridem-compat does too)"
+            )
         if damping_used:
             notes.append(
                 "contact damping: --peridem-compat: PeriDEM's particle-centre damping "

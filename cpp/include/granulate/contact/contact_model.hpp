@@ -181,6 +181,8 @@ class ContactModel {
   void detach_anchored(const Model& model, std::span<const std::array<index_t, 2>> pairs);
   /// The anchors of node i if its sphere is centred, else null.
   const SurfaceAnchor* centred_anchor(const Model& model, index_t i) const;
+  /// A nodal vector field (positions, velocities; n x 3) at node i's contact centre.
+  vec3 at_centre(const Model& model, const std::vector<real>& field, index_t i) const;
   /// Where contact sees node i: its contact centre c_i, or y_i.
   vec3 contact_position(const Model& model, const State& state, index_t i) const;
   /// The velocity of node i's contact centre (see contact_position).
