@@ -157,7 +157,7 @@ void ContactModel::configure(const Model& model) {
     material_max_mesh_size_[p.material] = std::max(material_max_mesh_size_[p.material], p.mesh_size);
   }
   built_ = false;
-  centres_found_ = false;
+  centres_.forget();
 }
 
 bool ContactModel::centres_particle(const Model& model, index_t p) const {
@@ -173,45 +173,12 @@ bool ContactModel::centres_particle(const Model& model, index_t p) const {
   return true;
 }
 
-void ContactModel::find_centred_particles(const Model& model, const State& state) {
-  centres_found_ = true;
-  const index_t count = static_cast<index_t>(model.particles().size());
-  particle_depth_.assign(count, 0);
-  detached_.clear();
-  any_centred_ = false;
-  for (index_t p = 0; p < count; ++p) {
-    if (centres_particle(model, p)) particle_depth_[p] = centring_depth(p);
-    any_centred_ = any_centred_ || particle_depth_[p] > 0;
+std::vector<real> ContactModel::centring_depths(const Model& model) const {
+  std::vector<real> depth(model.particles().size(), 0);
+  for (index_t p = 0; p < static_cast<index_t>(depth.size()); ++p) {
+    if (centres_particle(model, p)) depth[p] = centring_depth(p);
   }
-  if (!any_centred_ || state.bonds.broken(model.bond_offsets(), 0, model.node_count()) == 0) return;
-  for (index_t i = 0; i < model.node_count(); ++i) {
-    const SurfaceAnchor* anchor = centred_anchor(model, i);
-    if (anchor == nullptr) continue;
-    const index_t first = model.particles()[model.node_particle()[i]].first_node;
-    const NodeBonds bonds = model.node_bonds(i);
-    for (const index_t k : anchor->nodes) {
-      const index_t b = k == SurfaceAnchor::no_anchor ? bonds.count : bonds.find(first + k);
-      if (b != bonds.count && !state.bonds.intact(i, b)) detach(model, i);  // the bond broke
-    }
-  }
-}
-
-void ContactModel::detach(const Model& model, index_t i) {
-  if (detached_.empty()) detached_.assign(model.node_count(), 0);
-  detached_[i] = 1;
-}
-
-void ContactModel::detach_anchored(const Model& model, std::span<const std::array<index_t, 2>> pairs) {
-  if (!centres_found_ || !any_centred_) return;
-  for (const auto& [i, j] : pairs) {
-    for (const auto& [node, other] : {std::array<index_t, 2>{i, j}, std::array<index_t, 2>{j, i}}) {
-      const SurfaceAnchor* anchor = centred_anchor(model, node);
-      if (anchor == nullptr) continue;
-      const index_t local = other - model.particles()[model.node_particle()[node]].first_node;
-      if (std::find(anchor->nodes.begin(), anchor->nodes.end(), local) != anchor->nodes.end())
-        detach(model, node);
-    }
-  }
+  return depth;
 }
 
 real ContactModel::centring_depth(index_t p) const {
@@ -229,49 +196,12 @@ real ContactModel::centring_depth(index_t p) const {
   return contact::node_contact_radius(*law, particle_side_[p]) / (0.5 * particle_side_[p].mesh_size);
 }
 
-const SurfaceAnchor* ContactModel::centred_anchor(const Model& model, index_t i) const {
-  if (!any_centred_ || !(particle_depth_[model.node_particle()[i]] > 0)) return nullptr;
-  if (!detached_.empty() && detached_[i]) return nullptr;
-  return model.surface_anchor(i);
-}
-
-vec3 ContactModel::at_centre(const Model& model, const std::vector<real>& field, index_t i) const {
-  // f_i - sum_k w_k (f_k - f_i) over node i's anchors (the weights scaled to its depth).
-  const real* f = field.data();
-  vec3 c{f[3 * i], f[3 * i + 1], f[3 * i + 2]};
-  const SurfaceAnchor* anchor = centred_anchor(model, i);
-  if (anchor == nullptr) return c;
-  const index_t p = model.node_particle()[i];
-  const index_t first = model.particles()[p].first_node;
-  for (std::size_t k = 0; k < anchor->nodes.size() && anchor->nodes[k] != SurfaceAnchor::no_anchor; ++k) {
-    const index_t j = first + anchor->nodes[k];
-    const real w = particle_depth_[p] * anchor->weights[k];
-    for (int d = 0; d < 3; ++d) c[d] -= w * (f[3 * j + d] - f[3 * i + d]);
-  }
-  return c;
-}
-
 vec3 ContactModel::contact_position(const Model& model, const State& state, index_t i) const {
-  return at_centre(model, state.positions, i);
+  return centres_.at_centre(model, state.positions, i);
 }
 
 vec3 ContactModel::contact_velocity(const Model& model, const State& state, index_t i) const {
-  return at_centre(model, state.velocities, i);
-}
-
-void ContactModel::fill_contact_positions(const Model& model, const State& state,
-                                          std::vector<real>& x) const {
-  if (!any_centred_) {
-    x = state.positions;
-    return;
-  }
-  x.resize(state.positions.size());
-  const std::int64_t n = model.node_count();
-#pragma omp parallel for schedule(static)
-  for (std::int64_t i = 0; i < n; ++i) {
-    const vec3 c = contact_position(model, state, static_cast<index_t>(i));
-    for (int k = 0; k < 3; ++k) x[3 * i + k] = c[k];
-  }
+  return centres_.at_centre(model, state.velocities, i);
 }
 
 contact::PairLaw ContactModel::pair_law(index_t p, index_t q) const {
@@ -298,7 +228,7 @@ void ContactModel::set_law(index_t a, index_t b, const contact::Law& law) {
   max_contact_radius_ =
       std::max(max_contact_radius_, contact::resolve_contact_radius(law, coarsest_a, coarsest_b));
   built_ = false;
-  centres_found_ = false;
+  centres_.forget();
 }
 
 index_t ContactModel::add_wall(Wall wall, int dimension) {
@@ -322,7 +252,7 @@ void ContactModel::set_wall_law(index_t wall, index_t material, const contact::L
   const contact::ContactSide coarsest{material_max_mesh_size_[material], 0, 0};
   max_contact_radius_ = std::max(max_contact_radius_, contact::resolve_wall_contact_radius(law, coarsest));
   built_ = false;
-  centres_found_ = false;
+  centres_.forget();
 }
 
 void ContactModel::set_skin(real skin) {
@@ -947,7 +877,7 @@ std::size_t ContactModel::memory_bytes() const {
          bytes(slot_force_) + bytes(slot_normal_) + bytes(slot_point_) + bytes(slot_work_) +
          bytes(slot_exponent_) + bytes(damping_tables_) + bytes(wall_damping_tables_) +
          bytes(slot_surface_normal_) + bytes(touching_nodes_) + bytes(touching_normals_) +
-         bytes(particle_depth_) + bytes(detached_) + bytes(centre_forces_);
+         centres_.memory_bytes() + bytes(centre_forces_);
 }
 
 ContactCheckpoint ContactModel::checkpoint() const {
@@ -1030,7 +960,7 @@ void ContactModel::restore(const Model& model, const State& state, const Contact
   check_checkpoint(model, saved);
   skin_ = saved.skin;
   bodies_labelled_ = false;  // the restored bonds may differ from the current ones
-  centres_found_ = false;    // and so may the detached surface nodes
+  centres_.forget();         // and so may the detached surface nodes
   newly_broken_.clear();
   slots_ = saved.slots;
   particle_slot_count_ = saved.particle_slot_count;
@@ -1086,10 +1016,10 @@ void ContactModel::restore(const Model& model, const State& state, const Contact
 void ContactModel::add_forces(const Model& model, State& state, std::uint64_t broken_bonds) {
   if (!active()) return;
   const auto search_start = std::chrono::steady_clock::now();
-  if (!centres_found_) find_centred_particles(model, state);
+  if (!centres_.found()) centres_.find(model, state, centring_depths(model));
   real moved = 0;  // largest node displacement since the build
   if (needs_rebuild(model, state, moved)) {
-    fill_contact_positions(model, state, positions_at_build_);
+    centres_.fill_positions(model, state, positions_at_build_);
     rebuild(model, state, positions_at_build_, broken_bonds);
   } else if (broken_bonds != broken_at_build_) {
     update_after_breaks(model, state, broken_bonds, moved);
@@ -1445,7 +1375,7 @@ void ContactModel::node_forces(const Model& model, State& state, real dt) {
   // node's forces act on its contact centre: (1 + W) of them go to the node here, -w_k to its
   // anchors after (in node order, so the sums are the same for any thread count).
   const std::int64_t count = static_cast<std::int64_t>(contact_nodes_.size());
-  if (any_centred_) centre_forces_.assign(contact_nodes_.size(), vec3{0, 0, 0});
+  if (centres_.any()) centre_forces_.assign(contact_nodes_.size(), vec3{0, 0, 0});
 #pragma omp parallel for schedule(static)
   for (std::int64_t k = 0; k < count; ++k) {
     const index_t i = contact_nodes_[k];
@@ -1461,10 +1391,10 @@ void ContactModel::node_forces(const Model& model, State& state, real dt) {
       const vec force = wall_force(model, state, i, e, dt);
       for (int c = 0; c < 3; ++c) total[c] += force[c];
     }
-    const SurfaceAnchor* anchor = centred_anchor(model, i);
+    const SurfaceAnchor* anchor = centres_.anchor(model, i);
     if (anchor != nullptr) {
       centre_forces_[k] = total;
-      const real depth = particle_depth_[model.node_particle()[i]];
+      const real depth = centres_.depth(model, i);
       real own = 1;
       for (std::size_t a = 0; a < anchor->nodes.size() && anchor->nodes[a] != SurfaceAnchor::no_anchor; ++a)
         own += depth * anchor->weights[a];
@@ -1472,16 +1402,15 @@ void ContactModel::node_forces(const Model& model, State& state, real dt) {
     }
     for (int c = 0; c < 3; ++c) state.forces[3 * i + c] += total[c] / model.volumes()[i];
   }
-  if (!any_centred_) return;
+  if (!centres_.any()) return;
   for (std::int64_t k = 0; k < count; ++k) {
     const index_t i = contact_nodes_[k];
-    const SurfaceAnchor* anchor = centred_anchor(model, i);
+    const SurfaceAnchor* anchor = centres_.anchor(model, i);
     if (anchor == nullptr) continue;
-    const index_t p = model.node_particle()[i];
-    const index_t first = model.particles()[p].first_node;
+    const index_t first = model.particles()[model.node_particle()[i]].first_node;
     for (std::size_t a = 0; a < anchor->nodes.size() && anchor->nodes[a] != SurfaceAnchor::no_anchor; ++a) {
       const index_t j = first + anchor->nodes[a];
-      const real w = particle_depth_[p] * anchor->weights[a];
+      const real w = centres_.depth(model, i) * anchor->weights[a];
       for (int c = 0; c < 3; ++c) state.forces[3 * j + c] -= w * centre_forces_[k][c] / model.volumes()[j];
     }
   }

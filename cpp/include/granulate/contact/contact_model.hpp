@@ -10,6 +10,7 @@
 
 #include "granulate/contact/contact_law.hpp"
 #include "granulate/contact/power_law_damping.hpp"
+#include "granulate/contact/surface_centres.hpp"
 #include "granulate/model.hpp"
 #include "granulate/state.hpp"
 #include "granulate/walls.hpp"
@@ -107,7 +108,7 @@ class ContactModel {
   void bonds_broke(const Model& model, std::span<const std::array<index_t, 2>> pairs) {
     if (!active()) return;
     newly_broken_.insert(newly_broken_.end(), pairs.begin(), pairs.end());
-    detach_anchored(model, pairs);
+    centres_.detach_anchored(model, pairs);
   }
 
   /// Per wall: force (x, y, z) and torque about its centre (x, y, z) exerted by the particles
@@ -161,42 +162,21 @@ class ContactModel {
   void assign_springs();
   /// The free list: every pool spring no entry holds, in increasing order.
   void collect_free_springs();
-  // Surface nodes (the vertices on an imported mesh's or a grid's boundary) lie on the
-  // surface, where a lattice's outer nodes lie h/2 inside it: contact centres their spheres at
-  // c_i = (1 + W) y_i - sum_k w_k y_k (W = sum_k w_k) over their anchors (surface_anchors.hpp,
-  // the weights scaled from h/2 to the node's contact radius), one contact radius below every
-  // face at the node, following the particle as it turns and deforms. c_i is a
-  // virtual node: it moves at (1 + W) v_i - sum_k w_k v_k, and a force F on it goes as (1 + W) F
-  // to node i and -w_k F to anchor k (node_forces), which is F at c_i in force, moment and work:
-  // momentum, angular momentum and the springs' energy are kept. A node whose bond to an anchor
-  // broke is detached: its sphere is centred on itself from then on. Not with PeriDEM's law.
+  // Surface nodes (mesh and grid vertices on the boundary) have their spheres centred one
+  // contact radius inside (surface_centres.hpp); contact sees every node at its centre.
   /// Whether particle p's surface nodes are centred (its shape has anchors and no law of its
   /// material is PeriDEM's node-pair law).
   bool centres_particle(const Model& model, index_t p) const;
-  /// The particles whose surface nodes are centred, and the detached nodes, from the laws and
-  /// the bond states (at the first evaluation, and after a restore).
-  void find_centred_particles(const Model& model, const State& state);
-  void detach(const Model& model, index_t i);
-  /// Detaches the nodes whose bond to one of their anchors is among `pairs` (bonds that broke).
-  void detach_anchored(const Model& model, std::span<const std::array<index_t, 2>> pairs);
-  /// The anchors of node i if its sphere is centred, else null.
-  const SurfaceAnchor* centred_anchor(const Model& model, index_t i) const;
-  /// A nodal vector field (positions, velocities; n x 3) at node i's contact centre.
-  vec3 at_centre(const Model& model, const std::vector<real>& field, index_t i) const;
-  /// Where contact sees node i: its contact centre c_i, or y_i.
-  vec3 contact_position(const Model& model, const State& state, index_t i) const;
-  /// The velocity of node i's contact centre (see contact_position).
-  vec3 contact_velocity(const Model& model, const State& state, index_t i) const;
-  /// Every node's contact position, into x (n x 3).
-  void fill_contact_positions(const Model& model, const State& state, std::vector<real>& x) const;
-  bool centres_found_ = false;
-  bool any_centred_ = false;
-  /// Per particle: how deep its surface nodes' spheres are centred, over h/2 (0: not centred).
-  /// One contact radius deep, so that the sphere reaches the surface (the anchors give h/2).
-  std::vector<real> particle_depth_;
+  /// How deep particle p's surface nodes are centred: its node's contact radius over h/2, from
+  /// its material's law with itself, or else its first other law.
   real centring_depth(index_t p) const;
-  std::vector<std::uint8_t> detached_;  // per node once a centred node is detached
-  std::vector<vec3> centre_forces_;     // per contact node: the force on its centre (per step)
+  /// centring_depth of every particle that centres its surface nodes, 0 for the others.
+  std::vector<real> centring_depths(const Model& model) const;
+  /// Where contact sees node i (its contact centre), and how fast that point moves.
+  vec3 contact_position(const Model& model, const State& state, index_t i) const;
+  vec3 contact_velocity(const Model& model, const State& state, index_t i) const;
+  SurfaceCentres centres_;
+  std::vector<vec3> centre_forces_;  // per contact node: the force on its centre (per step)
 
   /// Nodes with list entries, grouped by body (each group in node order), and the per-step
   /// scratch of bodies and slots.
