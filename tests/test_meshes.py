@@ -92,7 +92,13 @@ def test_gmsh_binary_v4_and_a_vtu_volume_field(tmp_path: Path) -> None:
     meshio.write(
         tmp_path / "v.vtu", meshio.Mesh(mesh.points, vertices, point_data={"volume": given})
     )
-    np.testing.assert_array_equal(gr.read_mesh(tmp_path / "v.vtu", dimension=2).volumes, given)
+    from_points = gr.read_mesh(tmp_path / "v.vtu", dimension=2)
+    np.testing.assert_array_equal(from_points.volumes, given)
+    assert from_points.surface is None  # points alone do not tell which lie on the surface
+    # The structured square's boundary: 16 of its 25 vertices, corners at (+-1, +-1).
+    surface = gr.read_mesh(tmp_path / "b.msh").surface
+    assert np.count_nonzero(np.linalg.norm(surface, axis=1)) == 16
+    np.testing.assert_allclose(np.abs(surface[0, :2]), [1.0, 1.0], rtol=1e-12)
 
 
 def test_peridem_deck_meshes_read_with_their_element_areas() -> None:
