@@ -135,10 +135,10 @@ def placed_on_floor(case: str) -> tuple[gr.Simulation, gr.Body, float, float]:
 )
 def test_meshed_particles_rest_on_their_true_surface(case: str) -> None:
     """Meshes made elsewhere and grids have their outer nodes on the surface, where a lattice's
-    lie h/2 inside it; their contact spheres are centred h/2 below every face at the node, so
-    the particle rests on its surface within 0.1 h (before: PeriDEM's hexagon 0.475 h above
-    it). Measured after 5 ms: -0.025 h for the hexagon, rectangle and box (the 0.95 contact
-    radius factor), -0.045 h for the sphere, whose flat faces lie inside its vertices."""
+    lie h/2 inside it; their contact spheres are centred one contact radius below every face at
+    the node, so the particle rests on its surface within 0.1 h (before: PeriDEM's hexagon
+    0.475 h above it). Measured after 5 ms: -0.0001, -0.0000 and -0.0001 h for the hexagon,
+    rectangle and box, -0.020 h for the sphere, whose flat faces lie inside its vertices."""
     sim, body, resting, h = placed_on_floor(case)
     floor = gr.Plane((0, 0, 0)[: sim.dimension], (0, 1, 0)[: sim.dimension])
     sim.add_wall(floor, name="floor")
