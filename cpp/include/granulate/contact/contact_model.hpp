@@ -140,8 +140,8 @@ class ContactModel {
   /// Whether the lists must be searched again; `moved`: the largest node displacement since the
   /// build (0 when not computed).
   bool needs_rebuild(const Model& model, const State& state, real& moved) const;
-  /// A grid search at the contact positions x (see contact_positions) of `state`; `finish`: then
-  /// finish_lists.
+  /// A grid search at x, every node's contact position (contact_position) in `state`;
+  /// `finish`: then finish_lists.
   void rebuild(const Model& model, const State& state, const std::vector<real>& x, std::uint64_t broken_bonds,
                bool finish = true);
   /// After bonds broke (and nothing moved half the skin): the pairs of newly_broken_ into the
