@@ -666,3 +666,20 @@ def test_decks_in_peridems_older_format_translate_as_the_current_ones(tmp_path: 
         InputError, match=r"\[2\] names walls that do not exist \(walls are numbered 0 .. 1"
     ):
         peridem.translate(wrong)
+
+
+def test_a_wall_block_beside_particle_entries_is_ignored_as_peridem_does(tmp_path: Path) -> None:
+    """Today's format describes walls under Particle; a Wall block there is one PeriDEM does
+    not read, so it changes nothing (only the older format, where the wall zone has no
+    Particle entry, reads it)."""
+
+    def with_wall_block(text: str) -> str:
+        data = yaml.safe_load(text)
+        data["Wall"] = {"Zone_9": {"Type": "flexible", "All_Dofs_Constrained": True, "Mesh": True}}
+        return yaml.safe_dump(data)
+
+    new = peridem.translate(DECKS / "compression_small_set" / "input_0.yaml")
+    deck = broken_deck(tmp_path, "compression_small_set", with_wall_block)
+    translated = peridem.translate(deck)
+    assert translated.case == new.case
+    assert "Wall: not read (PeriDEM does not use it to run either)" in translated.notes

@@ -397,6 +397,7 @@ def _translate(path: Path, compat: bool, output: Path | None) -> Translation:
     zone_block = _block(deck, "Zone", "deck", problems)
     particle_block = _block(deck, "Particle", "deck", problems)
     wall_block = _block(deck, "Wall", "deck", problems)
+    older_walls = False
     mesh_block = _block(deck, "Mesh", "deck", problems)
     material_block = _block(deck, "Material", "deck", problems)
     count = zone_block.get("Zones", 1)
@@ -428,8 +429,9 @@ def _translate(path: Path, compat: bool, output: Path | None) -> Translation:
         zk = f"Zone_{z}"
         zinfo = _block(zone_block, zk, "Zone", problems)
         pinfo = _block(particle_block, zk, "Particle", problems)
-        if zk in wall_block:
-            pinfo = _older_wall_zone(zk, zinfo, pinfo, wall_block, problems)
+        if zk in wall_block and not pinfo:  # the older format: the Wall block says what it is
+            pinfo = _older_wall_zone(zk, zinfo, wall_block, problems)
+            older_walls = True
         problems.unknown(f"Zone.{zk}", zinfo, {"Is_Wall", "Type", "Parameters"})
         problems.unknown(f"Particle.{zk}", pinfo, _PARTICLE_ZONE_KEYS)
         if zinfo.get("Is_Wall", pinfo.get("Is_Wall", False)):
@@ -500,6 +502,9 @@ def _translate(path: Path, compat: bool, output: Path | None) -> Translation:
         else:
             problems.add(f"Mesh.{zk}: give File (a gmsh mesh) or CreateMesh with Mesh_Size")
             continue
+
+    if wall_block and not older_walls:  # beside Particle entries, as PeriDEM reads it: ignored
+        notes.append("Wall: not read (PeriDEM does not use it to run either)")
 
     # ---------------------------------------------------------------- materials
     for z in zones:
@@ -1207,7 +1212,6 @@ def to_yaml(translation: Translation, compat: bool) -> str:
 def _older_wall_zone(
     zk: str,
     zinfo: dict[str, Any],
-    pinfo: dict[str, Any],
     wall_block: dict[str, Any],
     problems: _Problems,
 ) -> dict[str, Any]:
@@ -1222,8 +1226,6 @@ def _older_wall_zone(
             f"Wall.{zk}: granulate reads meshed (Type: flexible, Mesh: true) walls, got "
             f"Type {winfo.get('Type')!r}, Mesh {winfo.get('Mesh')!r}"
         )
-    if pinfo:
-        problems.add(f"Particle.{zk}: a wall zone of the older format has no Particle entry")
     return {
         "Type": zinfo.get("Type", ""),
         "Parameters": zinfo.get("Parameters", []),
