@@ -669,11 +669,11 @@ void ContactModel::finish_lists(const Model& model) {
   wall_entry_reaction_.assign(wall_entry_.size(), {0, 0, 0, 0, 0, 0});
 }
 
-void ContactModel::rebuild(const Model& model, const State& state, const std::vector<real>& x,
-                           std::uint64_t broken_bonds, bool finish) {
+void ContactModel::rebuild(const Model& model, const State& state, std::uint64_t broken_bonds, bool finish) {
   if (skin_ < 0) skin_ = 0.5 * max_contact_radius_;
   const KeptLists kept{std::move(pair_offsets_), std::move(pair_partner_), std::move(pair_spring_),
                        std::move(wall_offsets_), std::move(wall_entry_),   std::move(wall_spring_)};
+  const std::vector<real>& x = positions_at_build_;
   const index_t n = model.node_count();
   const auto& particles = model.particles();
   const auto& node_particle = model.node_particle();
@@ -813,7 +813,6 @@ void ContactModel::rebuild(const Model& model, const State& state, const std::ve
   carry_over_springs(kept, n);
   if (finish) finish_lists(model);
 
-  if (&x != &positions_at_build_) positions_at_build_ = x;
   time_at_build_ = state.time;
   broken_at_build_ = broken_bonds;
   built_ = true;
@@ -977,13 +976,13 @@ void ContactModel::restore(const Model& model, const State& state, const Contact
     // Rebuild the lists from the positions and time they were built at: the same lists,
     // and rebuild() carries each pair's collision history over from the restored slots.
     State at_build = state;
-    at_build.positions = saved.positions_at_build;
     at_build.time = saved.time_at_build;
+    positions_at_build_ = saved.positions_at_build;
     // Lists updated after bond breaks are not those of a search: take the saved ones (a
     // checkpoint without them predates these updates, and a search gives them again).
     const bool saved_lists = saved.pair_offsets.size() == static_cast<std::size_t>(model.node_count()) + 1 &&
                              saved.pair_offsets.back() == saved.pair_partners.size();
-    rebuild(model, at_build, saved.positions_at_build, saved.broken_at_build, !saved_lists);
+    rebuild(model, at_build, saved.broken_at_build, !saved_lists);
     if (saved_lists) {
       pair_offsets_ = saved.pair_offsets;
       pair_partner_ = saved.pair_partners;
@@ -1020,7 +1019,7 @@ void ContactModel::add_forces(const Model& model, State& state, std::uint64_t br
   real moved = 0;  // largest node displacement since the build
   if (needs_rebuild(model, state, moved)) {
     centres_.fill_positions(model, state, positions_at_build_);
-    rebuild(model, state, positions_at_build_, broken_bonds);
+    rebuild(model, state, broken_bonds);
   } else if (broken_bonds != broken_at_build_) {
     update_after_breaks(model, state, broken_bonds, moved);
   }

@@ -140,10 +140,9 @@ class ContactModel {
   /// Whether the lists must be searched again; `moved`: the largest node displacement since the
   /// build (0 when not computed).
   bool needs_rebuild(const Model& model, const State& state, real& moved) const;
-  /// A grid search at x, every node's contact position (contact_position) in `state`;
-  /// `finish`: then finish_lists.
-  void rebuild(const Model& model, const State& state, const std::vector<real>& x, std::uint64_t broken_bonds,
-               bool finish = true);
+  /// A grid search at positions_at_build_, which the caller fills with every node's contact
+  /// position (contact_position); bonds and time from `state`; `finish`: then finish_lists.
+  void rebuild(const Model& model, const State& state, std::uint64_t broken_bonds, bool finish = true);
   /// After bonds broke (and nothing moved half the skin): the pairs of newly_broken_ into the
   /// lists.
   void update_after_breaks(const Model& model, const State& state, std::uint64_t broken_bonds, real moved);
