@@ -17,19 +17,6 @@ real det3(const vec& a, const vec& b, const vec& c) {
          a[2] * (b[0] * c[1] - b[1] * c[0]);
 }
 
-/// |det| of the unit vectors along the columns: 1 when they are orthogonal, 0 when they do not
-/// span. In 2D the third column is (0, 0, 1).
-real spread(const std::array<vec, 3>& columns, int dimension) {
-  std::array<vec, 3> unit = columns;
-  for (int k = 0; k < dimension; ++k) {
-    const real length =
-        std::sqrt(unit[k][0] * unit[k][0] + unit[k][1] * unit[k][1] + unit[k][2] * unit[k][2]);
-    for (real& c : unit[k]) c /= length;
-  }
-  if (dimension == 2) unit[2] = {0, 0, 1};
-  return std::abs(det3(unit[0], unit[1], unit[2]));
-}
-
 /// w with sum_k w_k columns_k = target (Cramer's rule; in 2D the third column is (0, 0, 1)).
 std::array<real, 3> solve(std::array<vec, 3> columns, const vec& target, int dimension) {
   if (dimension == 2) columns[2] = {0, 0, 1};
@@ -54,25 +41,31 @@ std::vector<index_t> nearest(const CellGrid& grid, const std::vector<real>& x, i
   return nodes;
 }
 
-/// The d candidates whose bond vectors from a span best (largest spread; the first such in
-/// nearest-first order); empty if none spreads over 0.2.
+/// The d candidates whose bond directions from a span best: the largest |det| of the unit
+/// vectors (1 when orthogonal; in 2D with (0, 0, 1) as third column), the first such in
+/// nearest-first order; empty if none exceeds 0.2.
 std::vector<index_t> best_span(const std::vector<real>& x, index_t a, const std::vector<index_t>& candidates,
                                int dimension) {
-  auto bond = [&](index_t j) {
-    return vec{x[3 * j] - x[3 * a], x[3 * j + 1] - x[3 * a + 1], x[3 * j + 2] - x[3 * a + 2]};
-  };
+  std::vector<vec> unit;
+  for (const index_t j : candidates) {
+    vec u{x[3 * j] - x[3 * a], x[3 * j + 1] - x[3 * a + 1], x[3 * j + 2] - x[3 * a + 2]};
+    const real length = std::sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+    for (real& c : u) c /= length;
+    unit.push_back(u);
+  }
+  const vec z{0, 0, 1};
   real best = 0.2;
   std::vector<index_t> chosen;
   const std::size_t n = candidates.size();
   for (std::size_t p = 0; p < n; ++p) {
     for (std::size_t q = p + 1; q < n; ++q) {
       if (dimension == 2) {
-        const real s = spread({bond(candidates[p]), bond(candidates[q]), vec{}}, 2);
+        const real s = std::abs(det3(unit[p], unit[q], z));
         if (s > best) best = s, chosen = {candidates[p], candidates[q]};
         continue;
       }
       for (std::size_t r = q + 1; r < n; ++r) {
-        const real s = spread({bond(candidates[p]), bond(candidates[q]), bond(candidates[r])}, 3);
+        const real s = std::abs(det3(unit[p], unit[q], unit[r]));
         if (s > best) best = s, chosen = {candidates[p], candidates[q], candidates[r]};
       }
     }
