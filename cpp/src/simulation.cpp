@@ -449,7 +449,7 @@ std::array<std::size_t, 2> Simulation::memory_bytes() const {
                       contact_.memory_bytes();
   for (const BondFamilies& f : m.families()) other += bytes(f.offsets) + bytes(f.forward);
   other += m.bond_schedule().memory_bytes();
-  for (const Shape& s : m.shapes()) other += bytes(s.positions) + bytes(s.volumes) + s.anchors.memory_bytes();
+  for (const Shape& s : m.shapes()) other += s.anchors.memory_bytes();  // nodes and volumes released
   return {bonds, other};
 }
 
