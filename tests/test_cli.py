@@ -125,3 +125,18 @@ def test_bench_quick_prints_the_documented_keys(tmp_path: Path) -> None:
     # 16 bytes in the shared bond family, 1 bit of state (each node's bits on whole bytes).
     assert rows[0]["memory"]["bytes_per_bond"] == pytest.approx(16.125, abs=0.02)
     assert granulate("bench", "--case", "nonsense").returncode == 2
+
+
+def test_a_long_set_up_is_announced_before_it_starts(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from granulate import cli
+    from granulate.case import load_case
+
+    text = (Path(__file__).parents[1] / "examples" / "cases" / "pile_2d.yaml").read_text()
+    for count, said in ((30, False), (200_000, True)):
+        case_file = tmp_path / f"pile_{count}.yaml"
+        case_file.write_text(text.replace("count: 30,", f"count: {count},"))
+        cli._announce_setup(load_case(case_file))  # loads the case only: nothing is placed
+        out = capsys.readouterr().out
+        assert ("packing 200,000 grains: set-up takes about 60 s" in out) is said, out

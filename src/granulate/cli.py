@@ -94,11 +94,20 @@ def _convert(deck: Path, target: Path, compat: bool, overwrite: bool) -> int:
     return 0
 
 
+def _announce_setup(case) -> None:
+    """Say before a long set-up (a packing of many grains) that it will take a while."""
+    grains = sum(packing.count for packing in case.spec.packings)
+    seconds = resources.setup_seconds(case.spec.dimension, grains)
+    if seconds >= 20:
+        print(f"packing {grains:,} grains: set-up takes about {duration(seconds)}", flush=True)
+
+
 def _check(path: Path, compat: bool = False) -> int:
     from granulate.case import load_case
 
     case = load_case(path, peridem_compat=compat)
     _notes(case)
+    _announce_setup(case)
     sim = case.build(outputs=False)
     case.stop_criteria()  # names of walls in stop criteria
     spec = case.spec.output
@@ -152,6 +161,7 @@ def _run_case(
     _notes(case)
     if out is None and case.spec.output is None:
         out = Path("out") / path.stem
+    _announce_setup(case)
     sim = case.build(output=out, resume=resume, overwrite=overwrite)
     directory = sim.output_directory
     assert directory is not None

@@ -516,16 +516,9 @@ def _random_sequential(
             p = _candidates(container, radius, margins[k], gap, rng, batch)
             if len(p) == 0:
                 continue
-            index = np.floor((p[:, :d] - lower[:d]) / cell).astype(np.int64) + 1
-            flat = index @ strides
-            near = members[flat[:, None] + offsets[None, :]].reshape(len(p), -1)
-            valid = near >= 0
-            centres = positions[np.where(valid, near, 0)]
-            reach = radii[np.where(valid, near, 0)] + radius + gap
-            distance = np.linalg.norm(centres - p[:, None, :], axis=2)
-            free = np.all(~valid | (distance >= reach), axis=1)
-            if free.any():
-                first = int(np.argmax(free))
+            flat = (np.floor((p[:, :d] - lower[:d]) / cell).astype(np.int64) + 1) @ strides
+            first = _first_free(p, flat, members, offsets, positions, radii, radius + gap)
+            if first >= 0:
                 positions[k] = p[first]
                 target = flat[first]
                 if fill[target] == members.shape[1]:
@@ -541,6 +534,32 @@ def _random_sequential(
                 "method='lattice' (denser)"
             )
     return positions
+
+
+def _first_free(
+    p: NDArray[np.float64],
+    flat: NDArray[np.int64],
+    members: NDArray[np.int64],
+    offsets: NDArray[np.int64],
+    positions: NDArray[np.float64],
+    radii: NDArray[np.float64],
+    reach: float,
+) -> int:
+    """The first candidate p[c] (cell flat[c]) at least radii[j] + reach from every placed j in
+    its cell's neighbourhood, or -1. Candidates are tested a few at a time: in a loose packing
+    the first one is usually free, and the answer is the same as testing them all at once."""
+    start, chunk = 0, 4
+    while start < len(p):
+        stop = min(start + chunk, len(p))
+        near = members[flat[start:stop, None] + offsets[None, :]].reshape(stop - start, -1)
+        valid = near >= 0
+        others = np.where(valid, near, 0)
+        distance = np.linalg.norm(positions[others] - p[start:stop, None, :], axis=2)
+        free = np.all(~valid | (distance >= radii[others] + reach), axis=1)
+        if free.any():
+            return start + int(np.argmax(free))
+        start, chunk = stop, 4 * chunk
+    return -1
 
 
 def _lattice_sites(

@@ -63,3 +63,14 @@ def bonds_per_node(dimension: int, horizon_factor: float) -> float:
 def simulation_bytes(nodes: float, bonds: float) -> float:
     """The core's memory for `nodes` nodes and `bonds` bonds in their families."""
     return BYTES_PER_NODE * nodes + BYTES_PER_BOND * bonds
+
+
+#: Seconds to place one grain of a random packing and add it as a particle: measured with
+#: benchmarks/packing.py (10,000 and 40,000 grains: 0.2-0.25 ms in 2D at 43 % of the area,
+#: 0.75-0.85 ms in 3D at 30 % of the volume), rounded up. Denser packings take longer.
+SETUP_SECONDS_PER_GRAIN = {2: 3e-4, 3: 1e-3}
+
+
+def setup_seconds(dimension: int, grains: int) -> float:
+    """About how long packing `grains` grains and adding them as particles takes [s]."""
+    return SETUP_SECONDS_PER_GRAIN[dimension] * grains

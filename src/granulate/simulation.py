@@ -223,6 +223,7 @@ class Simulation:
         self._dt_safety = dt_safety
         self._gravity = np.zeros(3)
         self.bodies: list[Body] = []
+        self._body_names: dict[str, Body] = {}  # every body by name (adding one is O(1))
         self._positions: list[NDArray[np.float64]] = []
         self._volumes: list[NDArray[np.float64]] = []
         # Per body without a reference shape: its surface offsets (a grid), or None.
@@ -459,8 +460,9 @@ class Simulation:
                 f"material must be a granulate.Material, got {type(material).__name__}"
             )
         index = len(self.bodies)
-        first = sum(b.node_count for b in self.bodies)
-        if name is not None and any(b.name == name for b in self.bodies):
+        last = self.bodies[-1] if self.bodies else None
+        first = last.first_node + last.node_count if last is not None else 0
+        if name is not None and name in self._body_names:
             raise InputError(f"a body named {name!r} exists already; give each body its own name")
         body = Body(
             index,
@@ -473,6 +475,7 @@ class Simulation:
             scale,
         )
         self.bodies.append(body)
+        self._body_names.setdefault(body.name, body)
         self._positions.append(np.ascontiguousarray(p))
         self._volumes.append(np.ascontiguousarray(v))
         self._surfaces.append(None)
@@ -839,11 +842,9 @@ class Simulation:
             if body.index >= len(self.bodies) or self.bodies[body.index] is not body:
                 raise InputError(f"body {body.name!r} belongs to another simulation")
             return body
-        for b in self.bodies:
-            if b.name == body:
-                return b
-        names = [b.name for b in self.bodies]
-        match = difflib.get_close_matches(str(body), names, n=1)
+        if body in self._body_names:
+            return self._body_names[body]
+        match = difflib.get_close_matches(str(body), list(self._body_names), n=1)
         hint = f"; did you mean {match[0]!r}?" if match else ""
         raise InputError(f"no body named {body!r}{hint}")
 
