@@ -460,8 +460,7 @@ class Simulation:
                 f"material must be a granulate.Material, got {type(material).__name__}"
             )
         index = len(self.bodies)
-        last = self.bodies[-1] if self.bodies else None
-        first = last.first_node + last.node_count if last is not None else 0
+        first = self.node_count
         if name is not None and name in self._body_names:
             raise InputError(f"a body named {name!r} exists already; give each body its own name")
         body = Body(
@@ -520,7 +519,7 @@ class Simulation:
 
         Criteria combine by intersection. Raises InputError when nothing is selected.
         """
-        count = sum(b.node_count for b in self.bodies)
+        count = self.node_count
         mask = np.ones(count, dtype=bool)
         if region is not None:
             mask &= region.contains(self.reference_positions)
@@ -542,7 +541,7 @@ class Simulation:
 
     def _nodes(self, nodes: ArrayLike) -> NDArray[np.uint32]:
         array = np.asarray(nodes).reshape(-1)
-        count = sum(b.node_count for b in self.bodies)
+        count = self.node_count
         if len(array) == 0:
             raise InputError("the node set is empty")
         if array.dtype.kind not in "iu" or np.any(array < 0) or np.any(array >= count):
@@ -1617,7 +1616,8 @@ class Simulation:
 
     @property
     def node_count(self) -> int:
-        return sum(b.node_count for b in self.bodies)
+        last = self.bodies[-1] if self.bodies else None
+        return last.first_node + last.node_count if last is not None else 0
 
     @property
     def bond_count(self) -> int:
