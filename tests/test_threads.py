@@ -15,12 +15,13 @@ import granulate as gr
 from granulate import threads
 
 
-def emulate(rates, seconds: float, later=None, start: int = 2, seed: int = 1):
+def emulate(rates, seconds: float, later=None, start: int = 2, seed: int = 1, busy: int = 0):
     """Drive a ThreadTuner(2) as Simulation.run does (chunks of 10 steps first, then half a
     second's worth) with steps per second `rates[count]` (20 % noise), switching to `later`
-    rates halfway. Returns the tuner and the steps done over those the best count would do."""
+    rates halfway, with `busy` tasks of others running. Returns the tuner and the steps done
+    over those the best count would do."""
     rnd = random.Random(seed)
-    tuner = threads.ThreadTuner(2, start=start)
+    tuner = threads.ThreadTuner(2, start=start, busy=lambda: busy)
     elapsed, steps_done, best_steps, limit = 0.0, 0, 0.0, 10
     while elapsed < seconds:
         now = rates if later is None or elapsed < seconds / 2 else later
@@ -42,6 +43,25 @@ def test_a_busy_cpu_sends_the_run_to_one_thread() -> None:
     assert tuner.current == 1
     assert tuner.seconds_at[2] < 0.05 * 20
     assert efficiency > 0.97
+
+
+def test_a_hopeless_trial_is_cut_short_and_not_repeated_while_others_run() -> None:
+    """Started at 1 thread next to a busy process where 2 threads run 10 times slower (the
+    issue saw 6-12 times): the trial of 2 threads (after 2 s) ends once it runs at under half
+    the usual rate for half a window, and no trial of more threads follows while
+    /proc/loadavg shows the other process running. Over 30 s: 0.016 s at 2 threads (0.63 s
+    over 4 s when each trial ran a window's steps and they came every 1, 2, 4 ... s). When
+    loadavg shows nobody, the trials go on, each as short; and when 2 threads are faster
+    although loadavg shows others (a container seeing the host's tasks), the trial wins."""
+    slow = {1: 10_000.0, 2: 1_000.0}
+    tuner, efficiency = emulate(slow, 30.0, start=1, busy=1)
+    assert tuner.current == 1 and len(tuner.trials) == 1 and tuner.skipped >= 2
+    assert tuner.seconds_at[2] < 0.03 and efficiency > 0.98
+    tuner, efficiency = emulate(slow, 30.0, start=1, busy=0)
+    assert tuner.current == 1 and len(tuner.trials) == 3 and tuner.skipped == 0
+    assert tuner.seconds_at[2] < 0.08 and efficiency > 0.98
+    tuner, _ = emulate({1: 5_000.0, 2: 10_000.0}, 10.0, start=1, busy=1)
+    assert tuner.current == 2
 
 
 def test_an_idle_machine_keeps_both_threads() -> None:

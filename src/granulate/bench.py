@@ -100,6 +100,8 @@ def _timed(sim, steps: int, case: str, threads: int, extra: dict | None = None) 
             <= BOND_BUDGET * sim.bond_count + NODE_BUDGET * sim.node_count,
         },
     }
+    if sim._tuner is not None:  # the adaptive policy: run time at each thread count
+        result["seconds_at_threads"] = {c: round(t, 3) for c, t in sim._tuner.seconds_at.items()}
     result.update(extra or {})
     return result
 
@@ -342,7 +344,10 @@ def contended(names: list[str] | None, quick: bool, as_json: bool, out: Path) ->
         time.sleep(0.2)
         if not as_json:
             print(f"one busy process alongside; {os.cpu_count()} CPUs")
-            print(f"{'case':<18} {'threads':<12} {'seconds':>8} {'M node-st/s':>11} {'vs 1':>6}")
+            print(
+                f"{'case':<18} {'threads':<12} {'seconds':>8} {'M node-st/s':>11} {'vs 1':>6}"
+                "  (adaptive: time at each count)"
+            )
         for name in chosen:
             single: dict[int, float] = {}  # the 1-thread rate of each row of the case
             for label, count, adaptive in policies:
@@ -354,9 +359,11 @@ def contended(names: list[str] | None, quick: bool, as_json: bool, out: Path) ->
                     if as_json:
                         print(json.dumps(result), flush=True)
                         continue
+                    at = result.get("seconds_at_threads", {})
                     print(
                         f"{result['case']:<18} {label:<12} {result['seconds']:8.2f} "
-                        f"{rate / 1e6:11.3f} {rate / single[k]:6.2f}",
+                        f"{rate / 1e6:11.3f} {rate / single[k]:6.2f}  "
+                        + ", ".join(f"{t:.2f} s at {c}" for c, t in at.items() if t > 0),
                         flush=True,
                     )
     finally:

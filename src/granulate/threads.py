@@ -10,8 +10,11 @@ chunks of steps without changing a bit of its output. That is what makes this po
   itself: the steps per second of each thread count it uses, in windows of at least
   MEASURE_SECONDS. Now and then (sooner when its rate drops by 40 %) it tries a neighbouring
   count for a short window between two windows at its own, and keeps the faster by
-  SWITCH_MARGIN, confirmed by the next full window. Failed trials back off to one a minute;
-  a run that started below the ceiling (others busy) first tries more threads after a second.
+  SWITCH_MARGIN, confirmed by the next full window. A trial that runs at under half the usual
+  rate for half a window ends there (it cannot win); after such a trial of more threads, the
+  next ones are skipped (backing off the same way) while /proc/loadavg shows others running.
+  Failed trials back off to one a minute; a run that started below the ceiling (others busy)
+  first tries more threads after 2 s.
 - Why: when another process holds a core, a thread waiting at the core's barriers for a
   descheduled sibling costs far more than the work it shares. Next to one busy process on 2
   CPUs, 2 fixed threads ran PeriDEM's small compression deck 2.5 times slower than 1 thread,
@@ -36,9 +39,10 @@ DROP = 0.6  # two windows below this fraction of the usual rate trigger a trial
 SMOOTHING = 0.3  # weight of a new window in the usual rate (an exponential average)
 FIRST_TRIAL_SECONDS = 0.1  # run time before the first trial
 WAIT_AFTER_SWITCH_SECONDS = 2.0  # before trying again after a switch
-FIRST_WAIT_SECONDS = 1.0  # the wait after a first failed trial, doubling after each failure
+FIRST_WAIT_SECONDS = 2.0  # the wait after a first failed trial, doubling after each failure
 LONGEST_WAIT_SECONDS = 60.0  # failed trials back off (doubling) to at most this interval
 DROP_WAIT_SECONDS = 5.0  # a drop in rate brings a trial forward to at most this long after one
+HOPELESS = 0.5  # a trial below this fraction of the usual rate for half a window ends there
 
 _adaptive = "OMP_NUM_THREADS" not in os.environ
 
@@ -121,10 +125,11 @@ class ThreadTuner:
     is kept when it beats the mean of those two, so a workload that changes as the run goes on
     (contacts forming, bonds breaking) does not bias the comparison."""
 
-    def __init__(self, most: int, start: int | None = None) -> None:
+    def __init__(self, most: int, start: int | None = None, busy=None) -> None:
         self.counts = candidate_counts(most)
+        self._busy = busy_cpus if busy is None else busy  # tasks of others running now
         # Start with the CPUs nothing else is running on (a guess the trials then check).
-        free = most - busy_cpus() if start is None else start
+        free = most - self._busy() if start is None else start
         self.current = max([c for c in self.counts if c <= free] or [1])
         self.seconds_at = dict.fromkeys(self.counts, 0.0)
         self.trials: list[tuple[float, int, bool]] = []  # (run time, count tried, kept)
@@ -136,20 +141,27 @@ class ThreadTuner:
         self._confirm: tuple[int, float] | None = None  # after a switch: the old count, rate
         self._low_windows = 0  # consecutive windows below DROP x usual
         self._run_seconds = 0.0
-        # Started below the ceiling because other processes run: trust that for a second
+        # Started below the ceiling because other processes run: trust that for 2 s
         # before trying more threads (a trial at the slower count is what a short run pays).
         first = FIRST_TRIAL_SECONDS if self.current == most else FIRST_WAIT_SECONDS
         self._next_trial = first
         self._wait = first
         self._last_trial = 0.0  # run time at the end of the last trial
         self._direction = -1  # trials go to fewer threads first
+        self._hopeless_up = False  # the last trial of more threads was hopeless
+        self.skipped = 0  # trials of more threads skipped because others still ran
 
     def threads(self) -> int:
         """The thread count for the next chunk."""
         due = self._run_seconds >= self._next_trial and self._rates["before"] > 0
         if self._phase == "run" and len(self.counts) > 1 and due:
-            self._phase, self._trial = "trial", self._neighbour()
-            self._window = [0, 0.0]
+            trial = self._neighbour()
+            if trial > self.current and self._hopeless_up and self._others_hold(trial):
+                self.skipped += 1
+                self._back_off()
+            else:
+                self._phase, self._trial = "trial", trial
+                self._window = [0, 0.0]
         return self._trial if self._phase == "trial" else self.current
 
     def step_cap(self) -> int | None:
@@ -160,7 +172,12 @@ class ThreadTuner:
             return None
         steps, seconds = self._window
         rate = self._usual if self._usual > 0 else steps / seconds if seconds > 0 else 0.0
-        return max(1, int(TRIAL_SECONDS * rate)) if rate > 0 else None
+        if rate <= 0:
+            return None
+        window = max(1, int(TRIAL_SECONDS * rate))
+        if self._phase == "trial":  # 1 step, then as many as so far: a slow count shows early
+            return max(1, min(window, self._window[0]))
+        return window
 
     def record(self, threads: int, steps: int, seconds: float) -> None:
         """A chunk of `steps` took `seconds` with `threads`."""
@@ -168,16 +185,39 @@ class ThreadTuner:
         self.seconds_at[threads] = self.seconds_at.get(threads, 0.0) + seconds
         self._window[0] += steps
         self._window[1] += seconds
+        if self._phase == "trial" and self._hopeless():
+            self._rates["trial"] = self._window[0] / self._window[1]
+            self._window = [0, 0.0]
+            self._hopeless_up = threads > self.current
+            self._decide(self._rates["before"])  # lost: no window back at the current count
+            return
         if self._window[1] < MEASURE_SECONDS:
             return
         rate = self._window[0] / self._window[1]
         self._window = [0, 0.0]
         if self._phase == "trial":
             self._rates["trial"], self._phase = rate, "check"
+            self._hopeless_up = False
         elif self._phase == "check":
             self._decide((self._rates["before"] + rate) / 2)
         else:
             self._measured(rate)
+
+    def _others_hold(self, count: int) -> bool:
+        """Other processes run on the CPUs `count` threads would need (/proc/loadavg)."""
+        return max(self.counts) - self._busy() < count
+
+    def _back_off(self) -> None:
+        """No switch: the next trial waits twice as long (at least FIRST_WAIT_SECONDS)."""
+        self._wait = min(max(2 * self._wait, FIRST_WAIT_SECONDS), LONGEST_WAIT_SECONDS)
+        self._next_trial = self._run_seconds + self._wait
+
+    def _hopeless(self) -> bool:
+        """The trial has run half a window at under HOPELESS x the rate before it: it cannot
+        win (a count that a busy CPU slows 10 times would cost a whole window's steps)."""
+        steps, seconds = self._window
+        before = self._rates["before"]
+        return seconds >= MEASURE_SECONDS / 2 and steps < HOPELESS * before * seconds
 
     def _measured(self, rate: float) -> None:
         """A window at the current count, between trials."""
@@ -218,7 +258,7 @@ class ThreadTuner:
         else:
             self._rates["before"] = baseline
             self._direction = -self._direction
-            self._wait = min(max(2 * self._wait, FIRST_WAIT_SECONDS), LONGEST_WAIT_SECONDS)
+            self._back_off()
         self._phase = "run"
         self._low_windows = 0
         self._last_trial = self._run_seconds
