@@ -67,7 +67,7 @@ def test_base_case_through_run_plot_and_render(tmp_path: Path) -> None:
     assert main(["run", str(BASE), "--out", str(out), "--quiet"]) == 0
     assert main(["run", str(BASE), "--out", str(out), "--quiet"]) == 2  # never overwritten
     assert main(["plot", str(out)]) == 0
-    for name in ("energies.png", "broken_bonds.png", "wall_box.png"):
+    for name in ("energies.png", "broken_bonds.png", "wall_box.png", "grading.png", "breakage.png"):
         assert (out / name).stat().st_size > 1000
     assert main(["render", str(out), "--gif"]) == 0
     assert (out / "renders" / "run.gif").stat().st_size > 1000

@@ -5,7 +5,7 @@
     granulate run input_0.yaml [--peridem-compat]   a PeriDEM deck, translated
     granulate convert input_0.yaml -o case.yaml     write a PeriDEM deck as a granulate case
     granulate run SCRIPT.py [ARGS...]          run a Python set-up script
-    granulate plot DIR                         PNG plots from DIR/history.csv
+    granulate plot DIR                         PNG plots from DIR/history.csv, DIR/frames
     granulate render DIR [--frame N] [--gif]   PNG images (and a GIF) of the particles
     granulate schema [--json]                  the case-file reference (or its JSON Schema)
     granulate bench [--quick] [--case NAME ...] [--threads N] [--json] [--contended]
@@ -266,7 +266,7 @@ def _main(argv: list[str] | None) -> int:
         help="next to one busy process: 1 thread, all fixed, all adaptive",
     )
     bench.add_argument("--out", type=Path, default=Path("out") / "bench", help="scratch output")
-    plot = commands.add_parser("plot", help="PNG plots of a run's history.csv")
+    plot = commands.add_parser("plot", help="PNG plots of a run's history.csv and fragment tables")
     plot.add_argument("directory", type=Path)
     render = commands.add_parser("render", help="PNG images of the particles coloured by damage")
     render.add_argument("directory", type=Path)

@@ -4,7 +4,12 @@
 - ``energies.png``: kinetic, strain and total energy against time;
 - ``broken_bonds.png``: broken bonds against time;
 - ``wall_<name>.png`` for every wall: the force components against the wall's displacement
-  (a compression test's load curve).
+  (a compression test's load curve);
+and from the fragment tables of the frames (``frames/fragments_NNNNNN.csv``):
+- ``grading.png``: grading curves (mass fraction passing against equivalent diameter, log
+  axis) of the first frame, the last and up to three between;
+- ``breakage.png``: Hardin's relative breakage Br and t10 against the frame's time
+  (granulate.fragments).
 
 ``render(directory, frame=None, gif=False)`` writes ``renders/frame_NNNNNN.png``: the nodes of
 each VTU frame coloured by damage (2D: in the plane; 3D: projected on x-z), and with ``gif`` an
@@ -18,6 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
+from granulate import fragments
 from granulate.errors import InputError
 
 
@@ -91,7 +97,63 @@ def plot_history(directory: str | Path) -> list[Path]:
         written.append(folder / f"wall_{wall}.png")
         figure.savefig(written[-1], dpi=120)
         plt.close(figure)
+    tables = sorted((folder / "frames").glob("fragments_*.csv"))
+    if tables:
+        written += plot_breakage(folder, tables)
     return written
+
+
+def plot_breakage(folder: Path, paths: list[Path]) -> list[Path]:
+    """grading.png and breakage.png from the frames' fragment tables (module docstring); a
+    frame's time is read from simulation.pvd (its number when that fails). Br is left out
+    when no initial piece is larger than Hardin's cut-off."""
+    plt = _pyplot()
+    tables = [fragments.read_table(path) for path in paths]
+    times = _frame_times(folder, len(tables))
+    initial = tables[0]
+    parent_volume = np.bincount(initial["particle"], initial["volume"])
+    dimension = 2 if np.all(initial["z"] == initial["z"][0]) else 3
+    parent_sizes = fragments.equivalent_diameter(parent_volume, dimension)
+    shown = sorted({0, len(tables) - 1, *np.linspace(0, len(tables) - 1, 5).astype(int)})
+
+    figure, axes = plt.subplots(figsize=(6, 4))
+    for k in shown:
+        sizes, passing = fragments.grading_curve(tables[k])
+        axes.step(sizes, passing, where="post", label=f"t = {times[k]:.4g} s")
+    axes.set_xscale("log")
+    axes.set_xlabel("equivalent diameter [m]")
+    axes.set_ylabel("mass fraction passing [-]")
+    axes.legend()
+    figure.tight_layout()
+    written = [folder / "grading.png"]
+    figure.savefig(written[-1], dpi=120)
+    plt.close(figure)
+
+    figure, axes = plt.subplots(figsize=(6, 4))
+    if np.max(initial["diameter"]) > fragments.HARDIN_CUTOFF:
+        br = [fragments.hardin_breakage(initial, t) for t in tables]
+        axes.plot(times, br, label="Br (Hardin)")
+    axes.plot(times, [fragments.t10(t, parent_sizes) for t in tables], label="t10")
+    axes.set_xlabel("time [s]")
+    axes.set_ylabel("breakage index [-]")
+    axes.legend()
+    figure.tight_layout()
+    written.append(folder / "breakage.png")
+    figure.savefig(written[-1], dpi=120)
+    plt.close(figure)
+    return written
+
+
+def _frame_times(folder: Path, count: int) -> list[float]:
+    """The times of the first `count` frames, from simulation.pvd."""
+    from xml.etree import ElementTree
+
+    try:
+        root = ElementTree.parse(folder / "simulation.pvd").getroot()
+        times = [float(entry.get("timestep", "nan")) for entry in root.iter("DataSet")]
+    except (OSError, ElementTree.ParseError, ValueError):
+        times = []
+    return times[:count] if len(times) >= count else [float(k) for k in range(count)]
 
 
 def _frames(directory: Path) -> list[Path]:

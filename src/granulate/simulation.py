@@ -28,7 +28,7 @@ from typing import Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from granulate import _core, resources, threads
+from granulate import _core, fragments, resources, threads
 from granulate._version import __version__
 from granulate.contact import Contact
 from granulate.errors import GranulateWarning, InputError
@@ -54,6 +54,7 @@ FIELDS = (
     "Damage_Z",
     "Dilatation",
     "Particle_ID",
+    "Fragment_ID",
     "Fixity",
     "Nodal_Volume",
 )
@@ -67,6 +68,11 @@ HISTORY_COLUMNS = (
     "node_contacts",
     "wall_contacts",
     "list_rebuilds",
+    "fragments",
+    "debris_nodes",
+    "debris_mass",
+    "particles_broken",
+    "mean_damage",
 )
 
 
@@ -224,6 +230,7 @@ class Simulation:
         self._gravity = np.zeros(3)
         self.bodies: list[Body] = []
         self._body_names: dict[str, Body] = {}  # every body by name (adding one is O(1))
+        self._labels: tuple[tuple[int, int], NDArray[np.uint32]] | None = None  # fragments
         self._positions: list[NDArray[np.float64]] = []
         self._volumes: list[NDArray[np.float64]] = []
         # Per body without a reference shape: its surface offsets (a grid), or None.
@@ -1604,7 +1611,7 @@ class Simulation:
 
         Fragments smaller than ``min_nodes`` (dust, single detached nodes) are left out.
         """
-        labels = self._build().fragments()
+        labels = self._fragment_labels()
         order = np.argsort(labels, kind="stable")
         _roots, starts, counts = np.unique(labels[order], return_index=True, return_counts=True)
         pieces = [
@@ -1613,6 +1620,29 @@ class Simulation:
             if c >= min_nodes
         ]
         return sorted(pieces, key=lambda piece: (-len(piece), int(piece[0])))
+
+    def _fragment_labels(self) -> NDArray[np.uint32]:
+        """Each node's piece: its smallest node (computed once per step and bond count)."""
+        core = self._build()
+        key = (int(core.step), int(core.broken_bonds()))
+        if self._labels is None or self._labels[0] != key:
+            self._labels = (key, core.fragments())
+        return self._labels[1]
+
+    def fragment_table(self) -> fragments.Table:
+        """One row per fragment (debris included, flagged) of the current state: its id,
+        parent particle, nodes, mass, volume, centre of mass, velocity and equivalent diameter
+        (granulate.fragments; ``pandas.DataFrame(table)`` makes it a data frame)."""
+        core, model = self._build(), self.model
+        return fragments.fragment_table(
+            self._fragment_labels(),
+            model.node_particle,
+            core.positions,
+            core.velocities,
+            model.volumes,
+            model.node_density,
+            self.dimension,
+        )
 
     @property
     def node_count(self) -> int:
@@ -1735,6 +1765,7 @@ class Simulation:
             "Damage_Z": lambda: z,
             "Dilatation": lambda: core.dilatation,
             "Particle_ID": lambda: self._model.node_particle,
+            "Fragment_ID": self._fragment_labels,
             "Fixity": lambda: core.fixity(),
             "Nodal_Volume": lambda: volumes,
         }
@@ -1746,6 +1777,9 @@ class Simulation:
         )
         out.pvd.add(core.time, Path("frames") / name)
         self._write_particles(out.directory / "frames" / f"particles_{out.frames:06d}.csv", phi)
+        fragments.write_table(
+            out.directory / "frames" / f"fragments_{out.frames:06d}.csv", self.fragment_table()
+        )
         out.frames += 1
         out.frame_step = int(core.step)
         self._write_run_json()
@@ -1767,6 +1801,7 @@ class Simulation:
             "wall_contacts": statistics.wall_contacts,
             "list_rebuilds": statistics.rebuilds,
         }
+        row.update(fragments.summary(self.fragment_table(), core.damage()[0], self._model.volumes))
         components = (
             ("fx", "fy", "tz") if self.dimension == 2 else ("fx", "fy", "fz", "tx", "ty", "tz")
         )
