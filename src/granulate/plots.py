@@ -118,8 +118,10 @@ def plot_breakage(folder: Path, paths: list[Path]) -> list[Path]:
 
     figure, axes = plt.subplots(figsize=(6, 4))
     for k in shown:
-        sizes, passing = fragments.grading_curve(tables[k])
-        axes.step(sizes, passing, where="post", label=f"t = {times[k]:.4g} s")
+        sizes, passing = fragments.grading_curve(tables[k])  # from 0 below the smallest
+        axes.step(
+            np.r_[sizes[0], sizes], np.r_[0, passing], where="post", label=f"t = {times[k]:.4g} s"
+        )
     axes.set_xscale("log")
     axes.set_xlabel("equivalent diameter [m]")
     axes.set_ylabel("mass fraction passing [-]")
