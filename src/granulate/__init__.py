@@ -10,7 +10,7 @@ a C++ core (OpenMP), set-up and output from Python.
     >>> body = sim.add_body(gr.Rectangle((0, 0), (0.05, 0.01)), rock, mesh_size=1e-3)
 """
 
-from granulate import _core, stopping, threads, walls
+from granulate import _core, fragments, stopping, threads, walls
 from granulate._version import __version__
 from granulate.contact import Contact
 from granulate.errors import GranulateWarning, InputError, InstabilityError
@@ -37,6 +37,7 @@ from granulate.packing import (
     pack,
     read_placements,
 )
+from granulate.results import Frame, Results
 from granulate.shapes import (
     Box,
     Cylinder,
@@ -93,6 +94,7 @@ __all__ = [
     "Ellipse",
     "Ellipsoid",
     "Fixed",
+    "Frame",
     "Grain",
     "GranulateWarning",
     "InputError",
@@ -112,6 +114,7 @@ __all__ = [
     "Rectangle",
     "ReferenceShape",
     "RegularPolygon",
+    "Results",
     "Rotation",
     "Shape",
     "Sieve",
@@ -130,6 +133,7 @@ __all__ = [
     "Wall",
     "__version__",
     "conforming",
+    "fragments",
     "get_num_threads",
     "lattice",
     "pack",

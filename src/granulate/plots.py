@@ -18,13 +18,14 @@ animated ``renders/run.gif``.
 
 from __future__ import annotations
 
-import csv
 from pathlib import Path
 
 import numpy as np
 
 from granulate import fragments
 from granulate.errors import InputError
+from granulate.io.history import read_history
+from granulate.io.vtu import read_pvd
 
 
 def _pyplot():
@@ -34,23 +35,6 @@ def _pyplot():
     import matplotlib.pyplot as plt
 
     return plt
-
-
-def read_history(directory: str | Path) -> dict[str, np.ndarray]:
-    """history.csv as columns of floats."""
-    path = Path(directory) / "history.csv"
-    if not path.is_file():
-        raise InputError(f"{path} does not exist; give the output directory of a run")
-    with path.open(newline="") as handle:
-        rows = list(csv.reader(handle))
-    if len(rows) < 2:
-        raise InputError(f"{path} has no rows yet")
-    header = rows[0]
-    try:
-        data = np.array([[float(v) for v in row] for row in rows[1:] if len(row) == len(header)])
-    except ValueError as error:
-        raise InputError(f"{path} is not a granulate history ({error})") from None
-    return {name: data[:, k] for k, name in enumerate(header)}
 
 
 def plot_history(directory: str | Path) -> list[Path]:
@@ -147,13 +131,10 @@ def plot_breakage(folder: Path, paths: list[Path]) -> list[Path]:
 
 
 def _frame_times(folder: Path, count: int) -> list[float]:
-    """The times of the first `count` frames, from simulation.pvd."""
-    from xml.etree import ElementTree
-
+    """The times of the first `count` frames, from simulation.pvd (numbers when unreadable)."""
     try:
-        root = ElementTree.parse(folder / "simulation.pvd").getroot()
-        times = [float(entry.get("timestep", "nan")) for entry in root.iter("DataSet")]
-    except (OSError, ElementTree.ParseError, ValueError):
+        times = [time for time, _ in read_pvd(folder / "simulation.pvd")]
+    except InputError:
         times = []
     return times[:count] if len(times) >= count else [float(k) for k in range(count)]
 

@@ -8,6 +8,10 @@ import os
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
+import numpy as np
+
+from granulate.errors import InputError
+
 
 class HistoryWriter:
     """Appends rows to a CSV file with a fixed header; every row is flushed to disk."""
@@ -53,3 +57,20 @@ class HistoryWriter:
 
     def close(self) -> None:
         self._handle.close()
+
+
+def read_history(directory: str | Path) -> dict[str, np.ndarray]:
+    """history.csv as columns of floats."""
+    path = Path(directory) / "history.csv"
+    if not path.is_file():
+        raise InputError(f"{path} does not exist; give the output directory of a run")
+    with path.open(newline="") as handle:
+        rows = list(csv.reader(handle))
+    if len(rows) < 2:
+        raise InputError(f"{path} has no rows yet")
+    header = rows[0]
+    try:
+        data = np.array([[float(v) for v in row] for row in rows[1:] if len(row) == len(header)])
+    except ValueError as error:
+        raise InputError(f"{path} is not a granulate history ({error})") from None
+    return {name: data[:, k] for k, name in enumerate(header)}

@@ -167,6 +167,26 @@ class PvdSeries:
         atomic_write(self.path, "\n".join(lines).encode())
 
 
+def read_pvd(path: str | os.PathLike[str]) -> list[tuple[float, Path]]:
+    """The (time, frame path) entries of a .pvd collection, paths resolved against its folder.
+    Raises InputError when it is missing or not a collection."""
+    from xml.etree import ElementTree
+
+    from granulate.errors import InputError
+
+    target = Path(path)
+    try:
+        root = ElementTree.parse(target).getroot()
+        return [
+            (float(entry.get("timestep", "nan")), target.parent / entry.get("file", ""))
+            for entry in root.iter("DataSet")
+        ]
+    except OSError as error:
+        raise InputError(f"cannot read {target}: {error.strerror or error}") from None
+    except (ElementTree.ParseError, ValueError) as error:
+        raise InputError(f"{target} is not a ParaView collection (.pvd): {error}") from None
+
+
 _NUMPY_TYPES = {
     "Float64": "<f8",
     "Float32": "<f4",
