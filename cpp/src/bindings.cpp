@@ -499,6 +499,7 @@ NB_MODULE(_core, m) {
       .def("compute_forces", &Simulation::compute_forces, nb::call_guard<nb::gil_scoped_release>())
       .def("kinetic_energy", &Simulation::kinetic_energy)
       .def("strain_energy", &Simulation::strain_energy)
+      .def("contact_energy", &Simulation::contact_energy)
       .def("broken_bonds", &Simulation::broken_bonds)
       .def("strain_energy_density",
            [](const Simulation& self) {

@@ -1205,6 +1205,28 @@ void ContactModel::sum_slot_springs(const Model& model, const State& state) {
   }
 }
 
+real ContactModel::spring_energy(const Model& model, const State& state) const {
+  if (!built_) return 0;
+  const auto& volume = model.volumes();
+  real energy = 0;
+  for (const index_t i : contact_nodes_) {
+    for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
+      if (pair_partner_[e] < i) continue;  // each pair once: the lists hold both directions
+      const real overlap = pair_geometry(model, state, i, e).overlap;
+      if (overlap > 0) energy += 0.5 * entry_stiffness(model, i, e) * overlap * overlap;
+    }
+    for (index_t e = wall_offsets_[i]; e < wall_offsets_[i + 1]; ++e) {
+      const contact::PairLaw& law = slot_law(wall_slot_[e]);
+      const WallPoints& points = wall_points_[e];
+      for (std::size_t k = 0; k < points.count; ++k) {
+        const real overlap = law.contact_radius - points.points[k].distance;
+        if (overlap > 0) energy += 0.5 * law.normal_stiffness * volume[i] * volume[i] * overlap * overlap;
+      }
+    }
+  }
+  return energy;
+}
+
 void ContactModel::slot_dashpots(const State& state, real dt) {
   // Damping between bodies (see contact_law.hpp): per pair of touching bodies, a dashpot
   // 2 zeta sqrt(M K_s) along the mean contact normal on the approach speed of the bodies at the

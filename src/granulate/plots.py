@@ -1,7 +1,8 @@
 """Plots and renders of a run directory, without ParaView (matplotlib, Agg backend).
 
 ``plot_history(directory)`` writes from history.csv:
-- ``energies.png``: kinetic, strain and total energy against time;
+- ``energies.png``: kinetic, strain and contact-spring energy against time, and the change of
+  the gravitational and total energy (their sum) since the start;
 - ``broken_bonds.png``: broken bonds against time;
 - ``wall_<name>.png`` for every wall: the force components against the wall's displacement
   (a compression test's load curve);
@@ -46,8 +47,13 @@ def plot_history(directory: str | Path) -> list[Path]:
     t = history["time"]
 
     figure, axes = plt.subplots(figsize=(6, 4))
-    for name in ("kinetic_energy", "strain_energy", "total_energy"):
-        axes.plot(t, history[name], label=name.replace("_", " "))
+    for name in ("kinetic_energy", "strain_energy", "contact_energy"):
+        if name in history:  # contact_energy: histories written since it exists
+            axes.plot(t, history[name], label=name.replace("_", " "))
+    for name in ("gravity_energy", "total_energy"):  # potentials: their change since the start
+        if name in history:
+            label = f"{name.replace('_', ' ')} - its start value"
+            axes.plot(t, history[name] - history[name][0], label=label)
     axes.set_xlabel("time [s]")
     axes.set_ylabel("energy [J, J/m in 2D]")
     axes.legend()

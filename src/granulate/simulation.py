@@ -63,6 +63,8 @@ HISTORY_COLUMNS = (
     "time",
     "kinetic_energy",
     "strain_energy",
+    "gravity_energy",
+    "contact_energy",
     "total_energy",
     "broken_bonds",
     "node_contacts",
@@ -1621,6 +1623,13 @@ class Simulation:
         ]
         return sorted(pieces, key=lambda piece: (-len(piece), int(piece[0])))
 
+    def gravity_energy(self) -> float:
+        """Potential energy in the gravity field, -sum m_i g . x_i [J; J/m in 2D] (zero at the
+        origin)."""
+        model = self.model
+        mass = np.asarray(model.node_density) * np.asarray(model.volumes)
+        return float(-(mass @ (self._build().positions @ np.asarray(self._gravity))))
+
     def _fragment_labels(self) -> NDArray[np.uint32]:
         """Each node's piece: its smallest node (computed once per step and bond count)."""
         core = self._build()
@@ -1789,13 +1798,16 @@ class Simulation:
         assert out is not None and self._model is not None
         core = self._build()
         kinetic, strain = core.kinetic_energy(), core.strain_energy()
+        gravity, contact = self.gravity_energy(), core.contact_energy()
         statistics = core.contact_statistics
         row: dict[str, float | int] = {
             "step": core.step,
             "time": core.time,
             "kinetic_energy": kinetic,
             "strain_energy": strain,
-            "total_energy": kinetic + strain,
+            "gravity_energy": gravity,
+            "contact_energy": contact,
+            "total_energy": kinetic + strain + gravity + contact,
             "broken_bonds": core.broken_bonds(),
             "node_contacts": statistics.node_contacts,
             "wall_contacts": statistics.wall_contacts,

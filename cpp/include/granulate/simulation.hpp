@@ -68,6 +68,7 @@ class Simulation {
   // Diagnostics (computed on demand; sums in a fixed order, so identical for any thread count).
   real kinetic_energy() const;  ///< sum 1/2 rho V |v|^2 [J; J/m in 2D]
   real strain_energy() const;   ///< sum W_i V_i [J; J/m in 2D]
+  real contact_energy() const { return contact_.spring_energy(*model_, state_); }  ///< [J; J/m]
   /// W_i per node [J/m^3, also in 2D]: LPS and PMB energy densities (see the evaluators).
   void strain_energy_density(real* out) const;
   /// phi_i = 1 - (intact weighted volume)/(initial weighted volume); z_i = max_j |s_ij| / s0.

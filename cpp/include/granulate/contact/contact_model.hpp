@@ -98,6 +98,10 @@ class ContactModel {
   /// S = 2 n kn min(V_i, V_j) against a coarser particle; the maximum over every particle and
   /// wall it has a law with. Infinity without contact.
   real stable_time_step(const Model& model) const;
+  /// Energy stored in the normal contact springs [J; J/m in 2D]: sum of k overlap^2 / 2 over
+  /// node pairs (each once) and node-wall points in contact at the state's positions, summed in
+  /// node order. The friction springs' energy is not included.
+  real spring_energy(const Model& model, const State& state) const;
   const std::vector<Wall>& walls() const { return walls_; }
 
   /// Adds contact force densities to state.forces at time t; updates wall reactions.
