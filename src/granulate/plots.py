@@ -38,6 +38,14 @@ def _pyplot():
     return plt
 
 
+def _save(plt, figure, path: Path) -> Path:
+    """Write a plot (tight layout, 120 dpi) and close it; returns the path."""
+    figure.tight_layout()
+    figure.savefig(path, dpi=120)
+    plt.close(figure)
+    return path
+
+
 def plot_history(directory: str | Path) -> list[Path]:
     """Write the history plots (see the module docstring); returns their paths."""
     history = read_history(directory)
@@ -57,19 +65,13 @@ def plot_history(directory: str | Path) -> list[Path]:
     axes.set_xlabel("time [s]")
     axes.set_ylabel("energy [J, J/m in 2D]")
     axes.legend()
-    figure.tight_layout()
-    written.append(folder / "energies.png")
-    figure.savefig(written[-1], dpi=120)
-    plt.close(figure)
+    written.append(_save(plt, figure, folder / "energies.png"))
 
     figure, axes = plt.subplots(figsize=(6, 4))
     axes.plot(t, history["broken_bonds"])
     axes.set_xlabel("time [s]")
     axes.set_ylabel("broken bonds")
-    figure.tight_layout()
-    written.append(folder / "broken_bonds.png")
-    figure.savefig(written[-1], dpi=120)
-    plt.close(figure)
+    written.append(_save(plt, figure, folder / "broken_bonds.png"))
 
     walls = sorted(
         {name[: -len("_displacement")] for name in history if name.endswith("_displacement")}
@@ -83,10 +85,7 @@ def plot_history(directory: str | Path) -> list[Path]:
         axes.set_xlabel(f"{wall} displacement [m or rad]")
         axes.set_ylabel("force on the wall [N, N/m in 2D]")
         axes.legend()
-        figure.tight_layout()
-        written.append(folder / f"wall_{wall}.png")
-        figure.savefig(written[-1], dpi=120)
-        plt.close(figure)
+        written.append(_save(plt, figure, folder / f"wall_{wall}.png"))
     tables = sorted((folder / "frames").glob("fragments_*.csv"))
     if tables:
         written += plot_breakage(folder, tables)
@@ -116,10 +115,7 @@ def plot_breakage(folder: Path, paths: list[Path]) -> list[Path]:
     axes.set_xlabel("equivalent diameter [m]")
     axes.set_ylabel("mass fraction passing [-]")
     axes.legend()
-    figure.tight_layout()
-    written = [folder / "grading.png"]
-    figure.savefig(written[-1], dpi=120)
-    plt.close(figure)
+    written = [_save(plt, figure, folder / "grading.png")]
 
     figure, axes = plt.subplots(figsize=(6, 4))
     if np.max(initial["diameter"]) > fragments.HARDIN_CUTOFF:
@@ -129,10 +125,7 @@ def plot_breakage(folder: Path, paths: list[Path]) -> list[Path]:
     axes.set_xlabel("time [s]")
     axes.set_ylabel("breakage index [-]")
     axes.legend()
-    figure.tight_layout()
-    written.append(folder / "breakage.png")
-    figure.savefig(written[-1], dpi=120)
-    plt.close(figure)
+    written.append(_save(plt, figure, folder / "breakage.png"))
     return written
 
 

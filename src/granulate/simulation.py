@@ -850,7 +850,7 @@ class Simulation:
             if body.index >= len(self.bodies) or self.bodies[body.index] is not body:
                 raise InputError(f"body {body.name!r} belongs to another simulation")
             return body
-        if body in self._body_names:
+        if isinstance(body, str) and body in self._body_names:
             return self._body_names[body]
         match = difflib.get_close_matches(str(body), list(self._body_names), n=1)
         hint = f"; did you mean {match[0]!r}?" if match else ""
@@ -1466,6 +1466,7 @@ class Simulation:
                 "time step or case file); run without --resume, or restore the original case"
             )
         core.restore(state)
+        self._labels = None  # fragments of the restored bonds
         out = self._output
         saved = header.get("output")
         if out is not None:

@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import math
 import os
+from collections.abc import Callable
 from pathlib import Path
 
 from granulate import _core
@@ -125,7 +126,9 @@ class ThreadTuner:
     is kept when it beats the mean of those two, so a workload that changes as the run goes on
     (contacts forming, bonds breaking) does not bias the comparison."""
 
-    def __init__(self, most: int, start: int | None = None, busy=None) -> None:
+    def __init__(
+        self, most: int, start: int | None = None, busy: Callable[[], int] | None = None
+    ) -> None:
         self.counts = candidate_counts(most)
         self._busy = busy_cpus if busy is None else busy  # tasks of others running now
         # Start with the CPUs nothing else is running on (a guess the trials then check).
