@@ -1089,8 +1089,7 @@ void ContactModel::measure_contacts(const Model& model, const State& state) {
         for (std::size_t k = 0; k < points.count; ++k) {
           points.points[k] = {found[k].distance, wall.rotate_to_world(found[k].normal, t)};
         }
-        wall_entry_stiffness_[e] =
-            static_cast<real>(points.count) * law.normal_stiffness * volume[i] * volume[i];
+        wall_entry_stiffness_[e] = static_cast<real>(points.count) * wall_spring_stiffness(model, i, e);
       }
     }
 #pragma omp critical
@@ -1165,7 +1164,6 @@ void ContactModel::measure_surface_normals(const Model& model, const State& stat
 void ContactModel::sum_slot_springs(const Model& model, const State& state) {
   // Spring force, spring-weighted normal (from the first body to the second, or from the wall to
   // the particle) and spring-weighted contact point per slot, summed in node order.
-  const auto& volume = model.volumes();
   for (const index_t i : contact_nodes_) {
     const vec3 xi = contact_position(model, state, i);
     for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
@@ -1192,7 +1190,7 @@ void ContactModel::sum_slot_springs(const Model& model, const State& state) {
       const WallPoints& points = wall_points_[e];
       for (std::size_t k = 0; k < points.count; ++k) {
         const real overlap = law.contact_radius - points.points[k].distance;
-        const real spring = contact::normal_force(law.normal_stiffness * volume[i] * volume[i], overlap);
+        const real spring = contact::normal_force(wall_spring_stiffness(model, i, e), overlap);
         const real lever = law.contact_radius - 0.5 * overlap;
         slot_force_[touch] += spring;
         for (int c = 0; c < 3; ++c) {
@@ -1207,7 +1205,6 @@ void ContactModel::sum_slot_springs(const Model& model, const State& state) {
 
 real ContactModel::spring_energy(const Model& model, const State& state) const {
   if (!built_) return 0;
-  const auto& volume = model.volumes();
   real energy = 0;
   for (const index_t i : contact_nodes_) {
     for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
@@ -1220,7 +1217,7 @@ real ContactModel::spring_energy(const Model& model, const State& state) const {
       const WallPoints& points = wall_points_[e];
       for (std::size_t k = 0; k < points.count; ++k) {
         const real overlap = law.contact_radius - points.points[k].distance;
-        if (overlap > 0) energy += 0.5 * law.normal_stiffness * volume[i] * volume[i] * overlap * overlap;
+        if (overlap > 0) energy += 0.5 * wall_spring_stiffness(model, i, e) * overlap * overlap;
       }
     }
   }
@@ -1442,6 +1439,10 @@ real ContactModel::entry_stiffness(const Model& model, index_t i, index_t e) con
                                  model.volumes()[pair_partner_[e]]);
 }
 
+real ContactModel::wall_spring_stiffness(const Model& model, index_t i, index_t e) const {
+  return contact::pair_stiffness(slot_law(wall_slot_[e]), model.volumes()[i], model.volumes()[i]);
+}
+
 ContactModel::PairGeometry ContactModel::pair_geometry(const Model& model, const State& state, index_t i,
                                                        index_t e) const {
   const index_t j = pair_partner_[e];
@@ -1504,7 +1505,7 @@ ContactModel::WallGeometry ContactModel::wall_geometry(const Model& model, index
   WallGeometry g;
   g.normal = deepest.normal;
   g.arm = {-lever * g.normal[0], -lever * g.normal[1], -lever * g.normal[2]};
-  g.stiffness = resolved.normal_stiffness * model.volumes()[i] * model.volumes()[i];
+  g.stiffness = wall_spring_stiffness(model, i, e);
   return g;
 }
 

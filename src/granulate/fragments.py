@@ -36,6 +36,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from granulate.errors import InputError
 from granulate.io.atomic import atomic_write
+from granulate.io.table import read_table as read_rows
 
 #: Columns of a fragment table, in the order they are written.
 COLUMNS = (
@@ -92,8 +93,9 @@ def fragment_table(
 
 def summary(table: Table, damage: ArrayLike, volumes: ArrayLike) -> dict[str, float | int]:
     """The history columns of a fragment table: fragments (pieces of two nodes or more),
-    debris_nodes, debris_mass, particles_broken (particles in two pieces or more) and the
-    volume-weighted mean damage of all nodes."""
+    debris_nodes, debris_mass, particles_split (particles in two pieces or more; not the stop
+    criterion's particles that lost every bond) and the volume-weighted mean damage of all
+    nodes."""
     debris = table["debris"] == 1
     pieces = np.bincount(table["particle"])
     v = np.asarray(volumes, dtype=np.float64)
@@ -101,7 +103,7 @@ def summary(table: Table, damage: ArrayLike, volumes: ArrayLike) -> dict[str, fl
         "fragments": int(np.count_nonzero(~debris)),
         "debris_nodes": int(np.count_nonzero(debris)),
         "debris_mass": float(table["mass"][debris].sum()),
-        "particles_broken": int(np.count_nonzero(pieces > 1)),
+        "particles_split": int(np.count_nonzero(pieces > 1)),
         "mean_damage": float(v @ np.asarray(damage, dtype=np.float64) / v.sum()),
     }
 
@@ -119,12 +121,9 @@ def write_table(path: str | Path, table: Table) -> None:
 
 def read_table(path: str | Path) -> Table:
     """A fragment table written by ``write_table`` (a run's frames/fragments_NNNNNN.csv)."""
-    try:
-        data = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
-    except (OSError, ValueError) as error:
-        raise InputError(f"cannot read the fragment table {path}: {error}") from None
-    if data.shape[1] != len(COLUMNS):
-        raise InputError(f"{path} is not a fragment table (expected columns {', '.join(COLUMNS)})")
+    data = read_rows(
+        path, what="fragment table", widths=(len(COLUMNS),), columns=", ".join(COLUMNS)
+    )
     table = {name: data[:, k] for k, name in enumerate(COLUMNS)}
     for name in ("fragment", "particle", "nodes", "debris"):
         table[name] = table[name].astype(np.int64)

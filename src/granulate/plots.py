@@ -26,7 +26,7 @@ import numpy as np
 from granulate import fragments
 from granulate.errors import InputError
 from granulate.io.history import read_history
-from granulate.io.vtu import read_pvd
+from granulate.results import Results
 
 
 def _pyplot():
@@ -86,23 +86,20 @@ def plot_history(directory: str | Path) -> list[Path]:
         axes.set_ylabel("force on the wall [N, N/m in 2D]")
         axes.legend()
         written.append(_save(plt, figure, folder / f"wall_{wall}.png"))
-    tables = sorted((folder / "frames").glob("fragments_*.csv"))
-    if tables:
-        written += plot_breakage(folder, tables)
+    if any((folder / "frames").glob("fragments_*.csv")):
+        written += plot_breakage(Results(folder))
     return written
 
 
-def plot_breakage(folder: Path, paths: list[Path]) -> list[Path]:
-    """grading.png and breakage.png from the frames' fragment tables (module docstring); a
-    frame's time is read from simulation.pvd (its number when that fails). Br is left out
-    when no initial piece is larger than Hardin's cut-off."""
+def plot_breakage(results: Results) -> list[Path]:
+    """grading.png and breakage.png from the frames' fragment tables (module docstring). Br is
+    left out when no initial piece is larger than Hardin's cut-off."""
     plt = _pyplot()
-    tables = [fragments.read_table(path) for path in paths]
-    times = _frame_times(folder, len(tables))
+    tables = [results.fragments(k) for k in range(len(results))]
+    times = results.times
     initial = tables[0]
     parent_volume = np.bincount(initial["particle"], initial["volume"])
-    dimension = 2 if np.all(initial["z"] == initial["z"][0]) else 3
-    parent_sizes = fragments.equivalent_diameter(parent_volume, dimension)
+    parent_sizes = fragments.equivalent_diameter(parent_volume, results.summary["dimension"])
     shown = sorted({0, len(tables) - 1, *np.linspace(0, len(tables) - 1, 5).astype(int)})
 
     figure, axes = plt.subplots(figsize=(6, 4))
@@ -115,7 +112,7 @@ def plot_breakage(folder: Path, paths: list[Path]) -> list[Path]:
     axes.set_xlabel("equivalent diameter [m]")
     axes.set_ylabel("mass fraction passing [-]")
     axes.legend()
-    written = [_save(plt, figure, folder / "grading.png")]
+    written = [_save(plt, figure, results.directory / "grading.png")]
 
     figure, axes = plt.subplots(figsize=(6, 4))
     if np.max(initial["diameter"]) > fragments.HARDIN_CUTOFF:
@@ -125,17 +122,8 @@ def plot_breakage(folder: Path, paths: list[Path]) -> list[Path]:
     axes.set_xlabel("time [s]")
     axes.set_ylabel("breakage index [-]")
     axes.legend()
-    written.append(_save(plt, figure, folder / "breakage.png"))
+    written.append(_save(plt, figure, results.directory / "breakage.png"))
     return written
-
-
-def _frame_times(folder: Path, count: int) -> list[float]:
-    """The times of the first `count` frames, from simulation.pvd (numbers when unreadable)."""
-    try:
-        times = [time for time, _ in read_pvd(folder / "simulation.pvd")]
-    except InputError:
-        times = []
-    return times[:count] if len(times) >= count else [float(k) for k in range(count)]
 
 
 def _frames(directory: Path) -> list[Path]:

@@ -19,7 +19,9 @@ from numpy.typing import NDArray
 from granulate import fragments
 from granulate.errors import InputError
 from granulate.io.history import read_history
+from granulate.io.table import read_table as read_rows
 from granulate.io.vtu import read_pvd, read_vtu_point_data
+from granulate.simulation import PARTICLE_COLUMNS
 
 
 @dataclass(frozen=True)
@@ -101,12 +103,11 @@ class Results:
         mass [kg; kg/m in 2D], damage."""
         k = self.index(frame, time=time)
         path = self._files[k].parent / f"particles_{self._number(k)}.csv"
-        try:
-            data = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
-            header = path.open().readline().strip().split(",")
-        except (OSError, ValueError) as error:
-            raise InputError(f"cannot read the particle table {path}: {error}") from None
-        return {name: data[:, j] for j, name in enumerate(header)}
+        names = PARTICLE_COLUMNS
+        data = read_rows(
+            path, what="particle table", widths=(len(names),), columns=", ".join(names)
+        )
+        return {name: data[:, j] for j, name in enumerate(names)}
 
     def fragments(self, frame: int | None = None, *, time: float | None = None) -> fragments.Table:
         """The frame's fragment table (granulate.fragments.COLUMNS)."""

@@ -58,6 +58,8 @@ FIELDS = (
     "Fixity",
     "Nodal_Volume",
 )
+#: Columns of the particle tables (frames/particles_NNNNNN.csv), in the order written.
+PARTICLE_COLUMNS = ("particle", "x", "y", "z", "vx", "vy", "vz", "mass", "damage")
 HISTORY_COLUMNS = (
     "step",
     "time",
@@ -73,7 +75,7 @@ HISTORY_COLUMNS = (
     "fragments",
     "debris_nodes",
     "debris_mass",
-    "particles_broken",
+    "particles_split",
     "mean_damage",
 )
 
@@ -1675,6 +1677,7 @@ class Simulation:
         return {
             "granulate": __version__,
             "case_fingerprint": self.case_fingerprint,
+            "dimension": self.dimension,
             "bodies": len(self.bodies),
             "nodes": self.node_count,
             "bonds": self.bond_count,
@@ -1713,7 +1716,7 @@ class Simulation:
             np.bincount(owner, volumes * damage, count) / np.bincount(owner, volumes, count)
         )
         buffer = io.StringIO()
-        buffer.write("particle,x,y,z,vx,vy,vz,mass,damage\n")
+        buffer.write(",".join(PARTICLE_COLUMNS) + "\n")
         np.savetxt(buffer, np.column_stack(columns), delimiter=",", fmt=["%d"] + ["%.17g"] * 8)
         atomic_write(path, buffer.getvalue().encode())
 
@@ -1742,10 +1745,9 @@ class Simulation:
         start = wallclock.perf_counter()
         try:
             step = int(self._build().step)
-            if frame and out.frame_step != step:
-                self._write_vtu_frame()
-            if frame and out.history_step != step:
-                self._write_history_row()
+            self._write_outputs(
+                frame and out.frame_step != step, frame and out.history_step != step
+            )
         finally:
             self._output_seconds += wallclock.perf_counter() - start
 
@@ -1755,16 +1757,29 @@ class Simulation:
         out = self._output
         assert out is not None
         step = self._build().step
-        if step % out.every == 0 or out.frames == 0:
-            self._write_vtu_frame()
-        if step % out.history_every == 0 or out.history is None:
-            self._write_history_row()
+        self._write_outputs(
+            step % out.every == 0 or out.frames == 0,
+            step % out.history_every == 0 or out.history is None,
+        )
 
-    def _write_vtu_frame(self) -> None:
+    def _write_outputs(self, frame: bool, history: bool) -> None:
+        """The frame and the history row of the current step, as asked; both take the step's
+        damage and fragment table from here."""
+        if not (frame or history):
+            return
+        phi, z = self._build().damage()
+        table = self.fragment_table()
+        if frame:
+            self._write_vtu_frame(phi, z, table)
+        if history:
+            self._write_history_row(phi, table)
+
+    def _write_vtu_frame(
+        self, phi: NDArray[np.float64], z: NDArray[np.float64], table: fragments.Table
+    ) -> None:
         out = self._output
         assert out is not None and self._model is not None
         core = self._build()
-        phi, z = core.damage()
         volumes = self._model.volumes
         available = {
             "Displacement": lambda: core.positions - self._reference,
@@ -1787,14 +1802,12 @@ class Simulation:
         )
         out.pvd.add(core.time, Path("frames") / name)
         self._write_particles(out.directory / "frames" / f"particles_{out.frames:06d}.csv", phi)
-        fragments.write_table(
-            out.directory / "frames" / f"fragments_{out.frames:06d}.csv", self.fragment_table()
-        )
+        fragments.write_table(out.directory / "frames" / f"fragments_{out.frames:06d}.csv", table)
         out.frames += 1
         out.frame_step = int(core.step)
         self._write_run_json()
 
-    def _write_history_row(self) -> None:
+    def _write_history_row(self, phi: NDArray[np.float64], table: fragments.Table) -> None:
         out = self._output
         assert out is not None and self._model is not None
         core = self._build()
@@ -1814,7 +1827,7 @@ class Simulation:
             "wall_contacts": statistics.wall_contacts,
             "list_rebuilds": statistics.rebuilds,
         }
-        row.update(fragments.summary(self.fragment_table(), core.damage()[0], self._model.volumes))
+        row.update(fragments.summary(table, phi, self._model.volumes))
         components = (
             ("fx", "fy", "tz") if self.dimension == 2 else ("fx", "fy", "fz", "tx", "ty", "tz")
         )

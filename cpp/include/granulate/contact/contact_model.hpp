@@ -217,6 +217,8 @@ class ContactModel {
   /// Spring stiffness k of node i's list entry e in double precision (pair_stiffness_ keeps it
   /// in single precision, as the in-contact flag and for the sums of pass B).
   real entry_stiffness(const Model& model, index_t i, index_t e) const;
+  /// Spring stiffness of each contact point of node i's wall entry e: kn V_i^2.
+  real wall_spring_stiffness(const Model& model, index_t i, index_t e) const;
   /// Forget a slot's collision (the bodies are apart).
   void end_collision(std::size_t slot);
   /// Damping ratio of a slot in contact that gives the requested restitution for the force law
