@@ -77,11 +77,11 @@ def test_a_disc_at_rest_on_a_wall_never_spins_up_and_sits_at_its_radius(full: bo
     contact spheres reach the surface; the node-pair law left it 0.4 h too high). mu = 0, 0.3
     and 1 under g = 9.81 and 100 with --full; the smoke test runs mu = 0 and 1 under g = 100
     and mu = 0.3 under g = 9.81."""
+    radius, h = 1e-3, 1e-4
     cases = [(mu, g) for mu in (0.0, 0.3, 1.0) for g in (9.81, 100.0)]
     for mu, gravity in cases if full else [(0.0, 100.0), (1.0, 100.0), (0.3, 9.81)]:
         sim = gr.Simulation(2, gravity=(0, -gravity))
         sim.contact = gr.Contact(restitution=0.5, friction=mu)
-        radius, h = 1e-3, 1e-4
         disc = sim.add_body(gr.Disc((0, radius + 0.02 * h), radius), SOFT, h)
         sim.add_wall(gr.Plane((0, 0), (0, 1)), name="floor")
         sim.run(until=0.02)
