@@ -16,14 +16,18 @@ import pytest
 import granulate as gr
 
 
-def tumbling_drum(out: Path, *, resume: bool = False, grid: bool = False) -> gr.Simulation:
+def tumbling_drum(
+    out: Path, *, resume: bool = False, grid: bool = False, law: str = "granulate"
+) -> gr.Simulation:
     """Grains breaking in a rotating drum: contact, friction, damping, walls and fracture.
     ``grid``: the fourth grain is a brittle grid-meshed square instead of a lattice triangle:
     its surface nodes have their contact spheres centred inside them (surface anchors), and
-    they lose them as its bonds break (it is damaged all through by step 2,000)."""
+    they lose them as its bonds break (it is damaged all through by step 2,000). ``law``: the
+    contact's pair_law ("surface": probes of the grains' smooth surfaces, with their groups
+    and the nodes opened by cracks joining the lists)."""
     rock = gr.Material(density=2000, youngs_modulus=1e8, poisson_ratio=0.25, fracture_energy=0.5)
     sim = gr.Simulation(2, gravity=(0, -9.81))
-    sim.contact = gr.Contact(restitution=0.5, friction=0.4)
+    sim.contact = gr.Contact(restitution=0.5, friction=0.4, pair_law=law)
     for k, (x, y) in enumerate([(-3e-3, -2e-3), (0, -4e-3), (3e-3, -2e-3), (0, 0)]):
         velocity = (0.2 * k - 0.3, -4.0)
         if k == 3 and grid:
@@ -63,16 +67,20 @@ def assert_same_outputs(a: Path, b: Path) -> None:
 
 # The shattered square's fragments hit hard enough to pass half the contact radius (warned).
 @pytest.mark.filterwarnings("ignore:contact. node pairs overlapped")
-@pytest.mark.parametrize("grid", [False, True], ids=["lattice", "grid"])
+@pytest.mark.parametrize(
+    ("grid", "law"),
+    [(False, "granulate"), (True, "granulate"), (True, "surface")],
+    ids=["lattice", "grid", "surface"],
+)
 def test_resumed_run_writes_the_same_bits_as_an_uninterrupted_one(
-    tmp_path: Path, grid: bool
+    tmp_path: Path, grid: bool, law: str
 ) -> None:
-    whole = tumbling_drum(tmp_path / "whole", grid=grid)
+    whole = tumbling_drum(tmp_path / "whole", grid=grid, law=law)
     whole.run(3000)
     assert whole.broken_bonds() > 0  # the run exercises fracture and fragments
-    first = tumbling_drum(tmp_path / "split", grid=grid)
+    first = tumbling_drum(tmp_path / "split", grid=grid, law=law)
     first.run(2300)  # the last checkpoint is at step 2000; later outputs get rewritten
-    second = tumbling_drum(tmp_path / "split", resume=True, grid=grid)
+    second = tumbling_drum(tmp_path / "split", resume=True, grid=grid, law=law)
     second.load_checkpoint(tmp_path / "split" / "checkpoint.npz")
     assert second.step == 2000
     second.run(1000)
@@ -223,9 +231,10 @@ def test_stop_criteria_end_the_run_at_a_fixed_step(tmp_path: Path) -> None:
 
 
 def test_checkpoints_of_the_earlier_contact_model_are_refused(tmp_path: Path) -> None:
-    """Formats 1 (before friction springs and per-node contact radii) and 2 (before the damping
-    fitted to each collision's force law) cannot continue the same trajectory: they are
-    refused with the reason and the fix, and the file is left alone."""
+    """Formats 1 (before friction springs and per-node contact radii), 2 (before the damping
+    fitted to each collision's force law) and 3 (before contact against the particles' smooth
+    surfaces) cannot continue the same trajectory: they are refused with the reason and the
+    fix, and the file is left alone."""
     import json
 
     sim = tumbling_drum(tmp_path / "a")
@@ -234,7 +243,7 @@ def test_checkpoints_of_the_earlier_contact_model_are_refused(tmp_path: Path) ->
     with np.load(checkpoint) as archive:
         data = {name: archive[name] for name in archive.files}
     header = json.loads(bytes(data["__header__"]).decode())
-    for format_ in (1, 2):
+    for format_ in (1, 2, 3):
         header["format"] = format_
         data["__header__"] = np.frombuffer(json.dumps(header).encode(), np.uint8)
         old = tmp_path / f"old{format_}.npz"

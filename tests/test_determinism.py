@@ -45,16 +45,16 @@ def test_one_and_two_threads_give_identical_bits(dimension: int) -> None:
     assert cracking_plate_digest(dimension, 1) == cracking_plate_digest(dimension, 2)
 
 
-def granular_digest(threads: int) -> str:
+def granular_digest(threads: int, law: str = "granulate") -> str:
     """Discs and a triangle tumbling in a rotating drum with lifters: contact, damping,
-    friction, walls and fracture all at once."""
+    friction, walls and fracture all at once (``law``: the contact's pair_law)."""
     gr.set_num_threads(threads)
     try:
         rock = gr.Material(
             density=2000, youngs_modulus=1e8, poisson_ratio=0.25, fracture_energy=2.0
         )
         sim = gr.Simulation(2, gravity=(0, -9.81))
-        sim.contact = gr.Contact(restitution=0.5, friction=0.4)
+        sim.contact = gr.Contact(restitution=0.5, friction=0.4, pair_law=law)
         for k, (x, y) in enumerate([(-3e-3, -2e-3), (0, -4e-3), (3e-3, -2e-3), (0, 0)]):
             shape = (
                 gr.Disc((x, y), 1.2e-3)
@@ -80,8 +80,9 @@ def granular_digest(threads: int) -> str:
         gr.set_num_threads(2)
 
 
-def test_granular_flow_is_bitwise_identical_for_one_and_two_threads() -> None:
-    assert granular_digest(1) == granular_digest(2)
+@pytest.mark.parametrize("law", ["granulate", "surface"])
+def test_granular_flow_is_bitwise_identical_for_one_and_two_threads(law: str) -> None:
+    assert granular_digest(1, law) == granular_digest(2, law)
 
 
 def test_repeated_runs_give_identical_bits() -> None:

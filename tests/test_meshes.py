@@ -238,7 +238,17 @@ def test_surface_offsets_reach_every_face_at_a_node() -> None:
     np.testing.assert_array_equal(np.unique(box.surface), [-1.0, 0.0, 1.0])
     corner = np.flatnonzero(np.all(box.positions == 0, axis=1))[0]
     np.testing.assert_array_equal(box.surface[corner], [-1.0, -1.0, -1.0])
-    assert gr.ReferenceShape.from_shape(gr.Disc((0, 0), 1), 0.1).surface is None
+    # A lattice's outer layer (nodes less than h deep) carries the shape's unit normal and its
+    # depth, so contact sees its surface points on the true circle.
+    lattice = gr.ReferenceShape.from_shape(gr.Disc((0, 0), 1), 0.1)
+    layer = np.linalg.norm(lattice.surface, axis=1) > 0
+    r = np.linalg.norm(lattice.positions[:, :2], axis=1)
+    np.testing.assert_array_equal(layer, 1 - r < 0.1)
+    np.testing.assert_allclose(
+        lattice.surface[layer, :2], lattice.positions[layer, :2] / r[layer, None]
+    )
+    points = lattice.positions[layer] + lattice.surface_depth[layer, None] * lattice.surface[layer]
+    np.testing.assert_allclose(np.linalg.norm(points, axis=1), 1.0, rtol=1e-6)
 
 
 def test_surface_offsets_of_the_wrong_size_are_refused() -> None:
@@ -247,7 +257,13 @@ def test_surface_offsets_of_the_wrong_size_are_refused() -> None:
     model = _core.Model(2)
     positions, volumes = np.zeros((2, 3)), np.ones(2)
     positions[1, 0] = 1.0
+    none = np.zeros(0)
     with pytest.raises(gr.InputError, match="1 surface offsets for 2 nodes"):
-        model.add_shape(positions, volumes, 1.0, np.zeros(3))
+        model.add_shape(positions, volumes, 1.0, np.zeros(3), none)
     with pytest.raises(gr.InputError, match="not finite"):
-        model.add_shape(positions, volumes, 1.0, np.array([0, 0, 0, np.nan, 0, 0]))
+        model.add_shape(positions, volumes, 1.0, np.array([0, 0, 0, np.nan, 0, 0]), none)
+    offsets = np.array([1.0, 0, 0, 0, 0, 0])
+    with pytest.raises(gr.InputError, match="1 surface depths for 2 nodes"):
+        model.add_shape(positions, volumes, 1.0, offsets, np.zeros(1))
+    with pytest.raises(gr.InputError, match="surface depth is negative"):
+        model.add_shape(positions, volumes, 1.0, offsets, np.array([-0.1, 0.0]))

@@ -243,12 +243,14 @@ NB_MODULE(_core, m) {
           "positions"_a, "volumes"_a, "material"_a, "mesh_size"_a, "horizon"_a = 0.0)
       .def(
           "add_shape",
-          [](Model& self, Points positions, Scalars volumes, real mesh_size, Scalars surface_offsets) {
+          [](Model& self, Points positions, Scalars volumes, real mesh_size, Scalars surface_offsets,
+             Scalars surface_depths) {
             return self.add_shape({positions.data(), positions.shape(0) * 3},
                                   {volumes.data(), volumes.shape(0)}, mesh_size,
-                                  {surface_offsets.data(), surface_offsets.shape(0)});
+                                  {surface_offsets.data(), surface_offsets.shape(0)},
+                                  {surface_depths.data(), surface_depths.shape(0)});
           },
-          "positions"_a, "volumes"_a, "mesh_size"_a, "surface_offsets"_a)
+          "positions"_a, "volumes"_a, "mesh_size"_a, "surface_offsets"_a, "surface_depths"_a)
       .def(
           "place_shape",
           [](Model& self, index_t shape, index_t material, Points positions, real scale, real horizon) {
@@ -330,7 +332,8 @@ NB_MODULE(_core, m) {
       .def_rw("friction", &contact::Law::friction)
       .def_rw("tangential_stiffness_ratio", &contact::Law::tangential_stiffness_ratio)
       .def_rw("peridem_friction", &contact::Law::peridem_friction)
-      .def_rw("node_pair", &contact::Law::node_pair);
+      .def_rw("node_pair", &contact::Law::node_pair)
+      .def_rw("surface", &contact::Law::surface);
   m.def("damping_ratio_from_restitution", &contact::damping_ratio_from_restitution, "restitution"_a);
   m.def("power_law_restitution", &contact::power_law_restitution, "damping_ratio"_a, "exponent"_a);
   m.def("power_law_damping_ratio", &contact::power_law_damping_ratio, "restitution"_a, "exponent"_a);

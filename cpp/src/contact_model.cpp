@@ -156,6 +156,7 @@ void ContactModel::configure(const Model& model) {
     particle_material_.push_back(p.material);
     material_max_mesh_size_[p.material] = std::max(material_max_mesh_size_[p.material], p.mesh_size);
   }
+  find_surface_particles();
   built_ = false;
   centres_.forget();
 }
@@ -181,6 +182,19 @@ std::vector<real> ContactModel::centring_depths(const Model& model) const {
   return depth;
 }
 
+void ContactModel::find_surface_particles() {
+  surface_particles_.assign(particle_material_.size(), 0);
+  any_surface_ = false;
+  for (index_t p = 0; p < static_cast<index_t>(surface_particles_.size()); ++p) {
+    const index_t m = particle_material_[p];
+    for (index_t b = 0; b < material_count_; ++b) {
+      if (law_set_[m * material_count_ + b] && laws_[m * material_count_ + b].surface)
+        surface_particles_[p] = 1;
+    }
+    any_surface_ = any_surface_ || surface_particles_[p];
+  }
+}
+
 real ContactModel::centring_depth(index_t p) const {
   // The node's contact radius over h/2, from its material's law with itself, or else its first
   // law with another material or a wall.
@@ -197,11 +211,69 @@ real ContactModel::centring_depth(index_t p) const {
 }
 
 vec3 ContactModel::contact_position(const Model& model, const State& state, index_t i) const {
-  return centres_.at_centre(model, state.positions, i);
+  if (!centres_.moved(i))
+    return {state.positions[3 * i], state.positions[3 * i + 1], state.positions[3 * i + 2]};
+  return centres_.at_centre(model, state, i);
 }
 
 vec3 ContactModel::contact_velocity(const Model& model, const State& state, index_t i) const {
-  return centres_.at_centre(model, state.velocities, i);
+  if (!centres_.moved(i))
+    return {state.velocities[3 * i], state.velocities[3 * i + 1], state.velocities[3 * i + 2]};
+  return centres_.centre_velocity(model, state, i);
+}
+
+const contact::SurfacePoint& ContactModel::surface_point(index_t j) const {
+  return surface_points_[surface_slot_[j]];
+}
+
+real ContactModel::probe_stiffness(const Model& model, index_t i, index_t target,
+                                   const contact::PairLaw& law) const {
+  // Per unit area the contact is as stiff as the sphere law's node pairs of the finer mesh,
+  // kn min(V_i, V_t)^2 per (finer h)^(d-1); a probe carries its own node's share of the surface,
+  // h_i^(d-1), and its side's share of the contact.
+  const real hi = particle_side_[model.node_particle()[i]].mesh_size;
+  const real ht = particle_side_[model.node_particle()[target]].mesh_size;
+  const real share = ht * ht / (hi * hi + ht * ht);
+  const real area =
+      dimension_ == 2 ? hi / std::min(hi, ht) : (hi * hi) / (std::min(hi, ht) * std::min(hi, ht));
+  return share * area * contact::pair_stiffness(law, model.volumes()[i], model.volumes()[target]);
+}
+
+real ContactModel::pair_reach(const Model& model, index_t i, index_t j, bool same_body) const {
+  const auto& owner = model.node_particle();
+  const contact::Law& law = laws_[model.node_material()[i] * material_count_ + model.node_material()[j]];
+  const real rc = contact::resolve_contact_radius(law, particle_side_[owner[i]], particle_side_[owner[j]]);
+  const SurfaceAnchor* ai = centres_.anchor(model, i);
+  const SurfaceAnchor* aj = centres_.anchor(model, j);
+  if (same_body || !law.surface || (ai == nullptr && aj == nullptr)) {
+    // Spheres at the contact centres, which lie rho |o| below the list positions (the surface
+    // points) of particles under the surface law.
+    real reach = rc;
+    if (ai != nullptr && surface_particle(owner[i])) reach += node_radius(law, model, i, j, rc) * ai->reach;
+    if (aj != nullptr && surface_particle(owner[j])) reach += node_radius(law, model, j, i, rc) * aj->reach;
+    return reach;
+  }
+  const real support_i = contact::surface_support_factor * particle_side_[owner[i]].mesh_size;
+  const real support_j = contact::surface_support_factor * particle_side_[owner[j]].mesh_size;
+  if (ai != nullptr && aj != nullptr) return std::max(support_i, support_j);
+  if (aj != nullptr) return support_j + node_radius(law, model, i, j, rc);  // i's sphere probes j's surface
+  return support_i + node_radius(law, model, j, i, rc);
+}
+
+real ContactModel::largest_pair_reach(const Model& model) const {
+  // Rc, plus the centres' depths below the surface points and the surface law's support where
+  // particles use it.
+  real coarsest = 0;
+  for (index_t p = 0; p < model.particles().size(); ++p) {
+    if (surface_particle(p)) coarsest = std::max(coarsest, model.particles()[p].mesh_size);
+  }
+  if (coarsest == 0) return max_contact_radius_;
+  real widest = 1;
+  for (const Shape& shape : model.shapes()) {
+    for (const SurfaceAnchor& a : shape.anchors.anchors) widest = std::max<real>(widest, a.reach);
+  }
+  return std::max(max_contact_radius_ * (1 + widest),
+                  contact::surface_support_factor * coarsest + max_contact_radius_);
 }
 
 contact::PairLaw ContactModel::pair_law(index_t p, index_t q) const {
@@ -227,6 +299,7 @@ void ContactModel::set_law(index_t a, index_t b, const contact::Law& law) {
   const contact::ContactSide coarsest_b{material_max_mesh_size_[b], 0, 0};
   max_contact_radius_ =
       std::max(max_contact_radius_, contact::resolve_contact_radius(law, coarsest_a, coarsest_b));
+  find_surface_particles();
   built_ = false;
   centres_.forget();
 }
@@ -343,7 +416,9 @@ real ContactModel::largest_displacement(const Model& model, const State& state) 
   real worst = 0;
 #pragma omp parallel for schedule(static) reduction(max : worst)
   for (std::int64_t i = 0; i < n; ++i) {
-    const vec3 x = contact_position(model, state, static_cast<index_t>(i));
+    const index_t node = static_cast<index_t>(i);
+    const real* y = &state.positions[3 * node];
+    const vec3 x = centres_.moved(node) ? centres_.at_list(model, state, node) : vec3{y[0], y[1], y[2]};
     real d2 = 0;
     for (int k = 0; k < 3; ++k) {
       const real d = x[k] - positions_at_build_[3 * i + k];
@@ -365,6 +440,27 @@ bool ContactModel::needs_rebuild(const Model& model, const State& state, real& m
   return moved > half_skin;
 }
 
+bool ContactModel::takes_part(const Model& model, const State& state, index_t i) const {
+  if (!surface_particle(model.node_particle()[i]) || on_surface(model, i)) return true;
+  const NodeBonds bonds = model.node_bonds(i);
+  for (index_t b = 0; b < bonds.count; ++b) {
+    if (!state.bonds.intact(i, b)) return true;  // on a crack face
+  }
+  return false;
+}
+
+bool ContactModel::breaks_open_new_nodes(const Model& model) const {
+  const auto& owner = model.node_particle();
+  for (const auto& [i, j] : newly_broken_) {
+    for (const index_t k : {i, j}) {
+      if (taking_part_.empty() || taking_part_[k] || !surface_particle(model.node_particle()[k])) continue;
+      const index_t m = model.node_material()[k];
+      if (law_set_[m * material_count_ + m] || particle_side_[owner[k]].mesh_size > 0) return true;
+    }
+  }
+  return false;
+}
+
 void ContactModel::update_after_breaks(const Model& model, const State& state, std::uint64_t broken_bonds,
                                        real moved) {
   // Bonds broke, nothing moved far: no grid search. The lists gain every newly unbonded pair
@@ -375,18 +471,15 @@ void ContactModel::update_after_breaks(const Model& model, const State& state, s
   // candidates. Then the bodies are labelled again.
   label_bodies(model, state, broken_bonds);
   const index_t n = model.node_count();
-  const auto& node_particle = model.node_particle();
   const auto& node_material = model.node_material();
   const real extra = skin_ + 2 * moved;
   std::vector<std::array<index_t, 2>> added;  // (node, partner), both ways
   for (const auto& [i, j] : newly_broken_) {
     const index_t m = node_material[i];  // a bond joins two nodes of one particle
     if (!law_set_[m * material_count_ + m]) continue;
-    const real limit =
-        contact::resolve_contact_radius(laws_[m * material_count_ + m], particle_side_[node_particle[i]],
-                                        particle_side_[node_particle[i]]) +
-        extra;
-    const vec3 xi = contact_position(model, state, i), xj = contact_position(model, state, j);
+    const real limit = pair_reach(model, i, j, node_body_[i] == node_body_[j]) + extra;
+    const vec3 xi = centres_.at_list(model, state, i);
+    const vec3 xj = centres_.at_list(model, state, j);
     const real dx = xj[0] - xi[0], dy = xj[1] - xi[1], dz = xj[2] - xi[2];
     if (dx * dx + dy * dy + dz * dz > limit * limit) continue;
     const index_t* listed = pair_partner_.data();
@@ -663,10 +756,73 @@ void ContactModel::finish_lists(const Model& model) {
   carry_over(0, particle_slots, 0, old_particle_slots);
   carry_over(particle_slots, slots_.size(), old_particle_slots, old_slots.size());
   group_contact_nodes(model);
+  find_groups(model);
   pair_stiffness_.assign(pair_partner_.size(), 0);
   wall_entry_stiffness_.assign(wall_entry_.size(), 0);
   wall_points_.assign(wall_entry_.size(), {});
   wall_entry_reaction_.assign(wall_entry_.size(), {0, 0, 0, 0, 0, 0});
+}
+
+void ContactModel::find_groups(const Model& model) {
+  // A node's probe entries: partners that carry surface points of another body, under a law that
+  // is not PeriDEM's node-pair law; one group per such body, in the order of first appearance.
+  const index_t n = model.node_count();
+  groups_.clear();
+  entry_group_.assign(pair_partner_.size(), no_group);
+  if (!any_surface_) {
+    // No particle uses the surface law: none of its per-node tables.
+    std::vector<index_t>().swap(group_offsets_);
+    std::vector<index_t>().swap(surface_slot_);
+    std::vector<index_t>().swap(entry_target_);
+    surface_nodes_.clear();
+    probes_.clear();
+    return;
+  }
+  group_offsets_.assign(static_cast<std::size_t>(n) + 1, 0);
+  for (index_t i = 0; i < n; ++i) {
+    const std::size_t first = groups_.size();
+    for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
+      const index_t j = pair_partner_[e];
+      if (node_body_[j] == node_body_[i] || !slot_law(pair_slot_[e]).surface || !on_surface(model, j))
+        continue;
+      std::size_t g = first;
+      while (g < groups_.size() && groups_[g].body != node_body_[j]) ++g;
+      if (g == groups_.size()) groups_.push_back({i, node_body_[j], pair_slot_[e]});
+      entry_group_[e] = static_cast<index_t>(g);
+    }
+    group_offsets_[i + 1] = static_cast<index_t>(groups_.size());
+  }
+  // The surface points that probes may reach: every node with entries that carries one.
+  surface_nodes_.clear();
+  surface_slot_.assign(n, no_group);
+  for (index_t i = 0; i < n; ++i) {
+    if (pair_offsets_[i] == pair_offsets_[i + 1] || !on_surface(model, i) ||
+        !surface_particle(model.node_particle()[i]))
+      continue;
+    surface_slot_[i] = static_cast<index_t>(surface_nodes_.size());
+    surface_nodes_.push_back(i);
+  }
+  surface_points_.resize(surface_nodes_.size());
+  surface_sizes_.resize(surface_nodes_.size());
+  // Each entry (i, j) of a node i with a surface point: the group of j that probes i's body.
+  entry_target_.assign(pair_partner_.size(), no_group);
+#pragma omp parallel for schedule(static)
+  for (std::int64_t ii = 0; ii < static_cast<std::int64_t>(n); ++ii) {
+    const index_t i = static_cast<index_t>(ii);
+    if (surface_slot_[i] == no_group) continue;
+    for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
+      const index_t j = pair_partner_[e];
+      if (node_body_[j] != node_body_[i]) entry_target_[e] = target_group(i, j);
+    }
+  }
+  probes_.assign(groups_.size(), {});
+}
+
+index_t ContactModel::target_group(index_t i, index_t j) const {
+  const index_t* begin = pair_partner_.data() + pair_offsets_[j];
+  const index_t* end = pair_partner_.data() + pair_offsets_[j + 1];
+  const index_t* at = std::lower_bound(begin, end, i);
+  return at == end || *at != i ? no_group : entry_group_[static_cast<std::size_t>(at - pair_partner_.data())];
 }
 
 void ContactModel::rebuild(const Model& model, const State& state, std::uint64_t broken_bonds, bool finish) {
@@ -679,7 +835,7 @@ void ContactModel::rebuild(const Model& model, const State& state, std::uint64_t
   const auto& node_particle = model.node_particle();
   const auto& node_material = model.node_material();
   const std::size_t particle_count = particles.size();
-  const real reach = max_contact_radius_ + skin_;
+  const real reach = largest_pair_reach(model) + skin_;
   newly_broken_.clear();  // the search finds every unbonded pair
   label_bodies(model, state, broken_bonds);
 
@@ -729,11 +885,20 @@ void ContactModel::rebuild(const Model& model, const State& state, std::uint64_t
     }
   }
 
-  // Node pairs: a grid over the nodes of particles near another particle or broken.
+  // Node pairs: a grid over the nodes that take part (takes_part) of particles near another
+  // particle or broken.
   std::vector<index_t> searched;
+  const std::vector<std::uint8_t>& surface = surface_particles_;
+  if (any_surface_) {
+    taking_part_.assign(n, 0);
+  } else {
+    std::vector<std::uint8_t>().swap(taking_part_);  // every node takes part
+  }
   for (std::size_t p = 0; p < particle_count; ++p) {
     if (!near_particle[p]) continue;
     for (index_t i = particles[p].first_node; i < particles[p].first_node + particles[p].node_count; ++i) {
+      if (surface[p] && !takes_part(model, state, i)) continue;
+      if (surface[p]) taking_part_[i] = 1;
       searched.push_back(i);
     }
   }
@@ -742,10 +907,7 @@ void ContactModel::rebuild(const Model& model, const State& state, std::uint64_t
   auto accept = [&](index_t i, index_t j, real r2) {
     const index_t mi = node_material[i], mj = node_material[j];
     if (!law_set_[mi * material_count_ + mj]) return false;
-    const real limit =
-        contact::resolve_contact_radius(laws_[mi * material_count_ + mj], particle_side_[node_particle[i]],
-                                        particle_side_[node_particle[j]]) +
-        skin_;
+    const real limit = pair_reach(model, i, j, node_body_[i] == node_body_[j]) + skin_;
     if (r2 > limit * limit) return false;
     return node_particle[i] != node_particle[j] || !intact_bond(model, state, i, j);
   };
@@ -794,7 +956,12 @@ void ContactModel::rebuild(const Model& model, const State& state, std::uint64_t
     std::vector<WallContact> local;
     for (std::size_t w = 0; w < walls_.size(); ++w) {
       if (!wall_law_set_[w * material_count_ + node_material[i]]) continue;
-      const real limit = wall_law(static_cast<index_t>(w), node_particle[i]).contact_radius + skin_;
+      // x is the list position: under the surface law the surface point, rho |o| above the
+      // contact centre.
+      const SurfaceAnchor* anchor = centres_.anchor(model, i);
+      const real radius = wall_law(static_cast<index_t>(w), node_particle[i]).contact_radius;
+      const bool above = anchor != nullptr && surface_particle(node_particle[i]);
+      const real limit = radius * (1 + (above ? anchor->reach : 0.0)) + skin_;
       const auto p = walls_[w].to_reference(&x[3 * i], state.time);
       for (std::size_t s = 0; s < walls_[w].surfaces.size(); ++s) {
         local.clear();
@@ -876,7 +1043,9 @@ std::size_t ContactModel::memory_bytes() const {
          bytes(slot_force_) + bytes(slot_normal_) + bytes(slot_point_) + bytes(slot_work_) +
          bytes(slot_exponent_) + bytes(damping_tables_) + bytes(wall_damping_tables_) +
          bytes(slot_surface_normal_) + bytes(touching_nodes_) + bytes(touching_normals_) +
-         centres_.memory_bytes() + bytes(centre_forces_);
+         centres_.memory_bytes() + bytes(anchor_forces_) + bytes(entry_group_) + bytes(entry_target_) +
+         bytes(taking_part_) + bytes(surface_nodes_) + bytes(surface_slot_) + bytes(surface_points_) +
+         bytes(surface_sizes_) + bytes(groups_) + bytes(group_offsets_) + bytes(probes_);
 }
 
 ContactCheckpoint ContactModel::checkpoint() const {
@@ -978,6 +1147,8 @@ void ContactModel::restore(const Model& model, const State& state, const Contact
     State at_build = state;
     at_build.time = saved.time_at_build;
     positions_at_build_ = saved.positions_at_build;
+    centres_.find(model, state, centring_depths(model),
+                  surface_particles_);  // which nodes carry surface points
     // Lists updated after bond breaks are not those of a search: take the saved ones (a
     // checkpoint without them predates these updates, and a search gives them again).
     const bool saved_lists = saved.pair_offsets.size() == static_cast<std::size_t>(model.node_count()) + 1 &&
@@ -1015,9 +1186,12 @@ void ContactModel::restore(const Model& model, const State& state, const Contact
 void ContactModel::add_forces(const Model& model, State& state, std::uint64_t broken_bonds) {
   if (!active()) return;
   const auto search_start = std::chrono::steady_clock::now();
-  if (!centres_.found()) centres_.find(model, state, centring_depths(model));
+  if (!centres_.found()) centres_.find(model, state, centring_depths(model), surface_particles_);
   real moved = 0;  // largest node displacement since the build
-  if (needs_rebuild(model, state, moved)) {
+  // A crack that opens nodes which took no part in contact needs a search: they may face
+  // another body now.
+  if (needs_rebuild(model, state, moved) ||
+      (broken_bonds != broken_at_build_ && breaks_open_new_nodes(model))) {
     centres_.fill_positions(model, state, positions_at_build_);
     rebuild(model, state, broken_bonds);
   } else if (broken_bonds != broken_at_build_) {
@@ -1027,22 +1201,49 @@ void ContactModel::add_forces(const Model& model, State& state, std::uint64_t br
   const real dt = has_last_time_ ? state.time - last_time_ : 0.0;
   last_time_ = state.time;
   has_last_time_ = true;
-  measure_contacts(model, state);         // A: distances, springs, wall contact points
+  if (any_surface_) measure_surface_points(model, state);  // A: the lists' surface points
+  measure_contacts(model, state);         //    distances, springs, probes, wall contact points
   sum_slot_stiffness();                   // B: K per pair of bodies; the touching bodies
   measure_bodies(model, state);           //    rigid-body motion of the touching bodies
   measure_surface_normals(model, state);  //    outward normals of the nodes in contact
   sum_slot_springs(model, state);         //    spring force, normal and contact point per slot
+  sum_probe_springs();                    //    the same for the surface probes
   slot_dashpots(state, dt);               //    the body dashpots, as loads on the bodies
   slot_redirects();                       //    each collision's force turned to the surface normal
-  node_forces(model, state, dt);          // C: springs, friction, fragment dashpots, per node
-  body_loads(model, state);               // E: dashpots and friction couples as rigid-body loads
-  sum_wall_reactions();                   // D: wall reactions
+  if (any_surface_) probe_frictions(model, state, dt);  // C: the surface probes' friction
+  node_forces(model, state, dt);                        //    springs, friction, fragment dashpots, per node
+  probe_couples(state);                                 //    the probes' friction couples, as loads
+  body_loads(model, state);  // E: dashpots and friction couples as rigid-body loads
+  sum_wall_reactions();      // D: wall reactions
 }
 
 real ContactModel::node_radius(const contact::Law& law, const Model& model, index_t i, index_t j,
                                real contact_radius) const {
   const auto& owner = model.node_particle();
   return contact::node_share(law, particle_side_[owner[i]], particle_side_[owner[j]], contact_radius);
+}
+
+void ContactModel::measure_surface_points(const Model& model, const State& state) {
+  // The surface points of the nodes with list entries, once per step, for every probe that
+  // reaches them (surface_slot_ numbers them in node order).
+  const std::int64_t count = static_cast<std::int64_t>(surface_nodes_.size());
+  surface_points_.resize(surface_nodes_.size());
+#pragma omp parallel for schedule(static)
+  for (std::int64_t k = 0; k < count; ++k) {
+    const index_t j = surface_nodes_[k];
+    contact::SurfacePoint& point = surface_points_[k];
+    const vec3 a = centres_.anchored_vector(model, state.positions, j);
+    const real size = std::sqrt(dot(a, a));
+    const real length = centres_.surface_length(model, j);
+    const real* y = state.positions.data();
+    for (int c = 0; c < 3; ++c) {
+      point.normal[c] = a[c] / size;
+      point.position[c] = y[3 * j + c] + length * point.normal[c];
+    }
+    point.curvature =
+        centres_.anchor(model, j)->curvature / particle_side_[model.node_particle()[j]].mesh_size;
+    surface_sizes_[k] = size;
+  }
 }
 
 void ContactModel::measure_contacts(const Model& model, const State& state) {
@@ -1056,17 +1257,29 @@ void ContactModel::measure_contacts(const Model& model, const State& state) {
 #pragma omp parallel
   {
     std::vector<WallContact> found;  // scratch of this thread
+    ProbeScratch probe_scratch;
     std::vector<index_t> touching_nodes;
     real deepest = 0;  // overlap / Rc
 #pragma omp for schedule(static) nowait
     for (std::int64_t ii = 0; ii < n; ++ii) {
       const index_t i = static_cast<index_t>(ii);
       if (pair_offsets_[i] == pair_offsets_[i + 1] && wall_offsets_[i] == wall_offsets_[i + 1]) continue;
-      const vec3 xi = contact_position(model, state, i);
+      vec3 xi{0, 0, 0};
+      bool have_xi = false;  // the contact centre, where a sphere pair or a wall needs it
+      auto centre = [&]() -> const vec3& {
+        if (!have_xi) xi = contact_position(model, state, i), have_xi = true;
+        return xi;
+      };
+      const bool surface_i = any_surface_ && on_surface(model, i);
       bool touching = false;
       for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
         const index_t j = pair_partner_[e];
         const contact::PairLaw& law = slot_law(pair_slot_[e]);
+        if (law.surface && node_body_[i] != node_body_[j] && (surface_i || on_surface(model, j))) {
+          pair_stiffness_[e] = 0;  // the surface law (measure_probes) decides
+          continue;
+        }
+        centre();
         const vec3 xj = contact_position(model, state, j);
         const real dx = xj[0] - xi[0], dy = xj[1] - xi[1], dz = xj[2] - xi[2];
         const real distance = std::sqrt(dx * dx + dy * dy + dz * dz);
@@ -1078,12 +1291,13 @@ void ContactModel::measure_contacts(const Model& model, const State& state) {
           deepest = std::max(deepest, 1 - distance / law.contact_radius);
       }
       if (touching) touching_nodes.push_back(i);
+      deepest = std::max(deepest, measure_probes(model, state, i, probe_scratch));
       for (index_t e = wall_offsets_[i]; e < wall_offsets_[i + 1]; ++e) {
         const Wall& wall = walls_[wall_entry_[e][0]];
         const contact::PairLaw& law = slot_law(wall_slot_[e]);
         found.clear();
-        wall.contacts(wall_entry_[e][1], wall.to_reference(xi.data(), t), law.contact_radius, dimension_,
-                      found);
+        wall.contacts(wall_entry_[e][1], wall.to_reference(centre().data(), t), law.contact_radius,
+                      dimension_, found);
         WallPoints& points = wall_points_[e];
         points.count = static_cast<std::uint8_t>(std::min(found.size(), points.points.size()));
         for (std::size_t k = 0; k < points.count; ++k) {
@@ -1101,19 +1315,111 @@ void ContactModel::measure_contacts(const Model& model, const State& state) {
   std::sort(touching_nodes_.begin(), touching_nodes_.end());  // the same for any thread count
 }
 
+real ContactModel::measure_probes(const Model& model, const State& state, index_t i, ProbeScratch& scratch) {
+  // Node i's probes of other bodies' surfaces (contact/surface_law.hpp): each group's points
+  // in reach that face the probe, their sums, then the gap, its gradient and the push, then
+  // each probe entry's share of the probe's stiffness (its in-contact flag). Returns the
+  // deepest overlap over Rc. A group with no point in reach is apart (push 0) and costs one
+  // distance per entry.
+  if (group_offsets_.empty() || group_offsets_[i] == group_offsets_[i + 1]) return 0;
+  const bool surface = on_surface(model, i);
+  const vec3 p = centres_.at_surface(model, state, i);
+  const index_t first = pair_offsets_[i], last = pair_offsets_[i + 1];
+  const index_t groups = group_offsets_[i + 1] - group_offsets_[i];
+  scratch.points.assign(last - first, nullptr);  // the points in reach (null: none)
+  scratch.weights.assign(last - first, 0.0);
+  scratch.nearest.assign(groups, -1);  // the distance of each group's nearest point in reach
+  const real* y = state.positions.data();
+  for (index_t e = first; e < last; ++e) {  // the points in reach, and each group's nearest
+    const index_t g = entry_group_[e];
+    if (g == no_group) continue;
+    const index_t j = pair_partner_[e];
+    const real support = contact::surface_support_factor * particle_side_[model.node_particle()[j]].mesh_size;
+    // The surface point lies at most its depth d_j from the node.
+    const vec to_node{p[0] - y[3 * j], p[1] - y[3 * j + 1], p[2] - y[3 * j + 2]};
+    const real reach = support + centres_.surface_length(model, j);
+    if (dot(to_node, to_node) >= reach * reach) continue;
+    const contact::SurfacePoint& point = surface_point(j);
+    const vec d{p[0] - point.position[0], p[1] - point.position[1], p[2] - point.position[2]};
+    const real distance = std::sqrt(dot(d, d));
+    if (!(distance < support)) continue;
+    scratch.points[e - first] = &point;
+    real& best = scratch.nearest[g - group_offsets_[i]];
+    if (best < 0) {  // the group's first point in reach: set the probe up
+      ProbeState& probe = probes_[g];
+      probe = ProbeState{};
+      const contact::PairLaw& law = slot_law(pair_slot_[e]);
+      const contact::Law& own = laws_[model.node_material()[i] * material_count_ + model.node_material()[j]];
+      probe.point = p;
+      probe.support = support;
+      probe.radius = surface ? 0.0 : node_radius(own, model, i, j, law.contact_radius);
+      probe.stiffness = probe_stiffness(model, i, j, law);
+      probe.contact_radius = law.contact_radius;
+    }
+    if (best < 0 || distance < best) {
+      best = distance;
+      probes_[g].facing = point.normal;
+    }
+  }
+  for (index_t e = first; e < last; ++e) {
+    const contact::SurfacePoint* point = scratch.points[e - first];
+    if (point == nullptr) continue;
+    ProbeState& probe = probes_[entry_group_[e]];
+    if (!contact::faces(*point, probe.facing)) continue;
+    const contact::PointTerms t = contact::point_terms(*point, p, probe.support);
+    scratch.weights[e - first] = t.weight;
+    probe.sums.add(t);
+  }
+  real deepest = 0;
+  for (index_t g = group_offsets_[i]; g < group_offsets_[i + 1]; ++g) {
+    ProbeState& probe = probes_[g];
+    probe.push = probe.taper = 0;
+    if (scratch.nearest[g - group_offsets_[i]] < 0 || !probe.sums.reached()) continue;
+    const real overlap = probe.radius - probe.sums.gap();
+    if (!(overlap > 0)) continue;
+    probe.gradient = probe.sums.gradient();
+    probe.push = probe.stiffness * overlap * contact::surface_taper(probe.sums.weight);
+    probe.taper = 0.5 * probe.stiffness * overlap * overlap * contact::surface_taper_slope(probe.sums.weight);
+    probe.friction = probe.foot = {0, 0, 0};
+    // The overlap that carries force (a probe tapered past the edge of its points does not).
+    deepest = std::max(deepest, probe.push / (probe.stiffness * probe.contact_radius));
+  }
+  for (index_t e = first; e < last; ++e) {
+    const index_t g = entry_group_[e];
+    if (g == no_group) continue;
+    const ProbeState& probe = probes_[g];
+    pair_stiffness_[e] =
+        probe.push == 0
+            ? 0.0f
+            : static_cast<float>(probe.stiffness * scratch.weights[e - first] / probe.sums.weight);
+  }
+  return deepest;
+}
+
+real ContactModel::surface_share(const ProbeState& probe, const contact::SurfacePoint& point) const {
+  if (!contact::faces(point, probe.facing)) return 0;
+  const vec d{probe.point[0] - point.position[0], probe.point[1] - point.position[1],
+              probe.point[2] - point.position[2]};
+  return contact::surface_weight(std::sqrt(dot(d, d)) / probe.support) / probe.sums.weight;
+}
+
 void ContactModel::sum_slot_stiffness() {
-  // K per pair of bodies, summed in entry order (each node pair is listed twice).
+  // K per pair of bodies, summed in entry order: each node pair of the sphere law is listed
+  // twice; a surface probe's entries share its stiffness.
   std::fill(slot_stiffness_.begin(), slot_stiffness_.end(), 0.0);
   std::uint64_t touching = 0, wall_touching = 0;
   for (std::size_t e = 0; e < pair_stiffness_.size(); ++e) {
-    slot_stiffness_[pair_slot_[e]] += 0.5 * pair_stiffness_[e];
-    touching += pair_stiffness_[e] > 0 ? 1 : 0;
+    const bool probe = entry_group_[e] != no_group;
+    slot_stiffness_[pair_slot_[e]] += (probe ? 1.0 : 0.5) * pair_stiffness_[e];
+    touching += pair_stiffness_[e] > 0 && !probe ? 1 : 0;
   }
+  touching /= 2;
+  for (const ProbeState& probe : probes_) touching += probe.push > 0 ? 1 : 0;
   for (std::size_t e = 0; e < wall_entry_stiffness_.size(); ++e) {
     slot_stiffness_[wall_slot_[e]] += wall_entry_stiffness_[e];
     wall_touching += wall_entry_stiffness_[e] > 0 ? 1 : 0;
   }
-  statistics_.node_contacts = touching / 2;
+  statistics_.node_contacts = touching;
   statistics_.wall_contacts = wall_touching;
   assign_springs();
   // The touching bodies (in a collision, or in a gap of one) and the slots in contact, numbered
@@ -1169,7 +1475,8 @@ void ContactModel::sum_slot_springs(const Model& model, const State& state) {
     for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
       const index_t j = pair_partner_[e];
       const std::size_t slot = pair_slot_[e];
-      if (pair_stiffness_[e] == 0 || node_body_[i] == node_body_[j] || node_body_[i] != slots_[slot][0])
+      if (pair_stiffness_[e] == 0 || entry_group_[e] != no_group || node_body_[i] == node_body_[j] ||
+          node_body_[i] != slots_[slot][0])
         continue;
       const index_t touch = slot_touch_[slot];
       const PairGeometry g = pair_geometry(model, state, i, e);
@@ -1203,12 +1510,38 @@ void ContactModel::sum_slot_springs(const Model& model, const State& state) {
   }
 }
 
+void ContactModel::sum_probe_springs() {
+  // The surface probes' pushes, in group order: the force k delta |G| along the surface's normal
+  // (from the slot's first body to its second), at the probe point.
+  for (std::size_t g = 0; g < groups_.size(); ++g) {
+    const ProbeState& probe = probes_[g];
+    if (probe.push == 0) continue;
+    const std::size_t slot = groups_[g].slot;
+    const index_t touch = slot_touch_[slot];
+    const real size = std::sqrt(dot(probe.gradient, probe.gradient));
+    const real force = probe.push * size;
+    // G points out of the target body; the slot's normal from its first body to its second.
+    const real sign = groups_[g].body == slots_[slot][0] ? 1.0 : -1.0;
+    slot_force_[touch] += force;
+    for (int k = 0; k < 3; ++k) {
+      const real along = sign * probe.gradient[k] / size;
+      slot_normal_[touch][k] += force * along;
+      slot_surface_normal_[touch][k] += force * along;
+      slot_point_[touch][k] += force * probe.point[k];
+    }
+  }
+}
+
 real ContactModel::spring_energy(const Model& model, const State& state) const {
   if (!built_) return 0;
   real energy = 0;
   for (const index_t i : contact_nodes_) {
     for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
       if (pair_partner_[e] < i) continue;  // each pair once: the lists hold both directions
+      const index_t j = pair_partner_[e];
+      if (slot_law(pair_slot_[e]).surface && node_body_[i] != node_body_[j] &&
+          (on_surface(model, i) || on_surface(model, j)))
+        continue;
       const real overlap = pair_geometry(model, state, i, e).overlap;
       if (overlap > 0) energy += 0.5 * entry_stiffness(model, i, e) * overlap * overlap;
     }
@@ -1220,6 +1553,11 @@ real ContactModel::spring_energy(const Model& model, const State& state) const {
         if (overlap > 0) energy += 0.5 * wall_spring_stiffness(model, i, e) * overlap * overlap;
       }
     }
+  }
+  // The surface probes, from their last evaluation: k delta^2 tau / 2 = P^2 / (2 k tau).
+  for (const ProbeState& probe : probes_) {
+    if (probe.push > 0)
+      energy += 0.5 * probe.push * probe.push / (probe.stiffness * contact::surface_taper(probe.sums.weight));
   }
   return energy;
 }
@@ -1388,35 +1726,162 @@ real ContactModel::damping_ratio(std::size_t slot, real advance) {
   return (wall_slot ? wall_damping_tables_ : damping_tables_)[law].at(slot_exponent_[slot]);
 }
 
-void ContactModel::node_forces(const Model& model, State& state, real dt) {
-  // Each node gathers its own contact forces and updates its own friction springs. A centred
-  // node's forces act on its contact centre: (1 + W) of them go to the node here, -w_k to its
-  // anchors after (in node order, so the sums are the same for any thread count).
+void ContactModel::probe_frictions(const Model& model, const State& state, real dt) {
   const std::int64_t count = static_cast<std::int64_t>(contact_nodes_.size());
-  if (centres_.any()) centre_forces_.assign(contact_nodes_.size(), vec3{0, 0, 0});
+#pragma omp parallel for schedule(static)
+  for (std::int64_t k = 0; k < count; ++k) probe_friction(model, state, contact_nodes_[k], dt);
+}
+
+void ContactModel::probe_friction(const Model& model, const State& state, index_t i, real dt) {
+  if (group_offsets_.empty() || group_offsets_[i] == group_offsets_[i + 1]) return;
+  const index_t material = model.node_material()[i];
+  for (index_t g = group_offsets_[i]; g < group_offsets_[i + 1]; ++g) {
+    ProbeState& probe = probes_[g];
+    if (probe.push == 0) continue;
+    const contact::Law& law = laws_[material * material_count_ + body_material_[groups_[g].body]];
+    if (law.friction == 0 && !law.peridem_friction) continue;
+    // The slip of p against the target's surface there, each side moving with its nodes and
+    // its body's rotation: v_i + w_A x (p - y_i) - sum_k (w_k / S) (v_k + w_B x (s_k - y_k)).
+    // The friction force acts on the nodes (the probe's, and the targets' in shares w_k / S),
+    // and the couples that put it at p go to the bodies as loads (probe_couples): the springs
+    // see no anchor's vibration.
+    const real* y = state.positions.data();
+    const real* u = state.velocities.data();
+    const vec& spin_target = body_spin(groups_[g].body);
+    vec3 target_velocity{0, 0, 0};
+    for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
+      if (entry_group_[e] != g) continue;
+      const index_t j = pair_partner_[e];
+      const contact::SurfacePoint& point = surface_point(j);
+      const real fraction = surface_share(probe, point);
+      if (fraction == 0) continue;
+      const vec turn = cross(spin_target, {point.position[0] - y[3 * j], point.position[1] - y[3 * j + 1],
+                                           point.position[2] - y[3 * j + 2]});
+      for (int c = 0; c < 3; ++c) {
+        probe.foot[c] += fraction * y[3 * j + c];
+        target_velocity[c] += fraction * (u[3 * j + c] + turn[c]);
+      }
+    }
+    const real size = std::sqrt(dot(probe.gradient, probe.gradient));
+    const vec normal{probe.gradient[0] / size, probe.gradient[1] / size, probe.gradient[2] / size};
+    const real normal_force = probe.push * size;
+    const vec turn =
+        cross(body_spin(node_body_[i]),
+              {probe.point[0] - y[3 * i], probe.point[1] - y[3 * i + 1], probe.point[2] - y[3 * i + 2]});
+    const real slip[3] = {u[3 * i] + turn[0] - target_velocity[0],
+                          u[3 * i + 1] + turn[1] - target_velocity[1],
+                          u[3 * i + 2] + turn[2] - target_velocity[2]};
+    if (law.peridem_friction) {
+      const real along = slip[0] * normal[0] + slip[1] * normal[1] + slip[2] * normal[2];
+      const real tangential[3] = {slip[0] - along * normal[0], slip[1] - along * normal[1],
+                                  slip[2] - along * normal[2]};
+      real force[3];
+      contact::peridem_friction_force(law.friction, normal_force, tangential, force);
+      probe.friction = {force[0], force[1], force[2]};
+      continue;
+    }
+    const real kt = law.tangential_stiffness_ratio * probe.stiffness;
+    for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
+      if (entry_group_[e] != g || pair_stiffness_[e] == 0) continue;
+      real force[3];
+      contact::tangential_force(kt, law.friction, normal_force, normal.data(), slip, dt,
+                                springs_[pair_spring_[e]].data(), force);
+      const real fraction = surface_share(probe, surface_point(pair_partner_[e]));
+      for (int c = 0; c < 3; ++c) probe.friction[c] += fraction * force[c];
+    }
+  }
+}
+
+void ContactModel::target_forces(const contact::SurfacePoint& point, real size, index_t group, vec3& on_point,
+                                 vec3& on_normal, vec3& on_friction) const {
+  // The exact reaction of a target's surface point and normal to the probe's energy (see
+  // contact/surface_law.hpp), and its share w / S of the friction force, opposite (on the
+  // node; probe_couples adds the couple).
+  const ProbeState& probe = probes_[group];
+  on_point = on_normal = on_friction = {0, 0, 0};
+  if (!contact::faces(point, probe.facing)) return;
+  const contact::PointTerms t = contact::point_terms(point, probe.point, probe.support);
+  if (t.weight == 0) return;
+  const real gap = probe.sums.gap(), weight = probe.sums.weight;
+  const vec3 share = contact::point_share(t, gap, weight);
+  const real fraction = t.weight / weight;
+  for (int c = 0; c < 3; ++c) {
+    on_point[c] = -probe.push * share[c] + probe.taper * t.weight_gradient[c];
+    on_friction[c] = -fraction * probe.friction[c];
+    on_normal[c] = probe.push * fraction * t.normal_sensitivity[c] / size;
+  }
+}
+
+void ContactModel::node_forces(const Model& model, State& state, real dt) {
+  // Each node gathers its own contact forces and updates its own friction springs: forces on
+  // its contact centre (sphere pairs, walls), on its surface point (as a probe, and as a target
+  // of other bodies' probes) and on its normal. An anchored node's forces on a point y + l n
+  // go to the node, and their levers (l / |A|) (1 - n n^T) F on A; forces on A go -W to the
+  // node here and w_k to its anchors after (in node order, so the sums are the same for any
+  // thread count; surface_centres.hpp).
+  const std::int64_t count = static_cast<std::int64_t>(contact_nodes_.size());
+  if (centres_.any()) anchor_forces_.assign(contact_nodes_.size(), vec3{0, 0, 0});
 #pragma omp parallel for schedule(static)
   for (std::int64_t k = 0; k < count; ++k) {
     const index_t i = contact_nodes_[k];
-    vec total{0, 0, 0};
+    vec at_centre{0, 0, 0}, at_surface{0, 0, 0}, on_vector{0, 0, 0};
     for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
-      if (pair_stiffness_[e] == 0) continue;
+      if (pair_stiffness_[e] == 0 || entry_group_[e] != no_group) continue;
       const vec force = pair_force(model, state, i, e, dt);
-      for (int c = 0; c < 3; ++c) total[c] += force[c];
+      for (int c = 0; c < 3; ++c) at_centre[c] += force[c];
     }
+    vec at_node{0, 0, 0};  // friction, with its couple as a rigid-body load
     for (index_t e = wall_offsets_[i]; e < wall_offsets_[i + 1]; ++e) {
       wall_entry_reaction_[e] = {0, 0, 0, 0, 0, 0};
       if (wall_entry_stiffness_[e] == 0) continue;
-      const vec force = wall_force(model, state, i, e, dt);
-      for (int c = 0; c < 3; ++c) total[c] += force[c];
+      vec on_centre, on_node;
+      wall_force(model, state, i, e, dt, on_centre, on_node);
+      for (int c = 0; c < 3; ++c) {
+        at_centre[c] += on_centre[c];
+        at_node[c] += on_node[c];
+      }
+    }
+    for (index_t g = group_offsets_.empty() ? 0 : group_offsets_[i];
+         !group_offsets_.empty() && g < group_offsets_[i + 1]; ++g) {
+      const ProbeState& probe = probes_[g];
+      for (int c = 0; c < 3; ++c) {
+        at_surface[c] += probe.push * probe.gradient[c] - probe.taper * probe.sums.spread[c];
+        at_node[c] += probe.friction[c];
+      }
     }
     const SurfaceAnchor* anchor = centres_.anchor(model, i);
+    if (anchor != nullptr && !surface_slot_.empty() && surface_slot_[i] != no_group) {
+      const contact::SurfacePoint& own = surface_point(i);
+      const real size = surface_sizes_[surface_slot_[i]];
+      for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
+        const index_t g = entry_target_[e];
+        if (g == no_group || probes_[g].push == 0) continue;
+        vec on_point, on_normal, on_friction;
+        target_forces(own, size, g, on_point, on_normal, on_friction);
+        for (int c = 0; c < 3; ++c) {
+          at_surface[c] += on_point[c];
+          on_vector[c] += on_normal[c];
+          at_node[c] += on_friction[c];
+        }
+      }
+    }
+    vec total{0, 0, 0};
+    for (int c = 0; c < 3; ++c) total[c] = at_centre[c] + at_surface[c] + at_node[c];
     if (anchor != nullptr) {
-      centre_forces_[k] = total;
-      const real depth = centres_.depth(model, i);
-      real own = 1;
+      // The levers of the forces on the centre and on the surface point (both on the normal).
+      const SurfaceCentres::Seen seen = centres_.seen(model, i);
+      vec along{0, 0, 0};
+      for (int c = 0; c < 3; ++c)
+        along[c] = seen.centre_length * at_centre[c] + seen.surface_length * at_surface[c];
+      if (along != vec{0, 0, 0}) {
+        const vec lever = centres_.lever(model, state, seen, i, 1.0, along);
+        for (int c = 0; c < 3; ++c) on_vector[c] += lever[c];
+      }
+      anchor_forces_[k] = on_vector;
+      real weights = 0;
       for (std::size_t a = 0; a < anchor->nodes.size() && anchor->nodes[a] != SurfaceAnchor::no_anchor; ++a)
-        own += depth * anchor->weights[a];
-      for (real& c : total) c *= own;
+        weights += anchor->weights[a];
+      for (int c = 0; c < 3; ++c) total[c] -= weights * on_vector[c];
     }
     for (int c = 0; c < 3; ++c) state.forces[3 * i + c] += total[c] / model.volumes()[i];
   }
@@ -1428,8 +1893,31 @@ void ContactModel::node_forces(const Model& model, State& state, real dt) {
     const index_t first = model.particles()[model.node_particle()[i]].first_node;
     for (std::size_t a = 0; a < anchor->nodes.size() && anchor->nodes[a] != SurfaceAnchor::no_anchor; ++a) {
       const index_t j = first + anchor->nodes[a];
-      const real w = centres_.depth(model, i) * anchor->weights[a];
-      for (int c = 0; c < 3; ++c) state.forces[3 * j + c] -= w * centre_forces_[k][c] / model.volumes()[j];
+      const real w = anchor->weights[a];
+      for (int c = 0; c < 3; ++c) state.forces[3 * j + c] += w * anchor_forces_[k][c] / model.volumes()[j];
+    }
+  }
+}
+
+void ContactModel::probe_couples(const State& state) {
+  // The friction force F_t acts on the probe's node y_i and, in shares, on the target's nodes
+  // (at their mean y = foot): the probe's body takes (p - y_i) x F_t, the target's
+  // (y - p) x F_t, so both act at p and their moments cancel.
+  const real* x = state.positions.data();
+  for (std::size_t g = 0; g < groups_.size(); ++g) {
+    const ProbeState& probe = probes_[g];
+    if (probe.push == 0 || probe.friction == vec3{0, 0, 0}) continue;
+    const index_t i = groups_[g].probe;
+    const vec own =
+        cross({probe.point[0] - x[3 * i], probe.point[1] - x[3 * i + 1], probe.point[2] - x[3 * i + 2]},
+              probe.friction);
+    const vec target = cross(
+        {probe.foot[0] - probe.point[0], probe.foot[1] - probe.point[1], probe.foot[2] - probe.point[2]},
+        probe.friction);
+    const index_t probe_touch = body_touch_[node_body_[i]], target_touch = body_touch_[groups_[g].body];
+    for (int c = 0; c < 3; ++c) {
+      body_load_[probe_touch][3 + c] += own[c];
+      body_load_[target_touch][3 + c] += target[c];
     }
   }
 }
@@ -1473,8 +1961,15 @@ vec3 ContactModel::pair_force(const Model& model, const State& state, index_t i,
   const real k = entry_stiffness(model, i, e);
   real push = contact::normal_force(k, g.overlap);
   if (node_body_[i] == node_body_[j]) {  // unbonded nodes of one body: a node-pair dashpot
+    // Its share of the body pair's dashpot, 2 zeta k sqrt(M / K), but at most what removes half
+    // the pair's approach speed in one step (c dt / m_ij <= 1/2): where few node pairs carry K,
+    // the body's mass M over a node's would make the explicit dashpot unstable.
     const real K = slot_stiffness_[pair_slot_[e]];
-    const real c = 2.0 * law.damping_ratio * k * std::sqrt(slot_reduced_mass_[pair_slot_[e]] / K);
+    const real mi = model.node_density()[i] * model.volumes()[i],
+               mj = model.node_density()[j] * model.volumes()[j];
+    const real stable = dt > 0 ? 0.5 * mi * mj / ((mi + mj) * dt) : 0.0;
+    const real c =
+        std::min(2.0 * law.damping_ratio * k * std::sqrt(slot_reduced_mass_[pair_slot_[e]] / K), stable);
     push = std::max(0.0, push + contact::damping_force(c, approach));
   }
   real friction[3] = {0, 0, 0};
@@ -1509,53 +2004,62 @@ ContactModel::WallGeometry ContactModel::wall_geometry(const Model& model, index
   return g;
 }
 
-vec3 ContactModel::wall_force(const Model& model, const State& state, index_t i, index_t e, real dt) {
-  // Springs at every contact point of the entry, friction at the deepest; the wall takes the
-  // opposite force at the contact point.
-  const vec xi = contact_position(model, state, i), vi = contact_velocity(model, state, i);
+void ContactModel::wall_force(const Model& model, const State& state, index_t i, index_t e, real dt,
+                              vec3& on_centre, vec3& on_node) {
+  // Springs at every contact point of the entry, on the node's contact centre; friction at the
+  // deepest point p, on the node with its couple (p - x_i) x F_t (friction_couple), from the
+  // slip of p moving with the node and its body's rotation. The wall takes the opposite force
+  // at p.
+  const vec xi = contact_position(model, state, i);
   const Wall& wall = walls_[wall_entry_[e][0]];
   const contact::Law& law = wall_laws_[wall_entry_[e][0] * material_count_ + model.node_material()[i]];
   const contact::PairLaw& resolved = slot_law(wall_slot_[e]);
   const WallPoints& points = wall_points_[e];
   const WallGeometry g = wall_geometry(model, i, e);
-  vec force{0, 0, 0};
+  on_centre = on_node = {0, 0, 0};
   real push_total = 0;
   for (std::size_t point = 0; point < points.count; ++point) {
     const real push =
         contact::normal_force(g.stiffness, resolved.contact_radius - points.points[point].distance);
     push_total += push;
-    for (int c = 0; c < 3; ++c) force[c] += push * points.points[point].normal[c];
+    for (int c = 0; c < 3; ++c) on_centre[c] += push * points.points[point].normal[c];
   }
   const vec point{xi[0] + g.arm[0], xi[1] + g.arm[1], xi[2] + g.arm[2]};
   const vec wall_velocity = wall.velocity_at(point.data(), state.time);
+  const real* x = state.positions.data();
+  const vec lever{point[0] - x[3 * i], point[1] - x[3 * i + 1], point[2] - x[3 * i + 2]};
+  const vec turn = cross(body_spin(node_body_[i]), lever);
+  const real* v = state.velocities.data();
+  const vec moving{v[3 * i] + turn[0], v[3 * i + 1] + turn[1], v[3 * i + 2] + turn[2]};
   real friction[3] = {0, 0, 0};
   if (law.peridem_friction) {
-    const vec relative{vi[0] - wall_velocity[0], vi[1] - wall_velocity[1], vi[2] - wall_velocity[2]};
+    const vec relative{moving[0] - wall_velocity[0], moving[1] - wall_velocity[1],
+                       moving[2] - wall_velocity[2]};
     const real speed = dot(relative, g.normal);
     const real tangential[3] = {relative[0] - speed * g.normal[0], relative[1] - speed * g.normal[1],
                                 relative[2] - speed * g.normal[2]};
     contact::peridem_friction_force(law.friction, push_total, tangential, friction);
   } else if (law.friction > 0) {
-    const vec turn = cross(body_spin(node_body_[i]), g.arm);
-    const real slip[3] = {vi[0] + turn[0] - wall_velocity[0], vi[1] + turn[1] - wall_velocity[1],
-                          vi[2] + turn[2] - wall_velocity[2]};
+    const real slip[3] = {moving[0] - wall_velocity[0], moving[1] - wall_velocity[1],
+                          moving[2] - wall_velocity[2]};
     contact::tangential_force(law.tangential_stiffness_ratio * g.stiffness, law.friction, push_total,
                               g.normal.data(), slip, dt, springs_[wall_spring_[e]].data(), friction);
   }
-  for (int c = 0; c < 3; ++c) force[c] += friction[c];
+  on_node = {friction[0], friction[1], friction[2]};
+  const vec force{on_centre[0] + on_node[0], on_centre[1] + on_node[1], on_centre[2] + on_node[2]};
   const vec torque =
       cross({point[0] - wall.center[0], point[1] - wall.center[1], point[2] - wall.center[2]}, force);
   wall_entry_reaction_[e] = {-force[0], -force[1], -force[2], -torque[0], -torque[1], -torque[2]};
-  return force;
 }
 
 vec3 ContactModel::friction_couple(const Model& model, const State& state, index_t i) const {
-  // The couple (p - x_i) x F_t of node i's friction forces about the node, from the springs as
-  // pass C left them (F_t = -kt xi, capped or not).
+  // The couple of node i's friction forces about the point they are applied at (the contact
+  // centre for node pairs, the node for walls), from the springs as pass C left them
+  // (F_t = -kt xi, capped or not).
   vec couple{0, 0, 0};
   const auto& node_material = model.node_material();
   for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
-    if (pair_spring_[e] == no_spring) continue;
+    if (pair_spring_[e] == no_spring || entry_group_[e] != no_group) continue;
     const contact::Law& law = laws_[node_material[i] * material_count_ + node_material[pair_partner_[e]]];
     if (law.peridem_friction || law.friction == 0) continue;
     const PairGeometry g = pair_geometry(model, state, i, e);
@@ -1572,7 +2076,11 @@ vec3 ContactModel::friction_couple(const Model& model, const State& state, index
     const WallGeometry g = wall_geometry(model, i, e);
     const real kt = law.tangential_stiffness_ratio * g.stiffness;
     const vec& xi = springs_[wall_spring_[e]];
-    const vec moment = cross(g.arm, {-kt * xi[0], -kt * xi[1], -kt * xi[2]});
+    const vec centre = contact_position(model, state, i);
+    const real* x = state.positions.data();
+    const vec lever{centre[0] + g.arm[0] - x[3 * i], centre[1] + g.arm[1] - x[3 * i + 1],
+                    centre[2] + g.arm[2] - x[3 * i + 2]};  // p - x_i
+    const vec moment = cross(lever, {-kt * xi[0], -kt * xi[1], -kt * xi[2]});
     for (int c = 0; c < 3; ++c) couple[c] += moment[c];
   }
   return couple;

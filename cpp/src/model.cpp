@@ -49,7 +49,7 @@ index_t Model::add_material(const MaterialParams& params) {
 }
 
 index_t Model::add_shape(std::span<const real> positions, std::span<const real> volumes, real mesh_size,
-                         std::span<const real> surface_offsets) {
+                         std::span<const real> surface_offsets, std::span<const real> surface_depths) {
   require_not_finalized("add a shape");
   const std::size_t n = volumes.size();
   const std::string name = "shape " + std::to_string(shapes_.size());
@@ -79,9 +79,18 @@ index_t Model::add_shape(std::span<const real> positions, std::span<const real> 
   }
   if (!std::all_of(surface_offsets.begin(), surface_offsets.end(), [](real o) { return std::isfinite(o); }))
     throw InputError(name + ": a surface offset is not finite");
+  if (!surface_depths.empty() && surface_depths.size() != n) {
+    throw InputError(name + ": " + std::to_string(surface_depths.size()) + " surface depths for " +
+                     std::to_string(n) + " nodes");
+  }
+  if (!std::all_of(surface_depths.begin(), surface_depths.end(),
+                   [mesh_size](real d) { return d >= 0 && d <= 2 * mesh_size; }))
+    throw InputError(name + ": a surface depth is negative, not finite or deeper than 2 mesh sizes");
   Shape shape;
-  if (std::any_of(surface_offsets.begin(), surface_offsets.end(), [](real o) { return o != 0; }))
+  if (std::any_of(surface_offsets.begin(), surface_offsets.end(), [](real o) { return o != 0; })) {
     shape.surface_offsets.assign(surface_offsets.begin(), surface_offsets.end());
+    shape.surface_depths.assign(surface_depths.begin(), surface_depths.end());
+  }
   shape.positions.assign(positions.begin(), positions.end());
   shape.volumes.assign(volumes.begin(), volumes.end());
   shape.mesh_size = mesh_size;
@@ -179,12 +188,13 @@ void Model::finalize() {
   // otherwise hold its nodes twice).
   for (Shape& shape : shapes_) {
     if (!shape.surface_offsets.empty()) {
-      shape.anchors =
-          build_surface_anchors(shape.positions, shape.surface_offsets, shape.mesh_size, dimension_);
+      shape.anchors = build_surface_anchors(shape.positions, shape.surface_offsets, shape.surface_depths,
+                                            shape.mesh_size, dimension_);
     }
     std::vector<real>().swap(shape.positions);
     std::vector<real>().swap(shape.volumes);
     std::vector<real>().swap(shape.surface_offsets);
+    std::vector<real>().swap(shape.surface_depths);
   }
   finalized_ = true;
 }

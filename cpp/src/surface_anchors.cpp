@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <utility>
 
 #include "granulate/cell_grid.hpp"
@@ -73,10 +74,66 @@ std::vector<index_t> best_span(const std::vector<real>& x, index_t a, const std:
   return chosen;
 }
 
+/// Wendland's C2 kernel (1 - q)^4 (1 + 4 q) for q < 1, else 0.
+real wendland(real q) {
+  if (!(q < 1)) return 0;
+  const real u = 1 - q;
+  return u * u * u * u * (1 + 4 * q);
+}
+
+/// The surface curvature of every anchored node (see surface_curvature), into its anchor.
+void estimate_curvatures(SurfaceAnchors& result, const std::vector<real>& x, std::span<const real> offsets,
+                         std::span<const real> depths, real mesh_size, int dimension) {
+  const std::size_t count = result.anchors.size();
+  std::vector<real> points(3 * count), normals(3 * count);
+  for (index_t a = 0; a < result.slot.size(); ++a) {
+    const index_t k = result.slot[a];
+    if (k == SurfaceAnchors::none) continue;
+    const vec o{offsets[3 * a], offsets[3 * a + 1], offsets[3 * a + 2]};
+    const real length = std::sqrt(o[0] * o[0] + o[1] * o[1] + o[2] * o[2]);
+    const real depth = depths.empty() ? 0.0 : depths[a];
+    for (int c = 0; c < 3; ++c) {
+      normals[3 * k + c] = o[c] / length;
+      points[3 * k + c] = x[3 * a + c] + depth * normals[3 * k + c];
+    }
+  }
+  const real radius = 2 * mesh_size;
+  const CellGrid grid = CellGrid::build(points, 0, static_cast<index_t>(count), radius);
+  std::vector<index_t> near;
+  for (index_t k = 0; k < count; ++k) {
+    near.clear();
+    grid.for_each_within(points, k, radius, dimension, [&](index_t j, real) { near.push_back(j); });
+    std::sort(near.begin(), near.end());  // the sums in a fixed order
+    result.anchors[k].curvature =
+        static_cast<float>(mesh_size * surface_curvature(points, normals, k, near, radius));
+  }
+}
+
 }  // namespace
 
+real surface_curvature(std::span<const real> points, std::span<const real> normals, index_t a,
+                       std::span<const index_t> neighbours, real radius) {
+  const real cos_limit = std::cos(std::numbers::pi / 6);
+  real bend = 0, spread = 0;
+  for (const index_t b : neighbours) {
+    if (b == a) continue;
+    real turn = 0, along = 0, d2 = 0;
+    for (int c = 0; c < 3; ++c) {
+      const real ds = points[3 * b + c] - points[3 * a + c];
+      turn += (normals[3 * b + c] - normals[3 * a + c]) * ds;
+      along += normals[3 * b + c] * normals[3 * a + c];
+      d2 += ds * ds;
+    }
+    if (!(along > cos_limit) || !(d2 > 0)) continue;
+    const real w = wendland(std::sqrt(d2) / radius);
+    bend += w * turn;
+    spread += w * d2;
+  }
+  return spread > 0 ? bend / spread : 0.0;
+}
+
 SurfaceAnchors build_surface_anchors(std::span<const real> positions, std::span<const real> offsets,
-                                     real mesh_size, int dimension) {
+                                     std::span<const real> depths, real mesh_size, int dimension) {
   const index_t n = static_cast<index_t>(positions.size() / 3);
   SurfaceAnchors result;
   const std::vector<real> x(positions.begin(), positions.end());
@@ -101,9 +158,13 @@ SurfaceAnchors build_surface_anchors(std::span<const real> positions, std::span<
       anchor.nodes[k] = chosen[k];
       anchor.weights[k] = static_cast<float>(w[k]);
     }
+    const real reach = std::sqrt(o[0] * o[0] + o[1] * o[1] + o[2] * o[2]);
+    anchor.reach = static_cast<float>(reach);
+    if (!depths.empty()) anchor.depth = static_cast<float>(depths[a] / mesh_size);
     result.slot[a] = static_cast<index_t>(result.anchors.size());
     result.anchors.push_back(anchor);
   }
+  estimate_curvatures(result, x, offsets, depths, mesh_size, dimension);
   return result;
 }
 

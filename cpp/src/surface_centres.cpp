@@ -1,14 +1,25 @@
 #include "granulate/contact/surface_centres.hpp"
 
 #include <algorithm>
+#include <array>
+#include <cmath>
 
 namespace granulate {
 
-void SurfaceCentres::find(const Model& model, const State& state, std::vector<real> depth) {
+void SurfaceCentres::find(const Model& model, const State& state, std::vector<real> depth,
+                          const std::vector<std::uint8_t>& outer_layers) {
   found_ = true;
   depth_ = std::move(depth);
-  detached_.clear();
+  surface_ = outer_layers;
   any_ = std::any_of(depth_.begin(), depth_.end(), [](real s) { return s > 0; });
+  // Which nodes are seen at anchors (1 byte each: most nodes have none, and contact asks for
+  // every node every step); under the surface law, which look them up many times per step, a
+  // pointer per node as well.
+  anchored_.assign(any_ ? model.node_count() : 0, 0);
+  for (index_t i = 0; i < anchored_.size(); ++i) anchored_[i] = lookup(model, i) != nullptr;
+  const bool cached = any_ && std::any_of(surface_.begin(), surface_.end(), [](std::uint8_t f) { return f; });
+  anchors_.assign(cached ? model.node_count() : 0, nullptr);
+  for (index_t i = 0; i < anchors_.size(); ++i) anchors_[i] = lookup(model, i);
   if (!any_ || state.bonds.broken(model.bond_offsets(), 0, model.node_count()) == 0) return;
   for (index_t i = 0; i < model.node_count(); ++i) {
     const SurfaceAnchor* a = anchor(model, i);
@@ -22,9 +33,16 @@ void SurfaceCentres::find(const Model& model, const State& state, std::vector<re
   }
 }
 
-void SurfaceCentres::detach(const Model& model, index_t i) {
-  if (detached_.empty()) detached_.assign(model.node_count(), 0);
-  detached_[i] = 1;
+void SurfaceCentres::detach(const Model&, index_t i) {
+  anchored_[i] = 0;
+  if (!anchors_.empty()) anchors_[i] = nullptr;
+}
+
+const SurfaceAnchor* SurfaceCentres::lookup(const Model& model, index_t i) const {
+  const index_t p = model.node_particle()[i];
+  if (!(depth_[p] > 0)) return nullptr;
+  const SurfaceAnchor* a = model.surface_anchor(i);
+  return a != nullptr && (a->depth == 0 || surface_[p]) ? a : nullptr;
 }
 
 void SurfaceCentres::detach_anchored(const Model& model, std::span<const std::array<index_t, 2>> pairs) {
@@ -39,38 +57,130 @@ void SurfaceCentres::detach_anchored(const Model& model, std::span<const std::ar
   }
 }
 
-const SurfaceAnchor* SurfaceCentres::anchor(const Model& model, index_t i) const {
-  if (!any_ || !(depth_[model.node_particle()[i]] > 0)) return nullptr;
-  if (!detached_.empty() && detached_[i]) return nullptr;
-  return model.surface_anchor(i);
+namespace {
+
+/// sum_k w_k (f_k - f_i) over anchor a of node i (first: its particle's first node).
+std::array<real, 3> anchored(const SurfaceAnchor& a, index_t first, const std::vector<real>& field,
+                             index_t i) {
+  std::array<real, 3> sum{0, 0, 0};
+  const real* f = field.data();
+  for (std::size_t k = 0; k < a.nodes.size() && a.nodes[k] != SurfaceAnchor::no_anchor; ++k) {
+    const index_t j = first + a.nodes[k];
+    for (int d = 0; d < 3; ++d) sum[d] += a.weights[k] * (f[3 * j + d] - f[3 * i + d]);
+  }
+  return sum;
 }
 
-SurfaceCentres::vec3 SurfaceCentres::at_centre(const Model& model, const std::vector<real>& field,
-                                               index_t i) const {
-  const real* f = field.data();
-  vec3 c{f[3 * i], f[3 * i + 1], f[3 * i + 2]};
-  const SurfaceAnchor* a = anchor(model, i);
-  if (a == nullptr) return c;
+}  // namespace
+
+SurfaceCentres::Seen SurfaceCentres::seen(const Model& model, index_t i) const {
+  Seen s;
+  s.anchor = anchor(model, i);
+  if (s.anchor == nullptr) return s;
   const index_t p = model.node_particle()[i];
-  const index_t first = model.particles()[p].first_node;
-  for (std::size_t k = 0; k < a->nodes.size() && a->nodes[k] != SurfaceAnchor::no_anchor; ++k) {
-    const index_t j = first + a->nodes[k];
-    const real w = depth_[p] * a->weights[k];
-    for (int d = 0; d < 3; ++d) c[d] -= w * (f[3 * j + d] - f[3 * i + d]);
+  const Particle& particle = model.particles()[p];
+  s.first = particle.first_node;
+  s.mesh_size = particle.mesh_size;
+  s.along_normal = surface_[p] != 0;
+  s.surface_length = s.anchor->depth * particle.mesh_size;
+  s.centre_length = (s.anchor->depth - 0.5 * depth_[p] * s.anchor->reach) * particle.mesh_size;
+  return s;
+}
+
+real SurfaceCentres::centre_length(const Model& model, index_t i) const {
+  return seen(model, i).centre_length;
+}
+
+real SurfaceCentres::surface_length(const Model& model, index_t i) const {
+  return seen(model, i).surface_length;
+}
+
+SurfaceCentres::vec3 SurfaceCentres::anchored_vector(const Model& model, const std::vector<real>& field,
+                                                     index_t i) const {
+  const SurfaceAnchor* a = anchor(model, i);
+  if (a == nullptr) return {0, 0, 0};
+  return anchored(*a, model.particles()[model.node_particle()[i]].first_node, field, i);
+}
+
+SurfaceCentres::vec3 SurfaceCentres::point(const Model& model, const State& state, const Seen& s, index_t i,
+                                           real length) const {
+  const real* y = state.positions.data();
+  vec3 q{y[3 * i], y[3 * i + 1], y[3 * i + 2]};
+  if (length == 0 || s.anchor == nullptr) return q;
+  (void)model;
+  const vec3 a = anchored(*s.anchor, s.first, state.positions, i);
+  // Outside the surface law the point is y + f A, f = length / ((h/2) |o|) (linear).
+  const real scale = s.along_normal ? length / std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2])
+                                    : length / (0.5 * s.mesh_size * s.anchor->reach);
+  for (int d = 0; d < 3; ++d) q[d] += scale * a[d];
+  return q;
+}
+
+SurfaceCentres::vec3 SurfaceCentres::point_velocity(const Model& model, const State& state, const Seen& s,
+                                                    index_t i, real length) const {
+  const real* v = state.velocities.data();
+  vec3 u{v[3 * i], v[3 * i + 1], v[3 * i + 2]};
+  if (length == 0 || s.anchor == nullptr) return u;
+  (void)model;
+  const vec3 rate = anchored(*s.anchor, s.first, state.velocities, i);
+  if (!s.along_normal) {
+    const real scale = length / (0.5 * s.mesh_size * s.anchor->reach);
+    for (int d = 0; d < 3; ++d) u[d] += scale * rate[d];
+    return u;
   }
-  return c;
+  const vec3 a = anchored(*s.anchor, s.first, state.positions, i);
+  const real size = std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+  const real along = (a[0] * rate[0] + a[1] * rate[1] + a[2] * rate[2]) / (size * size);
+  for (int d = 0; d < 3; ++d) u[d] += length * (rate[d] - along * a[d]) / size;
+  return u;
+}
+
+SurfaceCentres::vec3 SurfaceCentres::point(const Model& model, const State& state, index_t i,
+                                           real length) const {
+  return point(model, state, seen(model, i), i, length);
+}
+
+SurfaceCentres::vec3 SurfaceCentres::point_velocity(const Model& model, const State& state, index_t i,
+                                                    real length) const {
+  return point_velocity(model, state, seen(model, i), i, length);
+}
+
+SurfaceCentres::vec3 SurfaceCentres::lever(const Model& model, const State& state, index_t i, real length,
+                                           const vec3& force) const {
+  return lever(model, state, seen(model, i), i, length, force);
+}
+
+SurfaceCentres::vec3 SurfaceCentres::lever(const Model&, const State& state, const Seen& s, index_t i,
+                                           real length, const vec3& force) const {
+  if (length == 0 || s.anchor == nullptr) return {0, 0, 0};
+  if (!s.along_normal) {
+    const real scale = length / (0.5 * s.mesh_size * s.anchor->reach);
+    return {scale * force[0], scale * force[1], scale * force[2]};
+  }
+  const vec3 a = anchored(*s.anchor, s.first, state.positions, i);
+  const real size2 = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
+  const real size = std::sqrt(size2);
+  const real along = (a[0] * force[0] + a[1] * force[1] + a[2] * force[2]) / size2;
+  return {length * (force[0] - along * a[0]) / size, length * (force[1] - along * a[1]) / size,
+          length * (force[2] - along * a[2]) / size};
 }
 
 void SurfaceCentres::fill_positions(const Model& model, const State& state, std::vector<real>& x) const {
-  if (!any_) {
-    x = state.positions;
-    return;
-  }
   x.resize(state.positions.size());
   const std::int64_t n = model.node_count();
 #pragma omp parallel for schedule(static)
   for (std::int64_t i = 0; i < n; ++i) {
-    const vec3 c = at_centre(model, state.positions, static_cast<index_t>(i));
+    const vec3 c = at_list(model, state, static_cast<index_t>(i));
+    for (int k = 0; k < 3; ++k) x[3 * i + k] = c[k];
+  }
+}
+
+void SurfaceCentres::fill_centres(const Model& model, const State& state, std::vector<real>& x) const {
+  x.resize(state.positions.size());
+  const std::int64_t n = model.node_count();
+#pragma omp parallel for schedule(static)
+  for (std::int64_t i = 0; i < n; ++i) {
+    const vec3 c = at_centre(model, state, static_cast<index_t>(i));
     for (int k = 0; k < 3; ++k) x[3 * i + k] = c[k];
   }
 }

@@ -63,6 +63,16 @@ inline bool close(double a, double b, double rtol, double atol = 0) {
                                granulate_test::show(check_b_));                                      \
   } while (0)
 
+/// |a - b| <= atol + rtol max(|a|, |b|): for values that may be zero.
+#define CHECK_NEAR(a, b, rtol, atol)                                                                 \
+  do {                                                                                               \
+    const double check_a_ = (a), check_b_ = (b);                                                     \
+    if (!granulate_test::close(check_a_, check_b_, (rtol), (atol)))                                  \
+      granulate_test::fail(__FILE__, __LINE__,                                                       \
+                           std::string(#a " ~ " #b ": ") + granulate_test::show(check_a_) + " vs " + \
+                               granulate_test::show(check_b_));                                      \
+  } while (0)
+
 #define CHECK_THROWS(expression, type)                                                           \
   do {                                                                                           \
     bool thrown_ = false;                                                                        \

@@ -46,7 +46,7 @@ std::array<real, 3> offset(const SurfaceAnchor& anchor, const std::vector<real>&
 TEST_CASE("surface anchors put a face node's centre h/2 inside, a corner's h/2 from both faces") {
   const real h = 0.1;
   const Grid g = square_grid(h);
-  const SurfaceAnchors anchors = build_surface_anchors(g.positions, g.offsets, h, 2);
+  const SurfaceAnchors anchors = build_surface_anchors(g.positions, g.offsets, {}, h, 2);
   CHECK(anchors.of(12) == nullptr);  // the middle node
   CHECK(anchors.anchors.size() == 16);
   const auto face = offset(*anchors.of(2), g.positions, 2);  // (0, 2h) on the face x = 0
@@ -60,7 +60,7 @@ TEST_CASE("surface anchors put a face node's centre h/2 inside, a corner's h/2 f
 TEST_CASE("surface anchors follow any affine motion of the neighbourhood") {
   const real h = 0.1;
   const Grid g = square_grid(h);
-  const SurfaceAnchors anchors = build_surface_anchors(g.positions, g.offsets, h, 2);
+  const SurfaceAnchors anchors = build_surface_anchors(g.positions, g.offsets, {}, h, 2);
   // y = F x + t with F a rotation by 0.3 rad times a stretch: the offset is F (h/2, h/2).
   const real c = std::cos(0.3), s = std::sin(0.3);
   const std::array<real, 4> F{1.1 * c, -0.9 * s, 1.1 * s, 0.9 * c};

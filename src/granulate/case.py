@@ -480,10 +480,11 @@ class ContactSpec(Spec):
     friction_law: Literal["coulomb", "peridem"] = Field(
         "coulomb", description="'peridem': PeriDEM's friction (speeds sliding up), comparisons only"
     )
-    pair_law: Literal["granulate", "peridem"] = Field(
+    pair_law: Literal["granulate", "surface", "peridem"] = Field(
         "granulate",
-        description="'peridem': PeriDEM's node-pair law (one Rc from the finer mesh, springs "
-        "kn V_i V_j), comparisons only",
+        description="'surface': surface nodes probe the other particle's smooth surface; "
+        "'peridem': PeriDEM's node-pair law (one Rc from the finer mesh, springs kn V_i V_j), "
+        "comparisons only",
     )
 
     def make(self) -> Contact:

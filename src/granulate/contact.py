@@ -56,9 +56,12 @@ class Contact:
             friction, mu |F_n| along the slip velocity (it speeds sliding up instead of
             resisting it); for comparisons with PeriDEM only.
         pair_law: "granulate" (default: per-node contact radii, springs kn min(V_i, V_j)^2),
-            or "peridem": PeriDEM's node-pair law, one Rc per pair of particles (factor x the
-            finer mesh size, also against walls) and springs kn V_i V_j; for comparisons with
-            PeriDEM only (set by --peridem-compat).
+            "surface" (each surface node probes the other particle's smooth surface, from its
+            surface points, normals and curvatures: no node-scale bumps or gaps, so rotated
+            lattices and grains of different mesh sizes collide as round grains do; see
+            ARCHITECTURE.md), or "peridem": PeriDEM's node-pair law, one Rc per pair of
+            particles (factor x the finer mesh size, also against walls) and springs
+            kn V_i V_j; for comparisons with PeriDEM only (set by --peridem-compat).
     """
 
     restitution: float = 1.0
@@ -72,8 +75,10 @@ class Contact:
     pair_law: str = "granulate"
 
     def __post_init__(self) -> None:
-        if self.pair_law not in ("granulate", "peridem"):
-            raise InputError(f"pair_law must be 'granulate' or 'peridem', got {self.pair_law!r}")
+        if self.pair_law not in ("granulate", "surface", "peridem"):
+            raise InputError(
+                f"pair_law must be 'granulate', 'surface' or 'peridem', got {self.pair_law!r}"
+            )
         if self.friction_law not in ("coulomb", "peridem"):
             raise InputError(
                 f"friction_law must be 'coulomb' or 'peridem', got {self.friction_law!r}"

@@ -732,6 +732,39 @@ def grid_surface(shape: Rectangle | Box, positions: NDArray[np.float64]) -> NDAr
     return offsets
 
 
+def outer_layer(
+    shape: Shape, positions: NDArray[np.float64], mesh_size: float
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Where contact finds the surface above a lattice's or conforming discretisation's outer
+    nodes (see ReferenceShape.surface): for each node less than one mesh size h deep, the unit
+    outward normal n = grad phi of the shape's signed distance phi (central differences over
+    h/1000) and its depth -phi; zero for the nodes deeper in (and for the rare node where the
+    gradient is not a unit vector: on the medial axis of a thin part). A rotated lattice's
+    outer nodes lie from 0 to h below its faces; contact puts each one's surface point at
+    x + depth n, on the shape's true surface.
+
+    Returns (offsets (n, 3), depths (n,) [m])."""
+    d = shape.dimension
+    depths = -shape.signed_distance(positions)
+    near = np.flatnonzero(depths < mesh_size)
+    step = 1e-3 * mesh_size
+    gradient = np.zeros((len(near), 3))
+    for k in range(d):
+        shift = np.zeros(3)
+        shift[k] = step
+        p = positions[near]
+        gradient[:, k] = (shape.signed_distance(p + shift) - shape.signed_distance(p - shift)) / (
+            2 * step
+        )
+    length = np.linalg.norm(gradient, axis=1)
+    unit = np.abs(length - 1) < 0.05
+    offsets = np.zeros((len(positions), 3))
+    offsets[near[unit]] = gradient[unit] / length[unit, None]
+    layer = np.zeros(len(positions))
+    layer[near[unit]] = np.clip(depths[near[unit]], 0.0, mesh_size)
+    return offsets, layer
+
+
 def conforming(shape: Shape, mesh_size: float) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Nodes on rings (2D) or shells (3D) that follow the surface of a Disc, Ellipse, Sphere or
     Ellipsoid, so the particle's surface is smooth instead of a lattice staircase (this matters
@@ -929,12 +962,15 @@ class ReferenceShape:
     volumes: NDArray[np.float64]  # (n,) [m^d]
     mesh_size: float  # [m]
     dimension: int
-    #: (n, 3) the offsets o of the nodes on the surface (a mesh's boundary vertices, a grid's
-    #: boundary; n . o = 1 for each face normal n at the node, zero inside), or None where no
-    #: node lies on it (the lattice and conforming rings keep theirs h/2 inside). Contact centres
-    #: the spheres of these nodes at x - rho o (rho: their contact radius), so that they reach
-    #: the surface.
+    #: (n, 3) the offsets o of the nodes that carry the surface for contact: a mesh's or grid's
+    #: boundary vertices (n . o = 1 for each face normal n at the node), a lattice's or
+    #: conforming discretisation's outer layer (the unit outward normal; see outer_layer);
+    #: zero inside. None where the nodes do not tell (a mesh without elements).
     surface: NDArray[np.float64] | None = None
+    #: (n,) how deep below the surface each of those nodes lies [m] (0 on a mesh's boundary),
+    #: or None for all 0. Contact sees the surface at x + depth o / |o| (see
+    #: granulate's ARCHITECTURE.md, "Contact in one paragraph").
+    surface_depth: NDArray[np.float64] | None = None
 
     @staticmethod
     def from_shape(
@@ -951,9 +987,10 @@ class ReferenceShape:
         or "grid" (grid vertices with finite-element volumes: Rectangle, Box).
         ``centered``: move the shape's ``origin`` (centre or centroid) to (0, 0, 0), so that
         rotations and scales act about it."""
-        surface = None
+        depth = None
         if discretization == "lattice":
             positions, volumes = lattice(shape, mesh_size, jitter=jitter, seed=seed)
+            surface, depth = outer_layer(shape, positions, mesh_size)
         elif discretization in ("conforming", "grid"):
             if jitter:
                 raise InputError("jitter applies to the lattice discretization only")
@@ -961,6 +998,8 @@ class ReferenceShape:
             positions, volumes = make(shape, mesh_size)
             if discretization == "grid":
                 surface = grid_surface(shape, positions)
+            else:
+                surface, depth = outer_layer(shape, positions, mesh_size)
         else:
             raise InputError(
                 f"unknown discretization {discretization!r}; choose 'lattice', 'conforming' or "
@@ -968,7 +1007,7 @@ class ReferenceShape:
             )
         if centered:
             positions = positions - shape.origin
-        return ReferenceShape(positions, volumes, float(mesh_size), shape.dimension, surface)
+        return ReferenceShape(positions, volumes, float(mesh_size), shape.dimension, surface, depth)
 
     @staticmethod
     def from_mesh(

@@ -237,8 +237,9 @@ class Simulation:
         self._labels: tuple[tuple[int, int], NDArray[np.uint32]] | None = None  # fragments
         self._positions: list[NDArray[np.float64]] = []
         self._volumes: list[NDArray[np.float64]] = []
-        # Per body without a reference shape: its surface offsets (a grid), or None.
-        self._surfaces: list[NDArray[np.float64] | None] = []
+        # Per body without a reference shape: the discretised shape its nodes came from (for
+        # its surface offsets and depths), or None.
+        self._surfaces: list[ReferenceShape | None] = []
         self._initial_velocities: list[
             tuple[Body, NDArray[np.float64], float | NDArray[np.float64]]
         ] = []
@@ -340,7 +341,7 @@ class Simulation:
             angular_velocity=angular_velocity,
             name=name,
         )
-        self._surfaces[body.index] = reference.surface
+        self._surfaces[body.index] = reference
         return body
 
     def add_particle(
@@ -881,7 +882,7 @@ class Simulation:
                 core_materials.append(body.material)
             if body.reference is None:
                 shape = model.add_shape(
-                    positions, volumes, body.mesh_size, _surface_offsets(surface)
+                    positions, volumes, body.mesh_size, *_surface_arrays(surface)
                 )
                 model.place_shape(shape, material_ids[key], positions, 1.0, horizon)
                 continue
@@ -891,7 +892,7 @@ class Simulation:
                     reference.positions,
                     reference.volumes,
                     reference.mesh_size,
-                    _surface_offsets(reference.surface),
+                    *_surface_arrays(reference),
                 )
             model.place_shape(
                 shape_ids[id(reference)], material_ids[key], positions, body.scale, horizon
@@ -977,6 +978,7 @@ class Simulation:
         law.tangential_stiffness_ratio = contact.tangential_stiffness_ratio
         law.peridem_friction = contact.friction_law == "peridem"
         law.node_pair = contact.pair_law == "peridem"
+        law.surface = contact.pair_law == "surface"
         return law
 
     def _set_contact_laws(self, core: _core.Simulation, materials: list[Material]) -> None:
@@ -1860,8 +1862,14 @@ class Simulation:
         out.history_step = int(core.step)
 
 
-def _surface_offsets(surface: NDArray[np.float64] | None) -> NDArray[np.float64]:
-    """Surface offsets for the core, flat (3 per node), or none (an empty array)."""
-    if surface is None:
-        return np.zeros(0)
-    return np.ascontiguousarray(surface, dtype=np.float64).reshape(-1)
+def _surface_arrays(
+    reference: ReferenceShape | None,
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """A shape's surface offsets (flat, 3 per node) and depths for the core; empty arrays where
+    it has none (all depths 0: empty too)."""
+    if reference is None or reference.surface is None:
+        return np.zeros(0), np.zeros(0)
+    offsets = np.ascontiguousarray(reference.surface, dtype=np.float64).reshape(-1)
+    if reference.surface_depth is None:
+        return offsets, np.zeros(0)
+    return offsets, np.ascontiguousarray(reference.surface_depth, dtype=np.float64)

@@ -21,12 +21,14 @@ struct Shape {
   std::vector<real> positions;  ///< n x 3 [m], local frame (released by Model::finalize)
   std::vector<real> volumes;    ///< n [m^d] (released by Model::finalize)
   real mesh_size = 0;           ///< h [m] of the reference discretisation
-  /// Nodes on the shape's surface (the vertices on an imported mesh's or a grid's boundary),
-  /// n x 3 in the shape's frame: o_a with n_k . o_a = 1 for the outward normal n_k of every
-  /// boundary face at the node, zero inside; empty when no node lies on the surface (lattices
-  /// and conforming discretisations keep their outer nodes h/2 inside it). Turned into
-  /// `anchors` and released by Model::finalize.
+  /// Nodes on or just below the shape's surface, n x 3 in the shape's frame: o_a with
+  /// n_k . o_a = 1 for the outward normal n_k of every boundary face at a mesh's or grid's
+  /// boundary vertex, the unit outward normal for a node of a lattice's or conforming
+  /// discretisation's outer layer, zero inside; empty when the shape has none (a mesh without
+  /// elements). `surface_depths` (n [m], or empty: all 0) give each such node's depth below the
+  /// surface. Turned into `anchors` (see surface_anchors.hpp) and released by Model::finalize.
   std::vector<real> surface_offsets;
+  std::vector<real> surface_depths;
   SurfaceAnchors anchors;  ///< where contact centres the surface nodes' spheres
   index_t node_count() const { return static_cast<index_t>(volumes.size()); }  ///< before finalize
 };
@@ -115,10 +117,11 @@ class Model {
   index_t add_material(const MaterialParams& params);
 
   /// Adds a reference shape: positions n x 3 row-major [m] (z = 0 in 2D), volumes n [m^3, or
-  /// m^2 per unit thickness in 2D], its mesh size h [m], and optionally the offsets of the
-  /// nodes on its surface (n x 3, see Shape::surface_offsets). Returns the shape index.
+  /// m^2 per unit thickness in 2D], its mesh size h [m], and optionally the offsets and depths
+  /// of the nodes on or below its surface (n x 3 and n, see Shape::surface_offsets). Returns
+  /// the shape index.
   index_t add_shape(std::span<const real> positions, std::span<const real> volumes, real mesh_size,
-                    std::span<const real> surface_offsets = {});
+                    std::span<const real> surface_offsets = {}, std::span<const real> surface_depths = {});
 
   /// Places a shape as a particle: `positions` (n x 3) are the shape's nodes after scaling by
   /// `scale`, rotating and translating (the caller places them; they are checked to be a rigid

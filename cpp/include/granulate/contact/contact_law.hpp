@@ -73,6 +73,11 @@ struct Law {
   /// finer mesh size (also against walls), and pair springs kn V_i V_j. Otherwise each node has
   /// its own contact radius (see resolve) and the pair spring is kn min(V_i, V_j)^2.
   bool node_pair = false;
+  /// The surface law (contact/surface_law.hpp): each node on a particle's surface probes the
+  /// other particle's smooth surface, built from its surface points, normals and curvatures,
+  /// instead of meeting its nodes' spheres. Particles without surface points (meshes without
+  /// elements), crack faces and debris still meet as spheres.
+  bool surface = false;
 };
 
 /// One particle's side of a contact.
@@ -87,6 +92,7 @@ struct PairLaw {
   real contact_radius = 0;
   real normal_stiffness = 0;
   bool node_pair = false;  ///< PeriDEM's pair spring kn V_i V_j (else kn min(V_i, V_j)^2)
+  bool surface = false;    ///< the surface law (see Law::surface)
 };
 
 /// The finer of two particles (smaller h; on a tie, the smaller horizon), so laws are symmetric.
@@ -137,7 +143,8 @@ inline real resolve_normal_stiffness(const Law& law, const ContactSide& a, const
 
 /// Rc and kn of a law between particles a and b.
 inline PairLaw resolve(const Law& law, const ContactSide& a, const ContactSide& b, int dimension) {
-  return {resolve_contact_radius(law, a, b), resolve_normal_stiffness(law, a, b, dimension), law.node_pair};
+  return {resolve_contact_radius(law, a, b), resolve_normal_stiffness(law, a, b, dimension), law.node_pair,
+          law.surface};
 }
 
 /// Rc of a node of particle a against a rigid wall surface: the node's own contact radius

@@ -11,6 +11,7 @@
 #include "granulate/contact/contact_law.hpp"
 #include "granulate/contact/power_law_damping.hpp"
 #include "granulate/contact/surface_centres.hpp"
+#include "granulate/contact/surface_law.hpp"
 #include "granulate/model.hpp"
 #include "granulate/state.hpp"
 #include "granulate/walls.hpp"
@@ -175,11 +176,97 @@ class ContactModel {
   real centring_depth(index_t p) const;
   /// centring_depth of every particle that centres its surface nodes, 0 for the others.
   std::vector<real> centring_depths(const Model& model) const;
-  /// Where contact sees node i (its contact centre), and how fast that point moves.
+  /// Whether particle p meets others under the surface law (a law of its material says so):
+  /// then its outer layer's nodes (lattices, conforming discretisations) carry surface points
+  /// too; otherwise only a mesh's or grid's boundary vertices are centred.
+  bool surface_particle(index_t p) const { return surface_particles_[p] != 0; }
+  /// surface_particle of every particle, from the laws (at every law change).
+  void find_surface_particles();
+  std::vector<std::uint8_t> surface_particles_;
+  bool any_surface_ = false;
+  /// Where node i's contact sphere is centred (its contact centre), and how fast that point moves.
   vec3 contact_position(const Model& model, const State& state, index_t i) const;
   vec3 contact_velocity(const Model& model, const State& state, index_t i) const;
+  /// Whether node i takes part in node-pair contact: every node of a particle that does not use
+  /// the surface law, else the surface points and the nodes on crack faces (with a broken
+  /// bond): the nodes inside an intact surface never touch another body.
+  bool takes_part(const Model& model, const State& state, index_t i) const;
+  /// Whether the bonds broken since the last list change open nodes that took no part.
+  bool breaks_open_new_nodes(const Model& model) const;
+  std::vector<std::uint8_t> taking_part_;  // per node, at the last search
+  /// Whether node i carries a point of its body's surface (surface_centres.hpp).
+  bool on_surface(const Model& model, index_t i) const { return centres_.anchor(model, i) != nullptr; }
+  /// The list cutoff of nodes i and j (without the skin), between their surface points (their
+  /// positions where they have none): the surface law's support radius where either carries a
+  /// surface point of another body, else the pair's Rc (plus the centres' depths in one body).
+  real pair_reach(const Model& model, index_t i, index_t j, bool same_body) const;
+  /// The largest pair_reach any two nodes can have.
+  real largest_pair_reach(const Model& model) const;
   SurfaceCentres centres_;
-  std::vector<vec3> centre_forces_;  // per contact node: the force on its centre (per step)
+  std::vector<vec3> anchor_forces_;  // per contact node: the force on its anchored vector A_i
+
+  // Surface contact (contact/surface_law.hpp). A node's list entries whose partners carry
+  // surface points of one other body make one probe of that body's surface (a group); the
+  // partners see the same entries from their side as targets. Groups are numbered in node
+  // order at every list change; their sums and forces are per step.
+  static constexpr index_t no_group = ~index_t{0};
+  struct ProbeGroup {
+    index_t probe = 0;  ///< the probing node
+    index_t body = 0;   ///< the body whose surface it probes
+    index_t slot = 0;   ///< the slot of the two bodies
+  };
+  /// Per step: the sums over a group's surface points, and what the group's contact is.
+  struct ProbeState {
+    contact::SurfaceGap sums;
+    vec3 point{0, 0, 0};      ///< the probe point p (a surface point, or the node)
+    real radius = 0;          ///< its contact radius r (0 for a surface point)
+    real support = 0;         ///< the target's support radius a
+    real stiffness = 0;       ///< k of the probe
+    real contact_radius = 0;  ///< Rc of the pair's law (the scale of the deepest overlap)
+    real push = 0;            ///< P = k delta tau (0: apart)
+    real taper = 0;           ///< Q = k delta^2 tau'(S) / 2 (0 on a surface)
+    vec3 gradient{0, 0, 0};   ///< G, the surface's normal direction at p (out of the target)
+    vec3 friction{0, 0, 0};   ///< the friction force on the probe
+    vec3 foot{0, 0, 0};       ///< sum_k (w_k / S) y_k: where the target's nodes take the friction force
+    vec3 facing{0, 0, 0};     ///< the normal of the nearest point: the points counted face along it
+  };
+  std::vector<index_t> entry_group_;   // per pair entry: the group it belongs to as a probe entry
+  std::vector<index_t> entry_target_;  // per pair entry: the group that probes the node's body
+  std::vector<ProbeGroup> groups_;
+  std::vector<index_t> group_offsets_;  // per node: its groups (CSR)
+  std::vector<ProbeState> probes_;
+  /// The probe k of a group of node i against body b: beta kn V_i^2, beta = h_b^2 / (h_i^2 + h_b^2)
+  /// (the finer surface probes the coarser; equal meshes share the contact equally).
+  real probe_stiffness(const Model& model, index_t i, index_t target, const contact::PairLaw& law) const;
+  /// Node j's surface point as the surface law sees it (this step's, from measure_surface_points).
+  const contact::SurfacePoint& surface_point(index_t j) const;
+  void measure_surface_points(const Model& model, const State& state);
+  std::vector<index_t> surface_nodes_, surface_slot_;  // nodes with entries and surface points; per node
+  std::vector<contact::SurfacePoint> surface_points_;  // per step, per surface node
+  std::vector<real> surface_sizes_;                    // |A| of each, per step
+  /// Groups from the lists and the bodies (after every list change).
+  void find_groups(const Model& model);
+  /// The group of the probe j whose target body holds node i (the entry (j, i)), or no_group.
+  index_t target_group(index_t i, index_t j) const;
+  /// Pass A for node i's groups: the sums, the gap, the push, and its probe entries' springs.
+  struct ProbeScratch {  // per thread: per entry of the node, and per group
+    std::vector<const contact::SurfacePoint*> points;
+    std::vector<real> weights, nearest;
+  };
+  real measure_probes(const Model& model, const State& state, index_t i, ProbeScratch& scratch);
+  /// w_k / S of a target point in a group's sums (0 if it does not face the probe).
+  real surface_share(const ProbeState& probe, const contact::SurfacePoint& point) const;
+  /// Friction of every touching group (updates its entries' springs), per probing node in
+  /// parallel, after pass B.
+  void probe_frictions(const Model& model, const State& state, real dt);
+  /// Friction of node i's touching groups: each probe entry's spring (Cundall-Strack, on the
+  /// slip of the probe point against the target's surface velocity there, sum_k (w_k / S)
+  /// v(s_k)), weighted by w_k / S; and the foot f = sum_k (w_k / S) s_k.
+  void probe_friction(const Model& model, const State& state, index_t i, real dt);
+  /// The force on a target's surface point (`point`, with |A| = `size`) from a probing group,
+  /// and the force on its anchored vector A.
+  void target_forces(const contact::SurfacePoint& point, real size, index_t group, vec3& on_point,
+                     vec3& on_normal, vec3& on_friction) const;
 
   /// Nodes with list entries, grouped by body (each group in node order), and the per-step
   /// scratch of bodies and slots.
@@ -194,6 +281,7 @@ class ContactModel {
   void sum_slot_stiffness();
   void measure_bodies(const Model& model, const State& state);
   void sum_slot_springs(const Model& model, const State& state);
+  void sum_probe_springs();
   void slot_dashpots(const State& state, real dt);
   void slot_redirects();
   /// Velocity of a point moving with a touching body's rigid-body motion.
@@ -205,6 +293,8 @@ class ContactModel {
   vec3 pair_surface_normal(index_t i, index_t j, const vec3& line) const;
   void measure_surface_normals(const Model& model, const State& state);
   void node_forces(const Model& model, State& state, real dt);
+  /// The friction couples of the surface probes, as loads on their bodies (in group order).
+  void probe_couples(const State& state);
   void body_loads(const Model& model, State& state);
   void sum_wall_reactions();
   /// A node pair in contact: normal from i to j, overlap, and the levers of the contact point
@@ -233,8 +323,10 @@ class ContactModel {
     real stiffness = 0;
   };
   WallGeometry wall_geometry(const Model& model, index_t i, index_t e) const;
-  /// Force on node i of its wall entry e (updates the spring; sets the entry's reaction).
-  vec3 wall_force(const Model& model, const State& state, index_t i, index_t e, real dt);
+  /// Forces of node i's wall entry e: the springs on its contact centre, friction on the node
+  /// (updates the spring; sets the entry's reaction).
+  void wall_force(const Model& model, const State& state, index_t i, index_t e, real dt, vec3& on_centre,
+                  vec3& on_node);
   /// Sum of (p - c_i) x F_t over node i's friction forces, from the springs.
   vec3 friction_couple(const Model& model, const State& state, index_t i) const;
   /// Contact radius of node i in a contact of law `law` with node j (its share of the pair's Rc).

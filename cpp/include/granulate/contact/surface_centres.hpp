@@ -1,13 +1,23 @@
-// Where contact centres the spheres of nodes that lie on their particle's surface (the vertices
-// on an imported mesh's or a grid's boundary; see surface_anchors.hpp).
+// Where contact sees the nodes that carry a particle's surface (the anchored nodes of
+// surface_anchors.hpp: a mesh's or grid's boundary vertices, a lattice's or conforming
+// discretisation's outer layer).
 //
-// A lattice's outer nodes lie h/2 inside the surface; a boundary vertex lies on it. Its sphere is
-// centred one contact radius rho below every face at the node, at the virtual node
-//   c_i = y_i - s_p sum_k w_k (y_k - y_i),   s_p = rho / (h/2),
-// over its anchors k (weights w_k for a depth of h/2, scaled to rho). c_i moves at the matching
-// velocity, and a force F on it goes (1 + s W) F to the node and -s w_k F to anchor k (W = sum
-// w_k): that is F at c_i in momentum, moment and work. A node whose bond to one of its anchors
-// breaks is detached: its sphere is centred on itself from then on.
+// Each such node i has the anchored vector A_i = sum_k w_k (y_k - y_i) (about (h/2) o_i) and
+// its outward normal n_i = A_i / |A_i|. From them, for a particle whose laws give its nodes the
+// contact radius rho (s_p = rho / (h/2)):
+//   the surface point    s_i = y_i + d_i n_i               (on the particle's true surface, d_i
+//                        the node's depth),
+//   the contact centre   c_i = y_i + (d_i - rho |o_i|) n_i  (rho |o_i| below s_i, so that the
+//                        sphere of radius rho reaches every face at a mesh corner; walls, and
+//                        node pairs within one body, see the node's sphere there).
+// A point q = y_i + l n_i moves at v_i + l (1 - n n^T) A_i(v) / |A_i|. A force F on q goes F
+// to the node and, as the force (l / |A_i|) (1 - n n^T) F on A_i, -W of that to the node and
+// w_k to anchor k (W = sum w_k): F at q in momentum, moment and work. A force along the normal
+// stays on the node; only its tangential part reaches the anchors. Particles outside the
+// surface law keep the linear form q = y_i + (l / ((h/2) |o_i|)) A_i (the same point at rest;
+// it stretches with the neighbourhood), which needs no square root per node and step. A node
+// whose bond to one of its anchors breaks is detached: it is seen at itself from then on, and
+// carries no surface point.
 #pragma once
 
 #include <array>
@@ -26,8 +36,12 @@ class SurfaceCentres {
   using vec3 = std::array<real, 3>;
 
   /// Sets each particle's depth s_p (0: its nodes are not centred; one per particle) and the
-  /// detached nodes from the bond states (at the first evaluation, and after a restore).
-  void find(const Model& model, const State& state, std::vector<real> depth);
+  /// detached nodes from the bond states (at the first evaluation, and after a restore). A
+  /// particle not flagged in `outer_layers` keeps only its nodes on the surface (depth 0, a
+  /// mesh's or grid's boundary vertices); a lattice's or conforming outer layer is seen at its
+  /// nodes.
+  void find(const Model& model, const State& state, std::vector<real> depth,
+            const std::vector<std::uint8_t>& outer_layers);
   bool found() const { return found_; }
   void forget() { found_ = false; }
   bool any() const { return any_; }
@@ -35,27 +49,88 @@ class SurfaceCentres {
   /// Detaches the nodes whose bond to one of their anchors is among `pairs` (bonds that broke).
   void detach_anchored(const Model& model, std::span<const std::array<index_t, 2>> pairs);
 
-  /// The anchors of node i if its sphere is centred, else null.
-  const SurfaceAnchor* anchor(const Model& model, index_t i) const;
+  /// The anchors of node i if it carries a surface point (its particle's nodes are centred and
+  /// it is attached), else null.
+  /// Whether node i is seen away from itself (it has anchors): a cheap test for the hot loops.
+  bool moved(index_t i) const { return any_ && anchored_[i]; }
+  const SurfaceAnchor* anchor(const Model& model, index_t i) const {
+    if (!any_ || !anchored_[i]) return nullptr;
+    return anchors_.empty() ? lookup(model, i) : anchors_[i];
+  }
   /// s_p of node i's particle.
   real depth(const Model& model, index_t i) const { return depth_[model.node_particle()[i]]; }
-  /// A nodal vector field (positions, velocities; n x 3) at node i's centre: f_i - s_p sum_k
-  /// w_k (f_k - f_i), or f_i for a node that is not centred.
-  vec3 at_centre(const Model& model, const std::vector<real>& field, index_t i) const;
-  /// Every node's contact position, into x (n x 3).
+  /// How far out along its normal node i's contact centre lies [m]: d_i - rho |o_i| (0 without
+  /// anchors).
+  real centre_length(const Model& model, index_t i) const;
+  /// How far out along its normal node i's surface point lies [m]: d_i (0 without anchors).
+  real surface_length(const Model& model, index_t i) const;
+  /// y_i + length n_i at the state's positions (y_i for a node without anchors).
+  vec3 point(const Model& model, const State& state, index_t i, real length) const;
+  /// The velocity of that point: v_i + length (1 - n n^T) A_i(v) / |A_i|.
+  vec3 point_velocity(const Model& model, const State& state, index_t i, real length) const;
+  vec3 at_centre(const Model& model, const State& state, index_t i) const {
+    const Seen s = seen(model, i);
+    return point(model, state, s, i, s.centre_length);
+  }
+  vec3 centre_velocity(const Model& model, const State& state, index_t i) const {
+    const Seen s = seen(model, i);
+    return point_velocity(model, state, s, i, s.centre_length);
+  }
+  /// Node i's surface point: where node-pair search and surface contact see the node.
+  vec3 at_surface(const Model& model, const State& state, index_t i) const {
+    const Seen s = seen(model, i);
+    return point(model, state, s, i, s.surface_length);
+  }
+  vec3 surface_velocity(const Model& model, const State& state, index_t i) const {
+    const Seen s = seen(model, i);
+    return point_velocity(model, state, s, i, s.surface_length);
+  }
+  /// What one look-up of node i's anchors gives: the anchors, its particle's first node and h,
+  /// whether its points lie along the normal (the surface law) and its two lengths.
+  struct Seen {
+    const SurfaceAnchor* anchor = nullptr;
+    index_t first = 0;
+    real mesh_size = 0, surface_length = 0, centre_length = 0;
+    bool along_normal = false;
+  };
+  Seen seen(const Model& model, index_t i) const;
+  vec3 point(const Model& model, const State& state, const Seen& s, index_t i, real length) const;
+  vec3 point_velocity(const Model& model, const State& state, const Seen& s, index_t i, real length) const;
+  /// The force on A_i of a force F on the point y_i + length n_i: (length / |A_i|) (1 - n n^T) F
+  /// (length / ((h/2) |o_i|) F outside the surface law).
+  vec3 lever(const Model& model, const State& state, const Seen& s, index_t i, real length,
+             const vec3& force) const;
+  /// The force on A_i of a force F on the point y_i + length n_i: (length / |A_i|) (1 - n n^T) F.
+  vec3 lever(const Model& model, const State& state, index_t i, real length, const vec3& force) const;
+  /// A_i = sum_k w_k (f_k - f_i) of an anchored node for a nodal field f (zero without anchors).
+  vec3 anchored_vector(const Model& model, const std::vector<real>& field, index_t i) const;
+  /// Where the node-pair lists see node i: its surface point on a particle under the surface
+  /// law, else its contact centre.
+  vec3 at_list(const Model& model, const State& state, index_t i) const {
+    return surface_[model.node_particle()[i]] ? at_surface(model, state, i) : at_centre(model, state, i);
+  }
+  /// Every node's list position (at_list), into x (n x 3).
   void fill_positions(const Model& model, const State& state, std::vector<real>& x) const;
+  /// Every node's contact centre (its position if it has none), into x (n x 3).
+  void fill_centres(const Model& model, const State& state, std::vector<real>& x) const;
 
   std::size_t memory_bytes() const {
-    return depth_.capacity() * sizeof(real) + detached_.capacity() * sizeof(std::uint8_t);
+    return depth_.capacity() * sizeof(real) + anchors_.capacity() * sizeof(const SurfaceAnchor*) +
+           anchored_.capacity() + surface_.capacity();
   }
 
  private:
   void detach(const Model& model, index_t i);
+  /// Node i's anchors from the shape (none for an outer-layer node of a particle not under the
+  /// surface law).
+  const SurfaceAnchor* lookup(const Model& model, index_t i) const;
 
   bool found_ = false;
   bool any_ = false;
-  std::vector<real> depth_;             // per particle
-  std::vector<std::uint8_t> detached_;  // per node, once a node is detached
+  std::vector<real> depth_;                    // per particle
+  std::vector<std::uint8_t> surface_;          // per particle: under the surface law
+  std::vector<std::uint8_t> anchored_;         // per node: seen at its anchors (0 once detached)
+  std::vector<const SurfaceAnchor*> anchors_;  // per node under the surface law: lookup(), kept
 };
 
 }  // namespace granulate

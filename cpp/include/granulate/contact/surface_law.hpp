@@ -1,0 +1,165 @@
+// Contact against a body's smooth surface: the gap of a point from a surface given by points with
+// normals and curvatures (an implicit moving least-squares surface with osculating spheres).
+//
+// Body B's surface near a probe point p is seen through its surface points k (position s_k,
+// unit outward normal n_k, mean curvature kappa_k; see contact/surface_centres.hpp) within the
+// support radius a of p. Each point's osculating sphere (a plane where kappa = 0) gives the
+// signed distance of p from the surface as seen from k,
+//   d_k = (|kappa v + n_k| - 1) / kappa = (2 n_k . v + kappa |v|^2) / (|kappa v + n_k| + 1),
+// v = p - s_k (the second form holds for every kappa, 0 included), and the surface is their
+// weighted mean (Kolluri 2005, "Provably good moving least squares", with spheres for planes),
+//   g(p) = sum_k w_k d_k / sum_k w_k,   w_k = W(|v| / a),  W(q) = (1 - q)^4 (1 + 4 q) (Wendland
+// C2, zero for q >= 1). g is exact (the distance to the sphere, at any p in reach) for points on
+// a sphere or circle with radial normals and curvature 1/R, and on a plane, however irregular
+// the points; a lattice's outer layer, a conforming discretisation's and a mesh's boundary
+// differ only in where the points lie. Its gradient
+//   G = dg/dp = sum_k [w_k u_k + (d_k - g) e_k] / S,   u_k = (kappa v + n_k) / |kappa v + n_k|,
+//   e_k = dw_k/dp = W'(|v|/a) v / (a |v|),  S = sum_k w_k,
+// is the surface's normal there: smooth, with no node-scale tilt, whatever the two meshes.
+//
+// A probe of contact radius r (0 for a surface point, which touches when it crosses the
+// surface; rho for a node without one) has the energy E = k delta^2 tau(S) / 2, delta = r - g > 0.
+// The taper tau(S) = c^2 (3 - 2 c), c = S / S_0 (1 for c >= 1), brings E smoothly to zero where
+// the probe leaves the reach of the last points (past a corner or the edge of a fragment's old
+// surface, where a mean of one point's plane would still say "inside" and E would jump); on a
+// surface S is well above S_0. E depends only on the vectors p - s_k and on the normals n_k,
+// so it is unchanged by a translation or rotation of everything: the exact forces below sum
+// to zero in force and in moment (linear and angular momentum are conserved to round-off) and
+// do no work over a closed path (energy is conserved). With P = k delta tau (the push) and
+// Q = k delta^2 tau'(S) / 2:
+//   on p:      P G - Q sum_k e_k,
+//   on s_k:   -P G_k + Q e_k,      G_k = [w_k u_k + (d_k - g) e_k] / S   (sum_k G_k = G),
+//   on n_k:    P (w_k / S) (v - (n_k . v) n_k) / |kappa v + n_k|   (its tangential part;
+//              contact/surface_centres.hpp turns it into forces on the nodes that carry n_k).
+#pragma once
+
+#include <array>
+#include <cmath>
+
+#include "granulate/types.hpp"
+
+namespace granulate::contact {
+
+using vec3 = std::array<real, 3>;
+
+/// One point of a body's contact surface in the current configuration.
+struct SurfacePoint {
+  vec3 position{0, 0, 0};  ///< s [m]
+  vec3 normal{0, 0, 0};    ///< unit outward normal
+  real curvature = 0;      ///< mean curvature kappa [1/m]: 1/R on a convex sphere, 0 on a plane
+};
+
+/// The support radius of a body's surface points, over its mesh size: large enough that a
+/// probe anywhere on the surface of a rotated lattice or of a mesh has several points in reach,
+/// small enough that the next layer of nodes in does not reach the surface.
+inline constexpr real surface_support_factor = 1.5;
+
+/// S_0 of the taper: the weight of one point at 0.54 of the support radius.
+inline constexpr real surface_coverage = 0.2;
+
+/// tau(S) = c^2 (3 - 2 c), c = S / S_0, and 1 for c >= 1 (see above).
+inline real surface_taper(real weight) {
+  if (!(weight < surface_coverage)) return 1;
+  const real c = weight / surface_coverage;
+  return c * c * (3 - 2 * c);
+}
+
+/// d tau / dS.
+inline real surface_taper_slope(real weight) {
+  if (!(weight < surface_coverage)) return 0;
+  const real c = weight / surface_coverage;
+  return 6 * c * (1 - c) / surface_coverage;
+}
+
+/// The points of a probe's sums are those whose normals lie within 143 degrees of the normal
+/// of the point nearest to the probe: the faces at a corner (down to a 37 degree wedge) count
+/// together, the far side of a wall or protrusion thinner than the support does not (its
+/// normals point the other way, and would pull a deep probe through).
+inline constexpr real surface_facing = -0.8;
+
+/// Whether point k faces along `facing` (see surface_facing).
+inline bool faces(const SurfacePoint& point, const vec3& facing) {
+  return point.normal[0] * facing[0] + point.normal[1] * facing[1] + point.normal[2] * facing[2] >
+         surface_facing;
+}
+
+/// Wendland's C2 kernel W(q) = (1 - q)^4 (1 + 4 q), q = distance / support, zero for q >= 1.
+inline real surface_weight(real q) {
+  if (!(q < 1)) return 0;
+  const real u = 1 - q;
+  return u * u * u * u * (1 + 4 * q);
+}
+
+/// dW/dq = -20 q (1 - q)^3.
+inline real surface_weight_slope(real q) {
+  if (!(q < 1)) return 0;
+  const real u = 1 - q;
+  return -20 * q * u * u * u;
+}
+
+/// The terms of one surface point for a probe at p: its weight w, distance d, gradient u of d,
+/// gradient e of w, and the tangential sensitivity t = (v - (n . v) n) / |kappa v + n| of d to
+/// its normal.
+struct PointTerms {
+  real weight = 0, distance = 0;
+  vec3 gradient{0, 0, 0}, weight_gradient{0, 0, 0}, normal_sensitivity{0, 0, 0};
+};
+
+/// The terms of point k for a probe at p with support radius a (weight 0 out of reach).
+inline PointTerms point_terms(const SurfacePoint& point, const vec3& p, real support) {
+  PointTerms t;
+  const vec3 v{p[0] - point.position[0], p[1] - point.position[1], p[2] - point.position[2]};
+  const real length2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+  const real length = std::sqrt(length2);
+  const real q = length / support;
+  t.weight = surface_weight(q);
+  if (t.weight == 0) return t;
+  const real kappa = point.curvature;
+  const vec3& n = point.normal;
+  const vec3 a{kappa * v[0] + n[0], kappa * v[1] + n[1], kappa * v[2] + n[2]};
+  const real size = std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+  const real along = n[0] * v[0] + n[1] * v[1] + n[2] * v[2];
+  t.distance = (2 * along + kappa * length2) / (size + 1);
+  const real slope = length > 0 ? surface_weight_slope(q) / (support * length) : 0.0;
+  for (int c = 0; c < 3; ++c) {
+    t.gradient[c] = a[c] / size;
+    t.weight_gradient[c] = slope * v[c];
+    t.normal_sensitivity[c] = (v[c] - along * n[c]) / size;
+  }
+  return t;
+}
+
+/// The sums over a body's points in reach of one probe, and from them the gap g and its
+/// gradient G (see above).
+struct SurfaceGap {
+  real weight = 0;       ///< S = sum w_k
+  real weighted = 0;     ///< sum w_k d_k
+  vec3 pull{0, 0, 0};    ///< sum w_k u_k + d_k e_k
+  vec3 spread{0, 0, 0};  ///< sum e_k
+
+  void add(const PointTerms& t) {
+    weight += t.weight;
+    weighted += t.weight * t.distance;
+    for (int c = 0; c < 3; ++c) {
+      pull[c] += t.weight * t.gradient[c] + t.distance * t.weight_gradient[c];
+      spread[c] += t.weight_gradient[c];
+    }
+  }
+  bool reached() const { return weight > 0; }
+  real gap() const { return weighted / weight; }
+  /// G = (sum w u + sum d e - g sum e) / S.
+  vec3 gradient() const {
+    const real g = gap();
+    return {(pull[0] - g * spread[0]) / weight, (pull[1] - g * spread[1]) / weight,
+            (pull[2] - g * spread[2]) / weight};
+  }
+};
+
+/// G_k, point k's share of the gradient, given the probe's gap g and weight sum S.
+inline vec3 point_share(const PointTerms& t, real gap, real weight) {
+  return {(t.weight * t.gradient[0] + (t.distance - gap) * t.weight_gradient[0]) / weight,
+          (t.weight * t.gradient[1] + (t.distance - gap) * t.weight_gradient[1]) / weight,
+          (t.weight * t.gradient[2] + (t.distance - gap) * t.weight_gradient[2]) / weight};
+}
+
+}  // namespace granulate::contact

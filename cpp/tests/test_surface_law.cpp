@@ -1,0 +1,222 @@
+// The surface law (contact/surface_law.hpp): the gap of a point from a surface of points with
+// normals and curvatures, its gradient, and the forces of its energy.
+#include <array>
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "check.hpp"
+#include "granulate/contact/surface_law.hpp"
+#include "granulate/surface_anchors.hpp"
+
+using namespace granulate;
+using contact::SurfacePoint;
+using contact::vec3;
+
+namespace {
+
+/// Points scattered on a sphere of radius R about the origin, with radial normals and 1/R.
+std::vector<SurfacePoint> sphere_points(real radius, std::size_t count, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<real> normal(0, 1);
+  std::vector<SurfacePoint> points;
+  for (std::size_t k = 0; k < count; ++k) {
+    vec3 u{normal(rng), normal(rng), normal(rng)};
+    const real size = std::sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+    SurfacePoint p;
+    for (int c = 0; c < 3; ++c) {
+      p.normal[c] = u[c] / size;
+      p.position[c] = radius * p.normal[c];
+    }
+    p.curvature = 1 / radius;
+    points.push_back(p);
+  }
+  return points;
+}
+
+contact::SurfaceGap gap_at(const std::vector<SurfacePoint>& points, const vec3& p, real support) {
+  contact::SurfaceGap sums;
+  for (const SurfacePoint& point : points) sums.add(contact::point_terms(point, p, support));
+  return sums;
+}
+
+/// E = k delta^2 tau(S) / 2 of a probe of radius r at p.
+real energy(const std::vector<SurfacePoint>& points, const vec3& p, real support, real radius, real k) {
+  const contact::SurfaceGap sums = gap_at(points, p, support);
+  if (!sums.reached()) return 0;
+  const real overlap = radius - sums.gap();
+  return overlap > 0 ? 0.5 * k * overlap * overlap * contact::surface_taper(sums.weight) : 0.0;
+}
+
+}  // namespace
+
+TEST_CASE("the surface gap is the distance to a sphere whose points lie scattered on it") {
+  const real radius = 1.0, support = 0.4;
+  const auto points = sphere_points(radius, 4000, 7);
+  std::mt19937 rng(3);
+  std::normal_distribution<real> normal(0, 1);
+  for (int trial = 0; trial < 50; ++trial) {
+    vec3 u{normal(rng), normal(rng), normal(rng)};
+    const real size = std::sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+    for (const real lift : {-0.1, 0.0, 0.15}) {
+      const vec3 p{(radius + lift) * u[0] / size, (radius + lift) * u[1] / size,
+                   (radius + lift) * u[2] / size};
+      const contact::SurfaceGap sums = gap_at(points, p, support);
+      CHECK(sums.reached());
+      CHECK_NEAR(sums.gap(), lift, 1e-12, 1e-12);
+      const vec3 g = sums.gradient();
+      for (int c = 0; c < 3; ++c) CHECK_NEAR(g[c], u[c] / size, 1e-12, 1e-12);
+    }
+  }
+}
+
+TEST_CASE("the surface gap of a plane of points is the height above it, with no tilt") {
+  std::vector<SurfacePoint> points;
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<real> spread(-1, 1);
+  for (int k = 0; k < 300; ++k) {
+    SurfacePoint p;
+    p.position = {spread(rng), spread(rng), 0};
+    p.normal = {0, 0, 1};
+    points.push_back(p);
+  }
+  const contact::SurfaceGap sums = gap_at(points, {0.1, -0.2, 0.05}, 0.3);
+  CHECK_NEAR(sums.gap(), 0.05, 1e-14, 1e-15);
+  const vec3 g = sums.gradient();
+  CHECK(std::abs(g[0]) < 1e-14 && std::abs(g[1]) < 1e-14);
+  CHECK_CLOSE(g[2], 1.0, 1e-14);
+}
+
+/// The forces of a probe at p against central differences of E; their sums and moments.
+void check_forces(const std::vector<SurfacePoint>& points, const vec3& p, real support, real radius, real k);
+
+TEST_CASE("the surface law's forces are minus the gradient of its energy, and balance") {
+  // A probe pressed into an irregular, wavy surface: the force on p, on each s_k and on each
+  // n_k against central differences of E; the forces sum to zero, and so do their moments.
+  // Also at the edge of the points, where the taper brings E to zero.
+  std::vector<SurfacePoint> points;
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<real> spread(-0.5, 0.5), tilt(-0.2, 0.2), bend(-1, 1);
+  for (int k = 0; k < 40; ++k) {
+    SurfacePoint p;
+    p.position = {spread(rng), spread(rng), 0.05 * spread(rng)};
+    vec3 n{tilt(rng), tilt(rng), 1};
+    const real size = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    for (real& c : n) c /= size;
+    p.normal = n;
+    p.curvature = bend(rng);
+    points.push_back(p);
+  }
+  check_forces(points, {0.02, -0.03, 0.0}, 0.45, 0.1, 1e3);
+  // Past the edge: only a few points in reach, their weights below the taper's S_0.
+  const vec3 edge{0.82, 0.0, 0.0};
+  const contact::SurfaceGap sums = gap_at(points, edge, 0.45);
+  CHECK(sums.reached() && sums.weight < contact::surface_coverage);
+  check_forces(points, edge, 0.45, 0.1, 1e3);
+}
+
+void check_forces(const std::vector<SurfacePoint>& points, const vec3& p, real support, real radius, real k) {
+  const real step = 1e-7;
+  const contact::SurfaceGap sums = gap_at(points, p, support);
+  const real overlap = radius - sums.gap();
+  const real push = k * overlap * contact::surface_taper(sums.weight);
+  const real taper = 0.5 * k * overlap * overlap * contact::surface_taper_slope(sums.weight);
+  CHECK(push > 0);
+  const vec3 on_probe = [&] {
+    const vec3 g = sums.gradient();
+    return vec3{push * g[0] - taper * sums.spread[0], push * g[1] - taper * sums.spread[1],
+                push * g[2] - taper * sums.spread[2]};
+  }();
+  vec3 total = on_probe, moment{0, 0, 0};
+  auto add_moment = [&](const vec3& at, const vec3& f) {
+    moment[0] += at[1] * f[2] - at[2] * f[1];
+    moment[1] += at[2] * f[0] - at[0] * f[2];
+    moment[2] += at[0] * f[1] - at[1] * f[0];
+  };
+  add_moment(p, on_probe);
+  for (int c = 0; c < 3; ++c) {
+    vec3 plus = p, minus = p;
+    plus[c] += step;
+    minus[c] -= step;
+    const real slope =
+        (energy(points, plus, support, radius, k) - energy(points, minus, support, radius, k)) / (2 * step);
+    CHECK_NEAR(on_probe[c], -slope, 1e-5, 1e-6 * push);
+  }
+  for (std::size_t j = 0; j < points.size(); ++j) {
+    const contact::PointTerms t = contact::point_terms(points[j], p, support);
+    const vec3 share = contact::point_share(t, sums.gap(), sums.weight);
+    const vec3 on_point{-push * share[0] + taper * t.weight_gradient[0],
+                        -push * share[1] + taper * t.weight_gradient[1],
+                        -push * share[2] + taper * t.weight_gradient[2]};
+    // The force on n_j: push (w/S) t, a tangential vector; moments of a normal: n x F_n.
+    const real fraction = t.weight / sums.weight;
+    const vec3 on_normal{push * fraction * t.normal_sensitivity[0], push * fraction * t.normal_sensitivity[1],
+                         push * fraction * t.normal_sensitivity[2]};
+    for (int c = 0; c < 3; ++c) total[c] += on_point[c];
+    add_moment(points[j].position, on_point);
+    add_moment(points[j].normal, on_normal);
+    for (int c = 0; c < 3; ++c) {
+      auto moved = [&](real by) {
+        std::vector<SurfacePoint> shifted = points;
+        shifted[j].position[c] += by;
+        return energy(shifted, p, support, radius, k);
+      };
+      CHECK_NEAR(on_point[c], -(moved(step) - moved(-step)) / (2 * step), 1e-5, 1e-6 * push);
+      // Turning n_j by a small rotation keeps it a unit vector: the work of on_normal.
+      auto turned = [&](real by) {
+        std::vector<SurfacePoint> shifted = points;
+        vec3& n = shifted[j].normal;
+        vec3 axis{0, 0, 0};
+        axis[c] = 1;
+        const vec3 dn{axis[1] * n[2] - axis[2] * n[1], axis[2] * n[0] - axis[0] * n[2],
+                      axis[0] * n[1] - axis[1] * n[0]};
+        for (int d = 0; d < 3; ++d) n[d] += by * dn[d];
+        const real size = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        for (real& x : n) x /= size;
+        return energy(shifted, p, support, radius, k);
+      };
+      const vec3& n = points[j].normal;
+      vec3 axis{0, 0, 0};
+      axis[c] = 1;
+      const vec3 dn{axis[1] * n[2] - axis[2] * n[1], axis[2] * n[0] - axis[0] * n[2],
+                    axis[0] * n[1] - axis[1] * n[0]};
+      const real work = on_normal[0] * dn[0] + on_normal[1] * dn[1] + on_normal[2] * dn[2];
+      CHECK_NEAR(work, -(turned(step) - turned(-step)) / (2 * step), 1e-5, 1e-6 * push);
+    }
+  }
+  for (int c = 0; c < 3; ++c) {
+    CHECK(std::abs(total[c]) < 1e-12 * push);
+    CHECK(std::abs(moment[c]) < 1e-12 * push);
+  }
+}
+
+TEST_CASE("surface curvature: 1/R on a sphere, 0 on a plane, faces not averaged across an edge") {
+  std::vector<real> points, normals;
+  const real radius = 2.0;
+  std::mt19937 rng(2);
+  std::normal_distribution<real> normal(0, 1);
+  for (int k = 0; k < 400; ++k) {
+    vec3 u{normal(rng), normal(rng), normal(rng)};
+    const real size = std::sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+    for (int c = 0; c < 3; ++c) {
+      normals.push_back(u[c] / size);
+      points.push_back(radius * u[c] / size);
+    }
+  }
+  std::vector<index_t> all(400);
+  for (index_t k = 0; k < 400; ++k) all[k] = k;
+  for (const index_t a : {0u, 17u, 399u})
+    CHECK_CLOSE(surface_curvature(points, normals, a, all, 1.0), 0.5, 1e-12);
+  // Two faces of a box meeting at x = 0: points on z = 0 (x < 0) and on x = 0 (z < 0).
+  std::vector<real> box, box_normals;
+  for (int k = 0; k < 5; ++k) {
+    box.insert(box.end(), {-0.1 * k, 0.1 * (k % 2), 0});
+    box_normals.insert(box_normals.end(), {0, 0, 1});
+    box.insert(box.end(), {0, 0.1 * (k % 3), -0.1 * k - 0.05});
+    box_normals.insert(box_normals.end(), {1, 0, 0});
+  }
+  std::vector<index_t> near(10);
+  for (index_t k = 0; k < 10; ++k) near[k] = k;
+  CHECK(surface_curvature(box, box_normals, 0, near, 1.0) == 0.0);
+  CHECK(surface_curvature(box, box_normals, 1, near, 1.0) == 0.0);
+}
