@@ -872,6 +872,9 @@ class Simulation:
         material_ids: dict[int, int] = {}
         core_materials: list[Material] = []
         shape_ids: dict[int, int] = {}
+        # Lattices' and conforming discretisations' outer layers carry surface points only for
+        # the surface law (the node-sphere law sees those nodes at themselves: no anchors).
+        outer_layers = self._uses_surface_law()
         for body, positions, volumes, surface in zip(
             self.bodies, self._positions, self._volumes, self._surfaces, strict=True
         ):
@@ -882,7 +885,7 @@ class Simulation:
                 core_materials.append(body.material)
             if body.reference is None:
                 shape = model.add_shape(
-                    positions, volumes, body.mesh_size, *_surface_arrays(surface)
+                    positions, volumes, body.mesh_size, *_surface_arrays(surface, outer_layers)
                 )
                 model.place_shape(shape, material_ids[key], positions, 1.0, horizon)
                 continue
@@ -892,7 +895,7 @@ class Simulation:
                     reference.positions,
                     reference.volumes,
                     reference.mesh_size,
-                    *_surface_arrays(reference),
+                    *_surface_arrays(reference, outer_layers),
                 )
             model.place_shape(
                 shape_ids[id(reference)], material_ids[key], positions, body.scale, horizon
@@ -980,6 +983,12 @@ class Simulation:
         law.node_pair = contact.pair_law == "peridem"
         law.surface = contact.pair_law == "surface"
         return law
+
+    def _uses_surface_law(self) -> bool:
+        """Whether any contact law (the default, or one set per pair of materials) is the
+        surface law."""
+        laws = [self._contact, *self._pair_contacts.values()]
+        return any(law is not None and law.pair_law == "surface" for law in laws)
 
     def _set_contact_laws(self, core: _core.Simulation, materials: list[Material]) -> None:
         """Laws for every pair of materials and every (wall, material)."""
@@ -1863,13 +1872,18 @@ class Simulation:
 
 
 def _surface_arrays(
-    reference: ReferenceShape | None,
+    reference: ReferenceShape | None, outer_layers: bool
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """A shape's surface offsets (flat, 3 per node) and depths for the core; empty arrays where
-    it has none (all depths 0: empty too)."""
+    it has none (all depths 0: empty too). Without ``outer_layers`` the nodes below the surface
+    (depth > 0) are left out: only the surface law uses them."""
     if reference is None or reference.surface is None:
         return np.zeros(0), np.zeros(0)
-    offsets = np.ascontiguousarray(reference.surface, dtype=np.float64).reshape(-1)
+    offsets = np.array(reference.surface, dtype=np.float64)
     if reference.surface_depth is None:
-        return offsets, np.zeros(0)
-    return offsets, np.ascontiguousarray(reference.surface_depth, dtype=np.float64)
+        return offsets.reshape(-1), np.zeros(0)
+    depths = np.array(reference.surface_depth, dtype=np.float64)
+    if not outer_layers:
+        offsets[depths > 0] = 0.0
+        depths[:] = 0.0
+    return offsets.reshape(-1), depths
