@@ -768,9 +768,9 @@ void ContactModel::find_groups(const Model& model) {
   // is not PeriDEM's node-pair law; one group per such body, in the order of first appearance.
   const index_t n = model.node_count();
   groups_.clear();
-  entry_group_.assign(pair_partner_.size(), no_group);
   if (!any_surface_) {
-    // No particle uses the surface law: none of its per-node tables.
+    // No particle uses the surface law: none of its per-node or per-entry tables.
+    std::vector<index_t>().swap(entry_group_);
     std::vector<index_t>().swap(group_offsets_);
     std::vector<index_t>().swap(surface_slot_);
     std::vector<index_t>().swap(entry_target_);
@@ -778,6 +778,7 @@ void ContactModel::find_groups(const Model& model) {
     probes_.clear();
     return;
   }
+  entry_group_.assign(pair_partner_.size(), no_group);
   group_offsets_.assign(static_cast<std::size_t>(n) + 1, 0);
   for (index_t i = 0; i < n; ++i) {
     const std::size_t first = groups_.size();
@@ -1409,7 +1410,7 @@ void ContactModel::sum_slot_stiffness() {
   std::fill(slot_stiffness_.begin(), slot_stiffness_.end(), 0.0);
   std::uint64_t touching = 0, wall_touching = 0;
   for (std::size_t e = 0; e < pair_stiffness_.size(); ++e) {
-    const bool probe = entry_group_[e] != no_group;
+    const bool probe = probe_entry(e);
     slot_stiffness_[pair_slot_[e]] += (probe ? 1.0 : 0.5) * pair_stiffness_[e];
     touching += pair_stiffness_[e] > 0 && !probe ? 1 : 0;
   }
@@ -1475,7 +1476,7 @@ void ContactModel::sum_slot_springs(const Model& model, const State& state) {
     for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
       const index_t j = pair_partner_[e];
       const std::size_t slot = pair_slot_[e];
-      if (pair_stiffness_[e] == 0 || entry_group_[e] != no_group || node_body_[i] == node_body_[j] ||
+      if (pair_stiffness_[e] == 0 || probe_entry(e) || node_body_[i] == node_body_[j] ||
           node_body_[i] != slots_[slot][0])
         continue;
       const index_t touch = slot_touch_[slot];
@@ -1826,7 +1827,7 @@ void ContactModel::node_forces(const Model& model, State& state, real dt) {
     const index_t i = contact_nodes_[k];
     vec at_centre{0, 0, 0}, at_surface{0, 0, 0}, on_vector{0, 0, 0};
     for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
-      if (pair_stiffness_[e] == 0 || entry_group_[e] != no_group) continue;
+      if (pair_stiffness_[e] == 0 || probe_entry(e)) continue;
       const vec force = pair_force(model, state, i, e, dt);
       for (int c = 0; c < 3; ++c) at_centre[c] += force[c];
     }
@@ -2059,7 +2060,7 @@ vec3 ContactModel::friction_couple(const Model& model, const State& state, index
   vec couple{0, 0, 0};
   const auto& node_material = model.node_material();
   for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
-    if (pair_spring_[e] == no_spring || entry_group_[e] != no_group) continue;
+    if (pair_spring_[e] == no_spring || probe_entry(e)) continue;
     const contact::Law& law = laws_[node_material[i] * material_count_ + node_material[pair_partner_[e]]];
     if (law.peridem_friction || law.friction == 0) continue;
     const PairGeometry g = pair_geometry(model, state, i, e);

@@ -230,7 +230,9 @@ class ContactModel {
     vec3 foot{0, 0, 0};       ///< sum_k (w_k / S) y_k: where the target's nodes take the friction force
     vec3 facing{0, 0, 0};     ///< the normal of the nearest point: the points counted face along it
   };
-  std::vector<index_t> entry_group_;   // per pair entry: the group it belongs to as a probe entry
+  std::vector<index_t> entry_group_;  // per pair entry: the group it belongs to as a probe entry
+  /// Whether list entry e belongs to a surface probe (none without the surface law).
+  bool probe_entry(std::size_t e) const { return !entry_group_.empty() && entry_group_[e] != no_group; }
   std::vector<index_t> entry_target_;  // per pair entry: the group that probes the node's body
   std::vector<ProbeGroup> groups_;
   std::vector<index_t> group_offsets_;  // per node: its groups (CSR)
