@@ -14,7 +14,8 @@ import pytest
 
 import granulate as gr
 
-SOFT = gr.Material(density=1200, bulk_modulus=2.16e7, shear_modulus=1.296e7, fracture=False)
+from .test_contact import SOFT, oblique_pair
+
 PERIDEM_MESHES = Path(__file__).resolve().parents[1] / "data" / "peridem" / "compression_small_set"
 
 
@@ -30,6 +31,17 @@ def random_rotation(dimension: int, rng: np.random.Generator):
             [2 * (b * d - a * c), 2 * (c * d + a * b), a * a - b * b - c * c + d * d],
         ]
     )
+
+
+def run_through_contact(sim: gr.Simulation, steps: int) -> None:
+    """Run in chunks of `steps` until the bodies have touched and parted."""
+    touched = False
+    while True:
+        sim.run(steps)
+        in_contact = sim.core.contact_statistics.node_contacts > 0
+        touched = touched or in_contact
+        if touched and not in_contact:
+            return
 
 
 def velocity_of(sim: gr.Simulation, body: gr.Body) -> np.ndarray:
@@ -73,13 +85,7 @@ def head_on(
         )
     a, b = bodies
     before, start_b = velocity_of(sim, a) - velocity_of(sim, b), velocity_of(sim, b)
-    touched = False
-    while True:
-        sim.run(10)
-        in_contact = sim.core.contact_statistics.node_contacts > 0
-        touched = touched or in_contact
-        if touched and not in_contact:
-            break
+    run_through_contact(sim, 10)
     sim.run(100)
     after = velocity_of(sim, a) - velocity_of(sim, b)
     normal = velocity_of(sim, b) - start_b
@@ -158,13 +164,7 @@ def test_elastic_collisions_of_meshed_grains_with_corners_keep_their_energy(mesh
             velocity=(-0.5, 0),
         )
         energy = sim.kinetic_energy()
-        touched = False
-        while True:
-            sim.run(20)
-            in_contact = sim.core.contact_statistics.node_contacts > 0
-            touched = touched or in_contact
-            if touched and not in_contact:
-                break
+        run_through_contact(sim, 20)
         total = (sim.kinetic_energy() + sim.strain_energy()) / energy
         assert abs(total - 1) < 1e-3, (seed, total)
 
@@ -192,34 +192,18 @@ def test_oblique_collisions_keep_their_angular_momentum(dimension: int, friction
     friction too (the friction force acts on the nodes, and couples put it at the contact
     point on both bodies). With friction they leave spinning (measured 102 rad/s in 2D);
     without, their smooth surfaces leave them nearly still (0.5 rad/s; 0.6 m/s over R is 600)."""
-    sim = gr.Simulation(dimension)
-    sim.contact = gr.Contact(restitution=0.6, friction=friction, pair_law="surface")
-    radius, h = 1e-3, 1e-3 / (10 if dimension == 2 else 6)
-    shape = gr.Disc if dimension == 2 else gr.Sphere
-    zero = (0.0,) * (dimension - 2)
-    a = sim.add_body(shape((0, 0, *zero), radius), SOFT, h, discretization="conforming")
-    b = sim.add_body(
-        shape((2 * radius + 1.5 * h, 0.5 * radius, *zero), radius),
-        SOFT,
-        h,
-        discretization="conforming",
-    )
-    sim.velocities[a.nodes, 0] = 0.3
-    sim.velocities[b.nodes, 0] = -0.3
+    sim, a, b = oblique_pair(dimension, friction, pair_law="surface")
     before = angular_momentum(sim)
     scale = np.sum(
         np.linalg.norm(np.cross(sim.positions, sim.velocities), axis=1) * sim.volumes * SOFT.density
     )
-    touched = False
-    while not touched or sim.core.contact_statistics.node_contacts > 0:
-        sim.run(20)
-        touched = touched or sim.core.contact_statistics.node_contacts > 0
+    run_through_contact(sim, 20)
     np.testing.assert_allclose(angular_momentum(sim), before, rtol=0, atol=1e-12 * scale)
     spins = [abs(spin_about_z(sim, body)) for body in (a, b)]
     if friction > 0:
         assert min(spins) > 50.0, spins
     else:
-        assert max(spins) < 0.005 * 0.6 / radius, spins
+        assert max(spins) < 0.005 * 0.6 / 1e-3, spins
 
 
 @pytest.mark.validation
