@@ -450,12 +450,10 @@ bool ContactModel::takes_part(const Model& model, const State& state, index_t i)
 }
 
 bool ContactModel::breaks_open_new_nodes(const Model& model) const {
-  const auto& owner = model.node_particle();
+  if (taking_part_.empty()) return false;  // every node takes part already
   for (const auto& [i, j] : newly_broken_) {
     for (const index_t k : {i, j}) {
-      if (taking_part_.empty() || taking_part_[k] || !surface_particle(model.node_particle()[k])) continue;
-      const index_t m = model.node_material()[k];
-      if (law_set_[m * material_count_ + m] || particle_side_[owner[k]].mesh_size > 0) return true;
+      if (!taking_part_[k] && surface_particle(model.node_particle()[k])) return true;
     }
   }
   return false;
@@ -764,8 +762,8 @@ void ContactModel::finish_lists(const Model& model) {
 }
 
 void ContactModel::find_groups(const Model& model) {
-  // A node's probe entries: partners that carry surface points of another body, under a law that
-  // is not PeriDEM's node-pair law; one group per such body, in the order of first appearance.
+  // A node's probe entries: partners that carry surface points of another body, under the
+  // surface law; one group per such body, in the order of first appearance.
   const index_t n = model.node_count();
   groups_.clear();
   if (!any_surface_) {
@@ -1845,6 +1843,7 @@ void ContactModel::node_forces(const Model& model, State& state, real dt) {
     for (index_t g = group_offsets_.empty() ? 0 : group_offsets_[i];
          !group_offsets_.empty() && g < group_offsets_[i + 1]; ++g) {
       const ProbeState& probe = probes_[g];
+      if (probe.push == 0) continue;  // apart (its other fields may be an earlier step's)
       for (int c = 0; c < 3; ++c) {
         at_surface[c] += probe.push * probe.gradient[c] - probe.taper * probe.sums.spread[c];
         at_node[c] += probe.friction[c];
