@@ -238,17 +238,21 @@ def test_surface_offsets_reach_every_face_at_a_node() -> None:
     np.testing.assert_array_equal(np.unique(box.surface), [-1.0, 0.0, 1.0])
     corner = np.flatnonzero(np.all(box.positions == 0, axis=1))[0]
     np.testing.assert_array_equal(box.surface[corner], [-1.0, -1.0, -1.0])
-    # A lattice's outer layer (nodes less than h deep) carries the shape's unit normal and its
-    # depth, so contact sees its surface points on the true circle.
+    # A lattice has no node on its surface; for the surface law its outer layer (nodes less
+    # than h deep) carries the shape's unit normal and its depth, so contact sees its surface
+    # points on the true circle (a centred shape's too).
     lattice = gr.ReferenceShape.from_shape(gr.Disc((0, 0), 1), 0.1)
-    layer = np.linalg.norm(lattice.surface, axis=1) > 0
-    r = np.linalg.norm(lattice.positions[:, :2], axis=1)
-    np.testing.assert_array_equal(layer, 1 - r < 0.1)
-    np.testing.assert_allclose(
-        lattice.surface[layer, :2], lattice.positions[layer, :2] / r[layer, None]
-    )
-    points = lattice.positions[layer] + lattice.surface_depth[layer, None] * lattice.surface[layer]
-    np.testing.assert_allclose(np.linalg.norm(points, axis=1), 1.0, rtol=1e-6)
+    centred = gr.ReferenceShape.from_shape(gr.Disc((2, 1), 1), 0.1, centered=True)
+    assert lattice.surface is None and centred.surface is None
+    for reference in (lattice, centred):
+        normals, depths = reference.outer_layer_of
+        layer = np.linalg.norm(normals, axis=1) > 0
+        x = reference.positions[:, :2]
+        r = np.linalg.norm(x, axis=1)
+        np.testing.assert_array_equal(layer, 1 - r < 0.1)
+        np.testing.assert_allclose(normals[layer, :2], x[layer] / r[layer, None])
+        points = x[layer] + depths[layer, None] * normals[layer, :2]
+        np.testing.assert_allclose(np.linalg.norm(points, axis=1), 1.0, rtol=1e-6)
 
 
 def test_surface_offsets_of_the_wrong_size_are_refused() -> None:

@@ -962,15 +962,27 @@ class ReferenceShape:
     volumes: NDArray[np.float64]  # (n,) [m^d]
     mesh_size: float  # [m]
     dimension: int
-    #: (n, 3) the offsets o of the nodes that carry the surface for contact: a mesh's or grid's
-    #: boundary vertices (n . o = 1 for each face normal n at the node), a lattice's or
-    #: conforming discretisation's outer layer (the unit outward normal; see outer_layer);
-    #: zero inside. None where the nodes do not tell (a mesh without elements).
+    #: (n, 3) the offsets o of the nodes on the surface (a mesh's or grid's boundary vertices;
+    #: n . o = 1 for each face normal n at the node, zero inside), or None where no node lies on
+    #: it (a lattice's or conforming discretisation's outer nodes lie below it: see
+    #: outer_layer_of; a mesh without elements does not tell). Contact centres the spheres of
+    #: these nodes at x - rho o (rho: their contact radius), so that they reach the surface.
     surface: NDArray[np.float64] | None = None
-    #: (n,) how deep below the surface each of those nodes lies [m] (0 on a mesh's boundary),
-    #: or None for all 0. Contact sees the surface at x + depth o / |o| (see
-    #: granulate's ARCHITECTURE.md, "Contact in one paragraph").
-    surface_depth: NDArray[np.float64] | None = None
+    #: The shape a lattice or conforming discretisation was made from (and the shift of its
+    #: origin), for the surface law's outer layer (outer_layer_of).
+    source: Shape | None = None
+    source_shift: tuple[float, float, float] = (0.0, 0.0, 0.0)
+
+    @functools.cached_property
+    def outer_layer_of(self) -> tuple[NDArray[np.float64], NDArray[np.float64]] | None:
+        """The surface law's view of a lattice's or conforming discretisation's outer layer
+        (see outer_layer): the unit normals (n, 3) and depths (n,) [m] of its nodes less than h
+        deep; None for a mesh or grid (their boundary vertices carry ``surface``). Computed on
+        first use: the node-sphere law does not need it."""
+        if self.source is None:
+            return None
+        shifted = self.positions + np.asarray(self.source_shift)
+        return outer_layer(self.source, shifted, self.mesh_size)
 
     @staticmethod
     def from_shape(
@@ -987,10 +999,10 @@ class ReferenceShape:
         or "grid" (grid vertices with finite-element volumes: Rectangle, Box).
         ``centered``: move the shape's ``origin`` (centre or centroid) to (0, 0, 0), so that
         rotations and scales act about it."""
-        depth = None
+        surface, source = None, None
         if discretization == "lattice":
             positions, volumes = lattice(shape, mesh_size, jitter=jitter, seed=seed)
-            surface, depth = outer_layer(shape, positions, mesh_size)
+            source = shape
         elif discretization in ("conforming", "grid"):
             if jitter:
                 raise InputError("jitter applies to the lattice discretization only")
@@ -999,15 +1011,19 @@ class ReferenceShape:
             if discretization == "grid":
                 surface = grid_surface(shape, positions)
             else:
-                surface, depth = outer_layer(shape, positions, mesh_size)
+                source = shape
         else:
             raise InputError(
                 f"unknown discretization {discretization!r}; choose 'lattice', 'conforming' or "
                 "'grid'"
             )
+        shift = (0.0, 0.0, 0.0)
         if centered:
             positions = positions - shape.origin
-        return ReferenceShape(positions, volumes, float(mesh_size), shape.dimension, surface, depth)
+            shift = tuple(float(c) for c in shape.origin)
+        return ReferenceShape(
+            positions, volumes, float(mesh_size), shape.dimension, surface, source, shift
+        )
 
     @staticmethod
     def from_mesh(

@@ -1875,15 +1875,13 @@ def _surface_arrays(
     reference: ReferenceShape | None, outer_layers: bool
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """A shape's surface offsets (flat, 3 per node) and depths for the core; empty arrays where
-    it has none (all depths 0: empty too). Without ``outer_layers`` the nodes below the surface
-    (depth > 0) are left out: only the surface law uses them."""
-    if reference is None or reference.surface is None:
+    it has none (all depths 0: empty too). With ``outer_layers`` (the surface law) a lattice's
+    or conforming discretisation's outer layer, which only that law uses."""
+    if reference is None:
         return np.zeros(0), np.zeros(0)
-    offsets = np.array(reference.surface, dtype=np.float64)
-    if reference.surface_depth is None:
-        return offsets.reshape(-1), np.zeros(0)
-    depths = np.array(reference.surface_depth, dtype=np.float64)
-    if not outer_layers:
-        offsets[depths > 0] = 0.0
-        depths[:] = 0.0
-    return offsets.reshape(-1), depths
+    layer = reference.outer_layer_of if outer_layers else None
+    if layer is not None:
+        return np.ascontiguousarray(layer[0]).reshape(-1), np.ascontiguousarray(layer[1])
+    if reference.surface is None:
+        return np.zeros(0), np.zeros(0)
+    return np.ascontiguousarray(reference.surface, dtype=np.float64).reshape(-1), np.zeros(0)
