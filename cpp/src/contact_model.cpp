@@ -449,6 +449,12 @@ bool ContactModel::takes_part(const Model& model, const State& state, index_t i)
   return false;
 }
 
+bool ContactModel::surface_entry(const Model& model, index_t i, std::size_t e) const {
+  const index_t j = pair_partner_[e];
+  return slot_law(pair_slot_[e]).surface && node_body_[i] != node_body_[j] &&
+         (on_surface(model, i) || on_surface(model, j));
+}
+
 bool ContactModel::breaks_open_new_nodes(const Model& model) const {
   if (taking_part_.empty()) return false;  // every node takes part already
   for (const auto& [i, j] : newly_broken_) {
@@ -1226,21 +1232,19 @@ void ContactModel::measure_surface_points(const Model& model, const State& state
   // The surface points of the nodes with list entries, once per step, for every probe that
   // reaches them (surface_slot_ numbers them in node order).
   const std::int64_t count = static_cast<std::int64_t>(surface_nodes_.size());
-  surface_points_.resize(surface_nodes_.size());
 #pragma omp parallel for schedule(static)
   for (std::int64_t k = 0; k < count; ++k) {
     const index_t j = surface_nodes_[k];
+    const SurfaceCentres::Seen seen = centres_.seen(model, j);
     contact::SurfacePoint& point = surface_points_[k];
-    const vec3 a = centres_.anchored_vector(model, state.positions, j);
+    const vec3 a = SurfaceCentres::anchored_vector(seen, state.positions, j);
     const real size = std::sqrt(dot(a, a));
-    const real length = centres_.surface_length(model, j);
     const real* y = state.positions.data();
     for (int c = 0; c < 3; ++c) {
       point.normal[c] = a[c] / size;
-      point.position[c] = y[3 * j + c] + length * point.normal[c];
+      point.position[c] = y[3 * j + c] + seen.surface_length * point.normal[c];
     }
-    point.curvature =
-        centres_.anchor(model, j)->curvature / particle_side_[model.node_particle()[j]].mesh_size;
+    point.curvature = seen.anchor->curvature / seen.mesh_size;
     surface_sizes_[k] = size;
   }
 }
@@ -1269,12 +1273,11 @@ void ContactModel::measure_contacts(const Model& model, const State& state) {
         if (!have_xi) xi = contact_position(model, state, i), have_xi = true;
         return xi;
       };
-      const bool surface_i = any_surface_ && on_surface(model, i);
       bool touching = false;
       for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
         const index_t j = pair_partner_[e];
         const contact::PairLaw& law = slot_law(pair_slot_[e]);
-        if (law.surface && node_body_[i] != node_body_[j] && (surface_i || on_surface(model, j))) {
+        if (surface_entry(model, i, e)) {
           pair_stiffness_[e] = 0;  // the surface law (measure_probes) decides
           continue;
         }
@@ -1320,30 +1323,26 @@ real ContactModel::measure_probes(const Model& model, const State& state, index_
   // each probe entry's share of the probe's stiffness (its in-contact flag). Returns the
   // deepest overlap over Rc. A group with no point in reach is apart (push 0) and costs one
   // distance per entry.
-  if (group_offsets_.empty() || group_offsets_[i] == group_offsets_[i + 1]) return 0;
+  const auto [group_begin, group_end] = groups_of(i);
+  if (group_begin == group_end) return 0;
   const bool surface = on_surface(model, i);
   const vec3 p = centres_.at_surface(model, state, i);
   const index_t first = pair_offsets_[i], last = pair_offsets_[i + 1];
-  const index_t groups = group_offsets_[i + 1] - group_offsets_[i];
   scratch.points.assign(last - first, nullptr);  // the points in reach (null: none)
   scratch.weights.assign(last - first, 0.0);
-  scratch.nearest.assign(groups, -1);  // the distance of each group's nearest point in reach
-  const real* y = state.positions.data();
+  // The distance of each group's nearest point in reach (-1: none yet).
+  scratch.nearest.assign(group_end - group_begin, -1);
   for (index_t e = first; e < last; ++e) {  // the points in reach, and each group's nearest
     const index_t g = entry_group_[e];
     if (g == no_group) continue;
     const index_t j = pair_partner_[e];
     const real support = contact::surface_support_factor * particle_side_[model.node_particle()[j]].mesh_size;
-    // The surface point lies at most its depth d_j from the node.
-    const vec to_node{p[0] - y[3 * j], p[1] - y[3 * j + 1], p[2] - y[3 * j + 2]};
-    const real reach = support + centres_.surface_length(model, j);
-    if (dot(to_node, to_node) >= reach * reach) continue;
     const contact::SurfacePoint& point = surface_point(j);
     const vec d{p[0] - point.position[0], p[1] - point.position[1], p[2] - point.position[2]};
     const real distance = std::sqrt(dot(d, d));
     if (!(distance < support)) continue;
     scratch.points[e - first] = &point;
-    real& best = scratch.nearest[g - group_offsets_[i]];
+    real& best = scratch.nearest[g - group_begin];
     if (best < 0) {  // the group's first point in reach: set the probe up
       ProbeState& probe = probes_[g];
       probe = ProbeState{};
@@ -1370,10 +1369,10 @@ real ContactModel::measure_probes(const Model& model, const State& state, index_
     probe.sums.add(t);
   }
   real deepest = 0;
-  for (index_t g = group_offsets_[i]; g < group_offsets_[i + 1]; ++g) {
+  for (index_t g = group_begin; g < group_end; ++g) {
     ProbeState& probe = probes_[g];
     probe.push = probe.taper = 0;
-    if (scratch.nearest[g - group_offsets_[i]] < 0 || !probe.sums.reached()) continue;
+    if (scratch.nearest[g - group_begin] < 0 || !probe.sums.reached()) continue;
     const real overlap = probe.radius - probe.sums.gap();
     if (!(overlap > 0)) continue;
     probe.gradient = probe.sums.gradient();
@@ -1536,11 +1535,8 @@ real ContactModel::spring_energy(const Model& model, const State& state) const {
   real energy = 0;
   for (const index_t i : contact_nodes_) {
     for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
-      if (pair_partner_[e] < i) continue;  // each pair once: the lists hold both directions
-      const index_t j = pair_partner_[e];
-      if (slot_law(pair_slot_[e]).surface && node_body_[i] != node_body_[j] &&
-          (on_surface(model, i) || on_surface(model, j)))
-        continue;
+      if (pair_partner_[e] < i) continue;        // each pair once: the lists hold both directions
+      if (surface_entry(model, i, e)) continue;  // the probes below
       const real overlap = pair_geometry(model, state, i, e).overlap;
       if (overlap > 0) energy += 0.5 * entry_stiffness(model, i, e) * overlap * overlap;
     }
@@ -1727,14 +1723,22 @@ real ContactModel::damping_ratio(std::size_t slot, real advance) {
 
 void ContactModel::probe_frictions(const Model& model, const State& state, real dt) {
   const std::int64_t count = static_cast<std::int64_t>(contact_nodes_.size());
-#pragma omp parallel for schedule(static)
-  for (std::int64_t k = 0; k < count; ++k) probe_friction(model, state, contact_nodes_[k], dt);
+#pragma omp parallel
+  {
+    std::vector<real> shares;  // scratch of this thread
+#pragma omp for schedule(static)
+    for (std::int64_t k = 0; k < count; ++k) probe_friction(model, state, contact_nodes_[k], dt, shares);
+  }
 }
 
-void ContactModel::probe_friction(const Model& model, const State& state, index_t i, real dt) {
-  if (group_offsets_.empty() || group_offsets_[i] == group_offsets_[i + 1]) return;
+void ContactModel::probe_friction(const Model& model, const State& state, index_t i, real dt,
+                                  std::vector<real>& shares) {
+  const auto [group_begin, group_end] = groups_of(i);
+  if (group_begin == group_end) return;
   const index_t material = model.node_material()[i];
-  for (index_t g = group_offsets_[i]; g < group_offsets_[i + 1]; ++g) {
+  const index_t first = pair_offsets_[i], last = pair_offsets_[i + 1];
+  shares.resize(last - first);  // w_k / S of each entry, set for a group's entries before use
+  for (index_t g = group_begin; g < group_end; ++g) {
     ProbeState& probe = probes_[g];
     if (probe.push == 0) continue;
     const contact::Law& law = laws_[material * material_count_ + body_material_[groups_[g].body]];
@@ -1748,11 +1752,11 @@ void ContactModel::probe_friction(const Model& model, const State& state, index_
     const real* u = state.velocities.data();
     const vec& spin_target = body_spin(groups_[g].body);
     vec3 target_velocity{0, 0, 0};
-    for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
+    for (index_t e = first; e < last; ++e) {
       if (entry_group_[e] != g) continue;
       const index_t j = pair_partner_[e];
       const contact::SurfacePoint& point = surface_point(j);
-      const real fraction = surface_share(probe, point);
+      const real fraction = shares[e - first] = surface_share(probe, point);
       if (fraction == 0) continue;
       const vec turn = cross(spin_target, {point.position[0] - y[3 * j], point.position[1] - y[3 * j + 1],
                                            point.position[2] - y[3 * j + 2]});
@@ -1780,13 +1784,12 @@ void ContactModel::probe_friction(const Model& model, const State& state, index_
       continue;
     }
     const real kt = law.tangential_stiffness_ratio * probe.stiffness;
-    for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
+    for (index_t e = first; e < last; ++e) {
       if (entry_group_[e] != g || pair_stiffness_[e] == 0) continue;
       real force[3];
       contact::tangential_force(kt, law.friction, normal_force, normal.data(), slip, dt,
                                 springs_[pair_spring_[e]].data(), force);
-      const real fraction = surface_share(probe, surface_point(pair_partner_[e]));
-      for (int c = 0; c < 3; ++c) probe.friction[c] += fraction * force[c];
+      for (int c = 0; c < 3; ++c) probe.friction[c] += shares[e - first] * force[c];
     }
   }
 }
@@ -1840,8 +1843,8 @@ void ContactModel::node_forces(const Model& model, State& state, real dt) {
         at_node[c] += on_node[c];
       }
     }
-    for (index_t g = group_offsets_.empty() ? 0 : group_offsets_[i];
-         !group_offsets_.empty() && g < group_offsets_[i + 1]; ++g) {
+    const auto [group_begin, group_end] = groups_of(i);
+    for (index_t g = group_begin; g < group_end; ++g) {
       const ProbeState& probe = probes_[g];
       if (probe.push == 0) continue;  // apart (its other fields may be an earlier step's)
       for (int c = 0; c < 3; ++c) {
@@ -1874,7 +1877,7 @@ void ContactModel::node_forces(const Model& model, State& state, real dt) {
       for (int c = 0; c < 3; ++c)
         along[c] = seen.centre_length * at_centre[c] + seen.surface_length * at_surface[c];
       if (along != vec{0, 0, 0}) {
-        const vec lever = centres_.lever(model, state, seen, i, 1.0, along);
+        const vec lever = centres_.lever(state, seen, i, 1.0, along);
         for (int c = 0; c < 3; ++c) on_vector[c] += lever[c];
       }
       anchor_forces_[k] = on_vector;

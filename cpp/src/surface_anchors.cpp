@@ -6,6 +6,7 @@
 #include <utility>
 
 #include "granulate/cell_grid.hpp"
+#include "granulate/contact/surface_law.hpp"
 #include "granulate/types.hpp"
 
 namespace granulate {
@@ -74,13 +75,6 @@ std::vector<index_t> best_span(const std::vector<real>& x, index_t a, const std:
   return chosen;
 }
 
-/// Wendland's C2 kernel (1 - q)^4 (1 + 4 q) for q < 1, else 0.
-real wendland(real q) {
-  if (!(q < 1)) return 0;
-  const real u = 1 - q;
-  return u * u * u * u * (1 + 4 * q);
-}
-
 /// The surface curvature of every anchored node (see surface_curvature), into its anchor.
 void estimate_curvatures(SurfaceAnchors& result, const std::vector<real>& x, std::span<const real> offsets,
                          std::span<const real> depths, real mesh_size, int dimension) {
@@ -125,7 +119,7 @@ real surface_curvature(std::span<const real> points, std::span<const real> norma
       d2 += ds * ds;
     }
     if (!(along > cos_limit) || !(d2 > 0)) continue;
-    const real w = wendland(std::sqrt(d2) / radius);
+    const real w = contact::surface_weight(std::sqrt(d2) / radius);
     bend += w * turn;
     spread += w * d2;
   }

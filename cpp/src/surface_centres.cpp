@@ -16,10 +16,13 @@ void SurfaceCentres::find(const Model& model, const State& state, std::vector<re
   // every node every step); under the surface law, which look them up many times per step, a
   // pointer per node as well.
   anchored_.assign(any_ ? model.node_count() : 0, 0);
-  for (index_t i = 0; i < anchored_.size(); ++i) anchored_[i] = lookup(model, i) != nullptr;
   const bool cached = any_ && std::any_of(surface_.begin(), surface_.end(), [](std::uint8_t f) { return f; });
   anchors_.assign(cached ? model.node_count() : 0, nullptr);
-  for (index_t i = 0; i < anchors_.size(); ++i) anchors_[i] = lookup(model, i);
+  for (index_t i = 0; i < anchored_.size(); ++i) {
+    const SurfaceAnchor* a = lookup(model, i);
+    anchored_[i] = a != nullptr;
+    if (cached) anchors_[i] = a;
+  }
   if (!any_ || state.bonds.broken(model.bond_offsets(), 0, model.node_count()) == 0) return;
   for (index_t i = 0; i < model.node_count(); ++i) {
     const SurfaceAnchor* a = anchor(model, i);
@@ -28,12 +31,12 @@ void SurfaceCentres::find(const Model& model, const State& state, std::vector<re
     const NodeBonds bonds = model.node_bonds(i);
     for (const index_t k : a->nodes) {
       const index_t b = k == SurfaceAnchor::no_anchor ? bonds.count : bonds.find(first + k);
-      if (b != bonds.count && !state.bonds.intact(i, b)) detach(model, i);  // the bond broke
+      if (b != bonds.count && !state.bonds.intact(i, b)) detach(i);  // the bond broke
     }
   }
 }
 
-void SurfaceCentres::detach(const Model&, index_t i) {
+void SurfaceCentres::detach(index_t i) {
   anchored_[i] = 0;
   if (!anchors_.empty()) anchors_[i] = nullptr;
 }
@@ -52,26 +55,10 @@ void SurfaceCentres::detach_anchored(const Model& model, std::span<const std::ar
       const SurfaceAnchor* a = anchor(model, node);
       if (a == nullptr) continue;
       const index_t local = other - model.particles()[model.node_particle()[node]].first_node;
-      if (std::find(a->nodes.begin(), a->nodes.end(), local) != a->nodes.end()) detach(model, node);
+      if (std::find(a->nodes.begin(), a->nodes.end(), local) != a->nodes.end()) detach(node);
     }
   }
 }
-
-namespace {
-
-/// sum_k w_k (f_k - f_i) over anchor a of node i (first: its particle's first node).
-std::array<real, 3> anchored(const SurfaceAnchor& a, index_t first, const std::vector<real>& field,
-                             index_t i) {
-  std::array<real, 3> sum{0, 0, 0};
-  const real* f = field.data();
-  for (std::size_t k = 0; k < a.nodes.size() && a.nodes[k] != SurfaceAnchor::no_anchor; ++k) {
-    const index_t j = first + a.nodes[k];
-    for (int d = 0; d < 3; ++d) sum[d] += a.weights[k] * (f[3 * j + d] - f[3 * i + d]);
-  }
-  return sum;
-}
-
-}  // namespace
 
 SurfaceCentres::Seen SurfaceCentres::seen(const Model& model, index_t i) const {
   Seen s;
@@ -87,77 +74,68 @@ SurfaceCentres::Seen SurfaceCentres::seen(const Model& model, index_t i) const {
   return s;
 }
 
-real SurfaceCentres::centre_length(const Model& model, index_t i) const {
-  return seen(model, i).centre_length;
+SurfaceCentres::vec3 SurfaceCentres::anchored_vector(const Seen& s, const std::vector<real>& field,
+                                                     index_t i) {
+  vec3 sum{0, 0, 0};
+  if (s.anchor == nullptr) return sum;
+  const real* f = field.data();
+  const SurfaceAnchor& a = *s.anchor;
+  for (std::size_t k = 0; k < a.nodes.size() && a.nodes[k] != SurfaceAnchor::no_anchor; ++k) {
+    const index_t j = s.first + a.nodes[k];
+    for (int d = 0; d < 3; ++d) sum[d] += a.weights[k] * (f[3 * j + d] - f[3 * i + d]);
+  }
+  return sum;
 }
 
-real SurfaceCentres::surface_length(const Model& model, index_t i) const {
-  return seen(model, i).surface_length;
+namespace {
+
+/// The factor f of the linear form y_i + f A_i outside the surface law: length / ((h/2) |o_i|).
+real linear_scale(const SurfaceCentres::Seen& s, real length) {
+  return length / (0.5 * s.mesh_size * s.anchor->reach);
 }
 
-SurfaceCentres::vec3 SurfaceCentres::anchored_vector(const Model& model, const std::vector<real>& field,
-                                                     index_t i) const {
-  const SurfaceAnchor* a = anchor(model, i);
-  if (a == nullptr) return {0, 0, 0};
-  return anchored(*a, model.particles()[model.node_particle()[i]].first_node, field, i);
+real norm(const SurfaceCentres::vec3& a) {
+  return std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
 }
 
-SurfaceCentres::vec3 SurfaceCentres::point(const Model& model, const State& state, const Seen& s, index_t i,
-                                           real length) const {
+}  // namespace
+
+SurfaceCentres::vec3 SurfaceCentres::point(const State& state, const Seen& s, index_t i, real length) const {
   const real* y = state.positions.data();
   vec3 q{y[3 * i], y[3 * i + 1], y[3 * i + 2]};
   if (length == 0 || s.anchor == nullptr) return q;
-  (void)model;
-  const vec3 a = anchored(*s.anchor, s.first, state.positions, i);
-  // Outside the surface law the point is y + f A, f = length / ((h/2) |o|) (linear).
-  const real scale = s.along_normal ? length / std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2])
-                                    : length / (0.5 * s.mesh_size * s.anchor->reach);
+  const vec3 a = anchored_vector(s, state.positions, i);
+  const real scale = s.along_normal ? length / norm(a) : linear_scale(s, length);
   for (int d = 0; d < 3; ++d) q[d] += scale * a[d];
   return q;
 }
 
-SurfaceCentres::vec3 SurfaceCentres::point_velocity(const Model& model, const State& state, const Seen& s,
-                                                    index_t i, real length) const {
+SurfaceCentres::vec3 SurfaceCentres::point_velocity(const State& state, const Seen& s, index_t i,
+                                                    real length) const {
   const real* v = state.velocities.data();
   vec3 u{v[3 * i], v[3 * i + 1], v[3 * i + 2]};
   if (length == 0 || s.anchor == nullptr) return u;
-  (void)model;
-  const vec3 rate = anchored(*s.anchor, s.first, state.velocities, i);
+  const vec3 rate = anchored_vector(s, state.velocities, i);
   if (!s.along_normal) {
-    const real scale = length / (0.5 * s.mesh_size * s.anchor->reach);
+    const real scale = linear_scale(s, length);
     for (int d = 0; d < 3; ++d) u[d] += scale * rate[d];
     return u;
   }
-  const vec3 a = anchored(*s.anchor, s.first, state.positions, i);
-  const real size = std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+  const vec3 a = anchored_vector(s, state.positions, i);
+  const real size = norm(a);
   const real along = (a[0] * rate[0] + a[1] * rate[1] + a[2] * rate[2]) / (size * size);
   for (int d = 0; d < 3; ++d) u[d] += length * (rate[d] - along * a[d]) / size;
   return u;
 }
 
-SurfaceCentres::vec3 SurfaceCentres::point(const Model& model, const State& state, index_t i,
-                                           real length) const {
-  return point(model, state, seen(model, i), i, length);
-}
-
-SurfaceCentres::vec3 SurfaceCentres::point_velocity(const Model& model, const State& state, index_t i,
-                                                    real length) const {
-  return point_velocity(model, state, seen(model, i), i, length);
-}
-
-SurfaceCentres::vec3 SurfaceCentres::lever(const Model& model, const State& state, index_t i, real length,
+SurfaceCentres::vec3 SurfaceCentres::lever(const State& state, const Seen& s, index_t i, real length,
                                            const vec3& force) const {
-  return lever(model, state, seen(model, i), i, length, force);
-}
-
-SurfaceCentres::vec3 SurfaceCentres::lever(const Model&, const State& state, const Seen& s, index_t i,
-                                           real length, const vec3& force) const {
   if (length == 0 || s.anchor == nullptr) return {0, 0, 0};
   if (!s.along_normal) {
-    const real scale = length / (0.5 * s.mesh_size * s.anchor->reach);
+    const real scale = linear_scale(s, length);
     return {scale * force[0], scale * force[1], scale * force[2]};
   }
-  const vec3 a = anchored(*s.anchor, s.first, state.positions, i);
+  const vec3 a = anchored_vector(s, state.positions, i);
   const real size2 = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
   const real size = std::sqrt(size2);
   const real along = (a[0] * force[0] + a[1] * force[1] + a[2] * force[2]) / size2;
@@ -171,16 +149,6 @@ void SurfaceCentres::fill_positions(const Model& model, const State& state, std:
 #pragma omp parallel for schedule(static)
   for (std::int64_t i = 0; i < n; ++i) {
     const vec3 c = at_list(model, state, static_cast<index_t>(i));
-    for (int k = 0; k < 3; ++k) x[3 * i + k] = c[k];
-  }
-}
-
-void SurfaceCentres::fill_centres(const Model& model, const State& state, std::vector<real>& x) const {
-  x.resize(state.positions.size());
-  const std::int64_t n = model.node_count();
-#pragma omp parallel for schedule(static)
-  for (std::int64_t i = 0; i < n; ++i) {
-    const vec3 c = at_centre(model, state, static_cast<index_t>(i));
     for (int k = 0; k < 3; ++k) x[3 * i + k] = c[k];
   }
 }

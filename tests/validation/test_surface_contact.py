@@ -13,24 +13,18 @@ import numpy as np
 import pytest
 
 import granulate as gr
+from granulate.packing import random_rotations
 
-from .test_contact import SOFT, oblique_pair
+from .test_contact import (
+    SOFT,
+    angular_momentum,
+    body_centre,
+    body_velocity,
+    oblique_pair,
+    rigid_spin,
+)
 
 PERIDEM_MESHES = Path(__file__).resolve().parents[1] / "data" / "peridem" / "compression_small_set"
-
-
-def random_rotation(dimension: int, rng: np.random.Generator):
-    """An angle (2D) or a uniformly random rotation matrix (3D, from a unit quaternion)."""
-    if dimension == 2:
-        return float(rng.uniform(0, 2 * np.pi))
-    a, b, c, d = (q := rng.normal(size=4)) / np.linalg.norm(q)
-    return np.array(
-        [
-            [a * a + b * b - c * c - d * d, 2 * (b * c - a * d), 2 * (b * d + a * c)],
-            [2 * (b * c + a * d), a * a - b * b + c * c - d * d, 2 * (c * d - a * b)],
-            [2 * (b * d - a * c), 2 * (c * d + a * b), a * a - b * b - c * c + d * d],
-        ]
-    )
 
 
 def run_through_contact(sim: gr.Simulation, steps: int) -> None:
@@ -42,10 +36,6 @@ def run_through_contact(sim: gr.Simulation, steps: int) -> None:
         touched = touched or in_contact
         if touched and not in_contact:
             return
-
-
-def velocity_of(sim: gr.Simulation, body: gr.Body) -> np.ndarray:
-    return np.average(sim.velocities[body.nodes], axis=0, weights=sim.volumes[body.nodes])
 
 
 def head_on(
@@ -79,16 +69,16 @@ def head_on(
                 reference,
                 SOFT,
                 position=(x, 0, *zero),
-                rotation=random_rotation(dimension, rng),
+                rotation=random_rotations(rng, 1, dimension)[0],
                 velocity=((0.5 if k == 0 else -0.5) * speed, 0, *zero),
             )
         )
     a, b = bodies
-    before, start_b = velocity_of(sim, a) - velocity_of(sim, b), velocity_of(sim, b)
+    before, start_b = body_velocity(sim, a) - body_velocity(sim, b), body_velocity(sim, b)
     run_through_contact(sim, 10)
     sim.run(100)
-    after = velocity_of(sim, a) - velocity_of(sim, b)
-    normal = velocity_of(sim, b) - start_b
+    after = body_velocity(sim, a) - body_velocity(sim, b)
+    normal = body_velocity(sim, b) - start_b
     normal /= np.linalg.norm(normal)
     e = -float(after @ normal) / float(before @ normal)
     return e, float(np.max(np.abs(after[1:])) / speed)
@@ -169,21 +159,6 @@ def test_elastic_collisions_of_meshed_grains_with_corners_keep_their_energy(mesh
         assert abs(total - 1) < 1e-3, (seed, total)
 
 
-def angular_momentum(sim: gr.Simulation) -> np.ndarray:
-    masses = sim.volumes * SOFT.density
-    return np.sum(masses[:, None] * np.cross(sim.positions, sim.velocities), axis=0)
-
-
-def spin_about_z(sim: gr.Simulation, body: gr.Body) -> float:
-    x, v, m = sim.positions[body.nodes], sim.velocities[body.nodes], sim.volumes[body.nodes]
-    r = x - np.average(x, axis=0, weights=m)
-    w = v - np.average(v, axis=0, weights=m)
-    return float(
-        np.sum(m * (r[:, 0] * w[:, 1] - r[:, 1] * w[:, 0]))
-        / np.sum(m * (r[:, 0] ** 2 + r[:, 1] ** 2))
-    )
-
-
 @pytest.mark.validation
 @pytest.mark.parametrize(("dimension", "friction"), [(2, 0.0), (2, 0.5), (3, 0.5)])
 def test_oblique_collisions_keep_their_angular_momentum(dimension: int, friction: float) -> None:
@@ -193,13 +168,14 @@ def test_oblique_collisions_keep_their_angular_momentum(dimension: int, friction
     point on both bodies). With friction they leave spinning (measured 102 rad/s in 2D);
     without, their smooth surfaces leave them nearly still (0.5 rad/s; 0.6 m/s over R is 600)."""
     sim, a, b = oblique_pair(dimension, friction, pair_law="surface")
-    before = angular_momentum(sim)
+    densities = np.full(sim.node_count, SOFT.density)
+    before = angular_momentum(sim, densities)
     scale = np.sum(
         np.linalg.norm(np.cross(sim.positions, sim.velocities), axis=1) * sim.volumes * SOFT.density
     )
     run_through_contact(sim, 20)
-    np.testing.assert_allclose(angular_momentum(sim), before, rtol=0, atol=1e-12 * scale)
-    spins = [abs(spin_about_z(sim, body)) for body in (a, b)]
+    np.testing.assert_allclose(angular_momentum(sim, densities), before, rtol=0, atol=1e-12 * scale)
+    spins = [abs(rigid_spin(sim, body)) for body in (a, b)]
     if friction > 0:
         assert min(spins) > 50.0, spins
     else:
@@ -220,7 +196,7 @@ def test_a_turned_lattice_disc_rests_on_its_true_radius() -> None:
     body = sim.add_particle(disc, SOFT, position=(0, radius + 0.01 * h), rotation=0.3)
     sim.add_wall(gr.Plane((0, 0), (0, 1)), name="floor")
     sim.run(until=0.01)
-    centre = np.average(sim.positions[body.nodes], axis=0, weights=sim.volumes[body.nodes])
+    centre = body_centre(sim, body)
     assert abs(centre[1] - radius) < 0.1 * h, (centre[1] - radius) / h
 
 
@@ -240,9 +216,8 @@ def test_a_lattice_disc_rolls_on_a_turning_drum() -> None:
     drum = gr.Wall((gr.CircleContainer((0, 0), 10e-3),), motion=gr.Rotation.steady(rate))
     sim.add_wall(drum, name="drum")
     sim.run(until=0.04)
-    x, v, m = sim.positions[disc.nodes], sim.velocities[disc.nodes], sim.volumes[disc.nodes]
-    centre, velocity = np.average(x, axis=0, weights=m)[:2], np.average(v, axis=0, weights=m)[:2]
-    spin = spin_about_z(sim, disc)
+    centre, velocity = body_centre(sim, disc)[:2], body_velocity(sim, disc)[:2]
+    spin = rigid_spin(sim, disc)
     out = centre / np.linalg.norm(centre)
     contact = centre + 1e-3 * out
     tangent = np.array([-out[1], out[0]])

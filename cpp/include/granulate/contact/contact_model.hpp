@@ -196,6 +196,9 @@ class ContactModel {
   std::vector<std::uint8_t> taking_part_;  // per node, at the last search
   /// Whether node i carries a point of its body's surface (surface_centres.hpp).
   bool on_surface(const Model& model, index_t i) const { return centres_.anchor(model, i) != nullptr; }
+  /// Whether the surface law decides node i's list entry e (i probes j's body's surface, or j
+  /// probes i's): two bodies under the surface law, and one of the nodes carries a surface point.
+  bool surface_entry(const Model& model, index_t i, std::size_t e) const;
   /// The list cutoff of nodes i and j (without the skin), between their surface points (their
   /// positions where they have none): the surface law's support radius where either carries a
   /// surface point of another body, else the pair's Rc (plus the centres' depths in one body).
@@ -236,6 +239,11 @@ class ContactModel {
   std::vector<index_t> entry_target_;  // per pair entry: the group that probes the node's body
   std::vector<ProbeGroup> groups_;
   std::vector<index_t> group_offsets_;  // per node: its groups (CSR)
+  /// Node i's groups, [first, last) (none without the surface law).
+  std::array<index_t, 2> groups_of(index_t i) const {
+    if (group_offsets_.empty()) return {0, 0};
+    return {group_offsets_[i], group_offsets_[i + 1]};
+  }
   std::vector<ProbeState> probes_;
   /// The probe k of a group of node i against body b: beta kn V_i^2, beta = h_b^2 / (h_i^2 + h_b^2)
   /// (the finer surface probes the coarser; equal meshes share the contact equally).
@@ -263,8 +271,9 @@ class ContactModel {
   void probe_frictions(const Model& model, const State& state, real dt);
   /// Friction of node i's touching groups: each probe entry's spring (Cundall-Strack, on the
   /// slip of the probe point against the target's surface velocity there, sum_k (w_k / S)
-  /// v(s_k)), weighted by w_k / S; and the foot f = sum_k (w_k / S) s_k.
-  void probe_friction(const Model& model, const State& state, index_t i, real dt);
+  /// v(s_k)), weighted by w_k / S; and the foot f = sum_k (w_k / S) y_k (`shares`: scratch,
+  /// per entry of the node).
+  void probe_friction(const Model& model, const State& state, index_t i, real dt, std::vector<real>& shares);
   /// The force on a target's surface point (`point`, with |A| = `size`) from a probing group,
   /// and the force on its anchored vector A.
   void target_forces(const contact::SurfacePoint& point, real size, index_t group, vec3& on_point,

@@ -49,44 +49,19 @@ class SurfaceCentres {
   /// Detaches the nodes whose bond to one of their anchors is among `pairs` (bonds that broke).
   void detach_anchored(const Model& model, std::span<const std::array<index_t, 2>> pairs);
 
-  /// The anchors of node i if it carries a surface point (its particle's nodes are centred and
-  /// it is attached), else null.
   /// Whether node i is seen away from itself (it has anchors): a cheap test for the hot loops.
   bool moved(index_t i) const { return any_ && anchored_[i]; }
+  /// The anchors of node i if it carries a surface point (its particle's nodes are centred and
+  /// it is attached), else null.
   const SurfaceAnchor* anchor(const Model& model, index_t i) const {
-    if (!any_ || !anchored_[i]) return nullptr;
+    if (!moved(i)) return nullptr;
     return anchors_.empty() ? lookup(model, i) : anchors_[i];
   }
-  /// s_p of node i's particle.
-  real depth(const Model& model, index_t i) const { return depth_[model.node_particle()[i]]; }
-  /// How far out along its normal node i's contact centre lies [m]: d_i - rho |o_i| (0 without
-  /// anchors).
-  real centre_length(const Model& model, index_t i) const;
-  /// How far out along its normal node i's surface point lies [m]: d_i (0 without anchors).
-  real surface_length(const Model& model, index_t i) const;
-  /// y_i + length n_i at the state's positions (y_i for a node without anchors).
-  vec3 point(const Model& model, const State& state, index_t i, real length) const;
-  /// The velocity of that point: v_i + length (1 - n n^T) A_i(v) / |A_i|.
-  vec3 point_velocity(const Model& model, const State& state, index_t i, real length) const;
-  vec3 at_centre(const Model& model, const State& state, index_t i) const {
-    const Seen s = seen(model, i);
-    return point(model, state, s, i, s.centre_length);
-  }
-  vec3 centre_velocity(const Model& model, const State& state, index_t i) const {
-    const Seen s = seen(model, i);
-    return point_velocity(model, state, s, i, s.centre_length);
-  }
-  /// Node i's surface point: where node-pair search and surface contact see the node.
-  vec3 at_surface(const Model& model, const State& state, index_t i) const {
-    const Seen s = seen(model, i);
-    return point(model, state, s, i, s.surface_length);
-  }
-  vec3 surface_velocity(const Model& model, const State& state, index_t i) const {
-    const Seen s = seen(model, i);
-    return point_velocity(model, state, s, i, s.surface_length);
-  }
-  /// What one look-up of node i's anchors gives: the anchors, its particle's first node and h,
-  /// whether its points lie along the normal (the surface law) and its two lengths.
+
+  /// What one look-up of node i's anchors gives: the anchors (null: the node is seen at
+  /// itself), its particle's first node and h, whether its points lie along the normal (the
+  /// surface law), and how far out along the normal its surface point (d_i) and its contact
+  /// centre (d_i - rho |o_i|) lie [m].
   struct Seen {
     const SurfaceAnchor* anchor = nullptr;
     index_t first = 0;
@@ -94,16 +69,30 @@ class SurfaceCentres {
     bool along_normal = false;
   };
   Seen seen(const Model& model, index_t i) const;
-  vec3 point(const Model& model, const State& state, const Seen& s, index_t i, real length) const;
-  vec3 point_velocity(const Model& model, const State& state, const Seen& s, index_t i, real length) const;
+  /// y_i + length n_i at the state's positions (y_i for a node without anchors).
+  vec3 point(const State& state, const Seen& s, index_t i, real length) const;
+  /// The velocity of that point: v_i + length (1 - n n^T) A_i(v) / |A_i|.
+  vec3 point_velocity(const State& state, const Seen& s, index_t i, real length) const;
   /// The force on A_i of a force F on the point y_i + length n_i: (length / |A_i|) (1 - n n^T) F
   /// (length / ((h/2) |o_i|) F outside the surface law).
-  vec3 lever(const Model& model, const State& state, const Seen& s, index_t i, real length,
-             const vec3& force) const;
-  /// The force on A_i of a force F on the point y_i + length n_i: (length / |A_i|) (1 - n n^T) F.
-  vec3 lever(const Model& model, const State& state, index_t i, real length, const vec3& force) const;
+  vec3 lever(const State& state, const Seen& s, index_t i, real length, const vec3& force) const;
   /// A_i = sum_k w_k (f_k - f_i) of an anchored node for a nodal field f (zero without anchors).
-  vec3 anchored_vector(const Model& model, const std::vector<real>& field, index_t i) const;
+  static vec3 anchored_vector(const Seen& s, const std::vector<real>& field, index_t i);
+
+  /// Node i's contact centre, and how fast it moves.
+  vec3 at_centre(const Model& model, const State& state, index_t i) const {
+    const Seen s = seen(model, i);
+    return point(state, s, i, s.centre_length);
+  }
+  vec3 centre_velocity(const Model& model, const State& state, index_t i) const {
+    const Seen s = seen(model, i);
+    return point_velocity(state, s, i, s.centre_length);
+  }
+  /// Node i's surface point: where node-pair search and surface contact see the node.
+  vec3 at_surface(const Model& model, const State& state, index_t i) const {
+    const Seen s = seen(model, i);
+    return point(state, s, i, s.surface_length);
+  }
   /// Where the node-pair lists see node i: its surface point on a particle under the surface
   /// law, else its contact centre.
   vec3 at_list(const Model& model, const State& state, index_t i) const {
@@ -111,8 +100,6 @@ class SurfaceCentres {
   }
   /// Every node's list position (at_list), into x (n x 3).
   void fill_positions(const Model& model, const State& state, std::vector<real>& x) const;
-  /// Every node's contact centre (its position if it has none), into x (n x 3).
-  void fill_centres(const Model& model, const State& state, std::vector<real>& x) const;
 
   std::size_t memory_bytes() const {
     return depth_.capacity() * sizeof(real) + anchors_.capacity() * sizeof(const SurfaceAnchor*) +
@@ -120,7 +107,7 @@ class SurfaceCentres {
   }
 
  private:
-  void detach(const Model& model, index_t i);
+  void detach(index_t i);
   /// Node i's anchors from the shape (none for an outer-layer node of a particle not under the
   /// surface law).
   const SurfaceAnchor* lookup(const Model& model, index_t i) const;
