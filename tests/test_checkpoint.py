@@ -17,17 +17,23 @@ import granulate as gr
 
 
 def tumbling_drum(
-    out: Path, *, resume: bool = False, grid: bool = False, law: str = "granulate"
+    out: Path,
+    *,
+    resume: bool = False,
+    grid: bool = False,
+    law: str = "granulate",
+    rolling: float = 0.0,
 ) -> gr.Simulation:
     """Grains breaking in a rotating drum: contact, friction, damping, walls and fracture.
     ``grid``: the fourth grain is a brittle grid-meshed square instead of a lattice triangle:
     its surface nodes have their contact spheres centred inside them (surface anchors), and
     they lose them as its bonds break (it is damaged all through by step 2,000). ``law``: the
     contact's pair_law ("surface": probes of the grains' smooth surfaces, with their groups
-    and the nodes opened by cracks joining the lists)."""
+    and the nodes opened by cracks joining the lists). ``rolling``: mu_r, the rolling
+    resistance (its springs carried through the checkpoint)."""
     rock = gr.Material(density=2000, youngs_modulus=1e8, poisson_ratio=0.25, fracture_energy=0.5)
     sim = gr.Simulation(2, gravity=(0, -9.81))
-    sim.contact = gr.Contact(restitution=0.5, friction=0.4, pair_law=law)
+    sim.contact = gr.Contact(restitution=0.5, friction=0.4, pair_law=law, rolling_friction=rolling)
     for k, (x, y) in enumerate([(-3e-3, -2e-3), (0, -4e-3), (3e-3, -2e-3), (0, 0)]):
         velocity = (0.2 * k - 0.3, -4.0)
         if k == 3 and grid:
@@ -68,19 +74,24 @@ def assert_same_outputs(a: Path, b: Path) -> None:
 # The shattered square's fragments hit hard enough to pass half the contact radius (warned).
 @pytest.mark.filterwarnings("ignore:contact. node pairs overlapped")
 @pytest.mark.parametrize(
-    ("grid", "law"),
-    [(False, "granulate"), (True, "granulate"), (True, "surface")],
-    ids=["lattice", "grid", "surface"],
+    ("grid", "law", "rolling"),
+    [
+        (False, "granulate", 0.0),
+        (True, "granulate", 0.0),
+        (True, "surface", 0.0),
+        (False, "granulate", 0.3),
+    ],
+    ids=["lattice", "grid", "surface", "rolling"],
 )
 def test_resumed_run_writes_the_same_bits_as_an_uninterrupted_one(
-    tmp_path: Path, grid: bool, law: str
+    tmp_path: Path, grid: bool, law: str, rolling: float
 ) -> None:
-    whole = tumbling_drum(tmp_path / "whole", grid=grid, law=law)
+    whole = tumbling_drum(tmp_path / "whole", grid=grid, law=law, rolling=rolling)
     whole.run(3000)
     assert whole.broken_bonds() > 0  # the run exercises fracture and fragments
-    first = tumbling_drum(tmp_path / "split", grid=grid, law=law)
+    first = tumbling_drum(tmp_path / "split", grid=grid, law=law, rolling=rolling)
     first.run(2300)  # the last checkpoint is at step 2000; later outputs get rewritten
-    second = tumbling_drum(tmp_path / "split", resume=True, grid=grid, law=law)
+    second = tumbling_drum(tmp_path / "split", resume=True, grid=grid, law=law, rolling=rolling)
     second.load_checkpoint(tmp_path / "split" / "checkpoint.npz")
     assert second.step == 2000
     second.run(1000)

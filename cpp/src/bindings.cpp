@@ -84,6 +84,7 @@ nb::dict checkpoint_dict(const Simulation& self) {
   d["contact_slot_approach"] = copy_out(c.slot_approach);
   d["contact_slot_normal"] = copy_out(c.slot_normal);
   d["contact_slot_work"] = copy_out(c.slot_work);
+  d["contact_slot_rolling"] = copy_out(c.slot_rolling);
   d["contact_last_time"] = c.last_time;
   d["contact_has_last_time"] = c.has_last_time;
   d["contact_statistics"] = copy_out(
@@ -124,6 +125,8 @@ void restore_dict(Simulation& self, const nb::dict& d) {
   c.slot_approach = entry<real>(d, "contact_slot_approach");
   c.slot_normal = entry<real>(d, "contact_slot_normal");
   c.slot_work = entry<real>(d, "contact_slot_work");
+  // Written since rolling resistance exists; a checkpoint without it had none.
+  if (d.contains("contact_slot_rolling")) c.slot_rolling = entry<real>(d, "contact_slot_rolling");
   c.last_time = scalar<real>(d, "contact_last_time");
   c.has_last_time = scalar<bool>(d, "contact_has_last_time");
   const auto statistics = entry<std::uint64_t>(d, "contact_statistics");
@@ -331,6 +334,8 @@ NB_MODULE(_core, m) {
       .def_rw("damping_ratio", &contact::Law::damping_ratio)
       .def_rw("friction", &contact::Law::friction)
       .def_rw("tangential_stiffness_ratio", &contact::Law::tangential_stiffness_ratio)
+      .def_rw("rolling_friction", &contact::Law::rolling_friction)
+      .def_rw("rolling_damping", &contact::Law::rolling_damping)
       .def_rw("peridem_friction", &contact::Law::peridem_friction)
       .def_rw("node_pair", &contact::Law::node_pair)
       .def_rw("surface", &contact::Law::surface);

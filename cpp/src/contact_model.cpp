@@ -103,13 +103,15 @@ void require_valid(const contact::Law& law, const char* what) {
   const bool stiffness = law.normal_stiffness > 0 || (law.normal_stiffness == 0 && law.stiffness_factor > 0);
   if (!radius || !stiffness || !(law.damping_ratio >= 0) || !(law.damping_ratio < 1) ||
       !(law.friction >= 0) || !(law.tangential_stiffness_ratio > 0) ||
-      !(law.tangential_stiffness_ratio <= 1) ||
+      !(law.tangential_stiffness_ratio <= 1) || !(law.rolling_friction >= 0) ||
+      !std::isfinite(law.rolling_friction) || !(law.rolling_damping >= 0) || !(law.rolling_damping <= 1) ||
       !std::isfinite(law.contact_radius + law.contact_radius_factor) ||
       !std::isfinite(law.normal_stiffness + law.stiffness_factor)) {
     throw InputError(
         std::string(what) +
         " needs a positive contact radius (or factor) and stiffness (or factor), a damping ratio in "
-        "[0, 1), a non-negative friction coefficient and a tangential stiffness ratio in (0, 1]");
+        "[0, 1), non-negative friction and rolling friction coefficients, a tangential stiffness ratio "
+        "in (0, 1] and a rolling damping ratio in [0, 1]");
   }
 }
 
@@ -295,6 +297,7 @@ void ContactModel::set_law(index_t a, index_t b, const contact::Law& law) {
       contact::DampingTable(law.damping_ratio);
   law_set_[a * material_count_ + b] = law_set_[b * material_count_ + a] = 1;
   any_law_ = true;
+  any_rolling_ = any_rolling_ || law.rolling_friction > 0;
   const contact::ContactSide coarsest_a{material_max_mesh_size_[a], 0, 0};
   const contact::ContactSide coarsest_b{material_max_mesh_size_[b], 0, 0};
   max_contact_radius_ =
@@ -322,6 +325,7 @@ void ContactModel::set_wall_law(index_t wall, index_t material, const contact::L
   wall_laws_[wall * material_count_ + material] = law;
   wall_damping_tables_[wall * material_count_ + material] = contact::DampingTable(law.damping_ratio);
   wall_law_set_[wall * material_count_ + material] = 1;
+  any_rolling_ = any_rolling_ || law.rolling_friction > 0;
   const contact::ContactSide coarsest{material_max_mesh_size_[material], 0, 0};
   max_contact_radius_ = std::max(max_contact_radius_, contact::resolve_wall_contact_radius(law, coarsest));
   built_ = false;
@@ -651,6 +655,7 @@ void ContactModel::finish_lists(const Model& model) {
   const std::vector<real> old_normal = slot_last_normal_;
   const std::vector<real> old_work = slot_work_;
   const std::vector<float> old_exponent = slot_exponent_;
+  const std::vector<real> old_rolling = slot_rolling_;
   const std::size_t old_particle_slots = particle_slot_count_;
   // Bucketed by the first body (a counting sort), so the sorts are per body and small, and an
   // entry finds its slot among its first body's few slots (fragments make many entries).
@@ -745,6 +750,8 @@ void ContactModel::finish_lists(const Model& model) {
   slot_last_normal_.assign(3 * slots_.size(), 0);
   slot_work_.assign(slots_.size(), 0);
   slot_exponent_.assign(slots_.size(), 1.0f);
+  slot_rolling_.assign(any_rolling_ ? 3 * slots_.size() : 0, 0);
+  const bool carry_rolling = !slot_rolling_.empty() && old_rolling.size() == 3 * old_slots.size();
   // Old and new slots are sorted within their two parts (particle pairs, walls): merge walks.
   auto carry_over = [&](std::size_t slot, std::size_t slot_end, std::size_t old, std::size_t old_end) {
     for (; slot < slot_end && old < old_end; ++slot) {
@@ -754,6 +761,9 @@ void ContactModel::finish_lists(const Model& model) {
         slot_work_[slot] = old_work[old];
         slot_exponent_[slot] = old_exponent[old];
         for (int k = 0; k < 3; ++k) slot_last_normal_[3 * slot + k] = old_normal[3 * old + k];
+        if (carry_rolling) {
+          for (int k = 0; k < 3; ++k) slot_rolling_[3 * slot + k] = old_rolling[3 * old + k];
+        }
       }
     }
   };
@@ -1046,7 +1056,7 @@ std::size_t ContactModel::memory_bytes() const {
          bytes(wall_spring_) + bytes(contact_nodes_) + bytes(body_contact_offsets_) + bytes(body_touch_) +
          bytes(touching_bodies_) + bytes(slot_touch_) + bytes(body_motion_) + bytes(body_load_) +
          bytes(slot_force_) + bytes(slot_normal_) + bytes(slot_point_) + bytes(slot_work_) +
-         bytes(slot_exponent_) + bytes(damping_tables_) + bytes(wall_damping_tables_) +
+         bytes(slot_exponent_) + bytes(slot_rolling_) + bytes(damping_tables_) + bytes(wall_damping_tables_) +
          bytes(slot_surface_normal_) + bytes(touching_nodes_) + bytes(touching_normals_) +
          centres_.memory_bytes() + bytes(anchor_forces_) + bytes(entry_group_) + bytes(entry_target_) +
          bytes(taking_part_) + bytes(surface_nodes_) + bytes(surface_slot_) + bytes(surface_points_) +
@@ -1064,6 +1074,7 @@ ContactCheckpoint ContactModel::checkpoint() const {
   c.particle_slot_count = particle_slot_count_;
   c.slot_approach = slot_approach_;
   c.slot_normal = slot_last_normal_;
+  c.slot_rolling = slot_rolling_;
   for (std::size_t slot = 0; slot < slots_.size(); ++slot) {
     c.slot_work.push_back(slot_work_[slot]);
     c.slot_work.push_back(slot_exponent_[slot]);
@@ -1107,6 +1118,7 @@ void ContactModel::check_checkpoint(const Model& model, const ContactCheckpoint&
   const std::size_t slots = saved.slots.size();
   if (saved.slot_approach.size() != slots || saved.slot_normal.size() != 3 * slots ||
       saved.slot_work.size() != 2 * slots || saved.particle_slot_count > slots ||
+      (!saved.slot_rolling.empty() && saved.slot_rolling.size() != 3 * slots) ||
       (saved.built && saved.positions_at_build.size() != 3 * static_cast<std::size_t>(n)) ||
       saved.wall_reactions.size() != walls_.size()) {
     throw InputError("the checkpoint's contact data do not match this model (nodes or walls differ)");
@@ -1122,8 +1134,9 @@ void ContactModel::check_checkpoint(const Model& model, const ContactCheckpoint&
   }
   const bool finite = all_finite(saved.positions_at_build) && all_finite(saved.slot_approach) &&
                       all_finite(saved.slot_normal) && all_finite(saved.slot_work) &&
-                      all_finite(saved.springs) && std::isfinite(saved.skin) &&
-                      std::isfinite(saved.time_at_build) && std::isfinite(saved.last_time);
+                      all_finite(saved.slot_rolling) && all_finite(saved.springs) &&
+                      std::isfinite(saved.skin) && std::isfinite(saved.time_at_build) &&
+                      std::isfinite(saved.last_time);
   if (!finite) throw InputError("the checkpoint's contact data hold non-finite values");
   if (!saved.pair_offsets.empty() && !valid_lists(saved.pair_offsets, saved.pair_partners, n))
     throw InputError("the checkpoint's contact lists are out of range (partners past the node count)");
@@ -1139,6 +1152,9 @@ void ContactModel::restore(const Model& model, const State& state, const Contact
   particle_slot_count_ = saved.particle_slot_count;
   slot_approach_ = saved.slot_approach;
   slot_last_normal_ = saved.slot_normal;
+  // A checkpoint without rolling rotations (no law had mu_r > 0 then) restores them as zero.
+  slot_rolling_ = saved.slot_rolling;
+  if (any_rolling_) slot_rolling_.resize(3 * slots_.size(), 0);
   slot_work_.resize(slots_.size());
   slot_exponent_.resize(slots_.size());
   for (std::size_t slot = 0; slot < slots_.size(); ++slot) {
@@ -1214,6 +1230,7 @@ void ContactModel::add_forces(const Model& model, State& state, std::uint64_t br
   sum_slot_springs(model, state);         //    spring force, normal and contact point per slot
   sum_probe_springs();                    //    the same for the surface probes
   slot_dashpots(state, dt);               //    the body dashpots, as loads on the bodies
+  slot_rolling_resistance(state, dt);     //    the rolling torques, as couples on the bodies
   slot_redirects();                       //    each collision's force turned to the surface normal
   if (any_surface_) probe_frictions(model, state, dt);  // C: the surface probes' friction
   node_forces(model, state, dt);                        //    springs, friction, fragment dashpots, per node
@@ -1625,6 +1642,81 @@ void ContactModel::slot_dashpots(const State& state, real dt) {
       add_body_load(q, point, {damping * normal[0], damping * normal[1], damping * normal[2]});
     }
   }
+}
+
+void ContactModel::slot_rolling_resistance(const State& state, real dt) {
+  // Rolling resistance per pair of touching bodies (contact_law.hpp): the rolling spring on
+  // their relative rotation, its torque M on the first body and -M on the second (or the wall),
+  // as rigid-body couples.
+  if (slot_rolling_.empty()) return;
+  auto has_inertia = [](const BodyMotion& m) {
+    return m.inverse_inertia != std::array<real, 6>{0, 0, 0, 0, 0, 0};
+  };
+  for (std::size_t slot = 0; slot < slots_.size(); ++slot) {
+    real* rotation = &slot_rolling_[3 * slot];
+    const contact::PairLaw& law = slot_law(slot);
+    const bool wall_slot = slot >= particle_slot_count_;
+    const index_t p = slots_[slot][0], q = slots_[slot][1];
+    const index_t touch = slot_touch_[slot];
+    const vec sum = touch == not_touching ? vec{0, 0, 0} : slot_surface_normal_[touch];
+    const real norm = std::sqrt(dot(sum, sum));
+    const bool rolling = law.rolling_friction > 0 && (wall_slot || p != q) && norm > 0 &&
+                         slot_force_[touch] > 0 && has_inertia(body_motion_[body_touch_[p]]) &&
+                         (wall_slot || has_inertia(body_motion_[body_touch_[q]]));
+    if (!rolling) {
+      // In a gap of the collision (chattering surface nodes part for a few steps) the spring
+      // keeps its rotation and acts again when they touch; once the bodies are apart it starts
+      // again at the next touch.
+      if (!(slot_approach_[slot] > 0)) std::fill(rotation, rotation + 3, 0.0);
+      continue;
+    }
+    const BodyMotion& first = body_motion_[body_touch_[p]];
+    const real force = slot_force_[touch];
+    const vec point{slot_point_[touch][0] / force, slot_point_[touch][1] / force,
+                    slot_point_[touch][2] / force};
+    auto distance = [&](const vec& centre) {
+      const vec arm{point[0] - centre[0], point[1] - centre[1], point[2] - centre[2]};
+      return std::sqrt(dot(arm, arm));
+    };
+    const real rp = distance(first.centre);
+    const vec spin_q =
+        wall_slot ? walls_[q].angular_velocity(state.time) : body_motion_[body_touch_[q]].angular_velocity;
+    const real rq = wall_slot ? 0.0 : distance(body_motion_[body_touch_[q]].centre);
+    const real radius = wall_slot ? rp : rp * rq / (rp + rq);
+    const vec normal{sum[0] / norm, sum[1] / norm, sum[2] / norm};
+    const vec spin{first.angular_velocity[0] - spin_q[0], first.angular_velocity[1] - spin_q[1],
+                   first.angular_velocity[2] - spin_q[2]};
+    const real stiffness = law.tangential_stiffness_ratio * slot_stiffness_[slot] * radius * radius;
+    vec torque{0, 0, 0};
+    const bool rolls = contact::rolling_torque(stiffness, law.rolling_friction, radius, force, normal.data(),
+                                               spin.data(), dt, rotation, torque.data());
+    const real twist = dot(spin, normal);
+    const vec roll{spin[0] - twist * normal[0], spin[1] - twist * normal[1], spin[2] - twist * normal[2]};
+    const real speed = std::sqrt(dot(roll, roll));
+    if (!rolls && speed > 0 && law.rolling_damping > 0) {
+      const vec axis{roll[0] / speed, roll[1] / speed, roll[2] / speed};
+      real compliance = 1 / rolling_inertia(p, first, axis, rp);
+      if (!wall_slot) compliance += 1 / rolling_inertia(q, body_motion_[body_touch_[q]], axis, rq);
+      const real damping = 2 * law.rolling_damping * std::sqrt(stiffness / compliance);
+      for (int k = 0; k < 3; ++k) torque[k] -= damping * roll[k];
+    }
+    const index_t tp = body_touch_[p];
+    for (int k = 0; k < 3; ++k) body_load_[tp][3 + k] += torque[k];
+    if (wall_slot) {
+      for (int k = 0; k < 3; ++k) wall_damping_[q][3 + k] -= torque[k];
+    } else {
+      const index_t tq = body_touch_[q];
+      for (int k = 0; k < 3; ++k) body_load_[tq][3 + k] -= torque[k];
+    }
+  }
+}
+
+real ContactModel::rolling_inertia(index_t body, const BodyMotion& motion, const vec3& axis,
+                                   real lever) const {
+  // I about the axis through the centre, 1 / (a . I^-1 a), plus m r^2 (about the contact point).
+  const real inverse = dot(axis, symmetric_times(motion.inverse_inertia, axis));
+  if (!(inverse > 0)) return std::numeric_limits<real>::infinity();  // no rotation about this axis
+  return 1 / inverse + body_mass_[body] * lever * lever;
 }
 
 vec3 ContactModel::rigid_velocity(index_t body, const vec3& point) const {

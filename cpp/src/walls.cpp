@@ -317,10 +317,15 @@ std::array<real, 3> Wall::velocity_at(const real* x, real t) const {
     return {rate * direction[0], rate * direction[1], rate * direction[2]};
   }
   if (motion == Motion::rotation) {
-    const vec w{axis[0] * function.rate(t), axis[1] * function.rate(t), axis[2] * function.rate(t)};
-    return cross(w, {x[0] - center[0], x[1] - center[1], x[2] - center[2]});
+    return cross(angular_velocity(t), {x[0] - center[0], x[1] - center[1], x[2] - center[2]});
   }
   return {0, 0, 0};
+}
+
+std::array<real, 3> Wall::angular_velocity(real t) const {
+  if (motion != Motion::rotation) return {0, 0, 0};
+  const real rate = function.rate(t);
+  return {axis[0] * rate, axis[1] * rate, axis[2] * rate};
 }
 
 real Wall::motion_bound(real t0, real t1) const {

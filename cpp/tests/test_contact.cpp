@@ -70,6 +70,21 @@ TEST_CASE("the friction spring sticks below mu F_n, slides at it, turns with the
   for (int k = 0; k < 3; ++k) CHECK(mine_force[k] == -their_force[k] && mine[k] == -theirs[k]);
 }
 
+TEST_CASE("the rolling spring holds below mu_r R* F_n, rolls at it (and says so), ignores torsion") {
+  const real normal[3] = {0, 1, 0}, spin[3] = {0, 3.0, -2.0}, dt = 1e-3;  // spin: torsion 3, roll -2
+  real rotation[3] = {0, 0, 0}, torque[3];
+  // Holds: theta = omega_roll dt (the torsion about the normal is dropped), M = -k_r theta.
+  CHECK(!contact::rolling_torque(50.0, 0.2, 0.1, 10.0, normal, spin, dt, rotation, torque));
+  CHECK(rotation[1] == 0.0 && rotation[0] == 0.0);
+  CHECK_CLOSE(rotation[2], -2e-3, 1e-18);
+  CHECK_CLOSE(torque[2], 0.1, 1e-15);
+  // Rolls: 50 x 1.002 > mu_r R* F_n = 0.2, so the torque is capped there.
+  rotation[2] = -1.0;
+  CHECK(contact::rolling_torque(50.0, 0.2, 0.1, 10.0, normal, spin, dt, rotation, torque));
+  CHECK_CLOSE(torque[2], 0.2, 1e-15);
+  CHECK_CLOSE(rotation[2], -4e-3, 1e-15);
+}
+
 TEST_CASE("relative contact laws resolve per pair, symmetrically, from the finer particle") {
   contact::Law law;
   law.contact_radius_factor = 0.95;

@@ -477,6 +477,12 @@ class ContactSpec(Spec):
     tangential_stiffness_ratio: Annotated[float, Field(gt=0, le=1), NOT_BOOL] = Field(
         2.0 / 7.0, description="kt / kn of the friction spring"
     )
+    rolling_friction: NonNegative = Field(
+        0.0, description="rolling resistance mu_r [-]: torque capped at mu_r R* F_n"
+    )
+    rolling_damping: Annotated[float, Field(ge=0, le=1), NOT_BOOL] = Field(
+        0.3, description="eta_r [-]: the rolling dashpot's share of critical damping"
+    )
     friction_law: Literal["coulomb", "peridem"] = Field(
         "coulomb", description="'peridem': PeriDEM's friction (speeds sliding up), comparisons only"
     )

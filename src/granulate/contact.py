@@ -52,6 +52,18 @@ class Contact:
             through each other): raise it then.
         tangential_stiffness_ratio: kt / kn of the friction spring of each contact (Cundall &
             Strack), in (0, 1]; default 2/7.
+        rolling_friction: coefficient of rolling resistance mu_r >= 0 (default 0: none), for
+            calibrations in the habits of rigid-grain DEM (LIGGGHTS' coefficientRollingFriction;
+            the elastic-plastic spring-dashpot of Ai et al. 2011, model C): per pair of touching
+            bodies, a spring on their relative rolling rotation, k_r = kt R*^2, whose torque is
+            capped at mu_r R* F_n (R* the effective rolling radius, from each body's centre to
+            the contact point; F_n the normal force), and a dashpot while it holds. A disc or
+            sphere at rest on a slope of tan(a) <= mu_r does not roll; above, it rolls down at
+            g (sin a - mu_r cos a) / (1 + I / (m R^2)). Deformable grains already resist rolling
+            a little through their flattened contacts; mu_r adds to that.
+        rolling_damping: eta_r in [0, 1], the rolling dashpot's share of its critical damping
+            2 sqrt(I_r k_r) (default 0.3, Ai et al.'s choice; it stops a grain rocking on a
+            contact of few nodes). Only with rolling_friction > 0.
         friction_law: "coulomb" (default: the friction spring), or "peridem": PeriDEM's
             friction, mu |F_n| along the slip velocity (it speeds sliding up instead of
             resisting it); for comparisons with PeriDEM only.
@@ -71,6 +83,8 @@ class Contact:
     normal_stiffness: float | None = None
     stiffness_factor: float = 1.0
     tangential_stiffness_ratio: float = 2.0 / 7.0
+    rolling_friction: float = 0.0
+    rolling_damping: float = 0.3
     friction_law: str = "coulomb"
     pair_law: str = "granulate"
 
@@ -85,8 +99,12 @@ class Contact:
             )
         if not 0 < self.restitution <= 1:
             raise InputError(f"restitution must be in (0, 1], got {self.restitution}")
-        if not (self.friction >= 0 and math.isfinite(self.friction)):
-            raise InputError(f"friction must be a non-negative number, got {self.friction}")
+        for name in ("friction", "rolling_friction"):
+            value = getattr(self, name)
+            if not (value >= 0 and math.isfinite(value)):
+                raise InputError(f"{name} must be a non-negative number, got {value}")
+        if not 0 <= self.rolling_damping <= 1:
+            raise InputError(f"rolling_damping must be in [0, 1], got {self.rolling_damping}")
         if not 0 < self.tangential_stiffness_ratio <= 1:
             raise InputError(
                 "tangential_stiffness_ratio must be in (0, 1], got "

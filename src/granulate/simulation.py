@@ -979,6 +979,8 @@ class Simulation:
         law.damping_ratio = _core.damping_ratio_from_restitution(contact.restitution)
         law.friction = contact.friction
         law.tangential_stiffness_ratio = contact.tangential_stiffness_ratio
+        law.rolling_friction = contact.rolling_friction
+        law.rolling_damping = contact.rolling_damping
         law.peridem_friction = contact.friction_law == "peridem"
         law.node_pair = contact.pair_law == "peridem"
         law.surface = contact.pair_law == "surface"

@@ -230,12 +230,14 @@ def angular_momentum(sim: gr.Simulation, densities: np.ndarray) -> np.ndarray:
 
 
 def oblique_pair(
-    dimension: int, friction: float, pair_law: str = "granulate"
+    dimension: int, friction: float, pair_law: str = "granulate", rolling_friction: float = 0.0
 ) -> tuple[gr.Simulation, gr.Body, gr.Body]:
     """Two conforming grains of 1 mm (R/h = 10 in 2D, 6 in 3D) about to meet at 0.6 m/s, the
     second shifted sideways by R/2, e = 0.6."""
     sim = gr.Simulation(dimension)
-    sim.contact = gr.Contact(restitution=0.6, friction=friction, pair_law=pair_law)
+    sim.contact = gr.Contact(
+        restitution=0.6, friction=friction, pair_law=pair_law, rolling_friction=rolling_friction
+    )
     radius, h = 1e-3, 1e-3 / (10 if dimension == 2 else 6)
     shape = gr.Disc if dimension == 2 else gr.Sphere
     zero = (0.0,) * (dimension - 2)

@@ -84,6 +84,8 @@ struct Wall {
   std::array<real, 3> rotate_to_world(const std::array<real, 3>& v, real t) const;
   /// Velocity of the wall's material point at world position x, time t.
   std::array<real, 3> velocity_at(const real* x, real t) const;
+  /// Angular velocity of the wall at time t [rad/s] (zero unless it rotates).
+  std::array<real, 3> angular_velocity(real t) const;
   /// Largest distance any wall point has moved between times t0 and t1 (bound) [m].
   real motion_bound(real t0, real t1) const;
 

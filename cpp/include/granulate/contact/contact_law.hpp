@@ -43,6 +43,21 @@
 //             point (no torque on the pair). xi is kept per node pair (and per node-wall entry)
 //             across neighbour-list rebuilds and checkpoints. Law::peridem_friction gives
 //             PeriDEM's +mu F_n v_t / |v_t| instead (comparisons only).
+//   rolling:  optional rolling resistance (mu_r > 0), the elastic-plastic spring-dashpot of
+//             Ai et al. (2011, Powder Technol. 206:269, model C) with the spring of Iwashita &
+//             Oda (1998, EPSD2): per pair of touching bodies, the relative rolling rotation
+//             theta accumulates (omega_p - omega_q) dt, turned into the plane normal to the
+//             collision's normal (torsion excluded); the torque on p is M = -k_r theta - C_r
+//             omega_roll, k_r = k_t R*^2 (k_t = ratio x the sum K of the pair's springs), the
+//             spring capped at mu_r R* F_n (then theta shrinks and the dashpot is off: the
+//             bodies roll against a constant torque). C_r = 2 eta_r sqrt(I_r k_r), with 1/I_r =
+//             sum over the bodies of 1 / (I + m r^2) (I about the rolling axis). R* = r_p r_q /
+//             (r_p + r_q), r the distance from each body's centre to the contact point (r_p
+//             against a wall); F_n the sum of the pair's spring forces. p gets M and q -M as
+//             rigid-body couples, so angular momentum is conserved to round-off. A body
+//             without rotational inertia (a one-node fragment) takes none. theta is kept per
+//             pair of bodies across list rebuilds, the gaps of a collision and checkpoints, and
+//             reset when they part.
 // The force density on node i is F / V_i. Every term comes in equal and opposite pairs, so
 // Newton's third law holds to round-off.
 #pragma once
@@ -66,6 +81,8 @@ struct Law {
   real damping_ratio = 0;          ///< zeta, from the restitution coefficient
   real friction = 0;               ///< mu
   real tangential_stiffness_ratio = 2.0 / 7.0;  ///< kt / k_ij of the friction spring
+  real rolling_friction = 0;                    ///< mu_r of the rolling resistance (0: none)
+  real rolling_damping = 0.3;                   ///< eta_r, the rolling dashpot's damping ratio
   /// PeriDEM's friction, for comparisons only: mu F_n along +v_t (it speeds sliding up), no
   /// stick. See peridem_friction_force.
   bool peridem_friction = false;
@@ -91,8 +108,11 @@ struct ContactSide {
 struct PairLaw {
   real contact_radius = 0;
   real normal_stiffness = 0;
-  bool node_pair = false;  ///< PeriDEM's pair spring kn V_i V_j (else kn min(V_i, V_j)^2)
-  bool surface = false;    ///< the surface law (see Law::surface)
+  bool node_pair = false;               ///< PeriDEM's pair spring kn V_i V_j (else kn min(V_i, V_j)^2)
+  bool surface = false;                 ///< the surface law (see Law::surface)
+  real rolling_friction = 0;            ///< mu_r (see Law::rolling_friction)
+  real rolling_damping = 0;             ///< eta_r (see Law::rolling_damping)
+  real tangential_stiffness_ratio = 0;  ///< kt / k_ij, for the rolling stiffness
 };
 
 /// The finer of two particles (smaller h; on a tie, the smaller horizon), so laws are symmetric.
@@ -143,8 +163,13 @@ inline real resolve_normal_stiffness(const Law& law, const ContactSide& a, const
 
 /// Rc and kn of a law between particles a and b.
 inline PairLaw resolve(const Law& law, const ContactSide& a, const ContactSide& b, int dimension) {
-  return {resolve_contact_radius(law, a, b), resolve_normal_stiffness(law, a, b, dimension), law.node_pair,
-          law.surface};
+  return {resolve_contact_radius(law, a, b),
+          resolve_normal_stiffness(law, a, b, dimension),
+          law.node_pair,
+          law.surface,
+          law.rolling_friction,
+          law.rolling_damping,
+          law.tangential_stiffness_ratio};
 }
 
 /// Rc of a node of particle a against a rigid wall surface: the node's own contact radius
@@ -155,7 +180,13 @@ inline real resolve_wall_contact_radius(const Law& law, const ContactSide& a) {
 
 /// Rc (node to wall surface) and kn of a law between particle a and a rigid wall.
 inline PairLaw resolve_wall(const Law& law, const ContactSide& a, int dimension) {
-  return {resolve_wall_contact_radius(law, a), resolve_normal_stiffness(law, a, a, dimension), law.node_pair};
+  return {resolve_wall_contact_radius(law, a),
+          resolve_normal_stiffness(law, a, a, dimension),
+          law.node_pair,
+          false,
+          law.rolling_friction,
+          law.rolling_damping,
+          law.tangential_stiffness_ratio};
 }
 
 /// Spring stiffness of a node pair [N/m]: kn min(V_i, V_j)^2, so a fine particle's nodes against
@@ -199,9 +230,10 @@ inline void peridem_friction_force(real mu, real normal, const real tangential_v
 /// touched); it is first turned into the plane normal to the unit `normal` (keeping its length),
 /// then advanced by the tangential part of `slip` [m/s] x dt. The force on i is -kt xi, capped at
 /// mu F_n (`normal_force`, >= 0): when capped, xi shrinks to the length that carries mu F_n
-/// (the contact slides). Writes the force [N] into force[3]. Every operation is odd in (normal,
-/// slip, shear), so the pair's other entry computes exactly the opposite force.
-inline void tangential_force(real kt, real mu, real normal_force, const real normal[3], const real slip[3],
+/// (the contact slides). Writes the force [N] into force[3]; returns whether it was capped. Every
+/// operation is odd in (normal, slip, shear), so the pair's other entry computes exactly the
+/// opposite force.
+inline bool tangential_force(real kt, real mu, real normal_force, const real normal[3], const real slip[3],
                              real dt, real shear[3], real force[3]) {
   const real length = std::sqrt(shear[0] * shear[0] + shear[1] * shear[1] + shear[2] * shear[2]);
   const real along = shear[0] * normal[0] + shear[1] * normal[1] + shear[2] * normal[2];
@@ -214,11 +246,26 @@ inline void tangential_force(real kt, real mu, real normal_force, const real nor
   for (int k = 0; k < 3; ++k) shear[k] += (slip[k] - slip_normal * normal[k]) * dt;
   const real stretched = std::sqrt(shear[0] * shear[0] + shear[1] * shear[1] + shear[2] * shear[2]);
   const real limit = mu * normal_force;
-  if (kt * stretched > limit) {
+  const bool capped = kt * stretched > limit;
+  if (capped) {
     const real scale = stretched > 0 ? limit / (kt * stretched) : 0.0;
     for (int k = 0; k < 3; ++k) shear[k] *= scale;
   }
   for (int k = 0; k < 3; ++k) force[k] = -kt * shear[k];
+  return capped;
+}
+
+/// Rolling-resistance sub-model (EPSD2, see the header): advances the relative rolling rotation
+/// `rotation` [rad] of a pair of touching bodies by the part of their relative angular velocity
+/// `spin` [rad/s] (omega_p - omega_q) normal to `normal`, and writes the torque on p [N m; N m/m
+/// in 2D], -k_r rotation capped at mu_r R* F_n, into torque[3]; returns whether it was capped
+/// (the bodies roll: no dashpot then). The same spring and cap as the friction spring's
+/// (tangential_force), on rotations instead of displacements.
+inline bool rolling_torque(real rolling_stiffness, real mu_r, real effective_radius, real normal_force,
+                           const real normal[3], const real spin[3], real dt, real rotation[3],
+                           real torque[3]) {
+  return tangential_force(rolling_stiffness, mu_r * effective_radius, normal_force, normal, spin, dt,
+                          rotation, torque);
 }
 
 }  // namespace granulate::contact

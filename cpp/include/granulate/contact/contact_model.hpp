@@ -56,6 +56,8 @@ struct ContactCheckpoint {
   std::vector<real> slot_approach;
   std::vector<real> slot_normal;  ///< 3 per slot: the collision's last contact normal
   std::vector<real> slot_work;    ///< 2 per slot: the springs' work and the force-law exponent
+  /// 3 per slot: the rolling rotation of each pair of bodies (empty without rolling resistance).
+  std::vector<real> slot_rolling;
   std::vector<index_t> pair_offsets, pair_partners;  ///< the lists (updated after bond breaks)
   /// Friction springs: the pool (3 per spring) and each list entry's spring (none: 2^32 - 1).
   std::vector<real> springs;
@@ -294,6 +296,10 @@ class ContactModel {
   void sum_slot_springs(const Model& model, const State& state);
   void sum_probe_springs();
   void slot_dashpots(const State& state, real dt);
+  void slot_rolling_resistance(const State& state, real dt);
+  /// A touching body's moment of inertia for rolling about `axis` (unit) through the contact
+  /// point, at `lever` from its centre [kg m^2; per unit thickness in 2D].
+  real rolling_inertia(index_t body, const BodyMotion& motion, const vec3& axis, real lever) const;
   void slot_redirects();
   /// Velocity of a point moving with a touching body's rigid-body motion.
   vec3 rigid_velocity(index_t body, const vec3& point) const;
@@ -398,6 +404,10 @@ class ContactModel {
   // damping ratio that gives the requested restitution (power_law_damping.hpp).
   std::vector<real> slot_work_;
   std::vector<float> slot_exponent_;
+  // Rolling resistance (contact_law.hpp): the relative rolling rotation theta of each pair of
+  // bodies, 3 per slot, kept while they touch; empty unless a law has mu_r > 0.
+  bool any_rolling_ = false;
+  std::vector<real> slot_rolling_;
   // Damping ratio against the exponent p, per law (as laws_ and wall_laws_).
   std::vector<contact::DampingTable> damping_tables_, wall_damping_tables_;
   // Friction springs (tangential displacement xi) of the entries in contact, in a pool: each
@@ -428,7 +438,7 @@ class ContactModel {
     static constexpr vec3 none{0, 0, 0};
     return body_touch_[body] == not_touching ? none : body_motion_[body_touch_[body]].angular_velocity;
   }
-  std::vector<std::array<real, 6>> wall_damping_;
+  std::vector<std::array<real, 6>> wall_damping_;  // per wall: the dashpots' and rolling torques' share
   real last_time_ = 0;
   bool has_last_time_ = false;
   // Scratch, per entry: the spring stiffness k of the pair in contact, 0 if apart (single
