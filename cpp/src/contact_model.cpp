@@ -1713,9 +1713,10 @@ void ContactModel::slot_rolling_resistance(const State& state, real dt) {
 
 real ContactModel::rolling_inertia(index_t body, const BodyMotion& motion, const vec3& axis,
                                    real lever) const {
-  // I about the axis through the centre, 1 / (a . I^-1 a), plus m r^2 (about the contact point).
+  // I about the axis through the centre, 1 / (a . I^-1 a), plus m r^2 (about the contact point);
+  // a body that moves as told (every node prescribed) is as heavy as a wall.
   const real inverse = dot(axis, symmetric_times(motion.inverse_inertia, axis));
-  if (!(inverse > 0)) return std::numeric_limits<real>::infinity();  // no rotation about this axis
+  if (body_kinematic_[body] || !(inverse > 0)) return std::numeric_limits<real>::infinity();
   return 1 / inverse + body_mass_[body] * lever * lever;
 }
 
