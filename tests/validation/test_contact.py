@@ -229,6 +229,20 @@ def angular_momentum(sim: gr.Simulation, densities: np.ndarray) -> np.ndarray:
     return np.sum(masses[:, None] * np.cross(sim.positions, sim.velocities), axis=0)
 
 
+def momentum_scale(sim: gr.Simulation, densities: np.ndarray) -> float:
+    """sum_i m_i |x_i x v_i|: the scale against which angular momentum's round-off is judged."""
+    moments = np.linalg.norm(np.cross(sim.positions, sim.velocities), axis=1)
+    return float(np.sum(moments * sim.volumes * densities))
+
+
+def run_through_contact(sim: gr.Simulation) -> None:
+    """Runs 20 steps at a time until the bodies have touched and parted again."""
+    touched = False
+    while not touched or sim.core.contact_statistics.node_contacts > 0:
+        sim.run(20)
+        touched = touched or sim.core.contact_statistics.node_contacts > 0
+
+
 def oblique_pair(
     dimension: int, friction: float, pair_law: str = "granulate", rolling_friction: float = 0.0
 ) -> tuple[gr.Simulation, gr.Body, gr.Body]:
@@ -264,13 +278,8 @@ def test_oblique_collision_conserves_angular_momentum(dimension: int, friction: 
     sim, a, b = oblique_pair(dimension, friction)
     densities = np.full(sim.node_count, SOFT.density)
     before = angular_momentum(sim, densities)
-    scale = np.sum(
-        np.linalg.norm(np.cross(sim.positions, sim.velocities), axis=1) * sim.volumes * densities
-    )
-    touched = False
-    while not touched or sim.core.contact_statistics.node_contacts > 0:
-        sim.run(20)
-        touched = touched or sim.core.contact_statistics.node_contacts > 0
+    scale = momentum_scale(sim, densities)
+    run_through_contact(sim)
     spins = [rigid_spin(sim, body) for body in (a, b)]
     assert max(abs(s) for s in spins) > 1.0  # the collision turned the bodies
     np.testing.assert_allclose(angular_momentum(sim, densities), before, rtol=0, atol=1e-12 * scale)
@@ -308,15 +317,8 @@ def test_collisions_of_meshed_particles_conserve_angular_momentum(
         sim.velocities[b.nodes, 0] = -0.1
         densities = np.full(sim.node_count, SOFT.density)
         before, energy = angular_momentum(sim, densities), sim.kinetic_energy()
-        scale = np.sum(
-            np.linalg.norm(np.cross(sim.positions, sim.velocities), axis=1)
-            * sim.volumes
-            * densities
-        )
-        touched = False
-        while not touched or sim.core.contact_statistics.node_contacts > 0:
-            sim.run(20)
-            touched = touched or sim.core.contact_statistics.node_contacts > 0
+        scale = momentum_scale(sim, densities)
+        run_through_contact(sim)
         after = angular_momentum(sim, densities)
         np.testing.assert_allclose(after, before, rtol=0, atol=1e-12 * scale)
         if restitution == 1.0 and friction == 0.0:

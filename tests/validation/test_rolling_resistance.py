@@ -10,7 +10,14 @@ import pytest
 
 import granulate as gr
 
-from .test_contact import SOFT, angular_momentum, oblique_pair, rigid_spin
+from .test_contact import (
+    SOFT,
+    angular_momentum,
+    momentum_scale,
+    oblique_pair,
+    rigid_spin,
+    run_through_contact,
+)
 from .test_friction import rigid_motion
 
 RADIUS = 1e-3
@@ -90,15 +97,8 @@ def test_rolling_torques_conserve_angular_momentum() -> None:
         sim.velocities[a.nodes, 1] += SPIN * arm[:, 0]
         densities = np.full(sim.node_count, SOFT.density)
         before = angular_momentum(sim, densities)
-        scale = np.sum(
-            np.linalg.norm(np.cross(sim.positions, sim.velocities), axis=1)
-            * sim.volumes
-            * densities
-        )
-        touched = False
-        while not touched or sim.core.contact_statistics.node_contacts > 0:
-            sim.run(20)
-            touched = touched or sim.core.contact_statistics.node_contacts > 0
+        scale = momentum_scale(sim, densities)
+        run_through_contact(sim)
         spins[mu_r] = np.array([rigid_spin(sim, body) for body in (a, b)])
         np.testing.assert_allclose(
             angular_momentum(sim, densities), before, rtol=0, atol=1e-12 * scale
