@@ -57,13 +57,14 @@ class Contact:
             the elastic-plastic spring-dashpot of Ai et al. 2011, model C): per pair of touching
             bodies, a spring on their relative rolling rotation, k_r = kt R*^2, whose torque is
             capped at mu_r R* F_n (R* the effective rolling radius, from each body's centre to
-            the contact point; F_n the normal force), and a dashpot while it holds. A disc or
-            sphere at rest on a slope of tan(a) <= mu_r does not roll; above, it rolls down at
-            g (sin a - mu_r cos a) / (1 + I / (m R^2)). Deformable grains already resist rolling
-            a little through their flattened contacts; mu_r adds to that.
+            the contact point; F_n the normal force), and a dashpot while it holds. A disc at
+            rest on a slope of tan(a) <= mu_r does not roll; above, it rolls down at
+            g (sin a - mu_r cos a) / (1 + I / (m R^2)) (a coarse sphere, resting on one node,
+            still creeps slowly: ARCHITECTURE.md). Deformable grains already resist rolling a
+            little through their flattened contacts; mu_r adds to that.
         rolling_damping: eta_r in [0, 1], the rolling dashpot's share of its critical damping
-            2 sqrt(I_r k_r) (default 0.3, Ai et al.'s choice; it stops a grain rocking on a
-            contact of few nodes). Only with rolling_friction > 0.
+            2 sqrt(I_r k_r) (default 0.3; it damps a grain rocking on a contact of few nodes).
+            Only with rolling_friction > 0.
         friction_law: "coulomb" (default: the friction spring), or "peridem": PeriDEM's
             friction, mu |F_n| along the slip velocity (it speeds sliding up instead of
             resisting it); for comparisons with PeriDEM only.

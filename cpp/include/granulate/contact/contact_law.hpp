@@ -255,12 +255,12 @@ inline bool tangential_force(real kt, real mu, real normal_force, const real nor
   return capped;
 }
 
-/// Rolling-resistance sub-model (EPSD2, see the header): advances the relative rolling rotation
-/// `rotation` [rad] of a pair of touching bodies by the part of their relative angular velocity
-/// `spin` [rad/s] (omega_p - omega_q) normal to `normal`, and writes the torque on p [N m; N m/m
-/// in 2D], -k_r rotation capped at mu_r R* F_n, into torque[3]; returns whether it was capped
-/// (the bodies roll: no dashpot then). The same spring and cap as the friction spring's
-/// (tangential_force), on rotations instead of displacements.
+/// Rolling-resistance spring (see the header; the dashpot is added by the caller): advances the relative
+/// rolling rotation `rotation` [rad] of a pair of touching bodies by the part of their relative angular
+/// velocity `spin` [rad/s] (omega_p - omega_q) normal to `normal`, and writes the torque on p [N m; N m/m in
+/// 2D], -k_r rotation capped at mu_r R* F_n, into torque[3]; returns whether it was capped (the bodies roll:
+/// no dashpot then). The same spring and cap as the friction spring's (tangential_force), on rotations
+/// instead of displacements.
 inline bool rolling_torque(real rolling_stiffness, real mu_r, real effective_radius, real normal_force,
                            const real normal[3], const real spin[3], real dt, real rotation[3],
                            real torque[3]) {
