@@ -454,6 +454,7 @@ bool ContactModel::takes_part(const Model& model, const State& state, index_t i)
 }
 
 bool ContactModel::surface_entry(const Model& model, index_t i, std::size_t e) const {
+  if (!any_surface_) return false;
   const index_t j = pair_partner_[e];
   return slot_law(pair_slot_[e]).surface && node_body_[i] != node_body_[j] &&
          (on_surface(model, i) || on_surface(model, j));

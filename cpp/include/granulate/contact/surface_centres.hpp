@@ -21,6 +21,7 @@
 #pragma once
 
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -107,6 +108,9 @@ class SurfaceCentres {
   }
 
  private:
+  /// The factor f of the linear form y_i + f A_i outside the surface law: length / ((h/2) |o_i|).
+  static real linear_scale(const Seen& s, real length);
+  static real length_of(const vec3& a);
   void detach(index_t i);
   /// Node i's anchors from the shape (none for an outer-layer node of a particle not under the
   /// surface law).
@@ -119,5 +123,86 @@ class SurfaceCentres {
   std::vector<std::uint8_t> anchored_;         // per node: seen at its anchors (0 once detached)
   std::vector<const SurfaceAnchor*> anchors_;  // per node under the surface law: lookup(), kept
 };
+
+inline real SurfaceCentres::linear_scale(const Seen& s, real length) {
+  return length / (0.5 * s.mesh_size * s.anchor->reach);
+}
+
+inline real SurfaceCentres::length_of(const vec3& a) {
+  return std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+}
+
+inline SurfaceCentres::Seen SurfaceCentres::seen(const Model& model, index_t i) const {
+  // One look-up of the particle: a node still marked as anchored has the anchors find() found.
+  Seen s;
+  if (!moved(i)) return s;
+  const index_t p = model.node_particle()[i];
+  const Particle& particle = model.particles()[p];
+  s.anchor =
+      anchors_.empty() ? model.shapes()[particle.shape].anchors.of(i - particle.first_node) : anchors_[i];
+  s.first = particle.first_node;
+  s.mesh_size = particle.mesh_size;
+  s.along_normal = surface_[p] != 0;
+  s.surface_length = s.anchor->depth * particle.mesh_size;
+  s.centre_length = (s.anchor->depth - 0.5 * depth_[p] * s.anchor->reach) * particle.mesh_size;
+  return s;
+}
+
+inline SurfaceCentres::vec3 SurfaceCentres::anchored_vector(const Seen& s, const std::vector<real>& field,
+                                                            index_t i) {
+  vec3 sum{0, 0, 0};
+  if (s.anchor == nullptr) return sum;
+  const real* f = field.data();
+  const SurfaceAnchor& a = *s.anchor;
+  for (std::size_t k = 0; k < a.nodes.size() && a.nodes[k] != SurfaceAnchor::no_anchor; ++k) {
+    const index_t j = s.first + a.nodes[k];
+    for (int d = 0; d < 3; ++d) sum[d] += a.weights[k] * (f[3 * j + d] - f[3 * i + d]);
+  }
+  return sum;
+}
+
+inline SurfaceCentres::vec3 SurfaceCentres::point(const State& state, const Seen& s, index_t i,
+                                                  real length) const {
+  const real* y = state.positions.data();
+  vec3 q{y[3 * i], y[3 * i + 1], y[3 * i + 2]};
+  if (length == 0 || s.anchor == nullptr) return q;
+  const vec3 a = anchored_vector(s, state.positions, i);
+  const real scale = s.along_normal ? length / length_of(a) : linear_scale(s, length);
+  for (int d = 0; d < 3; ++d) q[d] += scale * a[d];
+  return q;
+}
+
+inline SurfaceCentres::vec3 SurfaceCentres::point_velocity(const State& state, const Seen& s, index_t i,
+                                                           real length) const {
+  const real* v = state.velocities.data();
+  vec3 u{v[3 * i], v[3 * i + 1], v[3 * i + 2]};
+  if (length == 0 || s.anchor == nullptr) return u;
+  const vec3 rate = anchored_vector(s, state.velocities, i);
+  if (!s.along_normal) {
+    const real scale = linear_scale(s, length);
+    for (int d = 0; d < 3; ++d) u[d] += scale * rate[d];
+    return u;
+  }
+  const vec3 a = anchored_vector(s, state.positions, i);
+  const real size = length_of(a);
+  const real along = (a[0] * rate[0] + a[1] * rate[1] + a[2] * rate[2]) / (size * size);
+  for (int d = 0; d < 3; ++d) u[d] += length * (rate[d] - along * a[d]) / size;
+  return u;
+}
+
+inline SurfaceCentres::vec3 SurfaceCentres::lever(const State& state, const Seen& s, index_t i, real length,
+                                                  const vec3& force) const {
+  if (length == 0 || s.anchor == nullptr) return {0, 0, 0};
+  if (!s.along_normal) {
+    const real scale = linear_scale(s, length);
+    return {scale * force[0], scale * force[1], scale * force[2]};
+  }
+  const vec3 a = anchored_vector(s, state.positions, i);
+  const real size2 = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
+  const real size = std::sqrt(size2);
+  const real along = (a[0] * force[0] + a[1] * force[1] + a[2] * force[2]) / size2;
+  return {length * (force[0] - along * a[0]) / size, length * (force[1] - along * a[1]) / size,
+          length * (force[2] - along * a[2]) / size};
+}
 
 }  // namespace granulate
