@@ -21,6 +21,13 @@ real dot(const vec& a, const vec& b) {
   return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
 }
 
+/// Gives back a vector's memory once it holds under half its capacity: lists shrink as bodies
+/// part, and a shattered sample's largest lists would otherwise stay allocated for the run.
+template <class T>
+void release_excess(std::vector<T>& v) {
+  if (v.capacity() > 2 * v.size() + 64) v.shrink_to_fit();
+}
+
 /// Symmetric 3x3 matrix (xx, yy, zz, xy, xz, yz) times a vector.
 vec symmetric_times(const std::array<real, 6>& m, const vec& v) {
   return {m[0] * v[0] + m[3] * v[1] + m[4] * v[2], m[3] * v[0] + m[1] * v[1] + m[5] * v[2],
@@ -776,6 +783,20 @@ void ContactModel::finish_lists(const Model& model) {
   wall_entry_stiffness_.assign(wall_entry_.size(), 0);
   wall_points_.assign(wall_entry_.size(), {});
   wall_entry_reaction_.assign(wall_entry_.size(), {0, 0, 0, 0, 0, 0});
+  release_excess(pair_partner_);
+  release_excess(pair_slot_);
+  release_excess(pair_spring_);
+  release_excess(pair_stiffness_);
+  release_excess(slots_);
+  release_excess(slot_reduced_mass_);
+  release_excess(slot_law_index_);
+  release_excess(slot_stiffness_);
+  release_excess(slot_approach_);
+  release_excess(slot_last_normal_);
+  release_excess(slot_work_);
+  release_excess(slot_exponent_);
+  release_excess(slot_rolling_);
+  release_excess(slot_touch_);
 }
 
 void ContactModel::find_groups(const Model& model) {
@@ -1456,6 +1477,8 @@ void ContactModel::sum_slot_stiffness() {
   }
   body_motion_.resize(touching_bodies_.size());
   body_load_.resize(touching_bodies_.size());
+  release_excess(body_motion_);
+  release_excess(body_load_);
   slot_force_.assign(in_contact, 0.0);
   slot_normal_.assign(in_contact, vec3{0, 0, 0});
   slot_point_.assign(in_contact, vec3{0, 0, 0});

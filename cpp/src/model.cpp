@@ -196,6 +196,13 @@ void Model::finalize() {
     std::vector<real>().swap(shape.surface_offsets);
     std::vector<real>().swap(shape.surface_depths);
   }
+  // The per-node arrays grew body by body (capacity up to twice their size); the model is
+  // complete now.
+  reference_positions_.shrink_to_fit();
+  volumes_.shrink_to_fit();
+  node_particle_.shrink_to_fit();
+  node_material_.shrink_to_fit();
+  node_density_.shrink_to_fit();
   finalized_ = true;
 }
 
