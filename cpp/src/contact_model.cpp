@@ -1673,66 +1673,76 @@ void ContactModel::slot_rolling_resistance(const State& state, real dt) {
   // their relative rotation, its torque M on the first body and -M on the second (or the wall),
   // as rigid-body couples.
   if (slot_rolling_.empty()) return;
-  auto has_inertia = [](const BodyMotion& m) {
-    return m.inverse_inertia != std::array<real, 6>{0, 0, 0, 0, 0, 0};
-  };
   for (std::size_t slot = 0; slot < slots_.size(); ++slot) {
-    real* rotation = &slot_rolling_[3 * slot];
-    const contact::PairLaw& law = slot_law(slot);
-    const bool wall_slot = slot >= particle_slot_count_;
-    const index_t p = slots_[slot][0], q = slots_[slot][1];
-    const index_t touch = slot_touch_[slot];
-    const vec sum = touch == not_touching ? vec{0, 0, 0} : slot_surface_normal_[touch];
-    const real norm = std::sqrt(dot(sum, sum));
-    const bool rolling = law.rolling_friction > 0 && (wall_slot || p != q) && norm > 0 &&
-                         slot_force_[touch] > 0 && has_inertia(body_motion_[body_touch_[p]]) &&
-                         (wall_slot || has_inertia(body_motion_[body_touch_[q]]));
-    if (!rolling) {
+    if (!resists_rolling(slot)) {
       // In a gap of the collision (chattering surface nodes part for a few steps) the spring
       // keeps its rotation and acts again when they touch; once the bodies are apart it starts
       // again at the next touch.
-      if (!(slot_approach_[slot] > 0)) std::fill(rotation, rotation + 3, 0.0);
+      if (!(slot_approach_[slot] > 0)) std::fill_n(&slot_rolling_[3 * slot], 3, 0.0);
       continue;
     }
-    const BodyMotion& first = body_motion_[body_touch_[p]];
-    const real force = slot_force_[touch];
-    const vec point{slot_point_[touch][0] / force, slot_point_[touch][1] / force,
-                    slot_point_[touch][2] / force};
-    auto distance = [&](const vec& centre) {
-      const vec arm{point[0] - centre[0], point[1] - centre[1], point[2] - centre[2]};
-      return std::sqrt(dot(arm, arm));
-    };
-    const real rp = distance(first.centre);
-    const vec spin_q =
-        wall_slot ? walls_[q].angular_velocity(state.time) : body_motion_[body_touch_[q]].angular_velocity;
-    const real rq = wall_slot ? 0.0 : distance(body_motion_[body_touch_[q]].centre);
-    const real radius = wall_slot ? rp : rp * rq / (rp + rq);
-    const vec normal{sum[0] / norm, sum[1] / norm, sum[2] / norm};
-    const vec spin{first.angular_velocity[0] - spin_q[0], first.angular_velocity[1] - spin_q[1],
-                   first.angular_velocity[2] - spin_q[2]};
-    const real stiffness = law.tangential_stiffness_ratio * slot_stiffness_[slot] * radius * radius;
-    vec torque{0, 0, 0};
-    const bool rolls = contact::rolling_torque(stiffness, law.rolling_friction, radius, force, normal.data(),
-                                               spin.data(), dt, rotation, torque.data());
-    const real twist = dot(spin, normal);
-    const vec roll{spin[0] - twist * normal[0], spin[1] - twist * normal[1], spin[2] - twist * normal[2]};
-    const real speed = std::sqrt(dot(roll, roll));
-    if (!rolls && speed > 0 && law.rolling_damping > 0) {
-      const vec axis{roll[0] / speed, roll[1] / speed, roll[2] / speed};
-      real compliance = 1 / rolling_inertia(p, first, axis, rp);
-      if (!wall_slot) compliance += 1 / rolling_inertia(q, body_motion_[body_touch_[q]], axis, rq);
-      const real damping = 2 * law.rolling_damping * std::sqrt(stiffness / compliance);
-      for (int k = 0; k < 3; ++k) torque[k] -= damping * roll[k];
-    }
-    const index_t tp = body_touch_[p];
-    for (int k = 0; k < 3; ++k) body_load_[tp][3 + k] += torque[k];
-    if (wall_slot) {
-      for (int k = 0; k < 3; ++k) wall_damping_[q][3 + k] -= torque[k];
-    } else {
-      const index_t tq = body_touch_[q];
-      for (int k = 0; k < 3; ++k) body_load_[tq][3 + k] -= torque[k];
+    const vec torque = slot_rolling_torque(state, slot, dt);
+    const index_t p = slots_[slot][0], q = slots_[slot][1];
+    for (int k = 0; k < 3; ++k) body_load_[body_touch_[p]][3 + k] += torque[k];
+    for (int k = 0; k < 3; ++k) {
+      if (slot >= particle_slot_count_) {
+        wall_damping_[q][3 + k] -= torque[k];
+      } else {
+        body_load_[body_touch_[q]][3 + k] -= torque[k];
+      }
     }
   }
+}
+
+bool ContactModel::resists_rolling(std::size_t slot) const {
+  auto turns = [&](index_t body) {
+    return body_motion_[body_touch_[body]].inverse_inertia != std::array<real, 6>{0, 0, 0, 0, 0, 0};
+  };
+  const bool wall_slot = slot >= particle_slot_count_;
+  const index_t p = slots_[slot][0], q = slots_[slot][1];
+  const index_t touch = slot_touch_[slot];
+  if (!(slot_law(slot).rolling_friction > 0) || (!wall_slot && p == q) || touch == not_touching) return false;
+  const vec& sum = slot_surface_normal_[touch];
+  return dot(sum, sum) > 0 && slot_force_[touch] > 0 && turns(p) && (wall_slot || turns(q));
+}
+
+vec3 ContactModel::slot_rolling_torque(const State& state, std::size_t slot, real dt) {
+  const contact::PairLaw& law = slot_law(slot);
+  const bool wall_slot = slot >= particle_slot_count_;
+  const index_t p = slots_[slot][0], q = slots_[slot][1];
+  const index_t touch = slot_touch_[slot];
+  const BodyMotion& first = body_motion_[body_touch_[p]];
+  const BodyMotion* second = wall_slot ? nullptr : &body_motion_[body_touch_[q]];
+  const real force = slot_force_[touch];
+  const vec point{slot_point_[touch][0] / force, slot_point_[touch][1] / force,
+                  slot_point_[touch][2] / force};
+  auto distance = [&](const vec& centre) {
+    const vec arm{point[0] - centre[0], point[1] - centre[1], point[2] - centre[2]};
+    return std::sqrt(dot(arm, arm));
+  };
+  const real rp = distance(first.centre), rq = wall_slot ? 0.0 : distance(second->centre);
+  const real radius = wall_slot ? rp : rp * rq / (rp + rq);
+  const vec& sum = slot_surface_normal_[touch];
+  const real norm = std::sqrt(dot(sum, sum));
+  const vec normal{sum[0] / norm, sum[1] / norm, sum[2] / norm};
+  const vec spin_q = wall_slot ? walls_[q].angular_velocity(state.time) : second->angular_velocity;
+  const vec spin{first.angular_velocity[0] - spin_q[0], first.angular_velocity[1] - spin_q[1],
+                 first.angular_velocity[2] - spin_q[2]};
+  const real stiffness = law.tangential_stiffness_ratio * slot_stiffness_[slot] * radius * radius;
+  vec torque{0, 0, 0};
+  const bool rolls = contact::rolling_torque(stiffness, law.rolling_friction, radius, force, normal.data(),
+                                             spin.data(), dt, &slot_rolling_[3 * slot], torque.data());
+  // The dashpot, while the spring holds: C_r = 2 eta_r sqrt(I_r k_r) on the rolling speed.
+  const real twist = dot(spin, normal);
+  const vec roll{spin[0] - twist * normal[0], spin[1] - twist * normal[1], spin[2] - twist * normal[2]};
+  const real speed = std::sqrt(dot(roll, roll));
+  if (rolls || !(speed > 0) || !(law.rolling_damping > 0)) return torque;
+  const vec axis{roll[0] / speed, roll[1] / speed, roll[2] / speed};
+  real compliance = 1 / rolling_inertia(p, first, axis, rp);
+  if (!wall_slot) compliance += 1 / rolling_inertia(q, *second, axis, rq);
+  const real damping = 2 * law.rolling_damping * std::sqrt(stiffness / compliance);
+  for (int k = 0; k < 3; ++k) torque[k] -= damping * roll[k];
+  return torque;
 }
 
 real ContactModel::rolling_inertia(index_t body, const BodyMotion& motion, const vec3& axis,

@@ -297,6 +297,11 @@ class ContactModel {
   void sum_probe_springs();
   void slot_dashpots(const State& state, real dt);
   void slot_rolling_resistance(const State& state, real dt);
+  /// Whether a slot's bodies resist rolling this step: a law with mu_r > 0, two bodies (or a
+  /// body and a wall) in contact, each able to turn (rotational inertia).
+  bool resists_rolling(std::size_t slot) const;
+  /// The rolling torque on a resisting slot's first body (advances its rolling rotation).
+  vec3 slot_rolling_torque(const State& state, std::size_t slot, real dt);
   /// A touching body's moment of inertia for rolling about `axis` (unit) through the contact
   /// point, at `lever` from its centre [kg m^2; per unit thickness in 2D].
   real rolling_inertia(index_t body, const BodyMotion& motion, const vec3& axis, real lever) const;
