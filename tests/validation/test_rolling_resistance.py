@@ -44,8 +44,8 @@ def ball_on_slope(
 def test_a_ball_on_a_slope_below_its_rolling_resistance_stays_put(full: bool) -> None:
     """tan(a) = 0.5, mu_r = 0.6: once the rolling spring has taken the load (5 ms for a disc at
     R/h = 10; 15 ms for a sphere at R/h = 8, with --full, about 80 s more), the ball moves less
-    than 1e-3 of its size in 10 ms (measured 1.7e-9 m and 5.3e-7 m). Without rolling
-    resistance it rolls down (the next test). A coarser sphere (R/h = 6) rests on one node and
+    than 1e-3 of its size in 10 ms (measured 1.7e-9 m and 5.3e-7 m). With mu_r below tan(a) it
+    rolls down (the next test). A coarser sphere (R/h = 6) rests on one node and
     rocks: it drifted 2.3e-6 m in 10 ms after 30 ms, and 5.6e-6 m at tan(a) = 0.3 (1.4 % of its
     free rolling); see ARCHITECTURE.md."""
     cases = [(2, 10, 0.005)] + ([(3, 8, 0.015)] if full else [])
