@@ -255,18 +255,20 @@ real ContactModel::pair_reach(const Model& model, index_t i, index_t j, bool sam
   const SurfaceAnchor* ai = centres_.anchor(model, i);
   const SurfaceAnchor* aj = centres_.anchor(model, j);
   if (same_body || !law.surface || (ai == nullptr && aj == nullptr)) {
-    // Spheres at the contact centres, which lie rho |o| below the list positions (the surface
-    // points) of particles under the surface law.
-    real reach = rc;
-    if (ai != nullptr && surface_particle(owner[i])) reach += node_radius(law, model, i, j, rc) * ai->reach;
-    if (aj != nullptr && surface_particle(owner[j])) reach += node_radius(law, model, j, i, rc) * aj->reach;
-    return reach;
+    // Spheres at the contact centres, below the list positions.
+    return rc + list_offset(model, i, node_radius(law, model, i, j, rc)) +
+           list_offset(model, j, node_radius(law, model, j, i, rc));
   }
   const real support_i = contact::surface_support_factor * particle_side_[owner[i]].mesh_size;
   const real support_j = contact::surface_support_factor * particle_side_[owner[j]].mesh_size;
   if (ai != nullptr && aj != nullptr) return std::max(support_i, support_j);
   if (aj != nullptr) return support_j + node_radius(law, model, i, j, rc);  // i's sphere probes j's surface
   return support_i + node_radius(law, model, j, i, rc);
+}
+
+real ContactModel::list_offset(const Model& model, index_t i, real radius) const {
+  const SurfaceAnchor* anchor = centres_.anchor(model, i);
+  return anchor != nullptr && surface_particle(model.node_particle()[i]) ? radius * anchor->reach : 0.0;
 }
 
 real ContactModel::largest_pair_reach(const Model& model) const {
@@ -993,12 +995,9 @@ void ContactModel::rebuild(const Model& model, const State& state, std::uint64_t
     std::vector<WallContact> local;
     for (std::size_t w = 0; w < walls_.size(); ++w) {
       if (!wall_law_set_[w * material_count_ + node_material[i]]) continue;
-      // x is the list position: under the surface law the surface point, rho |o| above the
-      // contact centre.
-      const SurfaceAnchor* anchor = centres_.anchor(model, i);
+      // x is the list position, list_offset out from the contact centre.
       const real radius = wall_law(static_cast<index_t>(w), node_particle[i]).contact_radius;
-      const bool above = anchor != nullptr && surface_particle(node_particle[i]);
-      const real limit = radius * (1 + (above ? anchor->reach : 0.0)) + skin_;
+      const real limit = radius + list_offset(model, i, radius) + skin_;
       const auto p = walls_[w].to_reference(&x[3 * i], state.time);
       for (std::size_t s = 0; s < walls_[w].surfaces.size(); ++s) {
         local.clear();
@@ -1631,10 +1630,7 @@ void ContactModel::slot_dashpots(const State& state, real dt) {
     }
     const vec normal{last_normal[0], last_normal[1], last_normal[2]};
     // The contact point: spring-weighted, or the first body's centre in a gap of the collision.
-    const vec point = in_contact ? vec{slot_point_[touch][0] / slot_force_[touch],
-                                       slot_point_[touch][1] / slot_force_[touch],
-                                       slot_point_[touch][2] / slot_force_[touch]}
-                                 : body_motion_[body_touch_[p]].centre;
+    const vec point = in_contact ? slot_contact_point(touch) : body_motion_[body_touch_[p]].centre;
     const vec velocity_p = rigid_velocity(p, point);
     const vec velocity_q = wall_slot ? walls_[q].velocity_at(point.data(), t) : rigid_velocity(q, point);
     const vec relative{velocity_p[0] - velocity_q[0], velocity_p[1] - velocity_q[1],
@@ -1714,8 +1710,7 @@ vec3 ContactModel::slot_rolling_torque(const State& state, std::size_t slot, rea
   const BodyMotion& first = body_motion_[body_touch_[p]];
   const BodyMotion* second = wall_slot ? nullptr : &body_motion_[body_touch_[q]];
   const real force = slot_force_[touch];
-  const vec point{slot_point_[touch][0] / force, slot_point_[touch][1] / force,
-                  slot_point_[touch][2] / force};
+  const vec point = slot_contact_point(touch);
   auto distance = [&](const vec& centre) {
     const vec arm{point[0] - centre[0], point[1] - centre[1], point[2] - centre[2]};
     return std::sqrt(dot(arm, arm));
@@ -1752,6 +1747,11 @@ real ContactModel::rolling_inertia(index_t body, const BodyMotion& motion, const
   const real inverse = dot(axis, symmetric_times(motion.inverse_inertia, axis));
   if (body_kinematic_[body] || !(inverse > 0)) return std::numeric_limits<real>::infinity();
   return 1 / inverse + body_mass_[body] * lever * lever;
+}
+
+vec3 ContactModel::slot_contact_point(index_t touch) const {
+  const real force = slot_force_[touch];
+  return {slot_point_[touch][0] / force, slot_point_[touch][1] / force, slot_point_[touch][2] / force};
 }
 
 vec3 ContactModel::rigid_velocity(index_t body, const vec3& point) const {
@@ -1808,8 +1808,7 @@ void ContactModel::slot_redirects() {
     // Turned only by the tilts the node layout gives (up to 30 degrees for a first touch of
     // two node spheres); a larger angle means surfaces the normals do not describe (corners).
     if (!(size > 0) || !(surface_size > 0) || dot(resultant, surface) < 0.7 * size * surface_size) continue;
-    const vec point{slot_point_[touch][0] / slot_force_[touch], slot_point_[touch][1] / slot_force_[touch],
-                    slot_point_[touch][2] / slot_force_[touch]};
+    const vec point = slot_contact_point(touch);
     vec turn;
     for (int k = 0; k < 3; ++k) turn[k] = size * surface[k] / surface_size - resultant[k];
     const vec vq = rigid_velocity(q, point), vp = rigid_velocity(p, point);

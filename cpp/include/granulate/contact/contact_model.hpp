@@ -205,6 +205,10 @@ class ContactModel {
   /// positions where they have none): the surface law's support radius where either carries a
   /// surface point of another body, else the pair's Rc (plus the centres' depths in one body).
   real pair_reach(const Model& model, index_t i, index_t j, bool same_body) const;
+  /// How far node i's list position lies out from its contact centre, for a contact radius
+  /// `radius` of the node: radius |o_i| for a surface point of a particle under the surface
+  /// law (at_list is then the surface point), 0 otherwise.
+  real list_offset(const Model& model, index_t i, real radius) const;
   /// The largest pair_reach any two nodes can have.
   real largest_pair_reach(const Model& model) const;
   SurfaceCentres centres_;
@@ -306,6 +310,8 @@ class ContactModel {
   /// point, at `lever` from its centre [kg m^2; per unit thickness in 2D].
   real rolling_inertia(index_t body, const BodyMotion& motion, const vec3& axis, real lever) const;
   void slot_redirects();
+  /// The spring-weighted contact point of a slot in contact (its index among them).
+  vec3 slot_contact_point(index_t touch) const;
   /// Velocity of a point moving with a touching body's rigid-body motion.
   vec3 rigid_velocity(index_t body, const vec3& point) const;
   /// A force at a point of a touching body, as a rigid-body load.

@@ -174,20 +174,11 @@ inline SurfaceCentres::vec3 SurfaceCentres::point(const State& state, const Seen
 
 inline SurfaceCentres::vec3 SurfaceCentres::point_velocity(const State& state, const Seen& s, index_t i,
                                                            real length) const {
+  // The rate of the point's offset is the lever map of A_i's rate.
   const real* v = state.velocities.data();
-  vec3 u{v[3 * i], v[3 * i + 1], v[3 * i + 2]};
-  if (length == 0 || s.anchor == nullptr) return u;
-  const vec3 rate = anchored_vector(s, state.velocities, i);
-  if (!s.along_normal) {
-    const real scale = linear_scale(s, length);
-    for (int d = 0; d < 3; ++d) u[d] += scale * rate[d];
-    return u;
-  }
-  const vec3 a = anchored_vector(s, state.positions, i);
-  const real size = length_of(a);
-  const real along = (a[0] * rate[0] + a[1] * rate[1] + a[2] * rate[2]) / (size * size);
-  for (int d = 0; d < 3; ++d) u[d] += length * (rate[d] - along * a[d]) / size;
-  return u;
+  if (length == 0 || s.anchor == nullptr) return {v[3 * i], v[3 * i + 1], v[3 * i + 2]};
+  const vec3 rate = lever(state, s, i, length, anchored_vector(s, state.velocities, i));
+  return {v[3 * i] + rate[0], v[3 * i + 1] + rate[1], v[3 * i + 2] + rate[2]};
 }
 
 inline SurfaceCentres::vec3 SurfaceCentres::lever(const State& state, const Seen& s, index_t i, real length,
