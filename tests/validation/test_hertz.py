@@ -21,8 +21,10 @@ E, NU, RADIUS = 3e7, 0.25, 1e-3
 
 def squeeze(nodes_across_radius: int, stiffness_factor: float, approach: float) -> float:
     """Force on the plates over Hertz's at a plate approach of 2 d (d = approach x R per
-    contact), reached at 0.05 m/s from first touch (the sphere touches both plates at t = 0)."""
-    speed = 0.05
+    contact), reached at 0.2 m/s from first touch (the sphere touches both plates at t = 0).
+    That is slow enough to be static: the sphere's wave crosses it about 90 times on the way,
+    and at 0.05 m/s the ratios differ by under 0.002."""
+    speed = 0.2
     sim = gr.Simulation(3)
     sim.contact = gr.Contact(restitution=1.0, stiffness_factor=stiffness_factor)
     grain = gr.Material(density=1200, youngs_modulus=E, poisson_ratio=NU, fracture=False)
@@ -46,9 +48,10 @@ def squeeze(nodes_across_radius: int, stiffness_factor: float, approach: float) 
 @pytest.mark.validation
 def test_sphere_between_plates_follows_hertz(full: bool) -> None:
     """stiffness_factor 100: at d = 0.11 R the contact is 2 h (R/h = 6) or 2.65 h (R/h = 8,
-    --full) in radius, and the force is Hertz's within 10 % (measured 0.950 and 0.988; at
-    d = 0.1 R 0.931 and 0.971). The default kn (factor 1) is far softer than the grain:
-    0.077 of Hertz's force at R/h = 8, 0.49 with factor 10."""
+    --full) in radius, and the force is Hertz's within 10 % (measured 0.949 and 0.991; at
+    d = 0.1 R 0.932 and 0.968; at 0.05 m/s 0.950 and 0.988, and at d = 0.1 R 0.931 and 0.971).
+    The default kn (factor 1) is far softer than the grain: 0.077 of Hertz's force at R/h = 8,
+    0.49 with factor 10."""
     ratio = squeeze(8 if full else 6, 100.0, 0.11)
     assert ratio == pytest.approx(1.0, abs=0.10)
 
