@@ -28,6 +28,13 @@ void release_excess(std::vector<T>& v) {
   if (v.capacity() > 2 * v.size() + 64) v.shrink_to_fit();
 }
 
+/// Gives back all of a vector's spare memory, for the arrays made anew at each list build: a
+/// copy per build, where the growth of the build would keep up to twice their size.
+template <class T>
+void fit(std::vector<T>& v) {
+  if (v.capacity() > v.size()) v.shrink_to_fit();
+}
+
 /// Symmetric 3x3 matrix (xx, yy, zz, xy, xz, yz) times a vector.
 vec symmetric_times(const std::array<real, 6>& m, const vec& v) {
   return {m[0] * v[0] + m[3] * v[1] + m[4] * v[2], m[3] * v[0] + m[1] * v[1] + m[5] * v[2],
@@ -595,21 +602,25 @@ void ContactModel::carry_over_springs(const KeptLists& kept, index_t n) {
          i);
     walk(kept.wall_offsets, kept.wall_entry, kept.wall_spring, wall_offsets_, wall_entry_, wall_spring_, i);
   }
-  collect_free_springs();
+  compact_springs();
 }
 
-void ContactModel::collect_free_springs() {
-  std::vector<std::uint8_t> held(springs_.size(), 0);
-  for (const index_t s : pair_spring_) {
-    if (s != no_spring) held[s] = 1;
-  }
-  for (const index_t s : wall_spring_) {
-    if (s != no_spring) held[s] = 1;
-  }
+void ContactModel::compact_springs() {
+  std::size_t held = 0;
+  for (const index_t s : pair_spring_) held += s != no_spring;
+  for (const index_t s : wall_spring_) held += s != no_spring;
+  std::vector<vec3> springs;
+  springs.reserve(held);
+  auto take = [&](index_t& s) {
+    if (s == no_spring) return;
+    springs.push_back(springs_[s]);
+    s = static_cast<index_t>(springs.size() - 1);
+  };
+  for (index_t& s : pair_spring_) take(s);
+  for (index_t& s : wall_spring_) take(s);
+  springs_ = std::move(springs);
   free_springs_.clear();
-  for (std::size_t s = springs_.size(); s-- > 0;) {  // popped from the back: smallest first
-    if (!held[s]) free_springs_.push_back(static_cast<index_t>(s));
-  }
+  release_excess(free_springs_);
 }
 
 void ContactModel::assign_springs() {
@@ -661,11 +672,6 @@ void ContactModel::finish_lists(const Model& model) {
   const auto& node_body = node_body_;
   // Slots: one per pair of bodies that appear in the lists, in sorted order.
   const std::vector<std::array<index_t, 2>> old_slots = slots_;
-  const std::vector<real> old_approach = slot_approach_;
-  const std::vector<real> old_normal = slot_last_normal_;
-  const std::vector<real> old_work = slot_work_;
-  const std::vector<float> old_exponent = slot_exponent_;
-  const std::vector<real> old_rolling = slot_rolling_;
   const std::size_t old_particle_slots = particle_slot_count_;
   // Bucketed by the first body (a counting sort), so the sorts are per body and small, and an
   // entry finds its slot among its first body's few slots (fragments make many entries).
@@ -726,13 +732,8 @@ void ContactModel::finish_lists(const Model& model) {
           particle_slots + (std::lower_bound(wall_keys.begin(), wall_keys.end(), key) - wall_keys.begin()));
     }
   }
-  // Reduced masses of the bodies (particles, or fragments once bonds break): two bodies
-  // m_p m_q / (m_p + m_q); unbonded nodes of one body (a crack that has not separated it),
-  // about m_p / 4; a body and a rigid wall, or a body whose every node is prescribed (a held
-  // particle, a meshed wall), the moving body's mass; two such bodies, 0 (no dashpot). The laws
-  // of the slots: one per pair of particles (or particle and wall) that the slots meet, however
-  // many fragments the particles broke into.
-  slot_reduced_mass_.resize(slots_.size());
+  // The laws of the slots: one per pair of particles (or particle and wall) that the slots
+  // meet, however many fragments the particles broke into.
   slot_law_index_.resize(slots_.size());
   resolved_laws_.clear();
   std::map<std::array<index_t, 3>, index_t> law_of;  // (kind: 0 particles, 1 wall; p; q or wall)
@@ -743,62 +744,33 @@ void ContactModel::finish_lists(const Model& model) {
         law_of.try_emplace({wall ? 1u : 0u, p, q}, static_cast<index_t>(resolved_laws_.size()));
     if (added) resolved_laws_.push_back(wall ? wall_law(q, p) : pair_law(p, q));
     slot_law_index_[s] = found->second;
-    const index_t bp = slots_[s][0];
-    const real mp = body_kinematic_[bp] ? 0.0 : body_mass_[bp];
-    if (s >= particle_slots) {
-      slot_reduced_mass_[s] = mp;
-    } else if (slots_[s][0] == slots_[s][1]) {
-      slot_reduced_mass_[s] = 0.25 * mp;
-    } else {
-      const index_t bq = slots_[s][1];
-      const real mq = body_kinematic_[bq] ? 0.0 : body_mass_[bq];
-      slot_reduced_mass_[s] = mp == 0 || mq == 0 ? mp + mq : mp * mq / (mp + mq);
-    }
   }
   slot_stiffness_.assign(slots_.size(), 0);
-  slot_approach_.assign(slots_.size(), 0);
-  slot_last_normal_.assign(3 * slots_.size(), 0);
-  slot_work_.assign(slots_.size(), 0);
-  slot_exponent_.assign(slots_.size(), 1.0f);
-  slot_rolling_.assign(any_rolling_ ? 3 * slots_.size() : 0, 0);
-  const bool carry_rolling = !slot_rolling_.empty() && old_rolling.size() == 3 * old_slots.size();
-  // Old and new slots are sorted within their two parts (particle pairs, walls): merge walks.
+  // The collisions carry over by slot. Old and new slots are sorted within their two parts
+  // (particle pairs, walls): merge walks.
+  std::vector<index_t> old_of_new(slots_.size(), contact::CollisionStore::none);
   auto carry_over = [&](std::size_t slot, std::size_t slot_end, std::size_t old, std::size_t old_end) {
     for (; slot < slot_end && old < old_end; ++slot) {
       while (old < old_end && old_slots[old] < slots_[slot]) ++old;
-      if (old < old_end && old_slots[old] == slots_[slot]) {
-        slot_approach_[slot] = old_approach[old];
-        slot_work_[slot] = old_work[old];
-        slot_exponent_[slot] = old_exponent[old];
-        for (int k = 0; k < 3; ++k) slot_last_normal_[3 * slot + k] = old_normal[3 * old + k];
-        if (carry_rolling) {
-          for (int k = 0; k < 3; ++k) slot_rolling_[3 * slot + k] = old_rolling[3 * old + k];
-        }
-      }
+      if (old < old_end && old_slots[old] == slots_[slot]) old_of_new[slot] = static_cast<index_t>(old);
     }
   };
   carry_over(0, particle_slots, 0, old_particle_slots);
   carry_over(particle_slots, slots_.size(), old_particle_slots, old_slots.size());
+  collisions_.renumber(old_of_new);
   group_contact_nodes(model);
   find_groups(model);
   pair_stiffness_.assign(pair_partner_.size(), 0);
   wall_entry_stiffness_.assign(wall_entry_.size(), 0);
   wall_points_.assign(wall_entry_.size(), {});
   wall_entry_reaction_.assign(wall_entry_.size(), {0, 0, 0, 0, 0, 0});
-  release_excess(pair_partner_);
-  release_excess(pair_slot_);
-  release_excess(pair_spring_);
-  release_excess(pair_stiffness_);
-  release_excess(slots_);
-  release_excess(slot_reduced_mass_);
-  release_excess(slot_law_index_);
-  release_excess(slot_stiffness_);
-  release_excess(slot_approach_);
-  release_excess(slot_last_normal_);
-  release_excess(slot_work_);
-  release_excess(slot_exponent_);
-  release_excess(slot_rolling_);
-  release_excess(slot_touch_);
+  for (auto* v : {&pair_offsets_, &pair_partner_, &pair_slot_, &pair_spring_, &wall_offsets_, &wall_slot_,
+                  &wall_spring_, &slot_law_index_, &slot_touch_, &contact_nodes_, &body_contact_offsets_})
+    fit(*v);
+  fit(pair_stiffness_);
+  fit(slots_);
+  fit(slot_stiffness_);
+  fit(wall_entry_);
 }
 
 void ContactModel::find_groups(const Model& model) {
@@ -1070,18 +1042,17 @@ std::size_t ContactModel::memory_bytes() const {
   return bytes(laws_) + bytes(wall_laws_) + bytes(node_body_) + bytes(body_mass_) +
          bytes(body_node_offsets_) + bytes(body_nodes_) + bytes(positions_at_build_) + bytes(pair_offsets_) +
          bytes(pair_partner_) + bytes(pair_slot_) + bytes(wall_offsets_) + bytes(wall_entry_) +
-         bytes(wall_slot_) + bytes(slots_) + bytes(slot_reduced_mass_) + bytes(slot_law_index_) +
-         bytes(resolved_laws_) + bytes(slot_stiffness_) + bytes(slot_approach_) + bytes(slot_last_normal_) +
-         bytes(pair_stiffness_) + bytes(wall_points_) + bytes(wall_entry_stiffness_) +
-         bytes(wall_entry_reaction_) + bytes(springs_) + bytes(free_springs_) + bytes(pair_spring_) +
-         bytes(wall_spring_) + bytes(contact_nodes_) + bytes(body_contact_offsets_) + bytes(body_touch_) +
-         bytes(touching_bodies_) + bytes(slot_touch_) + bytes(body_motion_) + bytes(body_load_) +
-         bytes(slot_force_) + bytes(slot_normal_) + bytes(slot_point_) + bytes(slot_work_) +
-         bytes(slot_exponent_) + bytes(slot_rolling_) + bytes(damping_tables_) + bytes(wall_damping_tables_) +
-         bytes(slot_surface_normal_) + bytes(touching_nodes_) + bytes(touching_normals_) +
-         centres_.memory_bytes() + bytes(anchor_forces_) + bytes(entry_group_) + bytes(entry_target_) +
-         bytes(taking_part_) + bytes(surface_nodes_) + bytes(surface_slot_) + bytes(surface_points_) +
-         bytes(surface_sizes_) + bytes(groups_) + bytes(group_offsets_) + bytes(probes_);
+         bytes(wall_slot_) + bytes(slots_) + bytes(slot_law_index_) + bytes(resolved_laws_) +
+         bytes(slot_stiffness_) + collisions_.memory_bytes() + bytes(pair_stiffness_) + bytes(wall_points_) +
+         bytes(wall_entry_stiffness_) + bytes(wall_entry_reaction_) + bytes(springs_) + bytes(free_springs_) +
+         bytes(pair_spring_) + bytes(wall_spring_) + bytes(contact_nodes_) + bytes(body_contact_offsets_) +
+         bytes(body_touch_) + bytes(touching_bodies_) + bytes(slot_touch_) + bytes(body_motion_) +
+         bytes(body_load_) + bytes(slot_force_) + bytes(slot_normal_) + bytes(slot_point_) +
+         bytes(damping_tables_) + bytes(wall_damping_tables_) + bytes(slot_surface_normal_) +
+         bytes(touching_nodes_) + bytes(touching_normals_) + centres_.memory_bytes() + bytes(anchor_forces_) +
+         bytes(entry_group_) + bytes(entry_target_) + bytes(taking_part_) + bytes(surface_nodes_) +
+         bytes(surface_slot_) + bytes(surface_points_) + bytes(surface_sizes_) + bytes(groups_) +
+         bytes(group_offsets_) + bytes(probes_);
 }
 
 ContactCheckpoint ContactModel::checkpoint() const {
@@ -1093,12 +1064,15 @@ ContactCheckpoint ContactModel::checkpoint() const {
   c.skin = skin_;
   c.slots = slots_;
   c.particle_slot_count = particle_slot_count_;
-  c.slot_approach = slot_approach_;
-  c.slot_normal = slot_last_normal_;
-  c.slot_rolling = slot_rolling_;
+  // Written out per slot (format 4), Collision{} for the slots without one.
   for (std::size_t slot = 0; slot < slots_.size(); ++slot) {
-    c.slot_work.push_back(slot_work_[slot]);
-    c.slot_work.push_back(slot_exponent_[slot]);
+    const contact::Collision collision = collisions_.get(slot);
+    c.slot_approach.push_back(collision.approach);
+    c.slot_normal.insert(c.slot_normal.end(), collision.normal.begin(), collision.normal.end());
+    c.slot_work.push_back(collision.work);
+    c.slot_work.push_back(collision.exponent);
+    if (any_rolling_)
+      c.slot_rolling.insert(c.slot_rolling.end(), collision.rolling.begin(), collision.rolling.end());
   }
   c.pair_offsets = pair_offsets_;
   c.pair_partners = pair_partner_;
@@ -1163,6 +1137,32 @@ void ContactModel::check_checkpoint(const Model& model, const ContactCheckpoint&
     throw InputError("the checkpoint's contact lists are out of range (partners past the node count)");
 }
 
+real ContactModel::slot_reduced_mass(std::size_t slot) const {
+  const index_t bp = slots_[slot][0], bq = slots_[slot][1];
+  const real mp = body_kinematic_[bp] ? 0.0 : body_mass_[bp];
+  if (slot >= particle_slot_count_) return mp;
+  if (bp == bq) return 0.25 * mp;
+  const real mq = body_kinematic_[bq] ? 0.0 : body_mass_[bq];
+  return mp == 0 || mq == 0 ? mp + mq : mp * mq / (mp + mq);
+}
+
+void ContactModel::restore_collisions(const ContactCheckpoint& saved) {
+  // A slot whose values are those of no collision gets no record. A checkpoint without rolling
+  // rotations (no law had mu_r > 0 then) restores them as zero.
+  collisions_.reset(slots_.size());
+  for (std::size_t slot = 0; slot < slots_.size(); ++slot) {
+    contact::Collision c;
+    c.approach = saved.slot_approach[slot];
+    c.work = saved.slot_work[2 * slot];
+    c.exponent = static_cast<float>(saved.slot_work[2 * slot + 1]);
+    for (int k = 0; k < 3; ++k) c.normal[k] = saved.slot_normal[3 * slot + k];
+    if (!saved.slot_rolling.empty()) {
+      for (int k = 0; k < 3; ++k) c.rolling[k] = saved.slot_rolling[3 * slot + k];
+    }
+    if (!(c == contact::Collision{})) collisions_.open(slot) = c;
+  }
+}
+
 void ContactModel::restore(const Model& model, const State& state, const ContactCheckpoint& saved) {
   check_checkpoint(model, saved);
   skin_ = saved.skin;
@@ -1171,17 +1171,7 @@ void ContactModel::restore(const Model& model, const State& state, const Contact
   newly_broken_.clear();
   slots_ = saved.slots;
   particle_slot_count_ = saved.particle_slot_count;
-  slot_approach_ = saved.slot_approach;
-  slot_last_normal_ = saved.slot_normal;
-  // A checkpoint without rolling rotations (no law had mu_r > 0 then) restores them as zero.
-  slot_rolling_ = saved.slot_rolling;
-  if (any_rolling_) slot_rolling_.resize(3 * slots_.size(), 0);
-  slot_work_.resize(slots_.size());
-  slot_exponent_.resize(slots_.size());
-  for (std::size_t slot = 0; slot < slots_.size(); ++slot) {
-    slot_work_[slot] = saved.slot_work[2 * slot];
-    slot_exponent_[slot] = static_cast<float>(saved.slot_work[2 * slot + 1]);
-  }
+  restore_collisions(saved);
   built_ = false;
   if (saved.built) {
     // Rebuild the lists from the positions and time they were built at: the same lists,
@@ -1217,7 +1207,7 @@ void ContactModel::restore(const Model& model, const State& state, const Contact
     }
     pair_spring_ = saved.pair_springs;
     wall_spring_ = saved.wall_springs;
-    collect_free_springs();
+    compact_springs();
   }
   last_time_ = saved.last_time;
   has_last_time_ = saved.has_last_time;
@@ -1470,7 +1460,7 @@ void ContactModel::sum_slot_stiffness() {
   index_t in_contact = 0;
   for (std::size_t slot = 0; slot < slots_.size(); ++slot) {
     slot_touch_[slot] = slot_stiffness_[slot] > 0 ? in_contact++ : not_touching;
-    if (slot_stiffness_[slot] == 0 && !(slot_approach_[slot] > 0)) continue;
+    if (slot_stiffness_[slot] == 0 && !(collisions_.approach(slot) > 0)) continue;
     touch(slots_[slot][0]);
     if (slot < particle_slot_count_) touch(slots_[slot][1]);
   }
@@ -1482,6 +1472,8 @@ void ContactModel::sum_slot_stiffness() {
   slot_normal_.assign(in_contact, vec3{0, 0, 0});
   slot_point_.assign(in_contact, vec3{0, 0, 0});
   slot_surface_normal_.assign(in_contact, vec3{0, 0, 0});
+  release_excess(slot_force_);
+  for (auto* v : {&slot_normal_, &slot_point_, &slot_surface_normal_}) release_excess(*v);
 }
 
 void ContactModel::measure_bodies(const Model& model, const State& state) {
@@ -1499,6 +1491,8 @@ void ContactModel::measure_surface_normals(const Model& model, const State& stat
   // The surface normal of every node in a node pair in contact between two bodies (listed by
   // measure_contacts, in node order, for the look-ups of pair_surface_normal), in parallel.
   touching_normals_.resize(touching_nodes_.size());
+  release_excess(touching_nodes_);
+  release_excess(touching_normals_);
   const std::int64_t count = static_cast<std::int64_t>(touching_nodes_.size());
 #pragma omp parallel for schedule(static)
   for (std::int64_t k = 0; k < count; ++k)
@@ -1610,7 +1604,7 @@ void ContactModel::slot_dashpots(const State& state, real dt) {
     const bool wall_slot = slot >= particle_slot_count_;
     const index_t p = slots_[slot][0], q = slots_[slot][1];
     if (!wall_slot && p == q) {  // fragments of one body: damped node pair by node pair
-      end_collision(slot);
+      collisions_.close(slot);
       continue;
     }
     const index_t touch = slot_touch_[slot];
@@ -1621,14 +1615,15 @@ void ContactModel::slot_dashpots(const State& state, real dt) {
     // part, touch again) within one collision when the contact is stiffer than the material,
     // and a dashpot restarted at each touch would damp the collision many times over.
     const bool in_contact = touch != not_touching && norm > 0 && slot_force_[touch] > 0;
-    real* last_normal = &slot_last_normal_[3 * slot];
-    if (in_contact) {
-      for (int k = 0; k < 3; ++k) last_normal[k] = sum[k] / norm;
-    } else if (!(slot_approach_[slot] > 0)) {
-      end_collision(slot);
+    if (!in_contact && !(collisions_.approach(slot) > 0)) {  // apart: the collision is over
+      collisions_.close(slot);
       continue;
     }
-    const vec normal{last_normal[0], last_normal[1], last_normal[2]};
+    contact::Collision& collision = collisions_.open(slot);
+    if (in_contact) {
+      for (int k = 0; k < 3; ++k) collision.normal[k] = sum[k] / norm;
+    }
+    const vec normal = collision.normal;
     // The contact point: spring-weighted, or the first body's centre in a gap of the collision.
     const vec point = in_contact ? slot_contact_point(touch) : body_motion_[body_touch_[p]].centre;
     const vec velocity_p = rigid_velocity(p, point);
@@ -1637,16 +1632,16 @@ void ContactModel::slot_dashpots(const State& state, real dt) {
                        velocity_p[2] - velocity_q[2]};
     // Closing speed along the normal (which points from p to q, or from the wall to p).
     const real approach = wall_slot ? -dot(relative, normal) : dot(relative, normal);
-    slot_approach_[slot] += approach * dt;
+    collision.approach += approach * dt;
     if (!in_contact) {  // a gap within the collision: no spring, no dashpot
-      slot_approach_[slot] = std::max(0.0, slot_approach_[slot]);
+      collision.approach = std::max(0.0, collision.approach);
       continue;
     }
-    const real zeta = damping_ratio(slot, approach * dt);
+    const real zeta = damping_ratio(slot, collision, approach * dt);
     if (zeta == 0) continue;
     const real K = slot_stiffness_[slot];
-    const real secant = slot_approach_[slot] > 0 ? std::min(K, slot_force_[touch] / slot_approach_[slot]) : K;
-    const real damping = 2.0 * zeta * std::sqrt(slot_reduced_mass_[slot] * secant) * approach;
+    const real secant = collision.approach > 0 ? std::min(K, slot_force_[touch] / collision.approach) : K;
+    const real damping = 2.0 * zeta * std::sqrt(slot_reduced_mass(slot) * secant) * approach;
     if (wall_slot) {  // the wall takes the opposite force, at the contact point
       add_body_load(p, point, {damping * normal[0], damping * normal[1], damping * normal[2]});
       const vec arm{point[0] - walls_[q].center[0], point[1] - walls_[q].center[1],
@@ -1668,13 +1663,14 @@ void ContactModel::slot_rolling_resistance(const State& state, real dt) {
   // Rolling resistance per pair of touching bodies (contact_law.hpp): the rolling spring on
   // their relative rotation, its torque M on the first body and -M on the second (or the wall),
   // as rigid-body couples.
-  if (slot_rolling_.empty()) return;
+  if (!any_rolling_) return;
   for (std::size_t slot = 0; slot < slots_.size(); ++slot) {
     if (!resists_rolling(slot)) {
       // In a gap of the collision (chattering surface nodes part for a few steps) the spring
       // keeps its rotation and acts again when they touch; once the bodies are apart it starts
       // again at the next touch.
-      if (!(slot_approach_[slot] > 0)) std::fill_n(&slot_rolling_[3 * slot], 3, 0.0);
+      contact::Collision* collision = collisions_.find(slot);
+      if (collision && !(collision->approach > 0)) collision->rolling = {0, 0, 0};
       continue;
     }
     const vec torque = slot_rolling_torque(state, slot, dt);
@@ -1725,8 +1721,9 @@ vec3 ContactModel::slot_rolling_torque(const State& state, std::size_t slot, rea
                  first.angular_velocity[2] - spin_q[2]};
   const real stiffness = law.tangential_stiffness_ratio * slot_stiffness_[slot] * radius * radius;
   vec torque{0, 0, 0};
-  const bool rolls = contact::rolling_torque(stiffness, law.rolling_friction, radius, force, normal.data(),
-                                             spin.data(), dt, &slot_rolling_[3 * slot], torque.data());
+  const bool rolls =
+      contact::rolling_torque(stiffness, law.rolling_friction, radius, force, normal.data(), spin.data(), dt,
+                              collisions_.open(slot).rolling.data(), torque.data());
   // The dashpot, while the spring holds: C_r = 2 eta_r sqrt(I_r k_r) on the rolling speed.
   const real twist = dot(spin, normal);
   const vec roll{spin[0] - twist * normal[0], spin[1] - twist * normal[1], spin[2] - twist * normal[2]};
@@ -1823,13 +1820,7 @@ void ContactModel::slot_redirects() {
   }
 }
 
-void ContactModel::end_collision(std::size_t slot) {
-  slot_approach_[slot] = 0;
-  slot_work_[slot] = 0;
-  slot_exponent_[slot] = 1;
-}
-
-real ContactModel::damping_ratio(std::size_t slot, real advance) {
+real ContactModel::damping_ratio(std::size_t slot, contact::Collision& collision, real advance) {
   // The springs' work since the bodies touched, and while they approach, the exponent of the
   // force law it implies: W = F x / (p + 1) for F = k x^p.
   const bool wall_slot = slot >= particle_slot_count_;
@@ -1839,12 +1830,12 @@ real ContactModel::damping_ratio(std::size_t slot, real advance) {
   if (slot_law(slot).node_pair) {  // PeriDEM's law keeps the linear zeta
     return (wall_slot ? wall_laws_ : laws_)[law].damping_ratio;
   }
-  const real force = slot_force_[slot_touch_[slot]], approach = slot_approach_[slot];
-  slot_work_[slot] += force * advance;
-  if (advance > 0 && slot_work_[slot] > 0 && approach > 0) {
-    slot_exponent_[slot] = static_cast<float>(std::clamp(force * approach / slot_work_[slot] - 1, 1.0, 3.0));
+  const real force = slot_force_[slot_touch_[slot]], approach = collision.approach;
+  collision.work += force * advance;
+  if (advance > 0 && collision.work > 0 && approach > 0) {
+    collision.exponent = static_cast<float>(std::clamp(force * approach / collision.work - 1, 1.0, 3.0));
   }
-  return (wall_slot ? wall_damping_tables_ : damping_tables_)[law].at(slot_exponent_[slot]);
+  return (wall_slot ? wall_damping_tables_ : damping_tables_)[law].at(collision.exponent);
 }
 
 void ContactModel::probe_frictions(const Model& model, const State& state, real dt) {
@@ -2098,7 +2089,7 @@ vec3 ContactModel::pair_force(const Model& model, const State& state, index_t i,
                mj = model.node_density()[j] * model.volumes()[j];
     const real stable = dt > 0 ? 0.5 * mi * mj / ((mi + mj) * dt) : 0.0;
     const real c =
-        std::min(2.0 * law.damping_ratio * k * std::sqrt(slot_reduced_mass_[pair_slot_[e]] / K), stable);
+        std::min(2.0 * law.damping_ratio * k * std::sqrt(slot_reduced_mass(pair_slot_[e]) / K), stable);
     push = std::max(0.0, push + contact::damping_force(c, approach));
   }
   real friction[3] = {0, 0, 0};

@@ -6,6 +6,7 @@
 
 #include "check.hpp"
 #include "fixtures.hpp"
+#include "granulate/contact/collisions.hpp"
 #include "granulate/contact/power_law_damping.hpp"
 #include "granulate/simulation.hpp"
 
@@ -83,6 +84,24 @@ TEST_CASE("the rolling spring holds below mu_r R* F_n, rolls at it (and says so)
   CHECK(contact::rolling_torque(50.0, 0.2, 0.1, 10.0, normal, spin, dt, rotation, torque));
   CHECK_CLOSE(torque[2], 0.2, 1e-15);
   CHECK_CLOSE(rotation[2], -4e-3, 1e-15);
+}
+
+TEST_CASE("collision records: opened on demand, reused once closed, carried by renumbering") {
+  contact::CollisionStore store;
+  store.reset(4);
+  CHECK(store.find(2) == nullptr && store.get(2) == contact::Collision{} && store.approach(2) == 0);
+  store.open(1).approach = 1e-6;
+  store.open(3).work = 2.0;
+  CHECK(store.open_count() == 2 && store.approach(1) == 1e-6 && store.get(3).work == 2.0);
+  store.close(1);
+  store.close(1);  // closing twice is harmless
+  CHECK(store.find(1) == nullptr && store.open_count() == 1);
+  CHECK(store.open(0) == contact::Collision{});  // a reused record starts as no collision
+  // New slots 0..2 are old slots 3, none and 0; old slot 1 has no record to carry.
+  store.open(0).approach = 5e-7;
+  store.renumber({3, contact::CollisionStore::none, 0});
+  CHECK(store.slot_count() == 3 && store.open_count() == 2);
+  CHECK(store.get(0).work == 2.0 && store.find(1) == nullptr && store.approach(2) == 5e-7);
 }
 
 TEST_CASE("relative contact laws resolve per pair, symmetrically, from the finer particle") {

@@ -8,6 +8,7 @@
 #include <span>
 #include <vector>
 
+#include "granulate/contact/collisions.hpp"
 #include "granulate/contact/contact_law.hpp"
 #include "granulate/contact/power_law_damping.hpp"
 #include "granulate/contact/surface_centres.hpp"
@@ -166,8 +167,9 @@ class ContactModel {
   void carry_over_springs(const KeptLists& kept, index_t node_count);
   /// Gives each entry in contact a spring and takes back those of entries apart (entry order).
   void assign_springs();
-  /// The free list: every pool spring no entry holds, in increasing order.
-  void collect_free_springs();
+  /// The pool holds only the springs entries hold, renumbered in entry order (pair entries,
+  /// then wall entries); the free list is empty. The numbering never enters a force.
+  void compact_springs();
   // Surface nodes (mesh and grid vertices on the boundary) have their spheres centred one
   // contact radius inside (surface_centres.hpp); contact sees every node at its centre.
   /// Whether particle p's surface nodes are centred (its shape has anchors and no law of its
@@ -337,11 +339,11 @@ class ContactModel {
   real entry_stiffness(const Model& model, index_t i, index_t e) const;
   /// Spring stiffness of each contact point of node i's wall entry e: kn V_i^2.
   real wall_spring_stiffness(const Model& model, index_t i, index_t e) const;
-  /// Forget a slot's collision (the bodies are apart).
-  void end_collision(std::size_t slot);
+  /// The collisions of a checkpoint's slots (slots_ restored).
+  void restore_collisions(const ContactCheckpoint& saved);
   /// Damping ratio of a slot in contact that gives the requested restitution for the force law
   /// of its collision, after adding the springs' work over `advance` (the approach this step).
-  real damping_ratio(std::size_t slot, real advance);
+  real damping_ratio(std::size_t slot, contact::Collision& collision, real advance);
   /// Force on node i of its list entry e (updates the entry's friction spring).
   vec3 pair_force(const Model& model, const State& state, index_t i, index_t e, real dt);
   /// A node-wall entry in contact: the deepest point's normal (towards the node), the arm
@@ -401,24 +403,24 @@ class ContactModel {
   // Bodies in contact: one slot per (particle, particle) or (particle, wall) pair in the lists.
   std::vector<std::array<index_t, 2>> slots_;  // particle pairs (p <= q), then (p, wall)
   std::size_t particle_slot_count_ = 0;
-  std::vector<real> slot_reduced_mass_;
+  /// Reduced mass of a slot's bodies (particles, or fragments once bonds break): two bodies
+  /// m_p m_q / (m_p + m_q); unbonded nodes of one body (a crack that has not separated it),
+  /// about m_p / 4; a body and a rigid wall, or a body whose every node is prescribed (a held
+  /// particle, a meshed wall), the moving body's mass; two such bodies, 0 (no dashpot) [kg].
+  real slot_reduced_mass(std::size_t slot) const;
   std::vector<index_t> slot_law_index_;          // Rc and kn of each slot's pair of bodies:
   std::vector<contact::PairLaw> resolved_laws_;  // an index into the laws of particle pairs
   const contact::PairLaw& slot_law(std::size_t slot) const { return resolved_laws_[slot_law_index_[slot]]; }
   std::vector<real> slot_stiffness_;  // K: sum of the contact springs, last evaluation
-  // Collision history per pair of bodies, kept across list rebuilds: the approach x of the two
-  // bodies since they touched (for the secant stiffness F / x of the dashpot).
-  std::vector<real> slot_approach_;
-  std::vector<real> slot_last_normal_;  // 3 per slot: normal of the last evaluation in contact
-  // The springs' work W since the bodies touched and the collision's force-law exponent
-  // p = F x / W - 1 (exact for F = k x^p), measured while the bodies approach; p picks the
-  // damping ratio that gives the requested restitution (power_law_damping.hpp).
-  std::vector<real> slot_work_;
-  std::vector<float> slot_exponent_;
-  // Rolling resistance (contact_law.hpp): the relative rolling rotation theta of each pair of
-  // bodies, 3 per slot, kept while they touch; empty unless a law has mu_r > 0.
+  // The collisions in progress (collisions.hpp), by slot, kept across list rebuilds: the
+  // approach x of the two bodies since they touched (for the secant stiffness F / x of the
+  // dashpot), the normal of the last step in contact, the springs' work W since the touch and
+  // the force-law exponent p = F x / W - 1 (exact for F = k x^p), measured while the bodies
+  // approach, which picks the damping ratio that gives the requested restitution
+  // (power_law_damping.hpp), and the rolling rotation theta (contact_law.hpp), used only when
+  // some law has mu_r > 0.
+  contact::CollisionStore collisions_;
   bool any_rolling_ = false;
-  std::vector<real> slot_rolling_;
   // Damping ratio against the exponent p, per law (as laws_ and wall_laws_).
   std::vector<contact::DampingTable> damping_tables_, wall_damping_tables_;
   // Friction springs (tangential displacement xi) of the entries in contact, in a pool: each
