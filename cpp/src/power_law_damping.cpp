@@ -9,10 +9,11 @@
 namespace granulate::contact {
 namespace {
 
-// x'' of the scale-free collision (zero outside contact).
+// x'' of the scale-free collision (zero outside contact), with x^p = (x^((p - 1) / 2))^2 x.
 real acceleration(real x, real speed, real zeta, real exponent) {
   if (x <= 0) return 0;
-  return -std::pow(x, exponent) - 2 * zeta * std::pow(x, 0.5 * (exponent - 1)) * speed;
+  const real root = std::pow(x, 0.5 * (exponent - 1));
+  return -root * root * x - 2 * zeta * root * speed;
 }
 
 // Restitution of the linear spring-dashpot with damping ratio zeta (the inverse of
@@ -48,12 +49,32 @@ real power_law_restitution(real zeta, real exponent) {
   return 0;
 }
 
-real power_law_damping_ratio(real restitution, real exponent) {
+real power_law_damping_ratio(real restitution, real exponent, real low, real high) {
   if (restitution >= 1) return 0;
-  real low = 0, high = 4;  // e falls as zeta grows
-  while (high - low > 1e-5) {
-    const real middle = 0.5 * (low + high);
-    (power_law_restitution(middle, exponent) > restitution ? low : high) = middle;
+  // f(zeta) = e(zeta) - e falls as zeta grows (f(0) = 1 - e). Regula falsi, Illinois variant
+  // (the end that stays put twice in a row has its f halved), on a bracket [low, high]: the
+  // given one if f changes sign on it, else [0, 4].
+  auto f = [&](real zeta) {
+    return zeta == 0 ? 1 - restitution : power_law_restitution(zeta, exponent) - restitution;
+  };
+  real f_low = f(low), f_high = f(high);
+  if (!(f_low > 0 && f_high <= 0)) {
+    low = 0, high = 4;
+    f_low = f(low), f_high = f(high);
+  }
+  int kept = 0;  // +1: low moved last, -1: high moved last
+  for (int k = 0; k < 200 && high - low > 1e-6; ++k) {
+    const real zeta = (low * f_high - high * f_low) / (f_high - f_low);
+    const real value = f(zeta);
+    if (value > 0) {
+      low = zeta, f_low = value;
+      if (kept == 1) f_high *= 0.5;
+      kept = 1;
+    } else {
+      high = zeta, f_high = value;
+      if (kept == -1) f_low *= 0.5;
+      kept = -1;
+    }
   }
   return 0.5 * (low + high);
 }
@@ -70,9 +91,11 @@ DampingTable::DampingTable(real linear_zeta) {
   }
   const real restitution = linear_restitution(linear_zeta);
   zeta_[0] = linear_zeta;
-  for (int k = 1; k < size; ++k) {
-    zeta_[k] =
-        linear_zeta == 0 ? 0 : power_law_damping_ratio(restitution, smallest_exponent + k * exponent_step);
+  for (int k = 1; k < size; ++k) {  // zeta grows with p: bracketed from the previous exponent's
+    const real previous = zeta_[k - 1];
+    zeta_[k] = linear_zeta == 0 ? 0
+                                : power_law_damping_ratio(restitution, smallest_exponent + k * exponent_step,
+                                                          previous, 1.5 * previous + 1e-3);
   }
   made.emplace(linear_zeta, zeta_);
 }

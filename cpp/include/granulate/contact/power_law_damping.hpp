@@ -21,9 +21,10 @@ namespace granulate::contact {
 /// Restitution of the scale-free collision above for damping ratio zeta and exponent p >= 1.
 real power_law_restitution(real zeta, real exponent);
 
-/// The damping ratio that gives restitution e (0 < e <= 1) for exponent p (bisection on
-/// power_law_restitution, to 1e-5 in zeta).
-real power_law_damping_ratio(real restitution, real exponent);
+/// The damping ratio that gives restitution e (0 < e <= 1) for exponent p: the root of
+/// power_law_restitution - e, to 1e-6 in zeta, searched in [low, high] if it lies there (else
+/// in [0, 4]).
+real power_law_damping_ratio(real restitution, real exponent, real low = 0, real high = 4);
 
 /// zeta at one restitution for exponents 1, 1.1, ..., 3, interpolated linearly between them.
 class DampingTable {
