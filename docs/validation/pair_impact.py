@@ -80,11 +80,12 @@ def pair_impact(
     spins: tuple[float, float],
     nodes_across_radius: int,
     friction: float = MU,
+    pair_law: str = "granulate",
 ) -> dict:
     """Bodies of `radii` spinning at omega R = `spins` meet at SPEED: their masses, friction,
     velocities and spins (omega R) before and after, and the normal restitution."""
     sim = gr.Simulation(dimension)
-    sim.contact = gr.Contact(restitution=RESTITUTION, friction=friction)
+    sim.contact = gr.Contact(restitution=RESTITUTION, friction=friction, pair_law=pair_law)
     bodies, centres = [], []
     for side, radius in zip((-1, 1), radii, strict=True):
         h = radius / nodes_across_radius
@@ -135,11 +136,18 @@ def spin_pairs(test: int, rates: np.ndarray) -> list[tuple[float, float]]:
     return [(w, w if test == 7 else 0.0) for w in rates]
 
 
-def table(dimension: int, test: int, rates: list[float], npr: int, friction: float) -> list[dict]:
+def table(
+    dimension: int,
+    test: int,
+    rates: list[float],
+    npr: int,
+    friction: float,
+    pair_law: str = "granulate",
+) -> list[dict]:
     """Run test 7 or 8 at omega R = rates x v_n and print the rebound against the theory."""
     radii = (RADIUS, RADIUS if test == 7 else LARGE * RADIUS)
     rows = [
-        pair_impact(dimension, radii, spins, npr, friction)
+        pair_impact(dimension, radii, spins, npr, friction, pair_law)
         for spins in spin_pairs(test, np.array(rates) * SPEED)
     ]
     print("omegaR/v_n  e     v_t1'   rigid    w1'R    rigid    v_t2'   w2'R  (over v_n)")
@@ -201,13 +209,19 @@ def main() -> None:
     parser.add_argument("--test", type=int, default=7, choices=(7, 8))
     parser.add_argument("--nodes", type=int, help="nodes per radius (default 10 in 2D, 6 in 3D)")
     parser.add_argument("--friction", type=float, help="another mu than 0.3: the table only")
+    parser.add_argument(
+        "--pair-law",
+        default="granulate",
+        choices=("granulate", "surface"),
+        help="surface: table only",
+    )
     parser.add_argument("--smoke", action="store_true")
     args = parser.parse_args()
     rates = [0.5, 2.0] if args.smoke else [0.1, 0.25, 0.5, 0.75, 1.0, 1.25, 1.5, 2.0, 3.0, 4.0]
     npr = args.nodes or (10 if args.dimension == 2 else 6)
     friction = MU if args.friction is None else args.friction
-    rows = table(args.dimension, args.test, rates, npr, friction)
-    if args.friction is None:
+    rows = table(args.dimension, args.test, rates, npr, friction, args.pair_law)
+    if args.friction is None and args.pair_law == "granulate":
         figure(args.dimension, args.test, rows, rates, npr)
 
 
