@@ -17,12 +17,17 @@ import restitution
 
 @pytest.mark.validation
 @pytest.mark.parametrize("dimension", [2, 3])
-def test_impacts_on_a_plane_rebound_with_the_requested_restitution(dimension: int) -> None:
+def test_impacts_on_a_plane_rebound_with_the_requested_restitution(
+    dimension: int, full: bool
+) -> None:
     """Within 0.05 of the requested e (Issue 13's tolerance) at 0.05 and 5 m/s. Measured: 2D
     0.114 / 0.507 at 0.05 m/s and 0.114 / 0.507 at 5 m/s for e = 0.1 / 0.5; 3D 0.080 / 0.485
     and 0.100 / 0.499. With the linear formula's damping ratio 3D gave 0.171 / 0.568 at 5 m/s
-    (the node springs of a sphere on a plane stiffen as F ~ x^2)."""
-    for speed in (0.05, 5.0):
-        for requested in (0.1, 0.5):
-            measured = restitution.rebound(dimension, requested, speed)
-            assert measured == pytest.approx(requested, abs=0.05), (speed, requested)
+    (the node springs of a sphere on a plane stiffen as F ~ x^2). The 3D smoke test leaves out
+    the slow impact at e = 0.5 (the slow impacts take the longest to land)."""
+    cases = [(speed, e) for speed in (0.05, 5.0) for e in (0.1, 0.5)]
+    if dimension == 3 and not full:
+        cases.remove((0.05, 0.5))
+    for speed, requested in cases:
+        measured = restitution.rebound(dimension, requested, speed)
+        assert measured == pytest.approx(requested, abs=0.05), (speed, requested)
