@@ -162,7 +162,14 @@ def table(
     return rows
 
 
-def figure(dimension: int, test: int, rows: list[dict], rates: list[float], npr: int) -> None:
+def figure(
+    dimension: int,
+    test: int,
+    rows: list[dict],
+    rates: list[float],
+    npr: int,
+    pair_law: str = "granulate",
+) -> None:
     """Rebound of body 1 against omega R / v_n for test 7 or 8, with the theory."""
     import matplotlib
 
@@ -199,8 +206,11 @@ def figure(dimension: int, test: int, rows: list[dict], rates: list[float], npr:
         if test == 7
         else f"a spinning {shape} and one {LARGE:g} times larger at rest"
     )
-    name = f"pair_impact_test{test}_{dimension}d.png"
-    save_test_figure(fig, test, f"Head-on impact of {what}", "v_n", f"R/h = {npr} each", name)
+    suffix = "" if pair_law == "granulate" else f"_{pair_law}"
+    law = "" if pair_law == "granulate" else f", pair_law {pair_law}"
+    name = f"pair_impact_test{test}_{dimension}d{suffix}.png"
+    resolution = f"R/h = {npr} each{law}"
+    save_test_figure(fig, test, f"Head-on impact of {what}", "v_n", resolution, name)
 
 
 def main() -> None:
@@ -213,7 +223,7 @@ def main() -> None:
         "--pair-law",
         default="granulate",
         choices=("granulate", "surface"),
-        help="surface: table only",
+        help="the contact's pair law (surface: the figure's name ends in _surface)",
     )
     parser.add_argument("--smoke", action="store_true")
     args = parser.parse_args()
@@ -221,8 +231,8 @@ def main() -> None:
     npr = args.nodes or (10 if args.dimension == 2 else 6)
     friction = MU if args.friction is None else args.friction
     rows = table(args.dimension, args.test, rates, npr, friction, args.pair_law)
-    if args.friction is None and args.pair_law == "granulate":
-        figure(args.dimension, args.test, rows, rates, npr)
+    if args.friction is None:
+        figure(args.dimension, args.test, rows, rates, npr, args.pair_law)
 
 
 if __name__ == "__main__":
