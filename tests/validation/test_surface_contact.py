@@ -111,22 +111,24 @@ def test_rotated_spheres_of_different_sizes_collide_head_on(full: bool) -> None:
     """3D: a conforming sphere of 0.5 mm on one of 2 mm (6 nodes per radius each, turned at
     random) at 1 m/s, e = 0.6: e within 0.05, lateral speed under 3 % of the approach (measured
     2.45 / 2.35 % and e 0.600 / 0.602 for seeds 0 / 1; the node-sphere law 6.9 / 12.1 %, e
-    0.574 / 0.512). Not the 1 % of 2D: at R/h = 6 the few surface points in a small contact
-    sample its pressure unevenly, and the sum of their pushes tilts."""
-    seeds = (0, 1) if full else (0,)
-    for seed in seeds:
+    0.574 / 0.512). Not the 1 % of 2D at this resolution: at R/h = 6 the few surface points in
+    a small contact sample its pressure unevenly, and the sum of their pushes tilts. The tilt
+    falls with h: 1.44 / 1.46 % at R/h = 8, 0.77 / 0.54 % at R/h = 10 (e 0.600 / 0.598), which
+    --full checks against 1 %."""
+    cases = [(6, 0.03, 0), (6, 0.03, 1), (10, 0.01, 0), (10, 0.01, 1)] if full else [(6, 0.03, 0)]
+    for nodes, bound, seed in cases:
         e, lateral = head_on(
             3,
             0.5e-3,
             2e-3,
-            nodes_across_radius=6,
+            nodes_across_radius=nodes,
             speed=1.0,
             restitution=0.6,
             seed=seed,
             discretization="conforming",
         )
-        assert abs(e - 0.6) < 0.05, (seed, e)
-        assert lateral < 0.03, (seed, lateral)
+        assert abs(e - 0.6) < 0.05, (nodes, seed, e)
+        assert lateral < bound, (nodes, seed, lateral)
 
 
 # A triangle's tip, one vertex on the other grain's face, sinks half a contact radius deep
