@@ -341,10 +341,8 @@ NB_MODULE(_core, m) {
       .def_rw("surface", &contact::Law::surface);
   m.def("damping_ratio_from_restitution", &contact::damping_ratio_from_restitution, "restitution"_a);
   m.def("power_law_restitution", &contact::power_law_restitution, "damping_ratio"_a, "exponent"_a);
-  m.def(
-      "power_law_damping_ratio",
-      [](real restitution, real exponent) { return contact::power_law_damping_ratio(restitution, exponent); },
-      "restitution"_a, "exponent"_a);
+  m.def("power_law_damping_ratio", &contact::power_law_damping_ratio, "restitution"_a, "exponent"_a,
+        "low"_a = 0.0, "high"_a = 4.0);
 
   nb::enum_<WallSurface::Kind>(m, "WallSurfaceKind")
       .value("plane", WallSurface::Kind::plane)

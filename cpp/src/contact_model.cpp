@@ -1608,19 +1608,19 @@ void ContactModel::slot_dashpots(const State& state, real dt) {
       continue;
     }
     const index_t touch = slot_touch_[slot];
-    const vec sum = touch == not_touching ? vec{0, 0, 0} : slot_surface_normal_[touch];
-    const real norm = std::sqrt(dot(sum, sum));
     // A collision lasts until the bodies are back where they first touched (approach x = 0),
     // not while springs are in contact: the surface nodes of deformable bodies chatter (touch,
     // part, touch again) within one collision when the contact is stiffer than the material,
     // and a dashpot restarted at each touch would damp the collision many times over.
-    const bool in_contact = touch != not_touching && norm > 0 && slot_force_[touch] > 0;
+    const bool in_contact = slot_in_contact(slot);
     if (!in_contact && !(collisions_.approach(slot) > 0)) {  // apart: the collision is over
       collisions_.close(slot);
       continue;
     }
     contact::Collision& collision = collisions_.open(slot);
     if (in_contact) {
+      const vec& sum = slot_surface_normal_[touch];
+      const real norm = std::sqrt(dot(sum, sum));
       for (int k = 0; k < 3; ++k) collision.normal[k] = sum[k] / norm;
     }
     const vec normal = collision.normal;
@@ -1692,10 +1692,16 @@ bool ContactModel::resists_rolling(std::size_t slot) const {
   };
   const bool wall_slot = slot >= particle_slot_count_;
   const index_t p = slots_[slot][0], q = slots_[slot][1];
+  if (!(slot_law(slot).rolling_friction > 0) || (!wall_slot && p == q) || !slot_in_contact(slot))
+    return false;
+  return turns(p) && (wall_slot || turns(q));
+}
+
+bool ContactModel::slot_in_contact(std::size_t slot) const {
   const index_t touch = slot_touch_[slot];
-  if (!(slot_law(slot).rolling_friction > 0) || (!wall_slot && p == q) || touch == not_touching) return false;
+  if (touch == not_touching) return false;
   const vec& sum = slot_surface_normal_[touch];
-  return dot(sum, sum) > 0 && slot_force_[touch] > 0 && turns(p) && (wall_slot || turns(q));
+  return dot(sum, sum) > 0 && slot_force_[touch] > 0;
 }
 
 vec3 ContactModel::slot_rolling_torque(const State& state, std::size_t slot, real dt) {
@@ -1713,17 +1719,15 @@ vec3 ContactModel::slot_rolling_torque(const State& state, std::size_t slot, rea
   };
   const real rp = distance(first.centre), rq = wall_slot ? 0.0 : distance(second->centre);
   const real radius = wall_slot ? rp : rp * rq / (rp + rq);
-  const vec& sum = slot_surface_normal_[touch];
-  const real norm = std::sqrt(dot(sum, sum));
-  const vec normal{sum[0] / norm, sum[1] / norm, sum[2] / norm};
+  contact::Collision& collision = collisions_.open(slot);  // its normal is this step's (slot_dashpots)
+  const vec normal = collision.normal;
   const vec spin_q = wall_slot ? walls_[q].angular_velocity(state.time) : second->angular_velocity;
   const vec spin{first.angular_velocity[0] - spin_q[0], first.angular_velocity[1] - spin_q[1],
                  first.angular_velocity[2] - spin_q[2]};
   const real stiffness = law.tangential_stiffness_ratio * slot_stiffness_[slot] * radius * radius;
   vec torque{0, 0, 0};
-  const bool rolls =
-      contact::rolling_torque(stiffness, law.rolling_friction, radius, force, normal.data(), spin.data(), dt,
-                              collisions_.open(slot).rolling.data(), torque.data());
+  const bool rolls = contact::rolling_torque(stiffness, law.rolling_friction, radius, force, normal.data(),
+                                             spin.data(), dt, collision.rolling.data(), torque.data());
   // The dashpot, while the spring holds: C_r = 2 eta_r sqrt(I_r k_r) on the rolling speed.
   const real twist = dot(spin, normal);
   const vec roll{spin[0] - twist * normal[0], spin[1] - twist * normal[1], spin[2] - twist * normal[2]};

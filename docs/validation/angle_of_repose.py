@@ -98,24 +98,22 @@ def _column_count(width: float) -> int:
 
 def measure(sim: gr.Simulation) -> Heap:
     """The heap's free surface from its grains (see the module docstring)."""
-    centres, tops, sizes = [], [], []
+    centres, sizes = [], []
     for body in sim.bodies:
-        nodes = body.nodes
-        x = sim.positions[nodes, :2]
-        centre = np.average(x, axis=0, weights=sim.volumes[nodes])
+        x = sim.positions[body.nodes, :2]
+        centre = np.average(x, axis=0, weights=sim.volumes[body.nodes])
         centres.append(centre)
-        tops.append(centre[1] + np.max(np.linalg.norm(x - centre, axis=1)))
         sizes.append(np.max(np.linalg.norm(x - centre, axis=1)))
-    centres, tops = np.array(centres), np.array(tops)
+    centres, sizes = np.array(centres), np.array(sizes)
+    tops = centres[:, 1] + sizes
     diameter = 2 * float(np.mean(sizes))
     slices = np.floor(centres[:, 0] / diameter).astype(int)
-    envelope = np.array(
-        [
-            (centres[i, 0], tops[i])
-            for s in np.unique(slices)
-            for i in [np.flatnonzero(slices == s)[np.argmax(tops[slices == s])]]
-        ]
-    )
+    envelope = []
+    for s in np.unique(slices):  # the highest grain of each slice
+        members = np.flatnonzero(slices == s)
+        highest = members[np.argmax(tops[members])]
+        envelope.append((centres[highest, 0], tops[highest]))
+    envelope = np.array(envelope)
     slope, _ = np.polyfit(envelope[:, 0], envelope[:, 1], 1)
     return Heap(
         angle=float(np.degrees(np.arctan(-slope))),

@@ -22,8 +22,7 @@ def settled_angle(
     heap, sim = angle_of_repose.collapse(
         friction, width=width, rolling_friction=rolling, until=until, seed=seed
     )
-    weight = sum(float(sim.volumes[b.nodes].sum()) for b in sim.bodies)
-    weight *= angle_of_repose.GRAIN.density * angle_of_repose.GRAVITY
+    weight = float(sim.volumes.sum()) * angle_of_repose.GRAIN.density * angle_of_repose.GRAVITY
     assert sim.kinetic_energy() < 0.01 * weight * width, "the heap is still moving"
     return heap.angle
 
@@ -38,9 +37,10 @@ def test_the_heap_of_a_collapsed_column_is_steeper_with_friction(full: bool) -> 
     more than a degree, and mu_r = 0.3 at least 5 over mu = 0.5 alone. One heap is a noisy
     measure: changing the damping ratios by 1e-6 (a04e262) moved seed 1's angles from 5.2 / 7.4
     / 10.6 / 18.5 to 4.8 / 7.6 / 10.0 / 18.9. The smoke test collapses an 8 mm x 24 mm column
-    (28 grains) for 0.1 s: 3.2 and 12.0 degrees for mu = 0 and 0.5 (4.1 and 11.7 before
-    a04e262; kinetic energy 7e-4 and 1.3e-3 of the weight times the width), asserted at least 4
-    degrees apart."""
+    (28 grains) for 0.1 s: 3.4 and 7.9 degrees for mu = 0 and 0.5 (kinetic energy 2e-4 and
+    1e-4 of the weight times the width), asserted at least 4 degrees apart. That margin is thin:
+    the same heaps gave 3.2 and 12.0 before the rounding of one build changed, 4.1 and 11.7
+    before a04e262, and packings 2 and 3 give 4.2 / 7.4 and 5.3 / 8.4."""
     if full:
         angles = [
             np.mean(

@@ -161,15 +161,21 @@ inline real resolve_normal_stiffness(const Law& law, const ContactSide& a, const
                                                 : 12 * effective / (std::numbers::pi * delta4));
 }
 
-/// Rc and kn of a law between particles a and b.
-inline PairLaw resolve(const Law& law, const ContactSide& a, const ContactSide& b, int dimension) {
-  return {resolve_contact_radius(law, a, b),
-          resolve_normal_stiffness(law, a, b, dimension),
+/// A law resolved to contact radius `rc` and stiffness `kn`, with its other terms as given.
+inline PairLaw resolved(const Law& law, real rc, real kn, bool surface) {
+  return {rc,
+          kn,
           law.node_pair,
-          law.surface,
+          surface,
           law.rolling_friction,
           law.rolling_damping,
           law.tangential_stiffness_ratio};
+}
+
+/// Rc and kn of a law between particles a and b.
+inline PairLaw resolve(const Law& law, const ContactSide& a, const ContactSide& b, int dimension) {
+  return resolved(law, resolve_contact_radius(law, a, b), resolve_normal_stiffness(law, a, b, dimension),
+                  law.surface);
 }
 
 /// Rc of a node of particle a against a rigid wall surface: the node's own contact radius
@@ -180,13 +186,8 @@ inline real resolve_wall_contact_radius(const Law& law, const ContactSide& a) {
 
 /// Rc (node to wall surface) and kn of a law between particle a and a rigid wall.
 inline PairLaw resolve_wall(const Law& law, const ContactSide& a, int dimension) {
-  return {resolve_wall_contact_radius(law, a),
-          resolve_normal_stiffness(law, a, a, dimension),
-          law.node_pair,
-          false,
-          law.rolling_friction,
-          law.rolling_damping,
-          law.tangential_stiffness_ratio};
+  return resolved(law, resolve_wall_contact_radius(law, a), resolve_normal_stiffness(law, a, a, dimension),
+                  false);
 }
 
 /// Spring stiffness of a node pair [N/m]: kn min(V_i, V_j)^2, so a fine particle's nodes against

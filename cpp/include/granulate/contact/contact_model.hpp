@@ -306,6 +306,8 @@ class ContactModel {
   /// Whether a slot's bodies resist rolling this step: a law with mu_r > 0, two bodies (or a
   /// body and a wall) in contact, each able to turn (rotational inertia).
   bool resists_rolling(std::size_t slot) const;
+  /// Whether a slot's bodies are in contact this step: springs loaded, surface normals summed.
+  bool slot_in_contact(std::size_t slot) const;
   /// The rolling torque on a resisting slot's first body (advances its rolling rotation).
   vec3 slot_rolling_torque(const State& state, std::size_t slot, real dt);
   /// A touching body's moment of inertia for rolling about `axis` (unit) through the contact
