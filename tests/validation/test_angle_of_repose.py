@@ -37,10 +37,12 @@ def test_the_heap_of_a_collapsed_column_is_steeper_with_friction(full: bool) -> 
     more than a degree, and mu_r = 0.3 at least 5 over mu = 0.5 alone. One heap is a noisy
     measure: changing the damping ratios by 1e-6 (a04e262) moved seed 1's angles from 5.2 / 7.4
     / 10.6 / 18.5 to 4.8 / 7.6 / 10.0 / 18.9. The smoke test collapses an 8 mm x 24 mm column
-    (28 grains) for 0.1 s: 3.4 and 7.9 degrees for mu = 0 and 0.5 (kinetic energy 2e-4 and
-    1e-4 of the weight times the width), asserted at least 4 degrees apart. That margin is thin:
-    the same heaps gave 3.2 and 12.0 before the rounding of one build changed, 4.1 and 11.7
-    before a04e262, and packings 2 and 3 give 4.2 / 7.4 and 5.3 / 8.4."""
+    (28 grains) for 0.1 s, packings 1 and 2, mu = 0 and 0.5: 3.4 / 4.2 and 7.9 / 7.4 degrees
+    (kinetic energy at most 3.4e-4 of the weight times the width), means asserted at least 2
+    degrees apart. One packing was not enough: its gap moved from 8.8 to 4.5 degrees with the
+    rounding of one build, and over packings 1-6 the gaps are 4.5, 3.2, 3.1, 6.9, 3.4 and 3.9
+    (mu = 0: 3.0-5.3 degrees, mu = 0.5: 6.9-10.6), so the mean of two is 3.6-5.0 and a single
+    heap could fall under a 4-degree margin by chance."""
     if full:
         angles = [
             np.mean(
@@ -52,5 +54,8 @@ def test_the_heap_of_a_collapsed_column_is_steeper_with_friction(full: bool) -> 
         assert low > none + 1.5 and high > none + 3.0 and high > low - 1.0, angles
         assert rolling > high + 5.0, angles
     else:
-        frictionless, frictional = (settled_angle(mu, 8e-3, 0.1) for mu in (0.0, 0.5))
-        assert frictional > frictionless + 4.0, (frictionless, frictional)
+        frictionless, frictional = (
+            np.mean([settled_angle(mu, 8e-3, 0.1, seed=seed) for seed in angle_of_repose.SEEDS])
+            for mu in (0.0, 0.5)
+        )
+        assert frictional > frictionless + 2.0, (frictionless, frictional)
