@@ -502,6 +502,26 @@ NB_MODULE(_core, m) {
       .def(
           "set_contact_skin", [](Simulation& self, real skin) { self.contact().set_skin(skin); }, "skin"_a)
       .def("wall_reactions", [](const Simulation& self) { return self.contact().wall_reactions(); })
+      .def(
+          "contact_network",
+          [](const Simulation& self) {
+            const ContactNetwork net = self.contact().network(self.model(), self.state());
+            nb::dict d;
+            d["particle_a"] = copy_out(net.particle_a);
+            d["node_a"] = copy_out(net.node_a);
+            d["particle_b"] = copy_out(net.particle_b);
+            d["node_b"] = copy_out(net.node_b);
+            d["wall"] = copy_out(net.wall);
+            d["point"] = copy_out(net.point);
+            d["normal"] = copy_out(net.normal);
+            d["force"] = copy_out(net.force);
+            return d;
+          },
+          "The contacts of the last force evaluation (ContactNetwork): a dict of flat arrays (copies).")
+      .def(
+          "bond_force_densities",
+          [](const Simulation& self) { return copy_out(self.bond_force_densities()); },
+          "The bonds' force densities alone at the current state [N/m^3], flat (nodes x 3).")
       .def_prop_ro("walls", [](const Simulation& self) { return self.contact().walls(); })
       .def_prop_ro("contact_statistics", [](const Simulation& self) { return self.contact().statistics(); })
       .def("run", &Simulation::run, "steps"_a, nb::call_guard<nb::gil_scoped_release>())

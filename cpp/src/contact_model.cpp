@@ -1048,11 +1048,11 @@ std::size_t ContactModel::memory_bytes() const {
          bytes(pair_spring_) + bytes(wall_spring_) + bytes(contact_nodes_) + bytes(body_contact_offsets_) +
          bytes(body_touch_) + bytes(touching_bodies_) + bytes(slot_touch_) + bytes(body_motion_) +
          bytes(body_load_) + bytes(slot_force_) + bytes(slot_normal_) + bytes(slot_point_) +
-         bytes(damping_tables_) + bytes(wall_damping_tables_) + bytes(slot_surface_normal_) +
-         bytes(touching_nodes_) + bytes(touching_normals_) + centres_.memory_bytes() + bytes(anchor_forces_) +
-         bytes(entry_group_) + bytes(entry_target_) + bytes(taking_part_) + bytes(surface_nodes_) +
-         bytes(surface_slot_) + bytes(surface_points_) + bytes(surface_sizes_) + bytes(groups_) +
-         bytes(group_offsets_) + bytes(probes_);
+         bytes(slot_load_) + bytes(damping_tables_) + bytes(wall_damping_tables_) +
+         bytes(slot_surface_normal_) + bytes(touching_nodes_) + bytes(touching_normals_) +
+         centres_.memory_bytes() + bytes(anchor_forces_) + bytes(entry_group_) + bytes(entry_target_) +
+         bytes(taking_part_) + bytes(surface_nodes_) + bytes(surface_slot_) + bytes(surface_points_) +
+         bytes(surface_sizes_) + bytes(groups_) + bytes(group_offsets_) + bytes(probes_);
 }
 
 ContactCheckpoint ContactModel::checkpoint() const {
@@ -1472,8 +1472,9 @@ void ContactModel::sum_slot_stiffness() {
   slot_normal_.assign(in_contact, vec3{0, 0, 0});
   slot_point_.assign(in_contact, vec3{0, 0, 0});
   slot_surface_normal_.assign(in_contact, vec3{0, 0, 0});
+  slot_load_.assign(in_contact, vec3{0, 0, 0});
   release_excess(slot_force_);
-  for (auto* v : {&slot_normal_, &slot_point_, &slot_surface_normal_}) release_excess(*v);
+  for (auto* v : {&slot_normal_, &slot_point_, &slot_surface_normal_, &slot_load_}) release_excess(*v);
 }
 
 void ContactModel::measure_bodies(const Model& model, const State& state) {
@@ -1642,6 +1643,7 @@ void ContactModel::slot_dashpots(const State& state, real dt) {
     const real K = slot_stiffness_[slot];
     const real secant = collision.approach > 0 ? std::min(K, slot_force_[touch] / collision.approach) : K;
     const real damping = 2.0 * zeta * std::sqrt(slot_reduced_mass(slot) * secant) * approach;
+    for (int k = 0; k < 3; ++k) slot_load_[touch][k] += damping * normal[k];
     if (wall_slot) {  // the wall takes the opposite force, at the contact point
       add_body_load(p, point, {damping * normal[0], damping * normal[1], damping * normal[2]});
       const vec arm{point[0] - walls_[q].center[0], point[1] - walls_[q].center[1],
@@ -1819,6 +1821,7 @@ void ContactModel::slot_redirects() {
       const real along = dot(turn, relative) / speed2;
       for (int k = 0; k < 3; ++k) turn[k] -= along * relative[k];
     }
+    for (int k = 0; k < 3; ++k) slot_load_[touch][k] += turn[k];
     add_body_load(q, point, turn);
     add_body_load(p, point, {-turn[0], -turn[1], -turn[2]});
   }
@@ -2098,9 +2101,8 @@ vec3 ContactModel::pair_force(const Model& model, const State& state, index_t i,
   }
   real friction[3] = {0, 0, 0};
   if (law.peridem_friction) {
-    const real tangential[3] = {relative[0] - approach * n[0], relative[1] - approach * n[1],
-                                relative[2] - approach * n[2]};
-    contact::peridem_friction_force(law.friction, push, tangential, friction);
+    const vec peridem = peridem_pair_friction(law, push, relative, n);
+    for (int c = 0; c < 3; ++c) friction[c] = peridem[c];
   } else if (law.friction > 0) {
     const vec turn_i =
         cross(body_spin(node_body_[i]), {g.lever_i * n[0], g.lever_i * n[1], g.lever_i * n[2]});
@@ -2113,6 +2115,87 @@ vec3 ContactModel::pair_force(const Model& model, const State& state, index_t i,
                               springs_[pair_spring_[e]].data(), friction);
   }
   return {-push * n[0] + friction[0], -push * n[1] + friction[1], -push * n[2] + friction[2]};
+}
+
+vec3 ContactModel::peridem_pair_friction(const contact::Law& law, real push, const vec3& relative,
+                                         const vec3& normal) const {
+  const real approach = dot(relative, normal);
+  const real tangential[3] = {relative[0] - approach * normal[0], relative[1] - approach * normal[1],
+                              relative[2] - approach * normal[2]};
+  vec friction{0, 0, 0};
+  contact::peridem_friction_force(law.friction, push, tangential, friction.data());
+  return friction;
+}
+
+vec3 ContactModel::evaluated_pair_force(const Model& model, const State& state, index_t i, index_t e) const {
+  const index_t j = pair_partner_[e];
+  const contact::Law& law = laws_[model.node_material()[i] * material_count_ + model.node_material()[j]];
+  const PairGeometry g = pair_geometry(model, state, i, e);
+  const vec& n = g.normal;
+  const real push = contact::normal_force(entry_stiffness(model, i, e), g.overlap);
+  vec friction{0, 0, 0};
+  if (law.peridem_friction) {
+    const vec vi = contact_velocity(model, state, i), vj = contact_velocity(model, state, j);
+    friction = peridem_pair_friction(law, push, {vi[0] - vj[0], vi[1] - vj[1], vi[2] - vj[2]}, n);
+  } else if (law.friction > 0 && pair_spring_[e] != no_spring) {
+    const real kt = law.tangential_stiffness_ratio * entry_stiffness(model, i, e);
+    for (int c = 0; c < 3; ++c) friction[c] = -kt * springs_[pair_spring_[e]][c];
+  }
+  return {-push * n[0] + friction[0], -push * n[1] + friction[1], -push * n[2] + friction[2]};
+}
+
+ContactNetwork ContactModel::network(const Model& model, const State& state) const {
+  // The force on each slot's first body, summed in node order (pair and wall entries), then in
+  // group order (probes), then the slot's loads (the dashpot and the turn, recorded on q).
+  ContactNetwork net;
+  if (!built_) return net;
+  std::vector<vec3> on_first(slot_load_.size(), vec3{0, 0, 0});
+  for (const index_t i : contact_nodes_) {
+    for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
+      const std::size_t slot = pair_slot_[e];
+      const index_t j = pair_partner_[e];
+      if (pair_stiffness_[e] == 0 || probe_entry(e) || node_body_[i] == node_body_[j] ||
+          node_body_[i] != slots_[slot][0])
+        continue;
+      if (slot_touch_[slot] == not_touching) continue;
+      const vec force = evaluated_pair_force(model, state, i, e);
+      for (int c = 0; c < 3; ++c) on_first[slot_touch_[slot]][c] += force[c];
+    }
+    for (index_t e = wall_offsets_[i]; e < wall_offsets_[i + 1]; ++e) {
+      if (wall_entry_stiffness_[e] == 0 || slot_touch_[wall_slot_[e]] == not_touching) continue;
+      for (int c = 0; c < 3; ++c) on_first[slot_touch_[wall_slot_[e]]][c] -= wall_entry_reaction_[e][c];
+    }
+  }
+  for (std::size_t g = 0; g < groups_.size(); ++g) {
+    const ProbeState& probe = probes_[g];
+    const std::size_t slot = groups_[g].slot;
+    if (probe.push == 0 || slot_touch_[slot] == not_touching) continue;
+    const real sign = node_body_[groups_[g].probe] == slots_[slot][0] ? 1.0 : -1.0;
+    for (int c = 0; c < 3; ++c)
+      on_first[slot_touch_[slot]][c] +=
+          sign * (probe.push * probe.gradient[c] - probe.taper * probe.sums.spread[c] + probe.friction[c]);
+  }
+  auto first_node = [&](index_t body) { return body_nodes_[body_node_offsets_[body]]; };
+  for (std::size_t slot = 0; slot < slots_.size(); ++slot) {
+    const bool wall_slot = slot >= particle_slot_count_;
+    const index_t p = slots_[slot][0], q = slots_[slot][1];
+    if (!slot_in_contact(slot) || (!wall_slot && p == q)) continue;
+    const index_t touch = slot_touch_[slot];
+    const vec& sum = slot_surface_normal_[touch];
+    const real size = std::sqrt(dot(sum, sum)), sign = wall_slot ? 1.0 : -1.0;  // from b towards a
+    const vec point = slot_contact_point(touch);
+    net.particle_a.push_back(body_particle_[p]);
+    net.node_a.push_back(first_node(p));
+    net.particle_b.push_back(wall_slot ? q : body_particle_[q]);
+    net.node_b.push_back(wall_slot ? ~index_t{0} : first_node(q));
+    net.wall.push_back(wall_slot ? 1 : 0);
+    for (int c = 0; c < 3; ++c) {
+      net.point.push_back(point[c]);
+      net.normal.push_back(sign * sum[c] / size);
+      net.force.push_back(on_first[touch][c] + (wall_slot ? 1.0 : -1.0) * slot_load_[touch][c]);
+    }
+  }
+  return net;
 }
 
 ContactModel::WallGeometry ContactModel::wall_geometry(const Model& model, index_t i, index_t e) const {

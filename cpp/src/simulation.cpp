@@ -192,6 +192,23 @@ void add_dilatation_terms(index_t i, const NodeBonds& bonds, std::uint8_t* bond_
 }
 
 /// What the pair-force loop reads and writes, as raw pointers (kept in registers).
+/// Runs body(i) for every node, colour by colour, the blocks of a colour in parallel (inside an
+/// omp parallel region). Each bond is evaluated once, at its lower-numbered end, and its terms are
+/// added to both ends; the colours keep concurrent blocks on disjoint nodes (see BondSchedule), so
+/// there are no atomics and the sums do not depend on the thread count. Nodes of a particle that
+/// gathers evaluate all their bonds and write only their own sums.
+template <class Body>
+void for_each_node_in_colours(const BondSchedule& schedule, Body&& body) {
+  for (std::size_t c = 0; c + 1 < schedule.colour_offsets.size(); ++c) {
+    const std::int64_t first = schedule.colour_offsets[c], last = schedule.colour_offsets[c + 1];
+#pragma omp for schedule(dynamic, 1)
+    for (std::int64_t k = first; k < last; ++k) {
+      const index_t block = schedule.blocks[k];
+      for (index_t i = schedule.block_starts[block]; i < schedule.block_starts[block + 1]; ++i) body(i);
+    }
+  }
+}
+
 struct PairForceArrays {
   const real* positions;
   const real* volumes;
@@ -252,6 +269,37 @@ void add_pair_forces(index_t i, const NodeBonds& bonds, const std::uint8_t* bond
 
 }  // namespace
 
+void Simulation::add_bond_forces(real* forces) const {
+  // Pass 2: pair forces, w_ij s y/|y| on i and -w_ji s y/|y| on j (w_ij = J beta V_j), from the
+  // pressures of pass 1.
+  const Model& m = *model_;
+  const BondSchedule& schedule = m.bond_schedule();
+  const PairForceArrays arrays{state_.positions.data(),     m.volumes().data(),       pressure_.data(),
+                               m.lps_coefficients().data(), m.pmb_stiffness().data(), forces};
+#pragma omp parallel
+  for_each_node_in_colours(schedule, [&](index_t i) {
+    const NodeBonds bonds = m.node_bonds(i);
+    const bool lps = m.materials()[m.node_material()[i]].params.model == ForceModel::lps;
+    const bool gathers = schedule.particle_gathers[m.node_particle()[i]];
+    const std::uint8_t* const bits = state_.bonds.node(i);
+    if (lps && !gathers) {
+      add_pair_forces<true, false>(i, bonds, bits, arrays);
+    } else if (!gathers) {
+      add_pair_forces<false, false>(i, bonds, bits, arrays);
+    } else if (lps) {
+      add_pair_forces<true, true>(i, bonds, bits, arrays);
+    } else {
+      add_pair_forces<false, true>(i, bonds, bits, arrays);
+    }
+  });
+}
+
+std::vector<real> Simulation::bond_force_densities() const {
+  std::vector<real> forces(state_.positions.size(), 0.0);
+  if (forces_current_) add_bond_forces(forces.data());
+  return forces;
+}
+
 void Simulation::compute_forces() {
   update_kinematic_nodes();
   const Model& m = *model_;
@@ -266,22 +314,9 @@ void Simulation::compute_forces() {
   const std::int64_t n = m.node_count();
   const auto g = body_acceleration_;
 
-  // Each bond is evaluated once, at its lower-numbered end, and its terms are added to both
-  // ends; the bond schedule's colours keep concurrent blocks on disjoint nodes (see
-  // BondSchedule), so there are no atomics and the sums do not depend on the thread count.
-  // Nodes of a particle that gathers evaluate all their bonds and write only their own sums.
   const BondSchedule& schedule = m.bond_schedule();
   const auto& volume = m.volumes();
-  auto for_each_node_by_colour = [&schedule](auto&& body) {
-    for (std::size_t c = 0; c + 1 < schedule.colour_offsets.size(); ++c) {
-      const std::int64_t first = schedule.colour_offsets[c], last = schedule.colour_offsets[c + 1];
-#pragma omp for schedule(dynamic, 1)
-      for (std::int64_t k = first; k < last; ++k) {
-        const index_t block = schedule.blocks[k];
-        for (index_t i = schedule.block_starts[block]; i < schedule.block_starts[block + 1]; ++i) body(i);
-      }
-    }
-  };
+  auto for_each_node_by_colour = [&schedule](auto&& body) { for_each_node_in_colours(schedule, body); };
 
   // Pass 1: stretch, irreversible breaking, sum_j w r e at both ends. A bond breaks at the end
   // that evaluates it; its other copy is cleared below, before any loop reads it (when both
@@ -344,25 +379,7 @@ void Simulation::compute_forces() {
     f[3 * i + 2] = density[i] * (g[2] - viscous_damping_ * vi[2]);
   }
 
-  // Pass 2: pair forces, w_ij s y/|y| on i and -w_ji s y/|y| on j (w_ij = J beta V_j).
-  const PairForceArrays arrays{
-      x.data(), volume.data(), pressure_.data(), lps_coefficients.data(), m.pmb_stiffness().data(), f.data()};
-#pragma omp parallel
-  for_each_node_by_colour([&](index_t i) {
-    const NodeBonds bonds = m.node_bonds(i);
-    const bool lps = materials[node_material[i]].params.model == ForceModel::lps;
-    const bool gathers = schedule.particle_gathers[m.node_particle()[i]];
-    if (lps && !gathers) {
-      add_pair_forces<true, false>(i, bonds, intact.node(i), arrays);
-    } else if (!gathers) {
-      add_pair_forces<false, false>(i, bonds, intact.node(i), arrays);
-    } else if (lps) {
-      add_pair_forces<true, true>(i, bonds, intact.node(i), arrays);
-    } else {
-      add_pair_forces<false, true>(i, bonds, intact.node(i), arrays);
-    }
-  });
-
+  add_bond_forces(f.data());  // pass 2
   broken_bond_copies_ += newly_broken;
 
   const auto contact_start = clock_type::now();

@@ -74,6 +74,10 @@ class Simulation {
   /// phi_i = 1 - (intact weighted volume)/(initial weighted volume); z_i = max_j |s_ij| / s0.
   void damage(real* phi, real* z) const;
   std::uint64_t broken_bonds() const;  ///< broken bonds, each counted once
+  /// The bonds' force densities alone at the current state [N/m^3, nodes x 3]: pass 2 of the
+  /// last force evaluation again, without body forces, damping, contact and loads (zero before
+  /// any evaluation). For particle stresses from internal forces.
+  std::vector<real> bond_force_densities() const;
   /// Breaks the bonds between the given node pairs (both copies; pre-cracks, notches). Pairs
   /// that are not bonded are an InputError; already broken ones are left as they are.
   void break_bonds(const std::vector<std::array<index_t, 2>>& pairs);
@@ -93,6 +97,8 @@ class Simulation {
   void restore(const State& state, const ContactCheckpoint& contact);
 
  private:
+  /// Adds the bond forces (pass 2 of compute_forces) to `forces` (nodes x 3).
+  void add_bond_forces(real* forces) const;
   void apply_prescribed_motion(bool positions_too);
   void check_stability() const;
   std::shared_ptr<Model> model_;

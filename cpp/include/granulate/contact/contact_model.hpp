@@ -69,6 +69,20 @@ struct ContactCheckpoint {
   std::vector<std::array<real, 6>> wall_reactions;
 };
 
+/// The contacts between bodies (particles, or their fragments once bonds break) and between
+/// bodies and walls at the last force evaluation, one per pair in contact (ContactModel::network).
+/// Contact k is between body a and body b (or wall b): `force` is the whole contact force on a
+/// from b (springs, friction, dashpot and the turn of slot_redirects, surface-law probes;
+/// rolling-resistance couples and friction couples are moments and not in it), `normal` the
+/// unit contact normal from b towards a (force . normal > 0 pushes them apart), `point` the
+/// spring-weighted contact point. A body is named by its particle and its smallest node.
+struct ContactNetwork {
+  std::vector<index_t> particle_a, node_a;  ///< a's particle and smallest node
+  std::vector<index_t> particle_b, node_b;  ///< b's, or (wall index, 2^32 - 1) for a wall
+  std::vector<std::uint8_t> wall;           ///< 1 where b is a wall
+  std::vector<real> point, normal, force;   ///< 3 per contact [m, -, N; N/m in 2D]
+};
+
 class ContactModel {
  public:
   /// Sizes the law tables for the model's materials (no contact until laws are set).
@@ -123,6 +137,9 @@ class ContactModel {
   /// [N, N m; per unit thickness in 2D], from the last evaluation.
   const std::vector<std::array<real, 6>>& wall_reactions() const { return wall_reactions_; }
   const ContactStatistics& statistics() const { return statistics_; }
+  /// The contacts of the last force evaluation (see ContactNetwork), in slot order: particle
+  /// pairs, then particle-wall pairs. `state` must be the state that evaluation saw.
+  ContactNetwork network(const Model& model, const State& state) const;
   /// Wall-clock seconds spent checking and rebuilding the neighbour lists.
   double search_seconds() const { return search_seconds_; }
   /// Bytes of the lists and per-entry scratch.
@@ -348,6 +365,12 @@ class ContactModel {
   real damping_ratio(std::size_t slot, contact::Collision& collision, real advance);
   /// Force on node i of its list entry e (updates the entry's friction spring).
   vec3 pair_force(const Model& model, const State& state, index_t i, index_t e, real dt);
+  /// PeriDEM's friction on node i of entry e: mu |push| against the tangential relative velocity.
+  vec3 peridem_pair_friction(const contact::Law& law, real push, const vec3& relative,
+                             const vec3& normal) const;
+  /// The force pair_force gave node i of entry e in the last evaluation, from the springs as it
+  /// left them (F_t = -kt xi), without the fragment dashpot (entries between two bodies only).
+  vec3 evaluated_pair_force(const Model& model, const State& state, index_t i, index_t e) const;
   /// A node-wall entry in contact: the deepest point's normal (towards the node), the arm
   /// p - x_i of its contact point and the spring stiffness kn V_i^2.
   struct WallGeometry {
@@ -448,6 +471,8 @@ class ContactModel {
   std::vector<vec3> slot_surface_normal_;       // spring-weighted sum of the surfaces' normals
   std::vector<index_t> touching_nodes_;         // nodes in a pair in contact between two bodies, in
   std::vector<vec3> touching_normals_;          // order, and their surface normals (per step)
+  // Per slot in contact: the dashpot's and the turn's force on q (on p for a wall slot), for network().
+  std::vector<vec3> slot_load_;
   /// Angular velocity of a body (zero if it touches nothing).
   const vec3& body_spin(index_t body) const {
     static constexpr vec3 none{0, 0, 0};
