@@ -597,6 +597,9 @@ class WallSpec(Spec):
     motion: MotionSpec | None = None
     contact: ContactSpec | None = None
     center: list[Finite] = Field([0, 0, 0], description="torque reference [m]")
+    area: Positive | None = Field(
+        None, description="nominal area for <name>_stress in history.csv [m^2; m in 2D]"
+    )
 
 
 # ----------------------------------------------------------------------------- loading
@@ -1103,6 +1106,7 @@ def _wall(w: WallSpec, case: CaseContext) -> walls.Wall:
         w.name,
         None if w.contact is None else w.contact.make(),
         w.center,
+        w.area,
     )
 
 

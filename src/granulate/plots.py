@@ -5,12 +5,18 @@
   the gravitational and total energy (their sum) since the start;
 - ``broken_bonds.png``: broken bonds against time;
 - ``wall_<name>.png`` for every wall: the force components against the wall's displacement
-  (a compression test's load curve);
+  (a compression test's load curve), and ``wall_<name>_stress.png`` for a wall given an area:
+  its stress [kPa] against its displacement [mm];
+- ``coordination.png``: the mean coordination number and the particle pairs in contact
+  against time;
 and from the fragment tables of the frames (``frames/fragments_NNNNNN.csv``):
 - ``grading.png``: grading curves (mass fraction passing against equivalent diameter, log
   axis) of the first frame, the last and up to three between;
 - ``breakage.png``: Hardin's relative breakage Br and t10 against the frame's time
-  (granulate.fragments).
+  (granulate.fragments);
+and from the last frame's contact table (``frames/contacts_NNNNNN.csv``), in 2D:
+- ``force_chains.png``: a line between the centres of every two bodies in contact (and to the
+  contact point on a wall), its width proportional to the normal force.
 
 ``render(directory, frame=None, gif=False)`` writes ``renders/frame_NNNNNN.png``: the nodes of
 each VTU frame coloured by damage (2D: in the plane; 3D: projected on x-z), and with ``gif`` an
@@ -23,7 +29,7 @@ from pathlib import Path
 
 import numpy as np
 
-from granulate import fragments
+from granulate import fragments, network
 from granulate.errors import InputError
 from granulate.io.history import read_history
 from granulate.results import Results
@@ -86,9 +92,54 @@ def plot_history(directory: str | Path) -> list[Path]:
         axes.set_ylabel("force on the wall [N, N/m in 2D]")
         axes.legend()
         written.append(_save(plt, figure, folder / f"wall_{wall}.png"))
+        if f"{wall}_stress" in history:
+            figure, axes = plt.subplots(figsize=(6, 4))
+            axes.plot(1e3 * np.abs(moved), 1e-3 * history[f"{wall}_stress"])
+            axes.set_xlabel(f"{wall} displacement [mm]")
+            axes.set_ylabel(f"{wall} stress: force per unit area [kPa]")
+            written.append(_save(plt, figure, folder / f"wall_{wall}_stress.png"))
+    if "coordination" in history:
+        figure, axes = plt.subplots(figsize=(6, 4))
+        axes.plot(t, history["coordination"], label="mean coordination number Z")
+        axes.set_xlabel("time [s]")
+        axes.set_ylabel("Z [-]")
+        twin = axes.twinx()
+        twin.plot(t, history["contacts"], color="tab:orange", label="particle pairs in contact")
+        twin.set_ylabel("particle pairs in contact")
+        figure.legend(loc="lower right")
+        written.append(_save(plt, figure, folder / "coordination.png"))
     if any((folder / "frames").glob("fragments_*.csv")):
         written += plot_breakage(Results(folder))
+    if any((folder / "frames").glob("contacts_*.csv")):
+        written += plot_force_chains(Results(folder))
     return written
+
+
+def plot_force_chains(results: Results, frame: int = -1) -> list[Path]:
+    """force_chains.png of a 2D run's frame (module docstring); nothing in 3D."""
+    if results.summary["dimension"] != 2:
+        return []
+    from matplotlib.collections import LineCollection
+
+    plt = _pyplot()
+    contacts, pieces = results.contacts(frame), results.fragments(frame)
+    points, lines = network.chain_lines(contacts, pieces)
+    force = np.clip(contacts["normal_force"], 0, None)
+    widths = 4 * force / force.max() if len(force) and force.max() > 0 else np.ones(len(force))
+    span = np.ptp(pieces["x"]), np.ptp(pieces["y"])
+    height = float(np.clip(6.5 * span[1] / max(span[0], 1e-300), 2.0, 8.0)) + 1.0
+    figure, axes = plt.subplots(figsize=(7, height))
+    axes.add_collection(
+        LineCollection(points[lines][:, :, :2], linewidths=widths, colors="tab:red")
+    )
+    axes.plot(pieces["x"], pieces["y"], ".", ms=2, color="0.6")
+    axes.set_aspect("equal")
+    axes.autoscale()
+    axes.set_xlabel("x [m]")
+    axes.set_ylabel("y [m]")
+    largest = float(force.max()) if len(force) else 0.0
+    axes.set_title(f"force chains at t = {results.times[frame]:.4g} s (widest: {largest:.3g} N/m)")
+    return [_save(plt, figure, results.directory / "force_chains.png")]
 
 
 def plot_breakage(results: Results) -> list[Path]:

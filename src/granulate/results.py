@@ -2,7 +2,7 @@
 
 The history is a dict of NumPy columns (``pandas.DataFrame(results.history)`` makes it a data
 frame), frames are picked by number or by time and come as positions and point-data arrays,
-and each frame's particle and fragment tables are dicts of columns too. Nothing needs
+and each frame's particle, fragment and contact tables are dicts of columns too. Nothing needs
 ParaView or a PVD parser.
 """
 
@@ -16,12 +16,10 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from granulate import fragments
+from granulate import fragments, network, particle_table
 from granulate.errors import InputError
 from granulate.io.history import read_history
-from granulate.io.table import read_table as read_rows
 from granulate.io.vtu import read_pvd, read_vtu_point_data
-from granulate.simulation import PARTICLE_COLUMNS
 
 
 @dataclass(frozen=True)
@@ -98,16 +96,19 @@ class Results:
 
     def particles(
         self, frame: int | None = None, *, time: float | None = None
-    ) -> dict[str, NDArray]:
-        """The frame's particle table: particle, centre x y z [m], velocity vx vy vz [m/s],
-        mass [kg; kg/m in 2D], damage."""
+    ) -> particle_table.Table:
+        """The frame's particle table (granulate.particle_table.COLUMNS): particle, time,
+        centre x y z [m], velocity vx vy vz [m/s], angular velocity wx wy wz [rad/s], mass
+        [kg; kg/m in 2D], gyration_radius [m], damage, coordination and the Love-Weber stress
+        sxx ... syz [Pa]."""
         k = self.index(frame, time=time)
-        path = self._files[k].parent / f"particles_{self._number(k)}.csv"
-        names = PARTICLE_COLUMNS
-        data = read_rows(
-            path, what="particle table", widths=(len(names),), columns=", ".join(names)
-        )
-        return {name: data[:, j] for j, name in enumerate(names)}
+        return particle_table.read_table(self._files[k].parent / f"particles_{self._number(k)}.csv")
+
+    def contacts(self, frame: int | None = None, *, time: float | None = None) -> network.Table:
+        """The frame's contact table (granulate.network.COLUMNS): the bodies in contact, the
+        contact point, normal, force, and normal and tangential force."""
+        k = self.index(frame, time=time)
+        return network.read_table(self._files[k].parent / f"contacts_{self._number(k)}.csv")
 
     def fragments(self, frame: int | None = None, *, time: float | None = None) -> fragments.Table:
         """The frame's fragment table (granulate.fragments.COLUMNS)."""

@@ -14,7 +14,6 @@ energies J per metre.
 from __future__ import annotations
 
 import difflib
-import io
 import json
 import signal
 import threading
@@ -28,7 +27,7 @@ from typing import Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from granulate import _core, fragments, resources, threads
+from granulate import _core, fragments, network, particle_table, resources, threads
 from granulate._version import __version__
 from granulate.contact import Contact
 from granulate.errors import GranulateWarning, InputError
@@ -59,7 +58,7 @@ FIELDS = (
     "Nodal_Volume",
 )
 #: Columns of the particle tables (frames/particles_NNNNNN.csv), in the order written.
-PARTICLE_COLUMNS = ("particle", "x", "y", "z", "vx", "vy", "vz", "mass", "damage")
+PARTICLE_COLUMNS = particle_table.COLUMNS
 HISTORY_COLUMNS = (
     "step",
     "time",
@@ -77,6 +76,8 @@ HISTORY_COLUMNS = (
     "debris_mass",
     "particles_split",
     "mean_damage",
+    "contacts",
+    "coordination",
 )
 
 
@@ -1710,28 +1711,59 @@ class Simulation:
             "neighbor_list_rebuilds": core.contact_statistics.rebuilds,
         }
 
-    def _write_particles(self, path: Path, damage: NDArray[np.float64]) -> None:
-        """One row per particle: centre of mass [m], its velocity [m/s], mass [kg; kg/m in
-        2D], volume-weighted mean damage."""
-        model = self.model
-        core = self._build()
+    def particle_table(
+        self, contacts: network.Table | None = None, damage: ArrayLike | None = None
+    ) -> particle_table.Table:
+        """One row per particle of the current state (granulate.particle_table): time, centre
+        of mass [m], velocity [m/s], angular velocity [rad/s], mass [kg; kg/m in 2D], radius
+        of gyration [m], volume-weighted mean damage, coordination and Love-Weber stress [Pa]
+        (granulate.network), from `contacts` (default: ``contact_table()``)."""
+        model, core = self.model, self._build()
         owner = np.asarray(model.node_particle)
         count = len(self.bodies)
-        mass = np.asarray(model.node_density) * np.asarray(model.volumes)
-        total = np.bincount(owner, mass, count)
-        columns = [np.arange(count)]
-        for array in (core.positions, core.velocities):
-            for k in range(3):
-                columns.append(np.bincount(owner, mass * array[:, k], count) / total)
-        columns.append(total)
         volumes = np.asarray(model.volumes)
-        columns.append(
-            np.bincount(owner, volumes * damage, count) / np.bincount(owner, volumes, count)
-        )
-        buffer = io.StringIO()
-        buffer.write(",".join(PARTICLE_COLUMNS) + "\n")
-        np.savetxt(buffer, np.column_stack(columns), delimiter=",", fmt=["%d"] + ["%.17g"] * 8)
-        atomic_write(path, buffer.getvalue().encode())
+        mass = np.asarray(model.node_density) * volumes
+        table = particle_table.motion(owner, mass, core.positions, core.velocities, count)
+        contacts = self.contact_table() if contacts is None else contacts
+        phi = core.damage()[0] if damage is None else np.asarray(damage)
+        particle_volume = np.bincount(owner, volumes, count)
+        table["particle"] = np.arange(count)
+        table["time"] = np.full(count, float(core.time))
+        table["damage"] = np.bincount(owner, volumes * phi, count) / particle_volume
+        table["coordination"] = network.coordination(contacts, count)
+        centres = np.column_stack([table[axis] for axis in "xyz"])
+        stresses = network.love_weber_stresses(contacts, centres, particle_volume, self.dimension)
+        particle_table.add_stresses(table, stresses, self.dimension)
+        return table
+
+    def contact_table(self) -> network.Table:
+        """One row per contact of the last force evaluation (pairs of particles or of their
+        fragments, and particles on walls): the bodies, contact point [m], normal, force on
+        the first body [N; N/m in 2D], normal and tangential force (granulate.network; wall
+        k is ``list(sim.wall_reactions())[k]``)."""
+        return network.contact_table(self._build().contact_network())
+
+    def particle_stresses(self, method: Literal["contacts", "bonds"] = "contacts") -> NDArray:
+        """Each particle's mean stress, (particles, D, D) [Pa; tension positive]: Love-Weber
+        from its contacts, or from its bond forces (granulate.network; the two agree for a
+        particle at rest)."""
+        model, core = self.model, self._build()
+        owner = np.asarray(model.node_particle)
+        count = len(self.bodies)
+        volumes = np.asarray(model.volumes)
+        mass = np.asarray(model.node_density) * volumes
+        table = particle_table.motion(owner, mass, core.positions, core.velocities, count)
+        centres = np.column_stack([table[axis] for axis in "xyz"])
+        if method == "contacts":
+            return network.love_weber_stresses(
+                self.contact_table(), centres, np.bincount(owner, volumes, count), self.dimension
+            )
+        if method == "bonds":
+            bonds = np.asarray(core.bond_force_densities()).reshape(-1, 3)
+            return network.internal_stresses(
+                bonds, core.positions, volumes, owner, centres, self.dimension
+            )
+        raise InputError(f"particle_stresses: method must be 'contacts' or 'bonds', got {method!r}")
 
     @property
     def output_seconds(self) -> float:
@@ -1782,13 +1814,18 @@ class Simulation:
             return
         phi, z = self._build().damage()
         table = self.fragment_table()
+        contacts = self.contact_table()
         if frame:
-            self._write_vtu_frame(phi, z, table)
+            self._write_vtu_frame(phi, z, table, contacts)
         if history:
-            self._write_history_row(phi, table)
+            self._write_history_row(phi, table, contacts)
 
     def _write_vtu_frame(
-        self, phi: NDArray[np.float64], z: NDArray[np.float64], table: fragments.Table
+        self,
+        phi: NDArray[np.float64],
+        z: NDArray[np.float64],
+        table: fragments.Table,
+        contacts: network.Table,
     ) -> None:
         out = self._output
         assert out is not None and self._model is not None
@@ -1814,13 +1851,40 @@ class Simulation:
             {field: available[field]() for field in out.fields},
         )
         out.pvd.add(core.time, Path("frames") / name)
-        self._write_particles(out.directory / "frames" / f"particles_{out.frames:06d}.csv", phi)
-        fragments.write_table(out.directory / "frames" / f"fragments_{out.frames:06d}.csv", table)
+        frames = out.directory / "frames"
+        particle_table.write_table(
+            frames / f"particles_{out.frames:06d}.csv", self.particle_table(contacts, phi)
+        )
+        fragments.write_table(frames / f"fragments_{out.frames:06d}.csv", table)
+        self._write_contacts(out.frames, contacts, table)
         out.frames += 1
         out.frame_step = int(core.step)
         self._write_run_json()
 
-    def _write_history_row(self, phi: NDArray[np.float64], table: fragments.Table) -> None:
+    def _write_contacts(self, frame: int, contacts: network.Table, pieces: fragments.Table) -> None:
+        """frames/contacts_NNNNNN.csv, the force chains frames/contacts_NNNNNN.vtu (a line from
+        each body's centre to the other's, or to the contact point on a wall) and contacts.pvd,
+        whose entries follow simulation.pvd's."""
+        out = self._output
+        assert out is not None
+        frames = out.directory / "frames"
+        network.write_table(frames / f"contacts_{frame:06d}.csv", contacts)
+        points, cells = network.chain_lines(contacts, pieces)
+        write_vtu(
+            frames / f"contacts_{frame:06d}.vtu",
+            points,
+            {},
+            lines=cells,
+            cell_data=network.chain_fields(contacts),
+        )
+        chains = PvdSeries(out.directory / "contacts.pvd")
+        for t, name in out.pvd.entries:
+            chains.entries.append((t, name.replace("/frame_", "/contacts_")))
+        chains.write()
+
+    def _write_history_row(
+        self, phi: NDArray[np.float64], table: fragments.Table, contacts: network.Table
+    ) -> None:
         out = self._output
         assert out is not None and self._model is not None
         core = self._build()
@@ -1841,16 +1905,22 @@ class Simulation:
             "list_rebuilds": statistics.rebuilds,
         }
         row.update(fragments.summary(table, phi, self._model.volumes))
+        row["contacts"] = len(network.coordination_pairs(contacts))
+        row["coordination"] = network.mean_coordination(contacts, len(self.bodies))
         components = (
             ("fx", "fy", "tz") if self.dimension == 2 else ("fx", "fy", "fz", "tx", "ty", "tz")
         )
         index = {"fx": 0, "fy": 1, "fz": 2, "tx": 3, "ty": 4, "tz": 5}
+        walls_by_name = dict(self._walls)
         for (name, _), reaction, wall in zip(
             self._walls, core.wall_reactions(), core.walls, strict=True
         ):
             for c in components:
                 row[f"{name}_{c}"] = float(reaction[index[c]])
             row[f"{name}_displacement"] = wall.displacement(core.time)
+            area = walls_by_name[name].area
+            if area is not None:
+                row[f"{name}_stress"] = float(np.linalg.norm(reaction[: self.dimension])) / area
         if out.tracked:
             forces = core.forces
             displacement = core.positions - self._reference

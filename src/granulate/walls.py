@@ -38,7 +38,7 @@ from granulate import _core
 from granulate.contact import Contact
 from granulate.errors import InputError
 from granulate.functions import Constant, Linear, TimeFunction
-from granulate.input_errors import checked_arguments
+from granulate.input_errors import check_number, checked_arguments
 from granulate.meshes import SurfaceMesh, read_file
 from granulate.shapes import Box, Disc, Ellipse, Polygon, Rectangle, Shape
 
@@ -258,7 +258,9 @@ class Wall:
     """Surfaces moving together, with an optional motion and contact parameters.
 
     ``contact`` defaults to the simulation's contact settings; ``center`` is the torque
-    reference point (the rotation centre for rotating walls).
+    reference point (the rotation centre for rotating walls); ``area``, the wall's nominal
+    area [m^2; m in 2D, per unit thickness], makes history.csv record its stress
+    ``<name>_stress``, the particles' resultant force on it over that area [Pa].
     """
 
     surfaces: tuple[Surface, ...]
@@ -266,6 +268,7 @@ class Wall:
     name: str | None = None
     contact: Contact | None = None
     center: ArrayLike = (0.0, 0.0, 0.0)
+    area: float | None = None
 
     def core(self, name: str, dimension: int) -> _core.Wall:
         try:
@@ -278,6 +281,10 @@ class Wall:
         wall.name = name
         if not self.surfaces:
             raise InputError("it has no surface")
+        if self.area is not None:
+            check_number("wall area", self.area)
+            if not (np.isfinite(self.area) and self.area > 0):
+                raise InputError(f"area must be positive [m^2; m in 2D], got {self.area!r}")
         wall.surfaces = [s.core(dimension) for s in self.surfaces]
         wall.center = _vec3(self.center, "wall center", dimension)
         if isinstance(self.motion, Translation):

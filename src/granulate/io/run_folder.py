@@ -15,7 +15,7 @@ from granulate.resources import size_text
 
 LOCK = ".granulate.lock"
 #: What a run writes (replaced together with --overwrite).
-RUN_FILES = ("simulation.pvd", "history.csv", "run.json", "checkpoint.npz")
+RUN_FILES = ("simulation.pvd", "contacts.pvd", "history.csv", "run.json", "checkpoint.npz")
 FRAME_PATTERNS = ("frame_*.vtu", "particles_*.csv")
 
 

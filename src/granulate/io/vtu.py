@@ -46,6 +46,8 @@ def _pool() -> ThreadPoolExecutor:
 
 
 def _blocks(array: NDArray[np.generic]) -> list[memoryview]:
+    if array.size == 0:  # an empty array is one empty block (memoryview cannot cast it)
+        return [memoryview(b"")]
     raw = memoryview(
         np.ascontiguousarray(array).astype(array.dtype.newbyteorder("<"), copy=False)
     ).cast("B")
@@ -81,26 +83,41 @@ def _compress_all(arrays: list[NDArray[np.generic]]) -> list[list[bytes]]:
     return out
 
 
+_VTK_VERTEX, _VTK_LINE = 1, 3
+
+
 def write_vtu(
     path: str | os.PathLike[str],
     points: NDArray[np.float64],
     point_data: Mapping[str, NDArray[np.generic]],
+    *,
+    lines: NDArray[np.int64] | None = None,
+    cell_data: Mapping[str, NDArray[np.generic]] | None = None,
 ) -> None:
-    """Write nodes and their fields as a .vtu file (atomically).
+    """Write points and their fields as a .vtu file (atomically): each point a vertex cell, or
+    with `lines` ((k, 2) point indices) line cells with `cell_data`.
 
     Args:
         path: target file.
-        points: (n, 3) node positions.
+        points: (n, 3) positions.
         point_data: name -> (n,) or (n, k) array; dtypes float64/float32/int64/int32/uint32/uint8.
+        lines: (k, 2) point indices of line cells (instead of one vertex per point).
+        cell_data: name -> (k,) or (k, m) array, one row per line.
     """
     n = len(points)
+    if lines is None:
+        connectivity, cells, kind = np.arange(n, dtype=np.int64), n, _VTK_VERTEX
+    else:
+        connectivity, cells, kind = np.asarray(lines, dtype=np.int64).ravel(), len(lines), _VTK_LINE
+    per_cell = 1 if lines is None else 2
     entries: list[tuple[str, str, NDArray[np.generic]]] = [
         ("point", name, np.asarray(values)) for name, values in point_data.items()
     ]
-    entries.append(("points", "", np.asarray(points, dtype=np.float64)))
-    entries.append(("cells", "connectivity", np.arange(n, dtype=np.int64)))
-    entries.append(("cells", "offsets", np.arange(1, n + 1, dtype=np.int64)))
-    entries.append(("cells", "types", np.ones(n, dtype=np.uint8)))
+    entries += [("cell", name, np.asarray(values)) for name, values in (cell_data or {}).items()]
+    entries.append(("points", "", np.asarray(points, dtype=np.float64).reshape(-1, 3)))
+    entries.append(("cells", "connectivity", connectivity))
+    entries.append(("cells", "offsets", np.arange(1, cells + 1, dtype=np.int64) * per_cell))
+    entries.append(("cells", "types", np.full(cells, kind, dtype=np.uint8)))
     entries = [
         (section, name, values if values.dtype in _VTK_TYPES else values.astype(np.float64))
         for section, name, values in entries
@@ -116,22 +133,26 @@ def write_vtu(
             f'format="appended" offset="{offset}"/>'
         )
         offset += sum(len(chunk) for chunk in payload)
-    point_count = len(point_data)
+    point_count, cell_count = len(point_data), len(cell_data or {})
+    geometry = point_count + cell_count
 
     xml = [
         '<?xml version="1.0"?>',
         '<VTKFile type="UnstructuredGrid" version="1.0" byte_order="LittleEndian" '
         'header_type="UInt64" compressor="vtkZLibDataCompressor">',
         "<UnstructuredGrid>",
-        f'<Piece NumberOfPoints="{n}" NumberOfCells="{n}">',
+        f'<Piece NumberOfPoints="{n}" NumberOfCells="{cells}">',
         "<PointData>",
         *descriptors[:point_count],
         "</PointData>",
+        "<CellData>",
+        *descriptors[point_count:geometry],
+        "</CellData>",
         "<Points>",
-        descriptors[point_count],
+        descriptors[geometry],
         "</Points>",
         "<Cells>",
-        *descriptors[point_count + 1 :],
+        *descriptors[geometry + 1 :],
         "</Cells>",
         "</Piece>",
         "</UnstructuredGrid>",
@@ -152,6 +173,10 @@ class PvdSeries:
     def add(self, time: float, frame: str | os.PathLike[str]) -> None:
         """Append a frame (path relative to the .pvd's folder) and rewrite the .pvd."""
         self.entries.append((time, Path(frame).as_posix()))
+        self.write()
+
+    def write(self) -> None:
+        """Write the .pvd listing the entries."""
         lines = [
             '<?xml version="1.0"?>',
             '<VTKFile type="Collection" version="0.1" byte_order="LittleEndian">',
