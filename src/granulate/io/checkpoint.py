@@ -25,7 +25,7 @@ from granulate.io.atomic import atomic_write
 
 # 2: per-contact friction springs and per-node contact radii; 3: each collision's force-law
 # exponent (the damping that gives the requested restitution)
-FORMAT = 4
+FORMAT = 5
 HEADER = "__header__"
 
 
@@ -77,8 +77,9 @@ def load(path: str | Path) -> tuple[dict[str, Any], dict[str, Any]]:
             f"checkpoint {file} has format {header.get('format')!r}; this granulate reads "
             f"format {FORMAT} (format 1 predates the contact model with friction springs and "
             "per-node contact radii, format 2 the damping fitted to each collision's force law, "
-            "format 3 contact against the particles' smooth surfaces; their trajectories "
-            "differ); run without --resume to start over"
+            "format 3 contact against the particles' smooth surfaces, format 4 the turned "
+            "collision forces fading out in lasting contacts; their trajectories differ); run "
+            "without --resume to start over"
         )
     checksum = header.get("checksum")
     if checksum is not None and checksum != content_checksum(data):

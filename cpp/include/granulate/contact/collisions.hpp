@@ -1,8 +1,10 @@
 #pragma once
 
 #include <array>
+#include <cmath>
 #include <cstddef>
 #include <limits>
+#include <numbers>
 #include <vector>
 
 #include "granulate/types.hpp"
@@ -18,9 +20,24 @@ struct Collision {
   std::array<real, 3> normal{0, 0, 0};   ///< unit normal of the last step in contact
   std::array<real, 3> rolling{0, 0, 0};  ///< theta: the rolling spring's rotation [rad]
   float exponent = 1;                    ///< p of F ~ x^p implied by W = F x / (p + 1), in [1, 3]
+  /// tau = sum dt / t_c over the steps in contact: the time since the touch in collision
+  /// durations t_c = pi sqrt(m / K_s) (half the period of the secant spring K_s = F / x on the
+  /// reduced mass m: an impact ends near tau = 1)
+  float phase = 0;
 
   bool operator==(const Collision&) const = default;
 };
+
+/// The share of a collision's turned force (ContactModel::slot_redirects) at phase tau: 1 up to
+/// 1.5 collision durations (an impact, its chattering included), cos^2 down to 0 at 3, then 0
+/// (a lasting contact: a resting, rolling or slowly loaded one).
+inline real impact_share(real phase) {
+  constexpr real full = 1.5, none = 3.0;
+  if (phase <= full) return 1.0;
+  if (phase >= none) return 0.0;
+  const real c = std::cos(0.5 * std::numbers::pi * (phase - full) / (none - full));
+  return c * c;
+}
 
 /// The collisions in progress, one record per body-pair slot that has one. A slot holds the
 /// index of its record (4 bytes); records live in a pool only while their collision lasts, so a

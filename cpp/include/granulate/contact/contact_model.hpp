@@ -56,7 +56,7 @@ struct ContactCheckpoint {
   std::uint64_t particle_slot_count = 0;
   std::vector<real> slot_approach;
   std::vector<real> slot_normal;  ///< 3 per slot: the collision's last contact normal
-  std::vector<real> slot_work;    ///< 2 per slot: the springs' work and the force-law exponent
+  std::vector<real> slot_work;    ///< 3 per slot: the springs' work, force-law exponent, phase
   /// 3 per slot: the rolling rotation of each pair of bodies (empty without rolling resistance).
   std::vector<real> slot_rolling;
   std::vector<index_t> pair_offsets, pair_partners;  ///< the lists (updated after bond breaks)
