@@ -125,3 +125,25 @@ def test_arrays_users_must_not_change_are_read_only() -> None:
     sim.positions[:, 1] += 1e-6
     sim.run(2)
     assert sim.velocities[0, 0] == pytest.approx(1.0, rel=1e-3)
+
+
+def test_setting_an_attribute_simulation_does_not_have_is_an_input_error() -> None:
+    """sim.viscous_damping = 200 after construction was stored as a new Python attribute and
+    the grains fell undamped (a 40-grain pile bounced for a simulated second); a misspelt
+    attribute is refused with the closest name, a read-only one too, and viscous_damping is a
+    property that reaches the core."""
+    sim = gr.Simulation(2, gravity=(0, -10))
+    sim.viscous_damping = 200.0
+    sim.add_body(
+        gr.Disc((0, 0.1), 1e-3),
+        gr.Material(density=1200, youngs_modulus=1e7, poisson_ratio=0.25, fracture=False),
+        2e-4,
+    )
+    sim.run(until=0.02)
+    assert float(sim.velocities[:, 1].mean()) == pytest.approx(-10 / 200, rel=0.02)
+    with pytest.raises(gr.InputError, match="did you mean 'viscous_damping'"):
+        sim.viscous_dampng = 1.0  # type: ignore[attr-defined]
+    with pytest.raises(gr.InputError, match="'node_count' cannot be set"):
+        sim.node_count = 3  # type: ignore[misc]
+    with pytest.raises(gr.InputError, match="cannot change the viscous damping after"):
+        sim.viscous_damping = 1.0

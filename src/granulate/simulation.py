@@ -32,7 +32,7 @@ from granulate._version import __version__
 from granulate.contact import Contact
 from granulate.errors import GranulateWarning, InputError
 from granulate.functions import Constant, Linear, TimeFunction, VelocityRamp
-from granulate.input_errors import check_number
+from granulate.input_errors import check_number, unknown_name
 from granulate.io import HistoryWriter, PvdSeries, atomic_write, write_vtu
 from granulate.io import checkpoint as checkpoint_file
 from granulate.io.run_folder import RunFolder
@@ -269,11 +269,7 @@ class Simulation:
         self.packings: list[Packing] = []
         #: Extra text identifying the set-up (a case file's hash), checked by load_checkpoint.
         self.case_fingerprint = ""
-        if not (np.isfinite(viscous_damping) and viscous_damping >= 0):
-            raise InputError(
-                f"viscous_damping must be a non-negative rate in 1/s, got {viscous_damping}"
-            )
-        self._viscous_damping = float(viscous_damping)
+        self.viscous_damping = viscous_damping
         if gravity is not None:
             self.gravity = gravity  # type: ignore[assignment]
 
@@ -658,6 +654,39 @@ class Simulation:
         self._gravity = self._vector(value, "gravity")
         if self._core is not None:
             self._core.set_body_acceleration(tuple(self._gravity))
+
+    #: The attributes a user may set besides the properties with setters.
+    _SETTABLE = ("dimension", "plane", "bodies", "packings", "case_fingerprint")
+
+    def __setattr__(self, name: str, value: object) -> None:
+        """Refuses attributes the class does not have: a misspelt or invented one
+        (``sim.damping = 5``) would otherwise be stored and do nothing."""
+        if name.startswith("_") or name in self._SETTABLE:
+            object.__setattr__(self, name, value)
+            return
+        known = getattr(type(self), name, None)
+        if isinstance(known, property) and known.fset is not None:
+            object.__setattr__(self, name, value)
+            return
+        settable = sorted(
+            n for n, v in vars(Simulation).items() if isinstance(v, property) and v.fset is not None
+        )
+        what = "cannot be set" if known is not None else "is not an attribute of Simulation"
+        raise InputError(f"{name!r} {what}{unknown_name(name, settable)}")
+
+    @property
+    def viscous_damping(self) -> float:
+        """Background damping rate gamma [1/s]: force density -gamma rho v on every node (set it
+        before the first run; settles piles quasi-statically)."""
+        return self._viscous_damping
+
+    @viscous_damping.setter
+    def viscous_damping(self, value: float) -> None:
+        self._require_building("change the viscous damping")
+        check_number("viscous_damping", value)
+        if not (np.isfinite(value) and value >= 0):
+            raise InputError(f"viscous_damping must be a non-negative rate in 1/s, got {value}")
+        self._viscous_damping = float(value)
 
     @property
     def contact(self) -> Contact | None:
