@@ -419,6 +419,40 @@ class Simulation:
         self.packings.append(packing)
         return bodies
 
+    def placements_now(self, bodies: Sequence[Body], placements: Placements) -> Placements:
+        """`placements` (a packing, say) moved to where `bodies`, the particles added from it,
+        are now: each one's rigid-body fit, its nodes' centroid and the rotation that best
+        maps its reference nodes onto its current ones (2D: the angle; 3D: Kabsch's, as a
+        rotation vector). The elastic strain is left out. To continue from a settled pile in a
+        new simulation, with walls placed on it: ``sim2.add_packing(sim.placements_now(bodies,
+        packing))``."""
+        if len(bodies) != len(placements):
+            raise InputError(
+                f"placements_now: {len(bodies)} bodies for {len(placements)} placements; give "
+                "the bodies add_packing (or add_placements) returned for them"
+            )
+        core, model = self._build(), self.model
+        volumes = np.asarray(model.volumes)
+        positions, rotations = placements.positions.copy(), placements.rotations.copy()
+        for k, body in enumerate(bodies):
+            nodes = slice(body.first_node, body.first_node + body.node_count)
+            w = volumes[nodes] / volumes[nodes].sum()
+            before, now = model.reference_positions[nodes], core.positions[nodes]
+            c0, c = w @ before, w @ now
+            a, b = before - c0, now - c
+            if self.dimension == 2:
+                cross = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
+                turn = float(np.arctan2(w @ cross, w @ np.sum(a * b, axis=1)))
+                rotation = rotation_matrix(turn, 2)
+                rotations[k] = rotations[k] + turn
+            else:
+                u, _, vt = np.linalg.svd((a * w[:, None]).T @ b)
+                flip = np.diag([1.0, 1.0, np.sign(np.linalg.det(vt.T @ u.T))])
+                rotation = vt.T @ flip @ u.T
+                rotations[k] = _rotation_vector(rotation @ rotation_matrix(rotations[k], 3))
+            positions[k] = c + rotation @ (placements.positions[k] - c0)
+        return replace(placements, positions=positions, rotations=rotations)
+
     def add_body_from_nodes(
         self,
         positions: ArrayLike,
@@ -1970,6 +2004,26 @@ class Simulation:
             out.history = HistoryWriter(out.directory / "history.csv", list(row))
         out.history.write(row)
         out.history_step = int(core.step)
+
+
+def _rotation_vector(rotation: NDArray[np.float64]) -> NDArray[np.float64]:
+    """The rotation vector (axis times angle [rad]) of a 3 x 3 rotation matrix."""
+    angle = float(np.arccos(np.clip((np.trace(rotation) - 1) / 2, -1.0, 1.0)))
+    if angle < 1e-12:
+        return np.zeros(3)
+    if np.pi - angle < 1e-6:  # a half turn: the axis from the symmetric part
+        axis = np.sqrt(np.clip((np.diag(rotation) + 1) / 2, 0.0, None))
+        k = int(np.argmax(axis))
+        axis = (rotation[k] + np.eye(3)[k]) / (2 * axis[k])
+        return angle * axis / np.linalg.norm(axis)
+    skew = np.array(
+        [
+            rotation[2, 1] - rotation[1, 2],
+            rotation[0, 2] - rotation[2, 0],
+            rotation[1, 0] - rotation[0, 1],
+        ]
+    )
+    return angle * skew / (2 * np.sin(angle))
 
 
 def _surface_arrays(
