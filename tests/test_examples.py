@@ -30,5 +30,7 @@ def test_example_smoke(
     for key, value in summary.items():
         if key.startswith("e_"):  # a restitution example: measured vs requested
             assert abs(value - float(key[2:])) < 0.05
+    if "final_stress" in summary:  # a compression: the wall carries the pile's resistance
+        assert summary["final_stress"] > 0
     if full and "load_over_weight" in summary:  # a settled pile carries its weight
         assert abs(summary["load_over_weight"] - 1) < 0.01
