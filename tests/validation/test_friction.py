@@ -227,10 +227,10 @@ def stack_height(mu: float, until: float, rolling_friction: float = 0.0) -> floa
 def test_a_stack_of_discs_holds_with_friction_and_collapses_without() -> None:
     """Rigid discs need mu >= 2 - sqrt(3) = 0.27 at both contacts for this stack to stand (the
     bottom discs would roll apart under the top one). mu = 0.5 holds it at its height
-    (1 + sqrt(3) = 2.73 R less the overlaps; measured 2.617 after 0.04 s, 2.609 from 0.07 s to
-    0.12 s), mu = 0.1 lets it collapse to the floor within 0.1 s (the top disc ends at its
-    radius; measured 0.99). Rolling resistance holds what friction alone cannot: mu = 0.1 with
-    mu_r = 0.5 keeps the stack standing (measured 2.605 from 0.02 s to 0.12 s; no rigid-body
+    (1 + sqrt(3) = 2.73 R less the overlaps; measured 2.615 after 0.04 s, 2.608 at 0.12 s),
+    mu = 0.1 lets it collapse to the floor within 0.1 s (the top disc ends at its radius;
+    measured 0.986). Rolling resistance holds what friction alone cannot: mu = 0.1 with mu_r =
+    0.5 keeps the stack standing (measured 2.606 at 0.04 s, 2.605 at 0.12 s; no rigid-body
     threshold is checked here, only that it stands)."""
     assert stack_height(0.5, until=0.04) > 2.6
     assert stack_height(0.1, until=0.1) < 1.1
