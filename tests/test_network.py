@@ -224,8 +224,8 @@ def test_love_weber_stress_agrees_with_the_bonds_at_rest(
 def test_a_run_writes_contact_tables_and_force_chains(tmp_path: Path) -> None:
     """Every frame has frames/contacts_NNNNNN.csv and .vtu, listed in contacts.pvd with
     simulation.pvd's times; Results reads the tables back equal to the live ones; the particle
-    table carries coordination and stress, and history.csv the wall stress, the contact count
-    and the mean coordination."""
+    table carries coordination and stress, and history.csv the wall stress, the contact count,
+    the mean coordination and the particles' mean stress."""
     sim, width = settled_pile(4, "granulate")
     sim.output(tmp_path / "run", every=20)
     sim.run(40)
@@ -243,6 +243,10 @@ def test_a_run_writes_contact_tables_and_force_chains(tmp_path: Path) -> None:
     assert history["contacts"][-1] == 2 and history["coordination"][-1] == pytest.approx(4 / 3)
     reaction = np.linalg.norm(sim.wall_reactions()["floor"][:2])
     assert history["floor_stress"][-1] == pytest.approx(reaction / width, rel=1e-12)
+    volumes = np.bincount(np.asarray(sim.model.node_particle), sim.volumes)
+    solid = network.assembly_stress(sim.particle_stresses(), volumes)
+    assert history["stress_yy"][-1] == pytest.approx(solid[1, 1], rel=1e-12)
+    assert history["stress_yy"][-1] < 0 and "stress_zz" not in history
     chains = (tmp_path / "run" / "frames" / "contacts_000002.vtu").read_bytes()
     assert b'NumberOfCells="5"' in chains and b'Name="Normal_Force"' in chains
 

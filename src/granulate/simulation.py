@@ -59,6 +59,14 @@ FIELDS = (
 )
 #: Columns of the particle tables (frames/particles_NNNNNN.csv), in the order written.
 PARTICLE_COLUMNS = particle_table.COLUMNS
+#: The assembly stress's components in history.csv (``stress_<name>``), per dimension.
+_STRESS_COMPONENTS = {
+    2: (("xx", (0, 0)), ("yy", (1, 1)), ("xy", (0, 1))),
+    3: (
+        ("xx", (0, 0)), ("yy", (1, 1)), ("zz", (2, 2)),
+        ("xy", (0, 1)), ("xz", (0, 2)), ("yz", (1, 2)),
+    ),
+}  # fmt: skip
 HISTORY_COLUMNS = (
     "step",
     "time",
@@ -1806,10 +1814,14 @@ class Simulation:
         k is ``list(sim.wall_reactions())[k]``)."""
         return network.contact_table(self._build().contact_network())
 
-    def particle_stresses(self, method: Literal["contacts", "bonds"] = "contacts") -> NDArray:
+    def particle_stresses(
+        self,
+        method: Literal["contacts", "bonds"] = "contacts",
+        contacts: network.Table | None = None,
+    ) -> NDArray:
         """Each particle's mean stress, (particles, D, D) [Pa; tension positive]: Love-Weber
-        from its contacts, or from its bond forces (granulate.network; the two agree for a
-        particle at rest)."""
+        from its contacts (`contacts`: the current contact table, made when not given), or from
+        its bond forces (granulate.network; the two agree for a particle at rest)."""
         model, core = self.model, self._build()
         owner = np.asarray(model.node_particle)
         count = len(self.bodies)
@@ -1818,8 +1830,9 @@ class Simulation:
         table = particle_table.motion(owner, mass, core.positions, core.velocities, count)
         centres = np.column_stack([table[axis] for axis in "xyz"])
         if method == "contacts":
+            table = self.contact_table() if contacts is None else contacts
             return network.love_weber_stresses(
-                self.contact_table(), centres, np.bincount(owner, volumes, count), self.dimension
+                table, centres, np.bincount(owner, volumes, count), self.dimension
             )
         if method == "bonds":
             bonds = np.asarray(core.bond_force_densities()).reshape(-1, 3)
@@ -1970,6 +1983,12 @@ class Simulation:
         row.update(fragments.summary(table, phi, self._model.volumes))
         row["contacts"] = len(network.coordination_pairs(contacts))
         row["coordination"] = network.mean_coordination(contacts, len(self.bodies))
+        owner, volumes = np.asarray(self._model.node_particle), np.asarray(self._model.volumes)
+        solid = network.assembly_stress(
+            self.particle_stresses(contacts=contacts), np.bincount(owner, volumes, len(self.bodies))
+        )
+        for name, (i, j) in _STRESS_COMPONENTS[self.dimension]:
+            row[f"stress_{name}"] = float(solid[i, j])
         components = (
             ("fx", "fy", "tz") if self.dimension == 2 else ("fx", "fy", "fz", "tx", "ty", "tz")
         )
