@@ -26,7 +26,6 @@ Breakage indices compare a grading F with the initial one F0:
 
 from __future__ import annotations
 
-import io
 import math
 from collections.abc import Mapping
 from pathlib import Path
@@ -35,8 +34,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from granulate.errors import InputError
-from granulate.io.atomic import atomic_write
-from granulate.io.table import read_table as read_rows
+from granulate.io.table import read_columns, write_columns
 
 #: Columns of a fragment table, in the order they are written.
 COLUMNS = (
@@ -45,6 +43,7 @@ COLUMNS = (
 )  # fmt: skip
 #: Hardin's cut-off size [m]: the No. 200 sieve.
 HARDIN_CUTOFF = 0.074e-3
+_INTEGERS = ("fragment", "particle", "nodes", "debris")
 
 Table = dict[str, NDArray]
 
@@ -110,24 +109,12 @@ def summary(table: Table, damage: ArrayLike, volumes: ArrayLike) -> dict[str, fl
 
 def write_table(path: str | Path, table: Table) -> None:
     """The table as CSV with a header row (``pandas.read_csv`` reads it)."""
-    buffer = io.StringIO()
-    buffer.write(",".join(COLUMNS) + "\n")
-    integers = {"fragment", "particle", "nodes", "debris"}
-    formats = ["%d" if name in integers else "%.17g" for name in COLUMNS]
-    rows = np.column_stack([table[name].astype(np.float64) for name in COLUMNS])
-    np.savetxt(buffer, rows, delimiter=",", fmt=formats)
-    atomic_write(path, buffer.getvalue().encode())
+    write_columns(path, table, COLUMNS, _INTEGERS)
 
 
 def read_table(path: str | Path) -> Table:
     """A fragment table written by ``write_table`` (a run's frames/fragments_NNNNNN.csv)."""
-    data = read_rows(
-        path, what="fragment table", widths=(len(COLUMNS),), columns=", ".join(COLUMNS)
-    )
-    table = {name: data[:, k] for k, name in enumerate(COLUMNS)}
-    for name in ("fragment", "particle", "nodes", "debris"):
-        table[name] = table[name].astype(np.int64)
-    return table
+    return read_columns(path, what="fragment table", columns=COLUMNS, integers=_INTEGERS)
 
 
 def grading_curve(table: Mapping[str, NDArray]) -> tuple[NDArray, NDArray]:

@@ -33,16 +33,13 @@ Tension is positive in the stresses; compression, as in a pile or a crushing tes
 
 from __future__ import annotations
 
-import io
 from collections.abc import Mapping
 from pathlib import Path
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from granulate.io.atomic import atomic_write
-from granulate.io.files import existing_file
-from granulate.io.table import read_table as read_rows
+from granulate.io.table import read_columns, write_columns
 
 #: Columns of a contact table (frames/contacts_NNNNNN.csv), in the order written: the bodies
 #: (a wall contact has particle_b = fragment_b = -1 and wall = the wall's index, else -1), the
@@ -229,24 +226,9 @@ def chain_fields(table: Mapping[str, NDArray]) -> dict[str, NDArray]:
 
 def write_table(path: str | Path, table: Table) -> None:
     """The table as CSV with a header row (``pandas.read_csv`` reads it)."""
-    buffer = io.StringIO()
-    buffer.write(",".join(COLUMNS) + "\n")
-    formats = ["%d" if name in _INTEGERS else "%.17g" for name in COLUMNS]
-    if len(table["particle_a"]):
-        rows = np.column_stack([np.asarray(table[name], dtype=np.float64) for name in COLUMNS])
-        np.savetxt(buffer, rows, delimiter=",", fmt=formats)
-    atomic_write(path, buffer.getvalue().encode())
+    write_columns(path, table, COLUMNS, _INTEGERS)
 
 
 def read_table(path: str | Path) -> Table:
     """A contact table written by ``write_table`` (a run's frames/contacts_NNNNNN.csv)."""
-    file = existing_file(path, "contact table file")
-    if file.read_text().split() == [",".join(COLUMNS)]:  # no contacts at that step
-        data = np.zeros((0, len(COLUMNS)))
-    else:
-        names = ", ".join(COLUMNS)
-        data = read_rows(file, what="contact table", widths=(len(COLUMNS),), columns=names)
-    table = {name: data[:, k] for k, name in enumerate(COLUMNS)}
-    for name in _INTEGERS:
-        table[name] = table[name].astype(np.int64)
-    return table
+    return read_columns(path, what="contact table", columns=COLUMNS, integers=_INTEGERS)

@@ -13,14 +13,12 @@ For particle p with nodes i (mass m_i, position x_i, velocity v_i; M = sum m_i):
 
 from __future__ import annotations
 
-import io
 from pathlib import Path
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from granulate.io.atomic import atomic_write
-from granulate.io.table import read_table as read_rows
+from granulate.io.table import read_columns, write_columns
 
 #: Columns of a particle table, in the order written.
 COLUMNS = (
@@ -79,20 +77,9 @@ def add_stresses(table: Table, stresses: ArrayLike, dimension: int) -> None:
 
 def write_table(path: str | Path, table: Table) -> None:
     """The table as CSV with a header row (``pandas.read_csv`` reads it)."""
-    buffer = io.StringIO()
-    buffer.write(",".join(COLUMNS) + "\n")
-    formats = ["%d" if name in _INTEGERS else "%.17g" for name in COLUMNS]
-    rows = np.column_stack([np.asarray(table[name], dtype=np.float64) for name in COLUMNS])
-    np.savetxt(buffer, rows, delimiter=",", fmt=formats)
-    atomic_write(path, buffer.getvalue().encode())
+    write_columns(path, table, COLUMNS, _INTEGERS)
 
 
 def read_table(path: str | Path) -> Table:
     """A particle table written by ``write_table`` (a run's frames/particles_NNNNNN.csv)."""
-    data = read_rows(
-        path, what="particle table", widths=(len(COLUMNS),), columns=", ".join(COLUMNS)
-    )
-    table = {name: data[:, k] for k, name in enumerate(COLUMNS)}
-    for name in _INTEGERS:
-        table[name] = table[name].astype(np.int64)
-    return table
+    return read_columns(path, what="particle table", columns=COLUMNS, integers=_INTEGERS)

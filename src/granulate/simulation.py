@@ -1789,12 +1789,8 @@ class Simulation:
         of mass [m], velocity [m/s], angular velocity [rad/s], mass [kg; kg/m in 2D], radius
         of gyration [m], volume-weighted mean damage, coordination and Love-Weber stress [Pa]
         (granulate.network), from `contacts` (default: ``contact_table()``)."""
-        model, core = self.model, self._build()
-        owner = np.asarray(model.node_particle)
-        count = len(self.bodies)
-        volumes = np.asarray(model.volumes)
-        mass = np.asarray(model.node_density) * volumes
-        table = particle_table.motion(owner, mass, core.positions, core.velocities, count)
+        core, count = self._build(), len(self.bodies)
+        owner, volumes, table = self._particle_motion()
         contacts = self.contact_table() if contacts is None else contacts
         phi = core.damage()[0] if damage is None else np.asarray(damage)
         particle_volume = np.bincount(owner, volumes, count)
@@ -1806,6 +1802,17 @@ class Simulation:
         stresses = network.love_weber_stresses(contacts, centres, particle_volume, self.dimension)
         particle_table.add_stresses(table, stresses, self.dimension)
         return table
+
+    def _particle_motion(self) -> tuple[NDArray, NDArray, particle_table.Table]:
+        """Each node's particle, each node's volume, and the particles' motion columns
+        (granulate.particle_table.motion)."""
+        model, core = self.model, self._build()
+        owner, volumes = np.asarray(model.node_particle), np.asarray(model.volumes)
+        mass = np.asarray(model.node_density) * volumes
+        motion = particle_table.motion(
+            owner, mass, core.positions, core.velocities, len(self.bodies)
+        )
+        return owner, volumes, motion
 
     def contact_table(self) -> network.Table:
         """One row per contact of the last force evaluation (pairs of particles or of their
@@ -1822,12 +1829,8 @@ class Simulation:
         """Each particle's mean stress, (particles, D, D) [Pa; tension positive]: Love-Weber
         from its contacts (`contacts`: the current contact table, made when not given), or from
         its bond forces (granulate.network; the two agree for a particle at rest)."""
-        model, core = self.model, self._build()
-        owner = np.asarray(model.node_particle)
-        count = len(self.bodies)
-        volumes = np.asarray(model.volumes)
-        mass = np.asarray(model.node_density) * volumes
-        table = particle_table.motion(owner, mass, core.positions, core.velocities, count)
+        core, count = self._build(), len(self.bodies)
+        owner, volumes, table = self._particle_motion()
         centres = np.column_stack([table[axis] for axis in "xyz"])
         if method == "contacts":
             table = self.contact_table() if contacts is None else contacts
