@@ -225,7 +225,7 @@ def test_a_run_writes_contact_tables_and_force_chains(tmp_path: Path) -> None:
     """Every frame has frames/contacts_NNNNNN.csv and .vtu, listed in contacts.pvd with
     simulation.pvd's times; Results reads the tables back equal to the live ones; the particle
     table carries coordination and stress, and history.csv the wall stress, the contact count,
-    the mean coordination and the particles' mean stress."""
+    the mean coordination, the particles' mean stress and the fabric tensor."""
     sim, width = settled_pile(4, "granulate")
     sim.output(tmp_path / "run", every=20)
     sim.run(40)
@@ -247,6 +247,9 @@ def test_a_run_writes_contact_tables_and_force_chains(tmp_path: Path) -> None:
     solid = network.assembly_stress(sim.particle_stresses(), volumes)
     assert history["stress_yy"][-1] == pytest.approx(solid[1, 1], rel=1e-12)
     assert history["stress_yy"][-1] < 0 and "stress_zz" not in history
+    fabric = network.fabric_tensor(live, 2)
+    assert history["fabric_xx"][-1] + history["fabric_yy"][-1] == pytest.approx(1.0, rel=1e-12)
+    assert history["fabric_xy"][-1] == pytest.approx(fabric[0, 1], rel=1e-12)
     chains = (tmp_path / "run" / "frames" / "contacts_000002.vtu").read_bytes()
     assert b'NumberOfCells="5"' in chains and b'Name="Normal_Force"' in chains
 

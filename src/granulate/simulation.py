@@ -59,7 +59,8 @@ FIELDS = (
 )
 #: Columns of the particle tables (frames/particles_NNNNNN.csv), in the order written.
 PARTICLE_COLUMNS = particle_table.COLUMNS
-#: The assembly stress's components in history.csv (``stress_<name>``), per dimension.
+#: The components of the assembly stress and the fabric tensor in history.csv (``stress_<name>``,
+#: ``fabric_<name>``), per dimension.
 _STRESS_COMPONENTS = {
     2: (("xx", (0, 0)), ("yy", (1, 1)), ("xy", (0, 1))),
     3: (
@@ -1990,8 +1991,11 @@ class Simulation:
         solid = network.assembly_stress(
             self.particle_stresses(contacts=contacts), np.bincount(owner, volumes, len(self.bodies))
         )
+        fabric = network.fabric_tensor(contacts, self.dimension)
         for name, (i, j) in _STRESS_COMPONENTS[self.dimension]:
             row[f"stress_{name}"] = float(solid[i, j])
+        for name, (i, j) in _STRESS_COMPONENTS[self.dimension]:
+            row[f"fabric_{name}"] = float(fabric[i, j])
         components = (
             ("fx", "fy", "tz") if self.dimension == 2 else ("fx", "fy", "fz", "tx", "ty", "tz")
         )
