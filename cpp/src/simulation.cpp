@@ -191,7 +191,6 @@ void add_dilatation_terms(index_t i, const NodeBonds& bonds, std::uint8_t* bond_
   sums[i] += sum;
 }
 
-/// What the pair-force loop reads and writes, as raw pointers (kept in registers).
 /// Runs body(i) for every node, colour by colour, the blocks of a colour in parallel (inside an
 /// omp parallel region). Each bond is evaluated once, at its lower-numbered end, and its terms are
 /// added to both ends; the colours keep concurrent blocks on disjoint nodes (see BondSchedule), so
@@ -209,6 +208,7 @@ void for_each_node_in_colours(const BondSchedule& schedule, Body&& body) {
   }
 }
 
+/// What the pair-force loop reads and writes, as raw pointers (kept in registers).
 struct PairForceArrays {
   const real* positions;
   const real* volumes;
@@ -316,7 +316,6 @@ void Simulation::compute_forces() {
 
   const BondSchedule& schedule = m.bond_schedule();
   const auto& volume = m.volumes();
-  auto for_each_node_by_colour = [&schedule](auto&& body) { for_each_node_in_colours(schedule, body); };
 
   // Pass 1: stretch, irreversible breaking, sum_j w r e at both ends. A bond breaks at the end
   // that evaluates it; its other copy is cleared below, before any loop reads it (when both
@@ -330,7 +329,7 @@ void Simulation::compute_forces() {
 #pragma omp for schedule(static)
     for (std::int64_t i = 0; i < n; ++i) dilatation_sums[i] = 0;
     std::vector<std::array<index_t, 2>> broken_here;
-    for_each_node_by_colour([&](index_t i) {
+    for_each_node_in_colours(schedule, [&](index_t i) {
       const Material& material = materials[node_material[i]];
       const NodeBonds bonds = m.node_bonds(i);
       const CriticalStretch criterion{m.particles()[m.node_particle()[i]].critical_stretch,
