@@ -1644,10 +1644,11 @@ void ContactModel::slot_dashpots(const State& state, real dt) {
     const real zeta = damping_ratio(slot, collision, approach * dt);
     const real K = slot_stiffness_[slot];
     const real secant = collision.approach > 0 ? std::min(K, slot_force_[touch] / collision.approach) : K;
-    const real duration = std::numbers::pi * std::sqrt(slot_reduced_mass(slot) / secant);
+    const real mass = slot_reduced_mass(slot);
+    const real duration = std::numbers::pi * std::sqrt(mass / secant);
     if (duration > 0) collision.phase = static_cast<float>(collision.phase + dt / duration);
     if (zeta == 0) continue;
-    const real damping = 2.0 * zeta * std::sqrt(slot_reduced_mass(slot) * secant) * approach;
+    const real damping = 2.0 * zeta * std::sqrt(mass * secant) * approach;
     for (int k = 0; k < 3; ++k) slot_load_[touch][k] += damping * normal[k];
     if (wall_slot) {  // the wall takes the opposite force, at the contact point
       add_body_load(p, point, {damping * normal[0], damping * normal[1], damping * normal[2]});
@@ -2155,8 +2156,9 @@ vec3 ContactModel::evaluated_pair_force(const Model& model, const State& state, 
 }
 
 ContactNetwork ContactModel::network(const Model& model, const State& state) const {
-  // The force on each slot's first body, summed in node order (pair and wall entries), then in
-  // group order (probes), then the slot's loads (the dashpot and the turn, recorded on q).
+  // The force on each slot's first body, summed in node order (pair and wall entries, whose
+  // springs make their slots touch), then in group order (probes), then the slot's loads (the
+  // dashpot and the turn, recorded on q).
   ContactNetwork net;
   if (!built_) return net;
   std::vector<vec3> on_first(slot_load_.size(), vec3{0, 0, 0});
@@ -2167,12 +2169,11 @@ ContactNetwork ContactModel::network(const Model& model, const State& state) con
       if (pair_stiffness_[e] == 0 || probe_entry(e) || node_body_[i] == node_body_[j] ||
           node_body_[i] != slots_[slot][0])
         continue;
-      if (slot_touch_[slot] == not_touching) continue;
       const vec force = evaluated_pair_force(model, state, i, e);
       for (int c = 0; c < 3; ++c) on_first[slot_touch_[slot]][c] += force[c];
     }
     for (index_t e = wall_offsets_[i]; e < wall_offsets_[i + 1]; ++e) {
-      if (wall_entry_stiffness_[e] == 0 || slot_touch_[wall_slot_[e]] == not_touching) continue;
+      if (wall_entry_stiffness_[e] == 0) continue;
       for (int c = 0; c < 3; ++c) on_first[slot_touch_[wall_slot_[e]]][c] -= wall_entry_reaction_[e][c];
     }
   }

@@ -51,7 +51,6 @@ COLUMNS = (
 _INTEGERS = ("particle_a", "fragment_a", "particle_b", "fragment_b", "wall")
 
 Table = dict[str, NDArray]
-_NO_BODY = 2**32 - 1
 
 
 def contact_table(core_network: Mapping[str, ArrayLike]) -> Table:
@@ -60,7 +59,6 @@ def contact_table(core_network: Mapping[str, ArrayLike]) -> Table:
     wall = np.asarray(core_network["wall"]).astype(bool)
     particle_b = np.asarray(core_network["particle_b"]).astype(np.int64)
     fragment_b = np.asarray(core_network["node_b"]).astype(np.int64)
-    fragment_b[fragment_b == _NO_BODY] = -1
     table: Table = {
         "particle_a": np.asarray(core_network["particle_a"]).astype(np.int64),
         "fragment_a": np.asarray(core_network["node_a"]).astype(np.int64),
@@ -147,7 +145,7 @@ def love_weber_stresses(
     d = dimension
     virial = np.zeros((count, d, d))
     a = table["particle_a"]
-    external = (table["wall"] >= 0) | (a != table["particle_b"])  # not one particle's pieces
+    external = a != table["particle_b"]  # walls (particle_b = -1) and other particles
     arm = (point - x_p[a])[external, :d]
     np.add.at(virial, a[external], arm[:, :, None] * force[external, None, :d])
     pairs = _between_particles(table)

@@ -57,8 +57,6 @@ FIELDS = (
     "Fixity",
     "Nodal_Volume",
 )
-#: Columns of the particle tables (frames/particles_NNNNNN.csv), in the order written.
-PARTICLE_COLUMNS = particle_table.COLUMNS
 #: The components of the assembly stress and the fabric tensor in history.csv (``stress_<name>``,
 #: ``fabric_<name>``), per dimension.
 _STRESS_COMPONENTS = {
@@ -1790,9 +1788,16 @@ class Simulation:
         of mass [m], velocity [m/s], angular velocity [rad/s], mass [kg; kg/m in 2D], radius
         of gyration [m], volume-weighted mean damage, coordination and Love-Weber stress [Pa]
         (granulate.network), from `contacts` (default: ``contact_table()``)."""
+        contacts = self.contact_table() if contacts is None else contacts
+        return self._particles(contacts, damage)[0]
+
+    def _particles(
+        self, contacts: network.Table, damage: ArrayLike | None
+    ) -> tuple[particle_table.Table, NDArray, NDArray]:
+        """The particle table, the particles' Love-Weber stresses (N, D, D) [Pa] and their
+        volumes [m^3; m^2 in 2D]: what a frame's table and a history row both need."""
         core, count = self._build(), len(self.bodies)
         owner, volumes, table = self._particle_motion()
-        contacts = self.contact_table() if contacts is None else contacts
         phi = core.damage()[0] if damage is None else np.asarray(damage)
         particle_volume = np.bincount(owner, volumes, count)
         table["particle"] = np.arange(count)
@@ -1802,7 +1807,7 @@ class Simulation:
         centres = np.column_stack([table[axis] for axis in "xyz"])
         stresses = network.love_weber_stresses(contacts, centres, particle_volume, self.dimension)
         particle_table.add_stresses(table, stresses, self.dimension)
-        return table
+        return table, stresses, particle_volume
 
     def _particle_motion(self) -> tuple[NDArray, NDArray, particle_table.Table]:
         """Each node's particle, each node's volume, and the particles' motion columns
@@ -1834,9 +1839,9 @@ class Simulation:
         owner, volumes, table = self._particle_motion()
         centres = np.column_stack([table[axis] for axis in "xyz"])
         if method == "contacts":
-            table = self.contact_table() if contacts is None else contacts
+            network_table = self.contact_table() if contacts is None else contacts
             return network.love_weber_stresses(
-                table, centres, np.bincount(owner, volumes, count), self.dimension
+                network_table, centres, np.bincount(owner, volumes, count), self.dimension
             )
         if method == "bonds":
             bonds = np.asarray(core.bond_force_densities()).reshape(-1, 3)
@@ -1895,10 +1900,11 @@ class Simulation:
         phi, z = self._build().damage()
         table = self.fragment_table()
         contacts = self.contact_table()
+        particles = self._particles(contacts, phi)
         if frame:
-            self._write_vtu_frame(phi, z, table, contacts)
+            self._write_vtu_frame(phi, z, table, contacts, particles[0])
         if history:
-            self._write_history_row(phi, table, contacts)
+            self._write_history_row(phi, table, contacts, particles[1:])
 
     def _write_vtu_frame(
         self,
@@ -1906,6 +1912,7 @@ class Simulation:
         z: NDArray[np.float64],
         table: fragments.Table,
         contacts: network.Table,
+        particles: particle_table.Table,
     ) -> None:
         out = self._output
         assert out is not None and self._model is not None
@@ -1932,9 +1939,7 @@ class Simulation:
         )
         out.pvd.add(core.time, Path("frames") / name)
         frames = out.directory / "frames"
-        particle_table.write_table(
-            frames / f"particles_{out.frames:06d}.csv", self.particle_table(contacts, phi)
-        )
+        particle_table.write_table(frames / f"particles_{out.frames:06d}.csv", particles)
         fragments.write_table(frames / f"fragments_{out.frames:06d}.csv", table)
         self._write_contacts(out.frames, contacts, table)
         out.frames += 1
@@ -1963,8 +1968,14 @@ class Simulation:
         chains.write()
 
     def _write_history_row(
-        self, phi: NDArray[np.float64], table: fragments.Table, contacts: network.Table
+        self,
+        phi: NDArray[np.float64],
+        table: fragments.Table,
+        contacts: network.Table,
+        stresses: tuple[NDArray, NDArray],
     ) -> None:
+        """The history row of the current step; `stresses`: the particles' Love-Weber
+        stresses and their volumes (_particles)."""
         out = self._output
         assert out is not None and self._model is not None
         core = self._build()
@@ -1987,10 +1998,7 @@ class Simulation:
         row.update(fragments.summary(table, phi, self._model.volumes))
         row["contacts"] = len(network.coordination_pairs(contacts))
         row["coordination"] = network.mean_coordination(contacts, len(self.bodies))
-        owner, volumes = np.asarray(self._model.node_particle), np.asarray(self._model.volumes)
-        solid = network.assembly_stress(
-            self.particle_stresses(contacts=contacts), np.bincount(owner, volumes, len(self.bodies))
-        )
+        solid = network.assembly_stress(*stresses)
         fabric = network.fabric_tensor(contacts, self.dimension)
         for name, (i, j) in _STRESS_COMPONENTS[self.dimension]:
             row[f"stress_{name}"] = float(solid[i, j])
@@ -2000,16 +2008,16 @@ class Simulation:
             ("fx", "fy", "tz") if self.dimension == 2 else ("fx", "fy", "fz", "tx", "ty", "tz")
         )
         index = {"fx": 0, "fy": 1, "fz": 2, "tx": 3, "ty": 4, "tz": 5}
-        walls_by_name = dict(self._walls)
-        for (name, _), reaction, wall in zip(
+        for (name, spec), reaction, wall in zip(
             self._walls, core.wall_reactions(), core.walls, strict=True
         ):
             for c in components:
                 row[f"{name}_{c}"] = float(reaction[index[c]])
             row[f"{name}_displacement"] = wall.displacement(core.time)
-            area = walls_by_name[name].area
-            if area is not None:
-                row[f"{name}_stress"] = float(np.linalg.norm(reaction[: self.dimension])) / area
+            if spec.area is not None:
+                row[f"{name}_stress"] = (
+                    float(np.linalg.norm(reaction[: self.dimension])) / spec.area
+                )
         if out.tracked:
             forces = core.forces
             displacement = core.positions - self._reference

@@ -38,7 +38,7 @@ from granulate import _core
 from granulate.contact import Contact
 from granulate.errors import InputError
 from granulate.functions import Constant, Linear, TimeFunction
-from granulate.input_errors import check_number, checked_arguments
+from granulate.input_errors import checked_arguments
 from granulate.meshes import SurfaceMesh, read_file
 from granulate.shapes import Box, Disc, Ellipse, Polygon, Rectangle, Shape
 
@@ -281,8 +281,7 @@ class Wall:
         wall.name = name
         if not self.surfaces:
             raise InputError("it has no surface")
-        if self.area is not None:
-            check_number("wall area", self.area)
+        if self.area is not None:  # a number: checked_arguments
             if not (np.isfinite(self.area) and self.area > 0):
                 raise InputError(f"area must be positive [m^2; m in 2D], got {self.area!r}")
         wall.surfaces = [s.core(dimension) for s in self.surfaces]
