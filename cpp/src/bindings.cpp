@@ -312,17 +312,13 @@ NB_MODULE(_core, m) {
                      return view(const_cast<std::size_t*>(self.bond_offsets().data()),
                                  self.bond_offsets().size(), 0, nb::find(self));
                    })
-      .def("bond_neighbors",
-           [](const Model& self) {
-             std::vector<index_t> neighbors(self.bond_count());
-             for (index_t i = 0; i < self.node_count(); ++i) {
-               const NodeBonds bonds = self.node_bonds(i);
-               for (index_t b = 0; b < bonds.count; ++b) neighbors[bonds.first + b] = bonds.neighbor(b);
-             }
-             return copy_out(neighbors);
-           })
-      .def_prop_ro("weighted_volume", [](Model& self) {
-        return view(const_cast<real*>(self.weighted_volume().data()), self.node_count(), 0, nb::find(self));
+      .def("bond_neighbors", [](const Model& self) {
+        std::vector<index_t> neighbors(self.bond_count());
+        for (index_t i = 0; i < self.node_count(); ++i) {
+          const NodeBonds bonds = self.node_bonds(i);
+          for (index_t b = 0; b < bonds.count; ++b) neighbors[bonds.first + b] = bonds.neighbor(b);
+        }
+        return copy_out(neighbors);
       });
 
   nb::class_<contact::Law>(m, "ContactLaw")

@@ -296,7 +296,6 @@ void Model::build_bonds() {
     any_lps = any_lps || materials_[p.material].params.model == ForceModel::lps;
     any_pmb = any_pmb || materials_[p.material].params.model == ForceModel::pmb;
   }
-  weighted_volume_.assign(nodes, 0);
   lps_coefficients_.assign(any_lps ? nodes : 0, {});
   pmb_stiffness_.assign(any_pmb ? nodes : 0, 0);
   std::vector<index_t> isolated;
@@ -315,7 +314,6 @@ void Model::build_bonds() {
 #pragma omp critical(granulate_isolated)
       isolated.push_back(i);
     }
-    weighted_volume_[i] = m;
     if (material.params.model == ForceModel::pmb && first_moment > 0) {
       pmb_stiffness_[i] = dimension_ * dimension_ * material.dilatation_modulus / first_moment;
     }

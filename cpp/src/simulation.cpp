@@ -461,8 +461,7 @@ std::array<std::size_t, 2> Simulation::memory_bytes() const {
                       bytes(state_.forces) + bytes(state_.dilatation) + bytes(pressure_) +
                       bytes(m.reference_positions()) + bytes(m.volumes()) + bytes(m.node_particle()) +
                       bytes(m.node_material()) + bytes(m.node_density()) + bytes(m.bond_offsets()) +
-                      bytes(m.weighted_volume()) + bytes(m.lps_coefficients()) + bytes(m.pmb_stiffness()) +
-                      contact_.memory_bytes();
+                      bytes(m.lps_coefficients()) + bytes(m.pmb_stiffness()) + contact_.memory_bytes();
   for (const BondFamilies& f : m.families()) other += bytes(f.offsets) + bytes(f.forward);
   other += m.bond_schedule().memory_bytes();
   for (const Shape& s : m.shapes()) other += s.anchors.memory_bytes();  // nodes and volumes released

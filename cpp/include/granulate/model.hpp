@@ -184,7 +184,6 @@ class Model {
     return b;
   }
   const BondSchedule& bond_schedule() const { return bond_schedule_; }
-  const std::vector<real>& weighted_volume() const { return weighted_volume_; }
   /// Per node, for LPS nodes (zero for others; empty when no particle uses LPS).
   const std::vector<lps::NodeCoefficients>& lps_coefficients() const { return lps_coefficients_; }
   /// k_i = d^2 kappa_d / sum_j w_ij r_ij of PMB nodes (0 for LPS nodes; empty when no particle
@@ -221,7 +220,6 @@ class Model {
   std::vector<BondFamilies> families_;
   std::vector<std::size_t> bond_offsets_;
   BondSchedule bond_schedule_;
-  std::vector<real> weighted_volume_;
   std::vector<lps::NodeCoefficients> lps_coefficients_;
   std::vector<real> pmb_stiffness_;
 };
