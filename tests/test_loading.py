@@ -112,20 +112,22 @@ def test_initial_velocity_and_spin() -> None:
 
 
 def test_two_bodies_with_different_materials_are_independent() -> None:
-    """No global state: each body behaves bit for bit as if it were alone (no contact yet)."""
+    """No global state: each body behaves bit for bit as if it were alone (no contact yet).
+    The two rectangles differ in height: a translated copy would share the first one's bonds
+    (shape_sharing.py) and match its lone self to round-off only."""
     soft = gr.Material(
         density=1000, bulk_modulus=1e8, shear_modulus=5e7, fracture_energy=5.0, influence="constant"
     )
     hard = gr.Material(
         density=3000, bulk_modulus=5e9, shear_modulus=3e9, fracture_energy=50.0, model="pmb"
     )
-    bodies = {"soft": (soft, 0.0, 2.0), "hard": (hard, 0.05, 3.0)}
+    bodies = {"soft": (soft, 0.0, 2.0, 0.01), "hard": (hard, 0.05, 3.0, 0.008)}
 
     def build(names: list[str]) -> gr.Simulation:
         sim = gr.Simulation(2, dt=2e-8)
         for name in names:
-            material, x0, speed = bodies[name]
-            body = sim.add_body(gr.Rectangle((x0, 0), (x0 + 0.01, 0.01)), material, 1e-3)
+            material, x0, speed, height = bodies[name]
+            body = sim.add_body(gr.Rectangle((x0, 0), (x0 + 0.01, height)), material, 1e-3)
             sim.prescribe_velocity(
                 sim.select(gr.Rectangle((x0 + 0.008, -1), (x0 + 1, 1)), body=body), (speed, 0)
             )

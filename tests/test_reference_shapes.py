@@ -27,6 +27,43 @@ def test_placed_particles_share_one_bond_family() -> None:
     assert bonds_for[50] == 50 * bonds_for[1]  # every particle has all its bonds
 
 
+@pytest.mark.parametrize("discretization", ["lattice", "conforming"])
+def test_bodies_added_alike_share_one_bond_family(discretization: str) -> None:
+    """add_body at six places makes one family (the crushing bench case's 16 -> 2.8 B/bond);
+    a larger, a finer and a jittered disc get their own. A copy bounces off a floor as the
+    same disc alone does, to 1e-12 of its mesh size."""
+    h, steps = 1e-4, 300  # the discs bounce off the floor by step 200
+
+    def disc_sim(centres: list[tuple[float, float]]) -> gr.Simulation:
+        sim = gr.Simulation(2, gravity=(0, -9.81))
+        for centre in centres:
+            sim.add_body(
+                gr.Disc(centre, 1e-3), ROCK, h, velocity=(0, -2.0), discretization=discretization
+            )
+        sim.add_wall(gr.Plane((0, 0), (0, 1)))
+        return sim
+
+    centres = [(2.2e-3 * k + 1e-3, 1.01e-3) for k in range(6)]
+    together = disc_sim(centres)
+    together.run(steps)
+    assert together._model.family_count == 1 and together._model.shape_count == 1
+    last = together.bodies[-1]
+    alone = disc_sim(centres[-1:])
+    alone.run(steps)
+    copy = slice(last.first_node, last.first_node + last.node_count)
+    assert np.mean(alone.velocities[:, 1]) > 1.0  # it has bounced
+    np.testing.assert_allclose(
+        together.displacements[copy], alone.displacements, rtol=0, atol=1e-12 * h
+    )
+
+    others = gr.Simulation(2)
+    variants = ((1e-3, h, 0.0), (1.2e-3, h, 0.0), (1e-3, 0.8 * h, 0.0), (1e-3, h, 0.1))
+    for k, (radius, size, jitter) in enumerate(variants):
+        others.add_body(gr.Disc((5e-3 * k, 0), radius), ROCK, size, jitter=jitter)
+    others.run(1)
+    assert others._model.shape_count == 4
+
+
 @pytest.mark.parametrize("dimension", [2, 3])
 def test_a_rotated_placement_behaves_as_the_rotated_body(dimension: int) -> None:
     """Pulling a placed, rotated particle gives the rotated displacements of the unrotated one."""

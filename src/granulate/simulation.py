@@ -38,6 +38,7 @@ from granulate.io import checkpoint as checkpoint_file
 from granulate.io.run_folder import RunFolder
 from granulate.materials import Material
 from granulate.packing import Grain, Packing, Placements, grains_by_kind
+from granulate.shape_sharing import TranslatedShapes
 from granulate.shapes import ReferenceShape, Shape, rotation_matrix
 from granulate.stopping import StopCriterion
 from granulate.walls import Surface, Wall
@@ -943,6 +944,7 @@ class Simulation:
         material_ids: dict[int, int] = {}
         core_materials: list[Material] = []
         shape_ids: dict[int, int] = {}
+        copies = TranslatedShapes()  # bodies added alike share a shape and its bonds
         # Lattices' and conforming discretisations' outer layers carry surface points only for
         # the surface law (the node-sphere law sees those nodes at themselves: no anchors).
         outer_layers = self._uses_surface_law()
@@ -955,9 +957,11 @@ class Simulation:
                 material_ids[key] = model.add_material(body.material.core_params(body.mesh_size))
                 core_materials.append(body.material)
             if body.reference is None:
-                shape = model.add_shape(
-                    positions, volumes, body.mesh_size, *_surface_arrays(surface, outer_layers)
-                )
+                surface_arrays = _surface_arrays(surface, outer_layers)
+                shape = copies.find(positions, volumes, body.mesh_size, surface_arrays)
+                if shape is None:
+                    shape = model.add_shape(positions, volumes, body.mesh_size, *surface_arrays)
+                    copies.remember(shape, positions, volumes, body.mesh_size, surface_arrays)
                 model.place_shape(shape, material_ids[key], positions, 1.0, horizon)
                 continue
             reference = body.reference
