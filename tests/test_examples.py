@@ -8,7 +8,8 @@ from pathlib import Path
 
 import pytest
 
-EXAMPLES = sorted((Path(__file__).parent.parent / "examples").glob("*.py"))
+FOLDER = Path(__file__).parent.parent / "examples"
+EXAMPLES = sorted([*FOLDER.glob("*.py"), *FOLDER.glob("*/*.py")])
 
 
 @pytest.mark.parametrize("script", EXAMPLES, ids=lambda p: p.stem)
@@ -32,5 +33,9 @@ def test_example_smoke(
             assert abs(value - float(key[2:])) < 0.05
     if "final_stress" in summary:  # a compression: the wall carries the pile's resistance
         assert summary["final_stress"] > 0
+    if "mean_damage" in summary:  # an attrition run: no grain is lost, damage is a fraction
+        assert summary["pieces"] >= summary["particles"]
+        assert 0 <= summary["mean_damage"] <= 1
+        assert (tmp_path / "out" / "attrition.png").stat().st_size > 0
     if full and "load_over_weight" in summary:  # a settled pile carries its weight
         assert abs(summary["load_over_weight"] - 1) < 0.01

@@ -1,7 +1,8 @@
 """The top wall's stress against its travel in the native compression workflow
-(examples/compression_2d.py: pack, settle to rest, place the wall on the pile, compress), on
-the axes of the PeriDEM paper's Fig. 3a (Jha et al., JMPS 2021), whose curve is drawn from the
-numbers read off the published figure (../shared/peridem/decks/n500_circ_hex/README.md).
+(examples/compression_2d/compression_2d.py: pack, settle to rest, place the wall on the pile,
+compress), on the axes of the PeriDEM paper's Fig. 3a (Jha et al., JMPS 2021), whose curve is
+drawn from the numbers read off the published figure
+(../shared/peridem/decks/n500_circ_hex/README.md).
 
 This is not yet the reproduction: the paper compresses 502 grains at 0.06 m/s (1.5 million
 steps of 63,000 nodes, about 44 hours in PeriDEM here); the run drawn is the example's default,
@@ -9,9 +10,9 @@ fewer grains in a narrower container at ten times the speed, so the onset (where
 meets the pile) and the level differ. It shows the workflow's load curve and what a user's
 figure looks like.
 
-Run: python examples/compression_2d.py --out out/compression, then
+Run: python examples/compression_2d/compression_2d.py --out out/compression, then
 python docs/validation/compression_curve.py out/compression; writes
-docs/validation/compression_curve.png.
+examples/compression_2d/compression_curve.png.
 """
 
 from __future__ import annotations
@@ -21,9 +22,10 @@ import json
 from pathlib import Path
 
 import numpy as np
-from oblique_impact import save
 
 import granulate as gr
+
+FIGURE = Path(__file__).parents[2] / "examples" / "compression_2d" / "compression_curve.png"
 
 # Fig. 3a of the paper, read off the published figure: wall penetration [mm], stress [kPa].
 PAPER = np.array(
@@ -72,7 +74,11 @@ def main() -> None:
         f" kPa after {1e3 * abs(history['top_displacement'][-1]):.2f} mm, broken bonds "
         f"{int(history['broken_bonds'][-1])}"
     )
-    save(fig, "Compression of discs and hexagons: the top wall's stress", "compression_curve.png")
+    fig.suptitle("Compression of discs and hexagons: the top wall's stress", fontsize=9)
+    fig.tight_layout()
+    out = FIGURE
+    fig.savefig(out, dpi=110)
+    print(f"wrote {out}")
 
 
 if __name__ == "__main__":

@@ -1,4 +1,4 @@
-"""Example 6: the PeriDEM paper's compression test as a user sets it up natively: 366 discs and
+"""The PeriDEM paper's compression test as a user sets it up natively: 366 discs and
 136 hexagons (radius uniform in [0.9, 1.1] mm, random orientations) are packed on lattice
 sites at the bottom of a 68 mm wide container, settle under gravity until they are at rest, and
 are then compressed by a top wall placed on the settled pile and moved down at 0.06 m/s (Jha et
@@ -6,9 +6,9 @@ al., JMPS 2021, section 5 and Fig. 3a). history.csv of the second stage has the 
 stress ``top_stress`` [Pa] (its force over the container's width) against its travel
 ``top_displacement``.
 
-    python examples/compression_2d.py --smoke           # 40 grains, 0.2 mm: seconds
-    python examples/compression_2d.py                   # 120 grains, 3.4 mm at 0.6 m/s
-    python examples/compression_2d.py --grains 502 --speed 0.06   # the paper's: hours
+    python examples/compression_2d/compression_2d.py --smoke     # 40 grains, 0.2 mm: seconds
+    python examples/compression_2d/compression_2d.py             # 120 grains, 3.4 mm, 0.6 m/s
+    python examples/compression_2d/compression_2d.py --grains 502 --speed 0.06  # hours
 
 Steps: (1) the material (LPS, linear influence, horizon 0.6 mm); (2) two grains, discs with
 conforming (ring) nodes and hexagons on a lattice, both of mesh size 0.2 mm at radius 1 mm;
