@@ -37,5 +37,7 @@ def test_example_smoke(
         assert summary["pieces"] >= summary["particles"]
         assert 0 <= summary["mean_damage"] <= 1
         assert (tmp_path / "out" / "attrition.png").stat().st_size > 0
+    if "peak_force" in summary:  # a crushed sphere: the plate meets it, and it cracks
+        assert summary["peak_force"] > 0 and summary["broken_bonds"] > 0
     if full and "load_over_weight" in summary:  # a settled pile carries its weight
         assert abs(summary["load_over_weight"] - 1) < 0.01
