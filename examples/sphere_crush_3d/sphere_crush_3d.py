@@ -1,7 +1,7 @@
 """A brittle sphere crushed between two plates: the load-displacement curve and the fragments.
 
-    python examples/sphere_crush_3d/sphere_crush_3d.py            # R/h = 6: 4 s
-    python examples/sphere_crush_3d/sphere_crush_3d.py --nodes-per-radius 12   # finer
+    python examples/sphere_crush_3d/sphere_crush_3d.py            # R/h = 12: about a minute
+    python examples/sphere_crush_3d/sphere_crush_3d.py --nodes-per-radius 6   # coarser: 4 s
     python examples/sphere_crush_3d/sphere_crush_3d.py --smoke    # R/h = 3, seconds
 
 Steps: (1) a brittle stone (LPS, E = 10 GPa, fracture energy 10 J/m^2); (2) a 1 mm sphere with
@@ -35,7 +35,7 @@ def main(argv: list[str] | None = None) -> dict[str, float]:
     parser.add_argument("--overwrite", action="store_true", help="replace an earlier run in --out")
     parser.add_argument("--travel", type=float, default=0.2e-3, help="plate travel [m]")
     parser.add_argument(
-        "--nodes-per-radius", type=float, default=6, help="R/h of the sphere (smoke: 3)"
+        "--nodes-per-radius", type=float, default=12, help="R/h of the sphere (smoke: 3)"
     )
     args = parser.parse_args(argv)
 
