@@ -23,6 +23,7 @@ from pathlib import Path
 import numpy as np
 
 import granulate as gr
+from granulate.plots import two_scales
 
 DRUM_RADIUS = 30e-3  # [m]
 
@@ -118,25 +119,12 @@ def main(argv: list[str] | None = None) -> dict[str, float]:
 
 
 def plot_attrition(history: dict[str, np.ndarray], path: Path) -> Path:
-    """Mean damage (volume-weighted) and fragment count against time, from history.csv."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    from matplotlib.ticker import MaxNLocator
-
-    figure, damage = plt.subplots(figsize=(6, 3.5))
-    damage.plot(1e3 * history["time"], history["mean_damage"], color="C0")
-    damage.set(xlabel="time [ms]", ylabel="mean damage")
-    damage.yaxis.label.set_color("C0")
-    pieces = damage.twinx()
-    pieces.step(1e3 * history["time"], history["fragments"], color="C3", where="post")
-    pieces.set_ylabel("pieces (a whole grain is one)", color="C3")
-    pieces.yaxis.set_major_locator(MaxNLocator(integer=True))
-    figure.tight_layout()
-    figure.savefig(path, dpi=90)
-    plt.close(figure)
-    return path
+    """Mean damage (volume-weighted) and the number of pieces against time, from history.csv."""
+    labels = ("time [ms]", "mean damage", "pieces (a whole grain is one)")
+    time = 1e3 * history["time"]
+    return two_scales(
+        path, time, history["mean_damage"], history["fragments"], labels, right_steps=True
+    )
 
 
 if __name__ == "__main__":

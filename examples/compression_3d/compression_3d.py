@@ -24,6 +24,7 @@ from pathlib import Path
 import numpy as np
 
 import granulate as gr
+from granulate.plots import two_scales
 
 SPEED = 0.5  # the top plate's [m/s]
 GAP = 0.05e-3  # between the plate and the highest sphere's surface at the start [m]
@@ -101,23 +102,10 @@ def main(argv: list[str] | None = None) -> dict[str, float]:
 
 def plot_compression(history: dict[str, np.ndarray], path: Path) -> Path:
     """The top plate's stress and the mean coordination against its travel, from history.csv."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    figure, load = plt.subplots(figsize=(6, 3.5))
-    travelled = 1e3 * history["top_displacement"]
-    load.plot(travelled, 1e-3 * history["top_stress"], color="C0")
-    load.set(xlabel="plate travel [mm]", ylabel="plate stress [kPa]")
-    load.yaxis.label.set_color("C0")
-    coordination = load.twinx()
-    coordination.plot(travelled, history["coordination"], color="C2")
-    coordination.set_ylabel("mean coordination", color="C2")
-    figure.tight_layout()
-    figure.savefig(path, dpi=90)
-    plt.close(figure)
-    return path
+    labels = ("plate travel [mm]", "plate stress [kPa]", "mean coordination")
+    travel = 1e3 * history["top_displacement"]
+    stress = 1e-3 * history["top_stress"]
+    return two_scales(path, travel, stress, history["coordination"], labels)
 
 
 if __name__ == "__main__":

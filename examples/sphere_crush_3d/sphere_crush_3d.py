@@ -23,6 +23,7 @@ from pathlib import Path
 import numpy as np
 
 import granulate as gr
+from granulate.plots import two_scales
 
 RADIUS = 1e-3  # [m]
 SPEED = 1.0  # the top plate's [m/s]
@@ -82,23 +83,9 @@ def main(argv: list[str] | None = None) -> dict[str, float]:
 
 def plot_crush(history: dict[str, np.ndarray], path: Path) -> Path:
     """The top plate's force against its travel, and the broken bonds, from history.csv."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    figure, load = plt.subplots(figsize=(6, 3.5))
-    travelled = 1e6 * history["top_displacement"]
-    load.plot(travelled, history["top_fy"], color="C0")
-    load.set(xlabel="plate travel [um]", ylabel="plate force [N]")
-    load.yaxis.label.set_color("C0")
-    bonds = load.twinx()
-    bonds.plot(travelled, history["broken_bonds"], color="C3")
-    bonds.set_ylabel("broken bonds", color="C3")
-    figure.tight_layout()
-    figure.savefig(path, dpi=90)
-    plt.close(figure)
-    return path
+    labels = ("plate travel [um]", "plate force [N]", "broken bonds")
+    travel = 1e6 * history["top_displacement"]
+    return two_scales(path, travel, history["top_fy"], history["broken_bonds"], labels)
 
 
 if __name__ == "__main__":

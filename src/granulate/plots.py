@@ -18,6 +18,9 @@ and from the last frame's contact table (``frames/contacts_NNNNNN.csv``), in 2D:
 - ``force_chains.png``: a line between the centres of every two bodies in contact (and to the
   contact point on a wall), its width proportional to the normal force.
 
+``two_scales(path, x, left, right, labels)`` draws two curves against one x axis, each on its
+own y scale (the examples' figures: a load and broken bonds, damage and pieces).
+
 ``render(directory, frame=None, gif=False)`` writes ``renders/frame_NNNNNN.png``: the nodes of
 each VTU frame coloured by damage (2D: in the plane; 3D: projected on x-z), and with ``gif`` an
 animated ``renders/run.gif``.
@@ -42,6 +45,35 @@ def _pyplot():
     import matplotlib.pyplot as plt
 
     return plt
+
+
+def two_scales(
+    path: str | Path,
+    x: np.ndarray,
+    left: np.ndarray,
+    right: np.ndarray,
+    labels: tuple[str, str, str],
+    *,
+    right_steps: bool = False,
+) -> Path:
+    """Write `left` (blue, left axis) and `right` (red, right axis) against `x`, labelled
+    (x, left, right); `right_steps` draws the right curve as steps with integer ticks (counts).
+    Returns the path."""
+    from matplotlib.ticker import MaxNLocator
+
+    plt = _pyplot()
+    figure, axis = plt.subplots(figsize=(6, 3.5))
+    axis.plot(x, left, color="C0")
+    axis.set(xlabel=labels[0], ylabel=labels[1])
+    axis.yaxis.label.set_color("C0")
+    other = axis.twinx()
+    if right_steps:
+        other.step(x, right, color="C3", where="post")
+        other.yaxis.set_major_locator(MaxNLocator(integer=True))
+    else:
+        other.plot(x, right, color="C3")
+    other.set_ylabel(labels[2], color="C3")
+    return _save(plt, figure, Path(path))
 
 
 def _save(plt, figure, path: Path) -> Path:
