@@ -82,18 +82,18 @@ def main(argv: list[str] | None = None) -> dict[str, float]:
     # (6) Run.
     sim.output(args.out, every=max(1, steps // 50), overwrite=args.overwrite)
     sim.run(steps)
-    history = gr.Results(args.out).history
+    summary, history = sim.summary(), gr.Results(args.out).history
     figure = plot_compression(history, Path(args.out) / "compression.png")
     stress = history["top_stress"]
     print(
-        f"{sim.summary()['steps']} steps in {sim.summary()['wall_seconds']:.1f} s; stress "
+        f"{summary['steps']} steps in {summary['wall_seconds']:.1f} s; stress "
         f"{1e-3 * stress[-1]:.3g} kPa after {1e3 * history['top_displacement'][-1]:.2f} mm, "
         f"coordination {history['coordination'][-1]:.2f}, broken bonds {sim.broken_bonds()}; "
         f"{figure}"
     )
     return {
         "nodes": sim.node_count,
-        "steps": sim.summary()["steps"],
+        "steps": summary["steps"],
         "final_stress": float(stress[-1]),
         "coordination": float(history["coordination"][-1]),
         "broken_bonds": sim.broken_bonds(),

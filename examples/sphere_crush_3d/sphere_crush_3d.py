@@ -61,19 +61,19 @@ def main(argv: list[str] | None = None) -> dict[str, float]:
     # (5) Run.
     sim.output(args.out, every=max(1, steps // 60), overwrite=args.overwrite)
     sim.run(steps)
-    history = gr.Results(args.out).history
+    summary, history = sim.summary(), gr.Results(args.out).history
     force, travelled = history["top_fy"], history["top_displacement"]
     peak = int(np.argmax(force))
     pieces = sim.fragments(min_nodes=10)
     figure = plot_crush(history, Path(args.out) / "crush.png")
     print(
-        f"{sim.summary()['steps']} steps in {sim.summary()['wall_seconds']:.1f} s; peak force "
+        f"{summary['steps']} steps in {summary['wall_seconds']:.1f} s; peak force "
         f"{force[peak]:.4g} N at {1e6 * travelled[peak]:.1f} um; broken bonds "
         f"{sim.broken_bonds()}; {len(pieces)} piece(s) of 10+ nodes; {figure}"
     )
     return {
         "nodes": sim.node_count,
-        "steps": sim.summary()["steps"],
+        "steps": summary["steps"],
         "peak_force": float(force[peak]),
         "peak_travel": float(travelled[peak]),
         "broken_bonds": sim.broken_bonds(),

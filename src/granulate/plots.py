@@ -131,15 +131,9 @@ def plot_history(directory: str | Path) -> list[Path]:
             axes.set_ylabel(f"{wall} stress: force per unit area [kPa]")
             written.append(_save(plt, figure, folder / f"wall_{wall}_stress.png"))
     if "coordination" in history:
-        figure, axes = plt.subplots(figsize=(6, 4))
-        axes.plot(t, history["coordination"], label="mean coordination number Z")
-        axes.set_xlabel("time [s]")
-        axes.set_ylabel("Z [-]")
-        twin = axes.twinx()
-        twin.plot(t, history["contacts"], color="tab:orange", label="particle pairs in contact")
-        twin.set_ylabel("particle pairs in contact")
-        figure.legend(loc="lower right")
-        written.append(_save(plt, figure, folder / "coordination.png"))
+        labels = ("time [s]", "mean coordination number Z", "particle pairs in contact")
+        coordination, pairs = history["coordination"], history["contacts"]
+        written.append(two_scales(folder / "coordination.png", t, coordination, pairs, labels))
     if any((folder / "frames").glob("fragments_*.csv")):
         written += plot_breakage(Results(folder))
     if any((folder / "frames").glob("contacts_*.csv")):

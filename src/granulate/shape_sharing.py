@@ -27,9 +27,9 @@ TOLERANCE = 1e-10
 
 
 @dataclass(frozen=True)
-class _Known:
+class _Known:  # the arrays of the body the shape was added for (references, not copies)
     shape: int
-    relative: NDArray[np.float64]  # node positions less the first node's [m]
+    positions: NDArray[np.float64]
     volumes: NDArray[np.float64]
     surface: tuple[NDArray[np.float64], NDArray[np.float64]]
 
@@ -48,13 +48,14 @@ class TranslatedShapes:
         surface: tuple[NDArray[np.float64], NDArray[np.float64]],
     ) -> int | None:
         """The shape of an earlier body these nodes are a translated copy of, or None."""
-        relative = positions - positions[0]
+        tolerance = TOLERANCE * mesh_size
         for known in self._known.get((len(positions), mesh_size), []):
+            shift = positions[0] - known.positions[0]
             if (
-                np.max(np.abs(known.relative[-1] - relative[-1])) <= TOLERANCE * mesh_size
+                np.max(np.abs(positions[-1] - known.positions[-1] - shift)) <= tolerance
                 and np.array_equal(known.volumes, volumes)
                 and all(np.array_equal(a, b) for a, b in zip(known.surface, surface, strict=True))
-                and np.max(np.abs(known.relative - relative)) <= TOLERANCE * mesh_size
+                and np.max(np.abs(positions - known.positions - shift)) <= tolerance
             ):
                 return known.shape
         return None
@@ -68,5 +69,5 @@ class TranslatedShapes:
         surface: tuple[NDArray[np.float64], NDArray[np.float64]],
     ) -> None:
         """Record that `shape` was added for a body with these nodes."""
-        known = _Known(shape, positions - positions[0], volumes, surface)
+        known = _Known(shape, positions, volumes, surface)
         self._known.setdefault((len(positions), mesh_size), []).append(known)
