@@ -12,7 +12,8 @@ import numpy as np
 import pytest
 
 import granulate as gr
-from granulate import network
+from granulate import network, plots
+from granulate.io.history import read_history
 from granulate.io.vtu import read_pvd
 
 RADIUS = 1e-3
@@ -252,6 +253,37 @@ def test_a_run_writes_contact_tables_and_force_chains(tmp_path: Path) -> None:
     assert history["fabric_xy"][-1] == pytest.approx(fabric[0, 1], rel=1e-12)
     chains = (tmp_path / "run" / "frames" / "contacts_000002.vtu").read_bytes()
     assert b'NumberOfCells="5"' in chains and b'Name="Normal_Force"' in chains
+
+
+def test_a_tracked_platen_given_an_area_records_its_stress(tmp_path: Path) -> None:
+    """A disc settled on a fixed rectangle (a meshed platen, like a PeriDEM deck's wall): the
+    platen's history.csv stress, its force resultant over the width given in track_areas, is
+    the disc's weight over that width (measured to 3e-7; asserted 1e-4)."""
+    sim = gr.Simulation(2, gravity=(0, -100.0), viscous_damping=300.0)
+    sim.contact = gr.Contact(restitution=0.2, friction=0.5)
+    disc = sim.add_body(gr.Disc((2e-3, 1.05e-3), RADIUS), grain(1e7), RADIUS / 4)
+    width = 4e-3
+    platen = sim.add_body(gr.Rectangle((0, -0.5e-3), (width, 0)), grain(1e7), RADIUS / 4)
+    sim.fix(platen.nodes)
+    sim.output(tmp_path / "run", 2000, track=[platen], track_areas={platen.name: width})
+    sim.run(until=0.08)
+    weight = float(sim.volumes[: disc.node_count].sum()) * DENSITY * 100.0
+    history = read_history(tmp_path / "run")
+    assert history[f"{platen.name}_stress"][-1] == pytest.approx(weight / width, rel=1e-4)
+    assert f"{disc.name}_stress" not in history
+    written = plots.plot_history(tmp_path / "run")
+    assert tmp_path / "run" / f"body_{platen.name}_stress.png" in written
+
+
+def test_bad_track_areas_are_input_errors(tmp_path: Path) -> None:
+    sim = gr.Simulation(2)
+    disc = sim.add_body(gr.Disc((0, 2e-3), RADIUS), grain(), RADIUS / 3, name="disc")
+    with pytest.raises(gr.InputError, match="'lid', which is not tracked; track it too"):
+        sim.output(tmp_path / "a", 10, track=[disc], track_areas={"lid": 1e-3})
+    with pytest.raises(gr.InputError, match=r"track_areas\['disc'\] must be a positive area"):
+        sim.output(tmp_path / "b", 10, track=[disc], track_areas={"disc": -1e-3})
+    with pytest.raises(gr.InputError, match="must map tracked bodies' names"):
+        sim.output(tmp_path / "c", 10, track=[disc], track_areas=[1e-3])  # type: ignore[arg-type]
 
 
 def test_bad_wall_areas_and_stress_methods_are_input_errors() -> None:

@@ -507,6 +507,9 @@ def test_keys_the_example_decks_do_not_use(tmp_path: Path) -> None:
     assert quadratic["components"] == "x"
     assert case["stop"]["node_distance"] == 0.1
     assert case["output"]["track"] == ["p0", "p1"]
+    # A particle placed from the CSV: its area is not known to the translator, and it says so.
+    assert case["output"]["track_areas"] == {}
+    assert any("p1 is placed from the particle file" in note for note in translation.notes)
     assert any("loc_rad" in note for note in translation.notes)
     assert main(["run", str(deck), "--out", str(tmp_path / "out"), "--quiet", "--steps", "20"]) == 0
 
@@ -653,10 +656,22 @@ def test_decks_in_peridems_older_format_translate_as_the_current_ones(tmp_path: 
     with a Wall block, Wall_List, Compressive_Test.Wall_Id. compression_small_set rewritten in
     it translates to the same case as the original (walls 0 and 1 are its particles 15 and 16),
     except the notes; its Time_Steps: 1 slip (fewer steps than one output interval) runs to
-    Final_Time at granulate's own time step, and says so."""
+    Final_Time at granulate's own time step, and says so. Its Compressive_Test (the original
+    has none) adds the loaded wall's area, the moving container's width (history.csv's
+    p16_stress)."""
     new = peridem.translate(DECKS / "compression_small_set" / "input_0.yaml")
-    old = peridem.translate(broken_deck(tmp_path / "a", "compression_small_set", older_format))
+    older = broken_deck(tmp_path / "a", "compression_small_set", older_format)
+    old = peridem.translate(older)
+    areas = old.case["output"].pop("track_areas")
+    assert new.case["output"].pop("track_areas") == {}
     assert old.case == new.case
+    moving = meshio.read(DECKS / "compression_small_set" / "mesh_moving_container_0.msh").points
+    assert areas == {"p16": pytest.approx(np.ptp(moving[:, 0]), rel=1e-12)}
+    assert any("p16_stress" in note for note in old.notes)
+    out = tmp_path / "out"
+    assert main(["run", str(older), "--out", str(out), "--quiet", "--steps", "400"]) == 0
+    rows = history(out)
+    assert all(r["p16_stress"] == math.hypot(r["p16_fx"], r["p16_fy"]) / areas["p16"] for r in rows)
     assert any("Contact_Data" in note for note in old.notes)
     slip = broken_deck(tmp_path / "b", "compression_small_set", lambda t: older_format(t, 1))
     translated = peridem.translate(slip)

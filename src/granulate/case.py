@@ -683,6 +683,20 @@ class OutputSpec(Spec):
     track: list[str] = Field(
         [], description="bodies whose force resultant and mean displacement history.csv records"
     )
+    track_areas: dict[str, Positive] = Field(
+        {},
+        description="nominal areas of tracked bodies, for <name>_stress in history.csv "
+        "[m^2; m in 2D]",
+    )
+
+    @model_validator(mode="after")
+    def _areas_of_tracked(self) -> OutputSpec:
+        untracked = sorted(set(self.track_areas) - set(self.track))
+        if untracked:
+            raise ValueError(
+                f"track_areas names {untracked}, which output.track does not list; track them too"
+            )
+        return self
 
 
 class RestartSpec(Spec):
@@ -1015,6 +1029,7 @@ class Case:
                 resume=resume,
                 history_every=o.history_every,
                 track=[_named(t, named, "output.track") for t in o.track],
+                track_areas=o.track_areas,
             )
         if spec.checkpoint is not None:
             sim.checkpoint_every(spec.checkpoint.every_steps, minutes=spec.checkpoint.every_minutes)

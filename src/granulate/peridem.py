@@ -419,6 +419,7 @@ def _translate(path: Path, compat: bool, output: Path | None) -> Translation:
     grains: dict[str, Any] = {}
     walls: set[int] = set()
     geometry_particle: set[int] = set()
+    zone_extent: dict[int, np.ndarray] = {}  # of a zone placed once, as meshed [m]
     constrained: set[int] = set()
     zone_mesh_size: dict[int, float] = {}
     zone_radius: dict[int, float] = {}
@@ -473,6 +474,7 @@ def _translate(path: Path, compat: bool, output: Path | None) -> Translation:
             }
             bodies.append({"zone": z, "body": body})
             zone_mesh_size[z] = h
+            zone_extent[z] = np.subtract(shape["upper"], shape["lower"])
         elif "File" in minfo:
             mesh_file = folder / str(minfo["File"]).strip()
             try:
@@ -482,6 +484,8 @@ def _translate(path: Path, compat: bool, output: Path | None) -> Translation:
                 continue
             h = smallest_spacing(mesh.positions)
             zone_mesh_size[z] = h
+            if z in geometry_particle:
+                zone_extent[z] = np.ptp(mesh.positions[:, :dimension], axis=0)
             grain["mesh"] = {
                 "file": file_ref(str(minfo["File"]).strip()),
                 "dimension": dimension,
@@ -1062,6 +1066,21 @@ def _translate(path: Path, compat: bool, output: Path | None) -> Translation:
         wall_id = by_wall[0] if by_wall else None
     if wall_id is not None and f"p{wall_id}" in named and f"p{wall_id}" not in track:
         track.append(f"p{wall_id}")
+    track_areas = {}
+    if wall_id is not None and f"p{wall_id}" in track:
+        area = _loaded_area(compressive, zone_extent.get(zone_of[wall_id]), dimension, problems)
+        if area is None and zone_of[wall_id] not in zone_extent:
+            notes.append(
+                f"Compressive_Test: p{wall_id} is placed from the particle file; its area is not "
+                "known here, so history.csv records its force, not its stress"
+            )
+        if area is not None:
+            track_areas[f"p{wall_id}"] = area
+            notes.append(
+                f"Compressive_Test: history.csv records p{wall_id}_stress, the force on the "
+                f"loaded wall over its extent across the loading direction ({area:.6g} "
+                f"{'m' if dimension == 2 else 'm^2'}); PeriDEM reports the force alone"
+            )
     directory = default_output_directory(folder)
     if "Path" in out:
         notes.append(
@@ -1074,6 +1093,7 @@ def _translate(path: Path, compat: bool, output: Path | None) -> Translation:
         "fields": fields,
         "history_every": test_every if track else every,
         "track": track,
+        "track_areas": track_areas,
     }
     if out.get("Perform_Out", True) is False:
         output_spec = None
@@ -1184,6 +1204,31 @@ def _youngs(spec: dict[str, Any], where: str, problems: _Problems) -> float | No
 
 #: Folder names that say nothing about a deck (PeriDEM's examples keep decks in ``inp/``).
 _GENERIC_FOLDERS = {"inp", "input", "inputs", "deck", "decks"}
+
+
+def _loaded_area(
+    compressive: dict[str, Any], extent: np.ndarray | None, dimension: int, problems: _Problems
+) -> float | None:
+    """The compressive test's wall area across its force direction (1-based, Particle_ or
+    Wall_Force_Direction): the product of the wall's extents along the other axes [m^2; m in
+    2D]; None for a wall not placed as meshed (its extent is not known here)."""
+    key = (
+        "Wall_Force_Direction"
+        if "Wall_Force_Direction" in compressive
+        else "Particle_Force_Direction"
+    )
+    if key not in compressive:
+        return None
+    direction = compressive[key]
+    if isinstance(direction, bool) or direction not in range(1, dimension + 1):
+        problems.add(
+            f"Particle.Compressive_Test.{key}: a direction 1 to {dimension}, got {direction!r}"
+        )
+        return None
+    if extent is None:
+        return None
+    area = float(np.prod(np.delete(extent[:dimension], direction - 1)))
+    return area if area > 0 else None
 
 
 def default_output_directory(folder: Path) -> str:

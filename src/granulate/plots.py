@@ -7,6 +7,8 @@
 - ``wall_<name>.png`` for every wall: the force components against the wall's displacement
   (a compression test's load curve), and ``wall_<name>_stress.png`` for a wall given an area:
   its stress [kPa] against its displacement [mm];
+- ``body_<name>_stress.png`` likewise for a tracked body given an area (``track_areas``; a
+  PeriDEM deck's compressive-test wall), against its mean displacement along its main motion;
 - ``coordination.png``: the mean coordination number and the particle pairs in contact
   against time;
 and from the fragment tables of the frames (``frames/fragments_NNNNNN.csv``):
@@ -125,11 +127,14 @@ def plot_history(directory: str | Path) -> list[Path]:
         axes.legend()
         written.append(_save(plt, figure, folder / f"wall_{wall}.png"))
         if f"{wall}_stress" in history:
-            figure, axes = plt.subplots(figsize=(6, 4))
-            axes.plot(1e3 * np.abs(moved), 1e-3 * history[f"{wall}_stress"])
-            axes.set_xlabel(f"{wall} displacement [mm]")
-            axes.set_ylabel(f"{wall} stress: force per unit area [kPa]")
-            written.append(_save(plt, figure, folder / f"wall_{wall}_stress.png"))
+            path = folder / f"wall_{wall}_stress.png"
+            written.append(_stress_plot(path, wall, moved, history[f"{wall}_stress"]))
+    for body in _stressed_bodies(history):
+        moved = max(
+            (history[f"{body}_u{a}"] for a in "xyz" if f"{body}_u{a}" in history), key=np.ptp
+        )
+        path = folder / f"body_{body}_stress.png"
+        written.append(_stress_plot(path, body, moved, history[f"{body}_stress"]))
     if "coordination" in history:
         labels = ("time [s]", "mean coordination number Z", "particle pairs in contact")
         coordination, pairs = history["coordination"], history["contacts"]
@@ -139,6 +144,22 @@ def plot_history(directory: str | Path) -> list[Path]:
     if any((folder / "frames").glob("contacts_*.csv")):
         written += plot_force_chains(Results(folder))
     return written
+
+
+def _stressed_bodies(history: dict[str, np.ndarray]) -> list[str]:
+    """Tracked bodies given an area (``<name>_stress`` beside ``<name>_ux``)."""
+    names = (name[: -len("_stress")] for name in history if name.endswith("_stress"))
+    return sorted(name for name in names if f"{name}_ux" in history)
+
+
+def _stress_plot(path: Path, name: str, moved: np.ndarray, stress: np.ndarray) -> Path:
+    """A wall's or a loaded body's stress [kPa] against its travel [mm]."""
+    plt = _pyplot()
+    figure, axes = plt.subplots(figsize=(6, 4))
+    axes.plot(1e3 * np.abs(moved), 1e-3 * stress)
+    axes.set_xlabel(f"{name} displacement [mm]")
+    axes.set_ylabel(f"{name} stress: force per unit area [kPa]")
+    return _save(plt, figure, path)
 
 
 def plot_force_chains(results: Results, frame: int = -1) -> list[Path]:

@@ -20,7 +20,7 @@ import threading
 import time as wallclock
 import warnings
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Literal
 
@@ -143,6 +143,7 @@ class _Output:
     history_every: int
     folder: RunFolder
     tracked: tuple[Body, ...] = ()
+    track_areas: dict[str, float] = field(default_factory=dict)  # body name -> area
     history: HistoryWriter | None = None
     frames: int = 0
     frame_step: int = -1  # the step of the last frame written (-1: none in this process)
@@ -870,6 +871,7 @@ class Simulation:
         resume: bool = False,
         history_every: int | None = None,
         track: Sequence[Body | str] = (),
+        track_areas: Mapping[str, float] | None = None,
     ) -> None:
         """Write VTU frames (``frames/``), ``simulation.pvd`` and particle snapshots
         (``frames/particles_*.csv``) every ``every`` steps, and a row of ``history.csv`` every
@@ -880,7 +882,10 @@ class Simulation:
         (contacts, walls, applied force densities, viscous damping; the internal bond forces
         cancel) [N; N/m in 2D], and ``<name>_ux, _uy[, _uz]``, its mean nodal displacement
         [m]. For a body whose nodes are all prescribed (a meshed wall, a loading platen) the
-        force is the reaction a load cell would measure.
+        force is the reaction a load cell would measure. ``track_areas`` maps tracked bodies'
+        names to a nominal area [m^2; m in 2D, per unit thickness], for which history.csv also
+        records ``<name>_stress``, the magnitude of that resultant over the area [Pa] (a loading
+        platen's stress, as ``Wall(area=)`` gives a wall's).
 
         A directory that already holds a run (simulation.pvd or frames) is refused unless
         ``overwrite`` is true (the old run is deleted when the new one starts writing, so an
@@ -904,6 +909,7 @@ class Simulation:
                 f"tracked bodies {clashing} are named like walls: their history.csv columns "
                 "(<name>_fx, ...) would overwrite each other; rename them"
             )
+        areas = _track_areas(track_areas or {}, tracked)
         unknown = [f for f in fields if f not in FIELDS]
         if unknown:
             raise InputError(f"unknown output fields {unknown}; choose from {', '.join(FIELDS)}")
@@ -917,6 +923,7 @@ class Simulation:
             history_every,
             folder,
             tracked,
+            areas,
         )
 
     def _body(self, body: Body | str) -> Body:
@@ -1939,7 +1946,7 @@ class Simulation:
         write_vtu(
             out.directory / "frames" / name,
             core.positions,
-            {field: available[field]() for field in out.fields},
+            {f: available[f]() for f in out.fields},
         )
         out.pvd.add(core.time, Path("frames") / name)
         frames = out.directory / "frames"
@@ -2038,10 +2045,38 @@ class Simulation:
                     row[f"{body.name}_f{axis}"] = float(resultant[k])
                 for k, axis in enumerate(axes):
                     row[f"{body.name}_u{axis}"] = float(mean[k])
+                if body.name in out.track_areas:
+                    row[f"{body.name}_stress"] = (
+                        float(np.linalg.norm(resultant)) / out.track_areas[body.name]
+                    )
         if out.history is None:
             out.history = HistoryWriter(out.directory / "history.csv", list(row))
         out.history.write(row)
         out.history_step = int(core.step)
+
+
+def _track_areas(areas: Mapping[str, float], tracked: tuple[Body, ...]) -> dict[str, float]:
+    """``Simulation.output``'s track_areas, checked: tracked bodies' names, positive areas."""
+    names = {b.name for b in tracked}
+    if not isinstance(areas, Mapping):
+        raise InputError(f"track_areas must map tracked bodies' names to areas, got {areas!r}")
+    checked = {}
+    for name, area in areas.items():
+        if name not in names:
+            raise InputError(
+                f"track_areas names {name!r}, which is not tracked; track it too "
+                f"(tracked: {sorted(names) or 'none'})"
+            )
+        if (
+            isinstance(area, bool)
+            or not isinstance(area, (int, float))
+            or not (np.isfinite(area) and area > 0)
+        ):
+            raise InputError(
+                f"track_areas[{name!r}] must be a positive area [m^2; m in 2D], got {area!r}"
+            )
+        checked[name] = float(area)
+    return checked
 
 
 def _rotation_vector(rotation: NDArray[np.float64]) -> NDArray[np.float64]:
