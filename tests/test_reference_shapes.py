@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 import granulate as gr
+from granulate import resources
 
 ROCK = gr.Material(density=2000, youngs_modulus=1e8, poisson_ratio=0.25, fracture_energy=5.0)
 
@@ -62,6 +63,31 @@ def test_bodies_added_alike_share_one_bond_family(discretization: str) -> None:
         others.add_body(gr.Disc((5e-3 * k, 0), radius), ROCK, size, jitter=jitter)
     others.run(1)
     assert others._model.shape_count == 4
+
+
+def test_the_memory_check_counts_a_shared_bond_family_once(monkeypatch: pytest.MonkeyPatch) -> None:
+    """50 equal discs added one by one fit in memory that their 50 bond families would not:
+    the free memory is set between the two estimates. 50 discs of mesh sizes 0.1 % apart (no
+    copies) are refused, naming the bonds."""
+    h = 1e-4
+
+    def discs(spread: float) -> gr.Simulation:
+        sim = gr.Simulation(2)
+        for k in range(50):
+            sim.add_body(gr.Disc((2.2e-3 * k, 0), 1e-3), ROCK, h * (1 + spread * k))
+        return sim
+
+    sim = discs(0.0)
+    nodes, per_disc = sim.node_count, sim.bodies[0].node_count
+    bonds = per_disc * resources.bonds_per_node(2, ROCK.resolved_horizon(h) / h)
+    shared = resources.simulation_bytes(nodes, bonds)
+    separate = resources.simulation_bytes(nodes, 50 * bonds)
+    free = (shared + separate) / 2 / resources.SHARE
+    monkeypatch.setattr(resources, "available_memory", lambda: int(free))
+    sim.run(1)
+    assert sim._model.family_count == 1
+    with pytest.raises(gr.InputError, match="bonds\\) would need about"):
+        discs(1e-3).run(1)
 
 
 @pytest.mark.parametrize("dimension", [2, 3])

@@ -3,9 +3,9 @@
 `Simulation.add_body` discretises each shape where it stands, so six equal discs at six places
 are six node sets. Each would get its own bond family (16 bytes a bond) although their bonds
 are the same. `TranslatedShapes` recognises a body whose nodes are those of an earlier body
-moved by one vector, with the same volumes, mesh size and surface data, and hands back the
-earlier body's shape, so that the core keeps one bond family for all of them (as it does for
-particles placed from one `ReferenceShape`).
+moved by one vector, with the same volumes, mesh size and surface data, and names that earlier
+body, so that the core keeps one shape and bond family for all of them (as it does for
+particles placed from one `ReferenceShape`), and the memory check counts that family once.
 
 A copy is accepted when every node lies within ``TOLERANCE`` mesh sizes of the earlier body's
 node moved by the vector between their first nodes. The shared family's reference lengths are
@@ -27,15 +27,15 @@ TOLERANCE = 1e-10
 
 
 @dataclass(frozen=True)
-class _Known:  # the arrays of the body the shape was added for (references, not copies)
-    shape: int
+class _Known:  # an earlier body's arrays (references, not copies)
+    body: int
     positions: NDArray[np.float64]
     volumes: NDArray[np.float64]
     surface: tuple[NDArray[np.float64], NDArray[np.float64]]
 
 
 class TranslatedShapes:
-    """The core shapes added so far for bodies without a reference shape, by their nodes."""
+    """The bodies without a reference shape seen so far, by their nodes."""
 
     def __init__(self) -> None:
         self._known: dict[tuple[int, float], list[_Known]] = {}
@@ -47,7 +47,7 @@ class TranslatedShapes:
         mesh_size: float,
         surface: tuple[NDArray[np.float64], NDArray[np.float64]],
     ) -> int | None:
-        """The shape of an earlier body these nodes are a translated copy of, or None."""
+        """The earlier body these nodes are a translated copy of, or None."""
         tolerance = TOLERANCE * mesh_size
         for known in self._known.get((len(positions), mesh_size), []):
             shift = positions[0] - known.positions[0]
@@ -57,17 +57,17 @@ class TranslatedShapes:
                 and all(np.array_equal(a, b) for a, b in zip(known.surface, surface, strict=True))
                 and np.max(np.abs(positions - known.positions - shift)) <= tolerance
             ):
-                return known.shape
+                return known.body
         return None
 
     def remember(
         self,
-        shape: int,
+        body: int,
         positions: NDArray[np.float64],
         volumes: NDArray[np.float64],
         mesh_size: float,
         surface: tuple[NDArray[np.float64], NDArray[np.float64]],
     ) -> None:
-        """Record that `shape` was added for a body with these nodes."""
-        known = _Known(shape, positions, volumes, surface)
+        """Record body number `body` with these nodes."""
+        known = _Known(body, positions, volumes, surface)
         self._known.setdefault((len(positions), mesh_size), []).append(known)

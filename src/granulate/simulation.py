@@ -945,16 +945,17 @@ class Simulation:
         if not self.bodies:
             raise InputError("the simulation has no body; add one with add_body")
         model = _core.Model(self.dimension, getattr(_core.PlaneMode, self.plane))
-        self._require_memory_for_model()
+        # Lattices' and conforming discretisations' outer layers carry surface points only for
+        # the surface law (the node-sphere law sees those nodes at themselves: no anchors).
+        outer_layers = self._uses_surface_law()
+        copy_of = self._translated_copies(outer_layers)
+        self._require_memory_for_model(copy_of)
         # One core material per Material; each particle carries its own horizon (absolute, or
         # horizon_factor times its mesh size), so particles of any size share one material.
         material_ids: dict[int, int] = {}
         core_materials: list[Material] = []
         shape_ids: dict[int, int] = {}
-        copies = TranslatedShapes()  # bodies added alike share a shape and its bonds
-        # Lattices' and conforming discretisations' outer layers carry surface points only for
-        # the surface law (the node-sphere law sees those nodes at themselves: no anchors).
-        outer_layers = self._uses_surface_law()
+        shape_of_body: dict[int, int] = {}  # bodies without a reference shape
         for body, positions, volumes, surface in zip(
             self.bodies, self._positions, self._volumes, self._surfaces, strict=True
         ):
@@ -964,11 +965,13 @@ class Simulation:
                 material_ids[key] = model.add_material(body.material.core_params(body.mesh_size))
                 core_materials.append(body.material)
             if body.reference is None:
-                surface_arrays = _surface_arrays(surface, outer_layers)
-                shape = copies.find(positions, volumes, body.mesh_size, surface_arrays)
-                if shape is None:
+                original = copy_of.get(body.index)
+                if original is None:
+                    surface_arrays = _surface_arrays(surface, outer_layers)
                     shape = model.add_shape(positions, volumes, body.mesh_size, *surface_arrays)
-                    copies.remember(shape, positions, volumes, body.mesh_size, surface_arrays)
+                else:
+                    shape = shape_of_body[original]
+                shape_of_body[body.index] = shape
                 model.place_shape(shape, material_ids[key], positions, 1.0, horizon)
                 continue
             reference = body.reference
@@ -1302,15 +1305,35 @@ class Simulation:
             self._write_final_state(frame=plan.write_final or reason is not None)
         return reason
 
-    def _require_memory_for_model(self) -> None:
+    def _translated_copies(self, outer_layers: bool) -> dict[int, int]:
+        """Bodies without a reference shape that are translated copies of an earlier one
+        (shape_sharing.py): body index -> the earlier body's index. They share its core shape
+        and bond family."""
+        copies, copy_of = TranslatedShapes(), {}
+        for body, positions, volumes, surface in zip(
+            self.bodies, self._positions, self._volumes, self._surfaces, strict=True
+        ):
+            if body.reference is not None:
+                continue
+            surface_arrays = _surface_arrays(surface, outer_layers)
+            original = copies.find(positions, volumes, body.mesh_size, surface_arrays)
+            if original is None:
+                copies.remember(body.index, positions, volumes, body.mesh_size, surface_arrays)
+            else:
+                copy_of[body.index] = original
+        return copy_of
+
+    def _require_memory_for_model(self, copy_of: Mapping[int, int]) -> None:
         """InputError before the bonds are built when the model would not fit in memory:
         every node's state, and one bond family per reference shape and horizon ratio
-        (particles placed from one shape share it) or per body."""
+        (particles placed from one shape share it) or per body not a translated copy of an
+        earlier one (`copy_of`)."""
         families: dict[tuple[int, float], float] = {}
         for body in self.bodies:
             ratio = body.material.resolved_horizon(body.mesh_size) / body.mesh_size
             self._check_material_for(body, ratio * body.mesh_size)
-            key = (id(body.reference) if body.reference is not None else -1 - body.index, ratio)
+            own = -1 - copy_of.get(body.index, body.index)
+            key = (id(body.reference) if body.reference is not None else own, ratio)
             family = body.node_count * resources.bonds_per_node(self.dimension, ratio)
             families[key] = family
         nodes, bonds = float(self.node_count), float(sum(families.values()))
