@@ -22,6 +22,10 @@ Test 6 analogue (--test 6): the body falls straight down (v_t = 0) spinning at o
 contact point slides at u = v_t - omega R, and the same impulse theory applies with the friction
 opposing u: gross sliding while |u| > mu (1 + e) v_n (1 + 1/k), rolling below.
 
+In 3D the figures also draw the Hertz-Mindlin (no slip) law of DEM codes for this sphere's
+elastic constants (hertz_mindlin.py), the reference in the sticking regime too; the table
+gives its v_t' and omega' R beside granulate's. 2D has no Hertz law to draw.
+
 Run: python docs/validation/oblique_impact.py [--dimension 2|3] [--test 4|5|6] [--smoke]; writes
 docs/validation/oblique_impact_<d>d.png (test 4), tangential_impact_<d>d.png (test 5) or
 spinning_impact_<d>d.png (test 6) and prints the table.
@@ -30,14 +34,20 @@ spinning_impact_<d>d.png (test 6) and prints the table.
 from __future__ import annotations
 
 import argparse
+import sys
 from pathlib import Path
 
 import numpy as np
 
 import granulate as gr
 
+sys.path.insert(0, str(Path(__file__).parent))
+import hertz_mindlin  # beside this script
+
 SOFT = gr.Material(density=1200, bulk_modulus=2.16e7, shear_modulus=1.296e7, fracture=False)
 RADIUS, SPEED, MU, RESTITUTION = 1e-3, 0.5, 0.3, 0.8
+#: Contact options besides e and mu (--tangential-stiffness-ratio), and the figure names' suffix.
+CONTACT_OPTIONS: dict[str, float] = {}
 
 
 def run_through_impact(sim: gr.Simulation, against_wall: bool = True) -> None:
@@ -78,10 +88,14 @@ def rigid_motion(sim: gr.Simulation, body: gr.Body) -> tuple[np.ndarray, np.ndar
 
 def save_test_figure(fig, test: int, heading: str, speed: str, resolution: str, name: str) -> None:
     """Title a Chung & Ooi test figure (what it shows, then its parameters) and save it."""
+    ratio = CONTACT_OPTIONS.get("tangential_stiffness_ratio")
     title = (
         f"{heading} (Chung & Ooi test {test} analogue)\n"
         f"{speed} = {SPEED} m/s, mu = {MU}, e = {RESTITUTION}, {resolution}"
+        + (f", kt/kn = {ratio:.3g}" if ratio is not None else "")
     )
+    if ratio is not None:
+        name = name.replace(".png", f"_kt{ratio:.3g}.png")
     save(fig, title, name)
 
 
@@ -101,7 +115,7 @@ def impact(
     (positive rolling forwards, towards +x): incoming and rebound velocities and spin."""
     h = RADIUS / nodes_across_radius
     sim = gr.Simulation(dimension)
-    sim.contact = gr.Contact(restitution=RESTITUTION, friction=MU)
+    sim.contact = gr.Contact(restitution=RESTITUTION, friction=MU, **CONTACT_OPTIONS)
     a = np.radians(angle)
     velocity = (speed * np.sin(a), -speed * np.cos(a), 0.0)[:dimension]
     centre = (0.0, RADIUS + 0.6 * h, 0.0)[:dimension]
@@ -163,16 +177,36 @@ def reversal(dimension: int, v_t: float) -> tuple[float, float]:
     return v_t - impulse, impulse / k
 
 
+def sphere() -> hertz_mindlin.Sphere:
+    """The tests' sphere for the Hertz-Mindlin law: SOFT's E and nu (from K and G)."""
+    k, g = 2.16e7, 1.296e7  # SOFT's bulk and shear moduli [Pa]
+    young, poisson = 9 * k * g / (3 * k + g), (3 * k - 2 * g) / (2 * (3 * k + g))
+    return hertz_mindlin.Sphere(RADIUS, SOFT.density, young, poisson)
+
+
+def mindlin(d: int, impacts: list[tuple[float, float, float]], e: float) -> np.ndarray | None:
+    """Hertz-Mindlin rebounds (v_t', omega' R) of impacts (v_n, v_t, omega R) in 3D, its
+    normal dashpot set to give e; None in 2D."""
+    if d == 2:
+        return None
+    body = sphere()
+    alpha = hertz_mindlin.damping_for(body, SPEED, e)
+    rebounds = [hertz_mindlin.rebound(body, *impact, MU, alpha)[1:] for impact in impacts]
+    return np.array(rebounds)
+
+
 def plot_rebound(
     measured: tuple[list[float], list[dict]],
     theory_curves: tuple[np.ndarray, np.ndarray],
     reversal_curves: tuple[np.ndarray, np.ndarray] | None,
     xlabel: str,
     unit: str = "v_n",
+    mindlin_curves: np.ndarray | None = None,
 ):
     """Two panels, v_t' and omega' R over SPEED (called `unit` on the axes) against x:
-    granulate's rows (points), the rigid-body theory (line) and, where given, the full reversal
-    of the contact point's velocity (dashed). Returns the figure."""
+    granulate's rows (points), the rigid-body theory (line), where given the full reversal of
+    the contact point's velocity (dashed) and the Hertz-Mindlin law at the theory's x (dotted).
+    Returns the figure."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -186,6 +220,8 @@ def plot_rebound(
             sticking, reversed_ = reversal_curves
             ax.plot(sticking, reversed_[:, column] / SPEED, "k--", lw=0.8, label="full reversal")
         ax.plot(fine, curves[:, column] / SPEED, "k-", label="rigid body, Coulomb")
+        if mindlin_curves is not None:
+            ax.plot(fine, mindlin_curves[:, column] / SPEED, "C3:", label="Hertz-Mindlin (DEM)")
         ax.plot(xs, [r[key] / SPEED for r in rows], "o", label="granulate")
         ax.set_xlabel(xlabel)
         ax.legend()
@@ -195,14 +231,26 @@ def plot_rebound(
     return fig
 
 
-def print_rows(label: str, xs: list[float], rows: list[dict], rigid: list, scale: float) -> None:
-    """The measured rebound against the rigid-body theory, one line per impact."""
-    print(f"{label:>8}  e     v_t'    rigid    omega'R  rigid   (over {scale} m/s)")
-    for x, row, (vt, wr) in zip(xs, rows, rigid, strict=True):
-        print(
+def print_rows(
+    label: str,
+    xs: list[float],
+    rows: list[dict],
+    rigid: list,
+    scale: float,
+    reference: np.ndarray | None = None,
+) -> None:
+    """The measured rebound against the rigid-body theory (and the Hertz-Mindlin law, in 3D),
+    one line per impact."""
+    extra = "  H-M v_t' H-M omega'R" if reference is not None else ""
+    print(f"{label:>8}  e     v_t'    rigid    omega'R  rigid{extra}   (over {scale} m/s)")
+    for k, (x, row, (vt, wr)) in enumerate(zip(xs, rows, rigid, strict=True)):
+        line = (
             f"{x:8.2f}  {row['e']:.3f} {row['v_t_after'] / scale:7.4f} {vt / scale:7.4f}  "
             f"{row['spin_R'] / scale:7.4f} {wr / scale:7.4f}"
         )
+        if reference is not None:
+            line += f"  {reference[k, 0] / scale:7.4f}  {reference[k, 1] / scale:7.4f}"
+        print(line)
 
 
 def sliding_limit(d: int, e: float) -> float:
@@ -217,9 +265,10 @@ def angle_figure(d: int, smoke: bool) -> None:
     npr = 10 if d == 2 else 6
     rows = [impact(d, angle, npr) for angle in angles]
     rigid = [theory(d, r["v_n"], r["v_t"], r["e"]) for r in rows]
-    print_rows("angle", angles, rows, rigid, SPEED)
-    fine = np.linspace(0.5, 85, 200)
     e_mean = float(np.mean([r["e"] for r in rows]))
+    at_rows = mindlin(d, [(r["v_n"], r["v_t"], 0.0) for r in rows], e_mean)
+    print_rows("angle", angles, rows, rigid, SPEED, at_rows)
+    fine = np.linspace(0.5, 85, 200)
     curves = np.array(
         [
             theory(d, SPEED * np.cos(np.radians(a)), SPEED * np.sin(np.radians(a)), e_mean)
@@ -228,12 +277,15 @@ def angle_figure(d: int, smoke: bool) -> None:
     )
     sticking = fine[fine < np.degrees(np.arctan(sliding_limit(d, e_mean)))]
     reversed_ = np.array([reversal(d, SPEED * np.sin(np.radians(a))) for a in sticking])
+    radians = np.radians(fine)
+    impacts = [(SPEED * np.cos(a), SPEED * np.sin(a), 0.0) for a in radians]
     fig = plot_rebound(
         (angles, rows),
         (fine, curves),
         (sticking, reversed_),
         "incidence angle from the normal [degrees]",
         unit="v",
+        mindlin_curves=mindlin(d, impacts, e_mean),
     )
     heading = f"Oblique impact of a {'disc' if d == 2 else 'sphere'} on a plane"
     save_test_figure(fig, 4, heading, "v", f"R/h = {npr}", f"oblique_impact_{d}d.png")
@@ -248,13 +300,21 @@ def tangential_figure(d: int, smoke: bool) -> None:
         for t in ratios
     ]
     rigid = [theory(d, r["v_n"], r["v_t"], r["e"]) for r in rows]
-    print_rows("v_t/v_n", ratios, rows, rigid, SPEED)
     e_mean = float(np.mean([r["e"] for r in rows]))
+    at_rows = mindlin(d, [(r["v_n"], r["v_t"], 0.0) for r in rows], e_mean)
+    print_rows("v_t/v_n", ratios, rows, rigid, SPEED, at_rows)
     fine = np.linspace(0.0, 5.2, 300)
     curves = np.array([theory(d, SPEED, t * SPEED, e_mean) for t in fine])
     sticking = fine[fine < sliding_limit(d, e_mean)]
     reversed_ = np.array([reversal(d, t * SPEED) for t in sticking])
-    fig = plot_rebound((ratios, rows), (fine, curves), (sticking, reversed_), "v_t / v_n before")
+    reference = mindlin(d, [(SPEED, t * SPEED, 0.0) for t in fine], e_mean)
+    fig = plot_rebound(
+        (ratios, rows),
+        (fine, curves),
+        (sticking, reversed_),
+        "v_t / v_n before",
+        mindlin_curves=reference,
+    )
     heading = f"Oblique impact of a {'disc' if d == 2 else 'sphere'} on a plane"
     save_test_figure(fig, 5, heading, "v_n", f"R/h = {npr}", f"tangential_impact_{d}d.png")
 
@@ -266,11 +326,15 @@ def spin_figure(d: int, smoke: bool) -> None:
     npr = 10 if d == 2 else 6
     rows = [impact(d, 0.0, npr, spin=float(w) * SPEED) for w in spins]
     rigid = [spinning_theory(d, r["v_n"], 0.0, r["spin_R_before"], r["e"]) for r in rows]
-    print_rows("omegaR/v", spins, rows, rigid, SPEED)
     e_mean = float(np.mean([r["e"] for r in rows]))
+    at_rows = mindlin(d, [(r["v_n"], 0.0, r["spin_R_before"]) for r in rows], e_mean)
+    print_rows("omegaR/v", spins, rows, rigid, SPEED, at_rows)
     fine = np.linspace(-4.2, 4.2, 400)
     curves = np.array([spinning_theory(d, SPEED, 0.0, w * SPEED, e_mean) for w in fine])
-    fig = plot_rebound((spins, rows), (fine, curves), None, "spin before, omega R / v_n")
+    reference = mindlin(d, [(SPEED, 0.0, w * SPEED) for w in fine], e_mean)
+    fig = plot_rebound(
+        (spins, rows), (fine, curves), None, "spin before, omega R / v_n", mindlin_curves=reference
+    )
     heading = f"Spinning {'disc' if d == 2 else 'sphere'} dropped on a plane"
     save_test_figure(fig, 6, heading, "v_n", f"R/h = {npr}", f"spinning_impact_{d}d.png")
 
@@ -280,7 +344,15 @@ def main() -> None:
     parser.add_argument("--dimension", type=int, default=2, choices=(2, 3))
     parser.add_argument("--test", type=int, default=4, choices=(4, 5, 6))
     parser.add_argument("--smoke", action="store_true")
+    parser.add_argument(
+        "--tangential-stiffness-ratio",
+        type=float,
+        help="Contact(tangential_stiffness_ratio=...) (default: granulate's 2/7); Mindlin's is "
+        "2 (1 - nu) / (2 - nu), 0.857 for these grains; the figure's name gets _kt<ratio>",
+    )
     args = parser.parse_args()
+    if args.tangential_stiffness_ratio is not None:
+        CONTACT_OPTIONS["tangential_stiffness_ratio"] = args.tangential_stiffness_ratio
     figures = {4: angle_figure, 5: tangential_figure, 6: spin_figure}
     figures[args.test](args.dimension, args.smoke)
 
