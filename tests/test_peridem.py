@@ -688,6 +688,15 @@ def test_decks_in_peridems_older_format_translate_as_the_current_ones(tmp_path: 
         peridem.translate(wrong)
 
 
+def test_a_compressive_test_direction_outside_the_dimension_is_refused(tmp_path: Path) -> None:
+    def direction_3(text: str) -> str:
+        return older_format(text).replace("Wall_Force_Direction: 2", "Wall_Force_Direction: 3")
+
+    deck = broken_deck(tmp_path, "compression_small_set", direction_3)
+    with pytest.raises(InputError, match="Wall_Force_Direction: a direction 1 to 2, got 3"):
+        peridem.translate(deck)
+
+
 def test_a_wall_block_beside_particle_entries_is_ignored_as_peridem_does(tmp_path: Path) -> None:
     """Today's format describes walls under Particle; a Wall block there is one PeriDEM does
     not read, so it changes nothing (only the older format, where the wall zone has no

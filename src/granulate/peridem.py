@@ -1220,7 +1220,11 @@ def _loaded_area(
     if key not in compressive:
         return None
     direction = compressive[key]
-    if isinstance(direction, bool) or direction not in range(1, dimension + 1):
+    if (
+        not isinstance(direction, int)
+        or isinstance(direction, bool)
+        or not 1 <= direction <= dimension
+    ):
         problems.add(
             f"Particle.Compressive_Test.{key}: a direction 1 to {dimension}, got {direction!r}"
         )
