@@ -12,7 +12,10 @@ figure looks like.
 
 Run: python examples/compression_2d/compression_2d.py --out out/compression, then
 python docs/validation/compression_curve.py out/compression; writes
-examples/compression_2d/compression_curve.png.
+examples/compression_2d/compression_curve.png. With ``--snapshots NAME`` it also writes
+examples/compression_2d/NAME: the nodes coloured by damage at the paper's four instants, wall
+travels of 0.5, 1.45, 1.95 and 2.4 mm (the frames nearest them), and with ``--figure NAME`` the
+curve under another name.
 """
 
 from __future__ import annotations
@@ -25,7 +28,9 @@ import numpy as np
 
 import granulate as gr
 
-FIGURE = Path(__file__).parents[2] / "examples" / "compression_2d" / "compression_curve.png"
+FOLDER = Path(__file__).parents[2] / "examples" / "compression_2d"
+#: The paper's damage snapshots t1 ... t4 (its Fig. 3): wall travel [mm].
+INSTANTS = (0.5, 1.45, 1.95, 2.4)
 
 # Fig. 3a of the paper, read off the published figure: wall penetration [mm], stress [kPa].
 PAPER = np.array(
@@ -40,6 +45,8 @@ PAPER = np.array(
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("run", help="the example's --out folder (holding compress/)")
+    parser.add_argument("--figure", default="compression_curve.png", help="the curve's file name")
+    parser.add_argument("--snapshots", help="file name of the damage snapshots (default: none)")
     args = parser.parse_args()
     run = Path(args.run)
     results = gr.Results(run / "compress")
@@ -76,7 +83,37 @@ def main() -> None:
     )
     fig.suptitle("Compression of discs and hexagons: the top wall's stress", fontsize=9)
     fig.tight_layout()
-    out = FIGURE
+    out = FOLDER / args.figure
+    fig.savefig(out, dpi=110)
+    print(f"wrote {out}")
+    if args.snapshots:
+        draw_snapshots(results, speed, FOLDER / args.snapshots)
+
+
+def draw_snapshots(results: gr.Results, speed: float, out: Path) -> None:
+    """Four panels: the nodes coloured by damage at the frames nearest the paper's instants."""
+    import matplotlib.pyplot as plt
+
+    frames = [results.frame(time=1e-3 * travel / speed) for travel in INSTANTS]
+    span = np.ptp(frames[0].positions[:, :2], axis=0)
+    height = 2 * 4.5 * span[1] / span[0] + 1.2  # two rows of panels 4.5 inches wide
+    fig, axes = plt.subplots(
+        2, 2, figsize=(10, height), sharex=True, sharey=True, layout="constrained"
+    )
+    for ax, travel, frame in zip(axes.flat, INSTANTS, frames, strict=True):
+        points = 1e3 * frame.positions
+        shown = ax.scatter(
+            points[:, 0], points[:, 1], c=frame["Damage"], s=0.3, cmap="inferno_r", vmin=0, vmax=1
+        )
+        moved = 1e3 * speed * frame.time
+        ax.set_title(f"travel {moved:.2f} mm (paper's instant: {travel} mm)", fontsize=8)
+        ax.set_aspect("equal")
+    for ax in axes[-1]:
+        ax.set_xlabel("x [mm]")
+    for ax in axes[:, 0]:
+        ax.set_ylabel("y [mm]")
+    fig.colorbar(shown, ax=axes, label="damage")
+    fig.suptitle("Damage at the PeriDEM paper's four instants (its Fig. 3)", fontsize=9)
     fig.savefig(out, dpi=110)
     print(f"wrote {out}")
 
