@@ -8,7 +8,8 @@ stress ``top_stress`` [Pa] (its force over the container's width) against its tr
 
     python examples/compression_2d/compression_2d.py --smoke     # 40 grains, 0.2 mm: seconds
     python examples/compression_2d/compression_2d.py             # 120 grains, 3.4 mm, 0.6 m/s
-    python examples/compression_2d/compression_2d.py --grains 502 --speed 0.06  # hours
+    python examples/compression_2d/compression_2d.py --grains 502 --speed 0.06  # the paper's
+    python examples/compression_2d/compression_2d.py --peridem-constants  # PeriDEM's 2D LPS
 
 Steps: (1) the material (LPS, linear influence, horizon 0.6 mm); (2) two grains, discs with
 conforming (ring) nodes and hexagons on a lattice, both of mesh size 0.2 mm at radius 1 mm;
@@ -17,6 +18,9 @@ they fall at most a gap); (4) settle: gravity, contact with restitution 0.95 and
 background damping, until the kinetic energy is below a millionth of the grains' weight times
 a millimetre; (5) compress: the same grains at their settled positions, a top wall placed just
 above the highest node, moved down; the wall stress against its travel is the load curve.
+``--peridem-constants`` uses PeriDEM's 2D peridynamics instead of granulate's: the 3D LPS
+constants and critical stretch in 2D (``Simulation(plane="peridem")``) and bonds that also
+break in compression (``Material(break_in_compression=True)``), as the paper's runs did.
 Stage 2 starts from the settled positions as PeriDEM's run2 restarts from its output_400
 (the settling's contact history is not carried over: at rest, without friction, there is
 none that matters).
@@ -37,22 +41,27 @@ RADIUS = 1.1e-3  # the largest grain radius [m]
 GAP = 0.05e-3  # the top wall starts this far above the highest node [m]
 
 
-def material() -> gr.Material:
-    """K, G [Pa], Gc [J/m^2], rho [kg/m^3] of the paper; horizon 0.6 mm for every grain."""
+def material(peridem: bool = False) -> gr.Material:
+    """K, G [Pa], Gc [J/m^2], rho [kg/m^3] of the paper; horizon 0.6 mm for every grain;
+    `peridem`: bonds break in compression too."""
     return gr.Material(
-        density=1200, bulk_modulus=2.16e7, shear_modulus=1.296e7, fracture_energy=50, horizon=0.6e-3
+        density=1200,
+        bulk_modulus=2.16e7,
+        shear_modulus=1.296e7,
+        fracture_energy=50,
+        horizon=0.6e-3,
+        break_in_compression=peridem,
     )
 
 
-def packing(count: int, width: float, seed: int) -> gr.Packing:
+def packing(count: int, width: float, seed: int, peridem: bool = False) -> gr.Packing:
     """`count` grains (the paper's 73 % discs) on lattice sites filling the bottom rows of a
     container `width` wide."""
     sizes = gr.Uniform(0.9e-3, 1.1e-3)
     discs = round(count * 366 / 502)
-    disc = gr.Grain(
-        gr.Disc((0, 0), 1e-3), material(), 0.2e-3, sizes, discs, discretization="conforming"
-    )
-    hexagon = gr.Grain(gr.RegularPolygon((0, 0), 1e-3, 6), material(), 0.2e-3, sizes, count - discs)
+    rock = material(peridem)
+    disc = gr.Grain(gr.Disc((0, 0), 1e-3), rock, 0.2e-3, sizes, discs, discretization="conforming")
+    hexagon = gr.Grain(gr.RegularPolygon((0, 0), 1e-3, 6), rock, 0.2e-3, sizes, count - discs)
     spacing = 2 * RADIUS * 1.05  # the lattice's spacing with pack's gap, about
     across = int(width // spacing)
     rows = math.ceil(count / (across - 0.5))
@@ -62,9 +71,10 @@ def packing(count: int, width: float, seed: int) -> gr.Packing:
     )
 
 
-def simulation(grains: gr.Packing, width: float) -> gr.Simulation:
-    """The grains in the container (floor and sides), frictionless contact, gravity."""
-    sim = gr.Simulation(dimension=2, gravity=(0, -10))
+def simulation(grains: gr.Packing, width: float, peridem: bool = False) -> gr.Simulation:
+    """The grains in the container (floor and sides), frictionless contact, gravity;
+    `peridem`: PeriDEM's 2D LPS constants."""
+    sim = gr.Simulation(dimension=2, gravity=(0, -10), plane="peridem" if peridem else "strain")
     sim.contact = gr.Contact(restitution=0.95, friction=0.0)
     sim.add_packing(grains)
     sides = (gr.Plane((0, 0), (0, 1)), gr.Plane((0, 0), (1, 0)), gr.Plane((width, 0), (-1, 0)))
@@ -73,11 +83,16 @@ def simulation(grains: gr.Packing, width: float) -> gr.Simulation:
 
 
 def settle(
-    grains: gr.Packing, width: float, until: float, out: Path, overwrite: bool
+    grains: gr.Packing,
+    width: float,
+    until: float,
+    out: Path,
+    overwrite: bool,
+    peridem: bool = False,
 ) -> tuple[gr.Simulation, list[gr.Body]]:
     """Stage 1: the grains fall onto each other and come to rest (background damping 50 /s),
     or `until` [s] has passed; returns the simulation and the grains' bodies."""
-    sim = simulation(grains, width)
+    sim = simulation(grains, width, peridem)
     bodies = sim.bodies[:]
     sim.viscous_damping = 50.0
     weight = float(sim.volumes.sum()) * 1200 * 10
@@ -97,10 +112,11 @@ def compress(
     travel: float,
     out: Path,
     overwrite: bool,
+    peridem: bool = False,
 ) -> gr.Simulation:
     """Stage 2: the settled grains under a top wall placed GAP above them, moved down at `speed`
     until it has travelled `travel`; its stress is recorded over the container's width."""
-    sim = simulation(settled.placements_now(bodies, grains), width)  # where they came to rest
+    sim = simulation(settled.placements_now(bodies, grains), width, peridem)  # where they rest
     top = float(settled.positions[:, 1].max()) + GAP
     plate = gr.Wall(
         (gr.Plane((0, top), (0, -1)),),
@@ -127,17 +143,31 @@ def main(argv: list[str] | None = None) -> dict[str, float]:
     parser.add_argument("--out", default="out/compression", help="output directory")
     parser.add_argument("--overwrite", action="store_true", help="replace an earlier run in --out")
     parser.add_argument("--seed", type=int, default=1, help="seed of the packing")
+    parser.add_argument(
+        "--peridem-constants",
+        action="store_true",
+        help="PeriDEM's 2D peridynamics: 3D LPS constants, bonds break in compression too",
+    )
     args = parser.parse_args(argv)
     count, travel, until = (40, 0.2e-3, 5e-3) if args.smoke else (args.grains, args.travel, 1.0)
     width = WIDTH * min(1.0, math.sqrt(count / 502))  # the paper's proportions
     out = Path(args.out)
 
-    grains = packing(count, width, args.seed)
+    peridem = args.peridem_constants
+    grains = packing(count, width, args.seed, peridem)
     print(grains.summary())
-    settled, bodies = settle(grains, width, until, out / "settle", args.overwrite)
+    settled, bodies = settle(grains, width, until, out / "settle", args.overwrite, peridem)
     print(f"settled at t = {settled.time:.4g} s, {settled.node_count} nodes, dt {settled.dt:.3g} s")
     sim = compress(
-        grains, width, settled, bodies, args.speed, travel, out / "compress", args.overwrite
+        grains,
+        width,
+        settled,
+        bodies,
+        args.speed,
+        travel,
+        out / "compress",
+        args.overwrite,
+        peridem,
     )
     history = gr.Results(out / "compress").history
     stress = history["top_stress"]
