@@ -1382,18 +1382,19 @@ class Simulation:
 
     def _warn_deep_contact(self, core: _core.Simulation) -> None:
         """Warn once when node pairs of two bodies came within half their contact distance
-        into each other: the contact layer is too soft for the impact, and nodes may pass
-        through each other (the overlap falls as 1 / sqrt(stiffness_factor))."""
+        into each other: the contact layer is too soft for the impact or the load, and nodes
+        may pass through each other (an impact's overlap falls as 1 / sqrt(stiffness_factor),
+        a steady load's as 1 / stiffness_factor)."""
         deepest = core.contact_statistics.deepest_overlap
         if self._deep_contact_warned or deepest < 0.5:
             return
         self._deep_contact_warned = True
         warnings.warn(
             f"contact: node pairs overlapped by {deepest:.0%} of their contact radius (by step "
-            f"{core.step}); the contact layer is too soft for these impacts and nodes may pass "
-            "through each other. Raise Contact(stiffness_factor=...) (the overlap falls as "
-            "1/sqrt of it; 10 keeps a 10 m/s impact of soft grains to a fifth) or load more "
-            "slowly",
+            f"{core.step}); the contact layer is too soft for these impacts or loads and nodes "
+            "may pass through each other. Raise Contact(stiffness_factor=...): an impact's "
+            "overlap falls as 1/sqrt of it (10 keeps a 10 m/s impact of soft grains to a fifth), "
+            "a steady load's as 1/its value; a stiffer contact shortens the time step",
             GranulateWarning,
             stacklevel=3,
         )
