@@ -12,10 +12,10 @@ figure looks like.
 
 Run: python examples/compression_2d/compression_2d.py --out out/compression, then
 python docs/validation/compression_curve.py out/compression; writes
-examples/compression_2d/compression_curve.png. With ``--snapshots NAME`` it also writes
-examples/compression_2d/NAME: the nodes coloured by damage at the paper's four instants, wall
-travels of 0.5, 1.45, 1.95 and 2.4 mm (the frames nearest them), and with ``--figure NAME`` the
-curve under another name.
+examples/compression_2d/compression_curve.png. Several runs draw several curves (``--labels``
+names them); ``--snapshots NAME ...`` also writes, per run, examples/compression_2d/NAME: the
+nodes coloured by damage at the paper's four instants, wall travels of 0.5, 1.45, 1.95 and
+2.4 mm (the frames nearest them); ``--figure NAME`` writes the curve under another name.
 """
 
 from __future__ import annotations
@@ -44,28 +44,38 @@ PAPER = np.array(
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("run", help="the example's --out folder (holding compress/)")
+    parser.add_argument("runs", nargs="+", help="the example's --out folders (holding compress/)")
+    parser.add_argument("--labels", nargs="+", help="one per run (default: grains and speed)")
     parser.add_argument("--figure", default="compression_curve.png", help="the curve's file name")
-    parser.add_argument("--snapshots", help="file name of the damage snapshots (default: none)")
+    parser.add_argument(
+        "--snapshots", nargs="+", help="file names of the damage snapshots, one per run"
+    )
     args = parser.parse_args()
-    run = Path(args.run)
-    results = gr.Results(run / "compress")
-    history = results.history
-    summary = json.loads((run / "compress" / "run.json").read_text())
-    grains = summary["bodies"]
-    speed = float(history["top_displacement"][-1] / history["time"][-1])
+    for given, what in ((args.labels, "--labels"), (args.snapshots, "--snapshots")):
+        if given is not None and len(given) != len(args.runs):
+            parser.error(f"give one name in {what} per run")
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     fig, ax = plt.subplots(figsize=(7, 4.2))
-    ax.plot(
-        1e3 * np.abs(history["top_displacement"]),
-        1e-3 * history["top_stress"],
-        "-",
-        label=f"granulate, native workflow: {grains} grains, wall at {speed:.2g} m/s",
-    )
+    for k, run in enumerate(map(Path, args.runs)):
+        results = gr.Results(run / "compress")
+        history = results.history
+        grains = json.loads((run / "compress" / "run.json").read_text())["bodies"]
+        speed = float(abs(history["top_displacement"][-1]) / history["time"][-1])
+        label = args.labels[k] if args.labels else f"{grains} grains, wall at {speed:.2g} m/s"
+        travel, stress = 1e3 * np.abs(history["top_displacement"]), history["top_stress"]
+        ax.plot(travel, 1e-3 * stress, "-", label=f"granulate: {label}")
+        print(
+            f"{run}: {grains} grains, wall at {speed:.3g} m/s: stress "
+            + ", ".join(f"{1e-3 * np.interp(x, travel, stress):.1f}" for x in PAPER[5:, 0])
+            + f" kPa at {', '.join(f'{x:g}' for x in PAPER[5:, 0])} mm; broken bonds "
+            f"{int(history['broken_bonds'][-1])}"
+        )
+        if args.snapshots:
+            draw_snapshots(results, speed, FOLDER / args.snapshots[k])
     ax.plot(
         PAPER[:, 0],
         PAPER[:, 1],
@@ -76,18 +86,11 @@ def main() -> None:
     ax.set_xlabel("wall travel (penetration) [mm]")
     ax.set_ylabel("top wall stress: force per unit area [kPa]")
     ax.legend(fontsize=8)
-    print(
-        f"{grains} grains, wall at {speed:.3g} m/s: stress {1e-3 * history['top_stress'][-1]:.3g}"
-        f" kPa after {1e3 * abs(history['top_displacement'][-1]):.2f} mm, broken bonds "
-        f"{int(history['broken_bonds'][-1])}"
-    )
     fig.suptitle("Compression of discs and hexagons: the top wall's stress", fontsize=9)
     fig.tight_layout()
     out = FOLDER / args.figure
     fig.savefig(out, dpi=110)
     print(f"wrote {out}")
-    if args.snapshots:
-        draw_snapshots(results, speed, FOLDER / args.snapshots)
 
 
 def draw_snapshots(results: gr.Results, speed: float, out: Path) -> None:

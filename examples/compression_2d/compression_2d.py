@@ -10,6 +10,7 @@ stress ``top_stress`` [Pa] (its force over the container's width) against its tr
     python examples/compression_2d/compression_2d.py             # 120 grains, 3.4 mm, 0.6 m/s
     python examples/compression_2d/compression_2d.py --grains 502 --speed 0.06  # the paper's
     python examples/compression_2d/compression_2d.py --peridem-constants  # PeriDEM's 2D LPS
+    python examples/compression_2d/compression_2d.py --stiffness-factor 10  # a stiffer contact
 
 Steps: (1) the material (LPS, linear influence, horizon 0.6 mm); (2) two grains, discs with
 conforming (ring) nodes and hexagons on a lattice, both of mesh size 0.2 mm at radius 1 mm;
@@ -20,7 +21,8 @@ a millimetre; (5) compress: the same grains at their settled positions, a top wa
 above the highest node, moved down; the wall stress against its travel is the load curve.
 ``--peridem-constants`` uses PeriDEM's 2D peridynamics instead of granulate's: the 3D LPS
 constants and critical stretch in 2D (``Simulation(plane="peridem")``) and bonds that also
-break in compression (``Material(break_in_compression=True)``), as the paper's runs did.
+break in compression (``Material(break_in_compression=True)``), as the paper's runs did;
+``--stiffness-factor`` multiplies the contact spring (``Contact(stiffness_factor=...)``).
 Stage 2 starts from the settled positions as PeriDEM's run2 restarts from its output_400
 (the settling's contact history is not carried over: at rest, without friction, there is
 none that matters).
@@ -30,6 +32,7 @@ from __future__ import annotations
 
 import argparse
 import math
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -41,25 +44,34 @@ RADIUS = 1.1e-3  # the largest grain radius [m]
 GAP = 0.05e-3  # the top wall starts this far above the highest node [m]
 
 
-def material(peridem: bool = False) -> gr.Material:
+@dataclass(frozen=True)
+class Options:
+    """peridem: PeriDEM's 2D peridynamics (3D LPS constants, bonds breaking in compression);
+    stiffness_factor: of the contact spring."""
+
+    peridem: bool = False
+    stiffness_factor: float = 1.0
+
+
+def material(options: Options = Options()) -> gr.Material:
     """K, G [Pa], Gc [J/m^2], rho [kg/m^3] of the paper; horizon 0.6 mm for every grain;
-    `peridem`: bonds break in compression too."""
+    with options.peridem, bonds break in compression too."""
     return gr.Material(
         density=1200,
         bulk_modulus=2.16e7,
         shear_modulus=1.296e7,
         fracture_energy=50,
         horizon=0.6e-3,
-        break_in_compression=peridem,
+        break_in_compression=options.peridem,
     )
 
 
-def packing(count: int, width: float, seed: int, peridem: bool = False) -> gr.Packing:
+def packing(count: int, width: float, seed: int, options: Options = Options()) -> gr.Packing:
     """`count` grains (the paper's 73 % discs) on lattice sites filling the bottom rows of a
     container `width` wide."""
     sizes = gr.Uniform(0.9e-3, 1.1e-3)
     discs = round(count * 366 / 502)
-    rock = material(peridem)
+    rock = material(options)
     disc = gr.Grain(gr.Disc((0, 0), 1e-3), rock, 0.2e-3, sizes, discs, discretization="conforming")
     hexagon = gr.Grain(gr.RegularPolygon((0, 0), 1e-3, 6), rock, 0.2e-3, sizes, count - discs)
     spacing = 2 * RADIUS * 1.05  # the lattice's spacing with pack's gap, about
@@ -71,11 +83,13 @@ def packing(count: int, width: float, seed: int, peridem: bool = False) -> gr.Pa
     )
 
 
-def simulation(grains: gr.Packing, width: float, peridem: bool = False) -> gr.Simulation:
-    """The grains in the container (floor and sides), frictionless contact, gravity;
-    `peridem`: PeriDEM's 2D LPS constants."""
-    sim = gr.Simulation(dimension=2, gravity=(0, -10), plane="peridem" if peridem else "strain")
-    sim.contact = gr.Contact(restitution=0.95, friction=0.0)
+def simulation(grains: gr.Packing, width: float, options: Options = Options()) -> gr.Simulation:
+    """The grains in the container (floor and sides), frictionless contact, gravity."""
+    plane = "peridem" if options.peridem else "strain"
+    sim = gr.Simulation(dimension=2, gravity=(0, -10), plane=plane)
+    sim.contact = gr.Contact(
+        restitution=0.95, friction=0.0, stiffness_factor=options.stiffness_factor
+    )
     sim.add_packing(grains)
     sides = (gr.Plane((0, 0), (0, 1)), gr.Plane((0, 0), (1, 0)), gr.Plane((width, 0), (-1, 0)))
     sim.add_wall(gr.Wall(sides), name="container")
@@ -88,11 +102,11 @@ def settle(
     until: float,
     out: Path,
     overwrite: bool,
-    peridem: bool = False,
+    options: Options = Options(),
 ) -> tuple[gr.Simulation, list[gr.Body]]:
     """Stage 1: the grains fall onto each other and come to rest (background damping 50 /s),
     or `until` [s] has passed; returns the simulation and the grains' bodies."""
-    sim = simulation(grains, width, peridem)
+    sim = simulation(grains, width, options)
     bodies = sim.bodies[:]
     sim.viscous_damping = 50.0
     weight = float(sim.volumes.sum()) * 1200 * 10
@@ -112,11 +126,11 @@ def compress(
     travel: float,
     out: Path,
     overwrite: bool,
-    peridem: bool = False,
+    options: Options = Options(),
 ) -> gr.Simulation:
     """Stage 2: the settled grains under a top wall placed GAP above them, moved down at `speed`
     until it has travelled `travel`; its stress is recorded over the container's width."""
-    sim = simulation(settled.placements_now(bodies, grains), width, peridem)  # where they rest
+    sim = simulation(settled.placements_now(bodies, grains), width, options)  # where they rest
     top = float(settled.positions[:, 1].max()) + GAP
     plate = gr.Wall(
         (gr.Plane((0, top), (0, -1)),),
@@ -148,15 +162,18 @@ def main(argv: list[str] | None = None) -> dict[str, float]:
         action="store_true",
         help="PeriDEM's 2D peridynamics: 3D LPS constants, bonds break in compression too",
     )
+    parser.add_argument(
+        "--stiffness-factor", type=float, default=1.0, help="of the contact spring (default 1)"
+    )
     args = parser.parse_args(argv)
     count, travel, until = (40, 0.2e-3, 5e-3) if args.smoke else (args.grains, args.travel, 1.0)
     width = WIDTH * min(1.0, math.sqrt(count / 502))  # the paper's proportions
     out = Path(args.out)
 
-    peridem = args.peridem_constants
-    grains = packing(count, width, args.seed, peridem)
+    options = Options(args.peridem_constants, args.stiffness_factor)
+    grains = packing(count, width, args.seed, options)
     print(grains.summary())
-    settled, bodies = settle(grains, width, until, out / "settle", args.overwrite, peridem)
+    settled, bodies = settle(grains, width, until, out / "settle", args.overwrite, options)
     print(f"settled at t = {settled.time:.4g} s, {settled.node_count} nodes, dt {settled.dt:.3g} s")
     sim = compress(
         grains,
@@ -167,7 +184,7 @@ def main(argv: list[str] | None = None) -> dict[str, float]:
         travel,
         out / "compress",
         args.overwrite,
-        peridem,
+        options,
     )
     history = gr.Results(out / "compress").history
     stress = history["top_stress"]
