@@ -4,11 +4,10 @@ compress), on the axes of the PeriDEM paper's Fig. 3a (Jha et al., JMPS 2021), w
 drawn from the numbers read off the published figure
 (../shared/peridem/decks/n500_circ_hex/README.md).
 
-This is not yet the reproduction: the paper compresses 502 grains at 0.06 m/s (1.5 million
-steps of 63,000 nodes, about 44 hours in PeriDEM here); the run drawn is the example's default,
-fewer grains in a narrower container at ten times the speed, so the onset (where the wall
-meets the pile) and the level differ. It shows the workflow's load curve and what a user's
-figure looks like.
+compression_curve.png draws the example's default run: 120 grains in a narrower container at
+ten times the paper's speed. fig3a.png draws the paper's size and rate, 502 grains at
+0.06 m/s, natively and with PeriDEM's 2D constants (the commands and what differs from the
+paper: examples/compression_2d/README.md).
 
 Run: python examples/compression_2d/compression_2d.py --out out/compression, then
 python docs/validation/compression_curve.py out/compression; writes

@@ -9,7 +9,7 @@ measure of how quasi-static a granular flow is (GDR MiDi 2004: below about 1e-3)
 
 Run: python docs/validation/loading_rate.py [--out DIR] [--speeds 1.2 0.6 ...]; writes
 docs/validation/loading_rate.png and prints the table (stress at 1.0, 1.6, 2.0, 2.4 and 3.4 mm,
-kinetic energy at the end over the wall's work, I). About 10 minutes on one thread.
+kinetic energy at the end over the wall's work, I). 15 minutes on one thread here.
 """
 
 from __future__ import annotations
