@@ -54,7 +54,7 @@ def main() -> None:
         stress = history["top_stress"]
         at = [1e-3 * float(np.interp(x, travel, stress)) for x in TRAVELS]
         work = float(np.sum(np.diff(np.abs(history["top_displacement"])) * stress[1:])) * width
-        inertial = speed / height * 2e-3 * math.sqrt(1200 / max(float(stress[-1]), 1.0))
+        inertial = inertial_number(speed, height, float(stress[-1]))
         print(
             f"{speed:5.2f} m/s, {sim.summary()['steps']:6d} steps: stress "
             + " / ".join(f"{s:5.1f}" for s in at)
@@ -62,6 +62,12 @@ def main() -> None:
             f"{float(history['kinetic_energy'][-1]) / work:.3f}; I = {inertial:.2g}"
         )
     plot(curves, height, Path(__file__).with_name("loading_rate.png"))
+
+
+def inertial_number(speed: float, height: float, stress: float) -> float:
+    """I = (v / H) d sqrt(rho / p): d = 2 mm, rho = 1200 kg/m^3, p = `stress` [Pa] (at least
+    1 Pa), H = `height` [m]."""
+    return speed / height * 2e-3 * math.sqrt(1200 / max(stress, 1.0))
 
 
 def plot(curves: dict[float, dict[str, np.ndarray]], height: float, path: Path) -> None:
@@ -73,7 +79,7 @@ def plot(curves: dict[float, dict[str, np.ndarray]], height: float, path: Path) 
     fig, ax = plt.subplots(figsize=(7, 4.2))
     for speed, history in curves.items():
         stress = history["top_stress"]
-        inertial = speed / height * 2e-3 * math.sqrt(1200 / max(float(stress[-1]), 1.0))
+        inertial = inertial_number(speed, height, float(stress[-1]))
         ax.plot(
             1e3 * np.abs(history["top_displacement"]),
             1e-3 * stress,

@@ -179,7 +179,7 @@ def reversal(dimension: int, v_t: float) -> tuple[float, float]:
 
 def sphere() -> hertz_mindlin.Sphere:
     """The tests' sphere for the Hertz-Mindlin law: SOFT's E and nu (from K and G)."""
-    k, g = 2.16e7, 1.296e7  # SOFT's bulk and shear moduli [Pa]
+    k, g = SOFT.elastic_moduli()
     young, poisson = 9 * k * g / (3 * k + g), (3 * k - 2 * g) / (2 * (3 * k + g))
     return hertz_mindlin.Sphere(RADIUS, SOFT.density, young, poisson)
 
