@@ -134,7 +134,10 @@ def restitution(tmp_path: Path, epsilon: float, *, held: bool, dt_divisor: int =
         data["Displacement_BC"] = {"Sets": 0}
         data["Force_BC"]["Gravity"] = [0.0, 0.0, 0.0]
     deck.write_text(yaml.safe_dump(data))
-    with pytest.warns(gr.GranulateWarning, match="time step"):
+    if dt_divisor == 1:  # the deck's dt is 4.4 times granulate's stable estimate
+        with pytest.warns(gr.GranulateWarning, match="time step"):
+            sim = load_case(deck).build(outputs=False)
+    else:
         sim = load_case(deck).build(outputs=False)
     discs = [slice(b.first_node, b.first_node + b.node_count) for b in sim.bodies]
     masses = [sim.volumes[d] for d in discs]
@@ -144,7 +147,7 @@ def restitution(tmp_path: Path, epsilon: float, *, held: bool, dt_divisor: int =
         return float(v[1] - v[0])
 
     before, last_contact = closing(), None
-    for step in range(100_000):
+    for step in range(100_000 * dt_divisor):
         sim.run(1)
         if sim.core.contact_statistics.node_contacts > 0:
             last_contact = step
@@ -164,15 +167,17 @@ def test_restitution_with_peridems_stiff_contact(
     collision). The dashpot treats them as one collision and gives the e asked for within 0.05:
     measured 0.537 / 0.784 / 0.913 with the lower disc held at the deck's dt (0.489 / 0.782 /
     0.938 before the surface nodes' spheres were centred a contact radius deep, f2366c2). Two
-    free discs at dt / 4 (--full) give 0.557 / 0.770 / 0.933 (0.483 / 0.779 / 0.942 before
-    f2366c2): 0.5 fails. The dashpot acts only while nodes touch, and the free discs' nodes touch
-    13 times, in 412 of the 533 steps from the first touch to the last (held: 5 times, 124 of
-    134), so the likely cause is the damping lost in the gaps. At the deck's
-    dt, 4.4 times granulate's stable estimate, free discs gain energy even without damping,
-    e = 9.6, as they do in PeriDEM."""
+    free discs (--full) at dt / 8, below granulate's stable estimate, give 0.555 / 0.763 / 0.932
+    (at dt / 4, 1.1 times the estimate: 0.557 / 0.770 / 0.933): 0.5 fails. The free discs' nodes
+    touch 13 times, in 412 of the 533 steps from the first touch to the last (held: 5 times, 124
+    of 134), and the dashpot acts only while they touch. Scaling it by 1 / sqrt(f), f the share
+    of the collision's steps in contact (the damping of the time-averaged spring), gave 0.471 /
+    0.741 / 0.925: the gaps are not the whole cause. At the deck's dt, 4.4 times granulate's
+    stable estimate, free discs gain energy even without damping, e = 9.6, as they do in
+    PeriDEM."""
     assert abs(restitution(tmp_path, epsilon, held=True) - epsilon) < 0.05
     if full:
-        free = restitution(tmp_path / "free", epsilon, held=False, dt_divisor=4)
+        free = restitution(tmp_path / "free", epsilon, held=False, dt_divisor=8)
         assert abs(free - epsilon) < 0.05
 
 
