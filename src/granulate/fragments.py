@@ -33,6 +33,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from granulate import reductions
 from granulate.errors import InputError
 from granulate.io.table import read_columns, write_columns
 
@@ -103,7 +104,7 @@ def summary(table: Table, damage: ArrayLike, volumes: ArrayLike) -> dict[str, fl
         "debris_nodes": int(np.count_nonzero(debris)),
         "debris_mass": float(table["mass"][debris].sum()),
         "particles_split": int(np.count_nonzero(pieces > 1)),
-        "mean_damage": float(v @ np.asarray(damage, dtype=np.float64) / v.sum()),
+        "mean_damage": reductions.dot(v, damage) / float(v.sum()),
     }
 
 
@@ -137,7 +138,7 @@ def hardin_breakage(
 
 def _potential(table: Mapping[str, NDArray], cutoff: float) -> float:
     d, m = np.asarray(table["diameter"]), np.asarray(table["mass"])
-    return float(m @ np.log10(np.maximum(d, cutoff) / cutoff) / m.sum())
+    return reductions.dot(m, np.log10(np.maximum(d, cutoff) / cutoff)) / float(m.sum())
 
 
 def einav_breakage(
@@ -165,7 +166,7 @@ def _area(table: Mapping[str, NDArray], smallest: float, largest: float) -> floa
     """int_{smallest}^{largest} F(d) dln d for the grading of `table`."""
     d, m = np.asarray(table["diameter"]), np.asarray(table["mass"])
     spans = np.log(largest / np.clip(d, smallest, largest))
-    return float(m @ spans / m.sum())
+    return reductions.dot(m, spans) / float(m.sum())
 
 
 def t10(table: Mapping[str, NDArray], parent_sizes: ArrayLike) -> float:

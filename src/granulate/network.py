@@ -39,6 +39,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from granulate import reductions
 from granulate.io.table import read_columns, write_columns
 
 #: Columns of a contact table (frames/contacts_NNNNNN.csv), in the order written: the bodies
@@ -122,7 +123,7 @@ def fabric_tensor(
         normals = lines / np.linalg.norm(lines, axis=1)[:, None]
     if len(normals) == 0:
         return np.zeros((dimension, dimension))
-    return normals.T @ normals / len(normals)
+    return reductions.outer_sum(normals, normals) / len(normals)
 
 
 def _symmetric(tensors: NDArray[np.float64]) -> NDArray[np.float64]:

@@ -27,7 +27,7 @@ from typing import Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from granulate import _core, fragments, network, particle_table, resources, threads
+from granulate import _core, fragments, network, particle_table, reductions, resources, threads
 from granulate._version import __version__
 from granulate.contact import Contact
 from granulate.errors import GranulateWarning, InputError
@@ -447,15 +447,17 @@ class Simulation:
             nodes = slice(body.first_node, body.first_node + body.node_count)
             w = volumes[nodes] / volumes[nodes].sum()
             before, now = model.reference_positions[nodes], core.positions[nodes]
-            c0, c = w @ before, w @ now
+            c0, c = reductions.weighted_sum(w, before), reductions.weighted_sum(w, now)
             a, b = before - c0, now - c
             if self.dimension == 2:
                 cross = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
-                turn = float(np.arctan2(w @ cross, w @ np.sum(a * b, axis=1)))
+                turn = float(
+                    np.arctan2(reductions.dot(w, cross), reductions.dot(w, np.sum(a * b, axis=1)))
+                )
                 rotation = rotation_matrix(turn, 2)
                 rotations[k] = rotations[k] + turn
             else:
-                u, _, vt = np.linalg.svd((a * w[:, None]).T @ b)
+                u, _, vt = np.linalg.svd(reductions.outer_sum(a * w[:, None], b))
                 flip = np.diag([1.0, 1.0, np.sign(np.linalg.det(vt.T @ u.T))])
                 rotation = vt.T @ flip @ u.T
                 rotations[k] = _rotation_vector(rotation @ rotation_matrix(rotations[k], 3))
@@ -1750,7 +1752,8 @@ class Simulation:
         origin)."""
         model = self.model
         mass = np.asarray(model.node_density) * np.asarray(model.volumes)
-        return float(-(mass @ (self._build().positions @ np.asarray(self._gravity))))
+        moment = reductions.weighted_sum(mass, self._build().positions)  # sum_i m_i x_i
+        return -reductions.dot(moment, self._gravity)
 
     def _fragment_labels(self) -> NDArray[np.uint32]:
         """Each node's piece: its smallest node (computed once per step and bond count)."""
