@@ -2066,7 +2066,8 @@ class Simulation:
             for body in out.tracked:
                 nodes = slice(body.first_node, body.first_node + body.node_count)
                 v = volumes[nodes]
-                resultant = v @ forces[nodes] - float(v @ density[nodes]) * gravity
+                weight = reductions.dot(v, density[nodes]) * gravity
+                resultant = reductions.weighted_sum(v, forces[nodes]) - weight
                 mean = displacement[nodes].mean(axis=0)
                 for k, axis in enumerate(axes):
                     row[f"{body.name}_f{axis}"] = float(resultant[k])
