@@ -14,13 +14,12 @@ energies J per metre.
 from __future__ import annotations
 
 import difflib
-import json
 import signal
 import threading
 import time as wallclock
 import warnings
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Literal
 
@@ -33,7 +32,7 @@ from granulate.contact import Contact
 from granulate.errors import GranulateWarning, InputError
 from granulate.functions import Constant, Linear, TimeFunction, VelocityRamp
 from granulate.input_errors import check_number, unknown_name
-from granulate.io import HistoryWriter, PvdSeries, atomic_write, write_vtu
+from granulate.io import HistoryWriter, PvdSeries
 from granulate.io import checkpoint as checkpoint_file
 from granulate.io.run_folder import RunFolder
 from granulate.materials import Material
@@ -42,6 +41,7 @@ from granulate.shape_sharing import TranslatedShapes
 from granulate.shapes import ReferenceShape, Shape, rotation_matrix
 from granulate.stopping import StopCriterion
 from granulate.walls import Surface, Wall
+from granulate.writers.outputs import Outputs
 
 Components = str  # any of "x", "y", "z", e.g. "xy"
 
@@ -58,15 +58,6 @@ FIELDS = (
     "Fixity",
     "Nodal_Volume",
 )
-#: The components of the assembly stress and the fabric tensor in history.csv (``stress_<name>``,
-#: ``fabric_<name>``), per dimension.
-_STRESS_COMPONENTS = {
-    2: (("xx", (0, 0)), ("yy", (1, 1)), ("xy", (0, 1))),
-    3: (
-        ("xx", (0, 0)), ("yy", (1, 1)), ("zz", (2, 2)),
-        ("xy", (0, 1)), ("xz", (0, 2)), ("yz", (1, 2)),
-    ),
-}  # fmt: skip
 HISTORY_COLUMNS = (
     "step",
     "time",
@@ -132,22 +123,6 @@ class Progress:
     broken_bonds: int
     steps_per_second: float
     wall_seconds: float
-
-
-@dataclass
-class _Output:
-    directory: Path
-    every: int
-    fields: tuple[str, ...]
-    pvd: PvdSeries
-    history_every: int
-    folder: RunFolder
-    tracked: tuple[Body, ...] = ()
-    track_areas: dict[str, float] = field(default_factory=dict)  # body name -> area
-    history: HistoryWriter | None = None
-    frames: int = 0
-    frame_step: int = -1  # the step of the last frame written (-1: none in this process)
-    history_step: int = -1  # likewise for the last history row
 
 
 @dataclass(frozen=True)
@@ -254,7 +229,7 @@ class Simulation:
             tuple[Body, NDArray[np.float64], float | NDArray[np.float64]]
         ] = []
         self._loads: list[tuple[str, tuple]] = []
-        self._output: _Output | None = None
+        self._output: Outputs | None = None
         self._contact: Contact | None = Contact()
         self._pair_contacts: dict[tuple[int, int], Contact | None] = {}
         self._peridem_damping: dict[tuple[int, int], tuple[float, float]] = {}
@@ -856,6 +831,11 @@ class Simulation:
         self._walls.append((label, wall))
         return label
 
+    @property
+    def walls(self) -> tuple[tuple[str, Wall], ...]:
+        """The walls added, in order, with their names (history.csv's <name>_fx, ...)."""
+        return tuple(self._walls)
+
     def wall_reactions(self) -> dict[str, NDArray[np.float64]]:
         """Per wall: (fx, fy, fz, tx, ty, tz), the force and torque the particles exert on it
         at the last step [N, N m; per unit thickness in 2D]."""
@@ -917,7 +897,7 @@ class Simulation:
             raise InputError(f"unknown output fields {unknown}; choose from {', '.join(FIELDS)}")
         path = Path(directory)
         folder = RunFolder(path, overwrite=overwrite, resume=resume)
-        self._output = _Output(
+        self._output = Outputs(
             path,
             every,
             tuple(fields),
@@ -1202,7 +1182,7 @@ class Simulation:
             raise
         finally:
             try:
-                self._write_run_json()
+                out.write_run_record(self)
             except OSError:
                 pass  # a full disk: the error that stopped the run is the one to report
             out.folder.stop_writing()
@@ -1235,8 +1215,7 @@ class Simulation:
         step, out, check_every = core.step, self._output, plan.check_every
         boundaries = [target - step, limit]
         if out is not None:
-            boundaries.append(out.every - step % out.every)
-            boundaries.append(out.history_every - step % out.history_every)
+            boundaries.append(out.steps_to_next(step))
         if plan.stop:
             boundaries.append(check_every - step % check_every)
         if self._checkpoint is not None and self._checkpoint.every_steps:
@@ -1277,9 +1256,7 @@ class Simulation:
                     # Aim at chunks of about half a second: responsive to Ctrl-C and progress.
                     rate = chunk / max(elapsed, 1e-9)
                     chunk_limit = int(min(10_000, max(1, 0.5 * rate)))
-                    if out is not None and (
-                        core.step % out.every == 0 or core.step % out.history_every == 0
-                    ):
+                    if out is not None and out.is_output_step(core.step):
                         self._write_output()
                     if stop and core.step % check_every == 0:
                         reason = next((r for c in stop if (r := c.check(self)) is not None), None)
@@ -1894,193 +1871,23 @@ class Simulation:
         return self._output_seconds
 
     def _write_output(self) -> None:
+        """The frame and history row the current step writes (Outputs.write_step), timed."""
+        assert self._output is not None
         start = wallclock.perf_counter()
         try:
-            self._write_frame()
+            self._output.write_step(self)
         finally:
             self._output_seconds += wallclock.perf_counter() - start
-
-    def _write_run_json(self) -> None:
-        out = self._output
-        assert out is not None
-        atomic_write(out.directory / "run.json", json.dumps(self.summary(), indent=2).encode())
 
     def _write_final_state(self, frame: bool) -> None:
         """The end of a run: with ``frame``, the frame and history row of the last step when
         it was not an output step (run() then writes run.json with the run's status)."""
-        out = self._output
-        assert out is not None
+        assert self._output is not None
         start = wallclock.perf_counter()
         try:
-            step = int(self._build().step)
-            self._write_outputs(
-                frame and out.frame_step != step, frame and out.history_step != step
-            )
+            self._output.write_final(self, frame)
         finally:
             self._output_seconds += wallclock.perf_counter() - start
-
-    def _write_frame(self) -> None:
-        """The frame (when the step is a frame step) and the history row (when it is a
-        history step) of the current step."""
-        out = self._output
-        assert out is not None
-        step = self._build().step
-        self._write_outputs(
-            step % out.every == 0 or out.frames == 0,
-            step % out.history_every == 0 or out.history is None,
-        )
-
-    def _write_outputs(self, frame: bool, history: bool) -> None:
-        """The frame and the history row of the current step, as asked; both take the step's
-        damage and fragment table from here."""
-        if not (frame or history):
-            return
-        phi, z = self._build().damage()
-        table = self.fragment_table()
-        contacts = self.contact_table()
-        particles = self._particles(contacts, phi)
-        if frame:
-            self._write_vtu_frame(phi, z, table, contacts, particles[0])
-        if history:
-            self._write_history_row(phi, table, contacts, particles[1:])
-
-    def _write_vtu_frame(
-        self,
-        phi: NDArray[np.float64],
-        z: NDArray[np.float64],
-        table: fragments.Table,
-        contacts: network.Table,
-        particles: particle_table.Table,
-    ) -> None:
-        out = self._output
-        assert out is not None and self._model is not None
-        core = self._build()
-        volumes = self._model.volumes
-        available = {
-            "Displacement": lambda: core.positions - self._reference,
-            "Velocity": lambda: core.velocities,
-            "Force_Density": lambda: core.forces,
-            "Force": lambda: core.forces * volumes[:, None],
-            "Damage": lambda: phi,
-            "Damage_Z": lambda: z,
-            "Dilatation": lambda: core.dilatation,
-            "Particle_ID": lambda: self._model.node_particle,
-            "Fragment_ID": self._fragment_labels,
-            "Fixity": lambda: core.fixity(),
-            "Nodal_Volume": lambda: volumes,
-        }
-        name = f"frame_{out.frames:06d}.vtu"
-        write_vtu(
-            out.directory / "frames" / name,
-            core.positions,
-            {f: available[f]() for f in out.fields},
-        )
-        out.pvd.add(core.time, Path("frames") / name)
-        frames = out.directory / "frames"
-        particle_table.write_table(frames / f"particles_{out.frames:06d}.csv", particles)
-        fragments.write_table(frames / f"fragments_{out.frames:06d}.csv", table)
-        self._write_contacts(out.frames, contacts, table)
-        out.frames += 1
-        out.frame_step = int(core.step)
-        self._write_run_json()
-
-    def _write_contacts(self, frame: int, contacts: network.Table, pieces: fragments.Table) -> None:
-        """frames/contacts_NNNNNN.csv, the force chains frames/contacts_NNNNNN.vtu (a line from
-        each body's centre to the other's, or to the contact point on a wall) and contacts.pvd,
-        whose entries follow simulation.pvd's."""
-        out = self._output
-        assert out is not None
-        frames = out.directory / "frames"
-        network.write_table(frames / f"contacts_{frame:06d}.csv", contacts)
-        points, cells = network.chain_lines(contacts, pieces)
-        write_vtu(
-            frames / f"contacts_{frame:06d}.vtu",
-            points,
-            {},
-            lines=cells,
-            cell_data=network.chain_fields(contacts),
-        )
-        chains = PvdSeries(out.directory / "contacts.pvd")
-        for t, name in out.pvd.entries:
-            chains.entries.append((t, name.replace("/frame_", "/contacts_")))
-        chains.write()
-
-    def _write_history_row(
-        self,
-        phi: NDArray[np.float64],
-        table: fragments.Table,
-        contacts: network.Table,
-        stresses: tuple[NDArray, NDArray],
-    ) -> None:
-        """The history row of the current step; `stresses`: the particles' Love-Weber
-        stresses and their volumes (_particles)."""
-        out = self._output
-        assert out is not None and self._model is not None
-        core = self._build()
-        kinetic, strain = core.kinetic_energy(), core.strain_energy()
-        gravity, contact = self.gravity_energy(), core.contact_energy()
-        statistics = core.contact_statistics
-        row: dict[str, float | int] = {
-            "step": core.step,
-            "time": core.time,
-            "kinetic_energy": kinetic,
-            "strain_energy": strain,
-            "gravity_energy": gravity,
-            "contact_energy": contact,
-            "total_energy": kinetic + strain + gravity + contact,
-            "broken_bonds": core.broken_bonds(),
-            "node_contacts": statistics.node_contacts,
-            "wall_contacts": statistics.wall_contacts,
-            "list_rebuilds": statistics.rebuilds,
-        }
-        row.update(fragments.summary(table, phi, self._model.volumes))
-        row["contacts"] = len(network.coordination_pairs(contacts))
-        row["coordination"] = network.mean_coordination(contacts, len(self.bodies))
-        solid = network.assembly_stress(*stresses)
-        fabric = network.fabric_tensor(contacts, self.dimension)
-        for name, (i, j) in _STRESS_COMPONENTS[self.dimension]:
-            row[f"stress_{name}"] = float(solid[i, j])
-        for name, (i, j) in _STRESS_COMPONENTS[self.dimension]:
-            row[f"fabric_{name}"] = float(fabric[i, j])
-        components = (
-            ("fx", "fy", "tz") if self.dimension == 2 else ("fx", "fy", "fz", "tx", "ty", "tz")
-        )
-        index = {"fx": 0, "fy": 1, "fz": 2, "tx": 3, "ty": 4, "tz": 5}
-        for (name, spec), reaction, wall in zip(
-            self._walls, core.wall_reactions(), core.walls, strict=True
-        ):
-            for c in components:
-                row[f"{name}_{c}"] = float(reaction[index[c]])
-            row[f"{name}_displacement"] = wall.displacement(core.time)
-            if spec.area is not None:
-                row[f"{name}_stress"] = (
-                    float(np.linalg.norm(reaction[: self.dimension])) / spec.area
-                )
-        if out.tracked:
-            forces = core.forces
-            displacement = core.positions - self._reference
-            volumes = self._model.volumes
-            density = self._model.node_density
-            gravity = self._gravity
-            axes = "xyz"[: self.dimension]
-            for body in out.tracked:
-                nodes = slice(body.first_node, body.first_node + body.node_count)
-                v = volumes[nodes]
-                weight = reductions.dot(v, density[nodes]) * gravity
-                resultant = reductions.weighted_sum(v, forces[nodes]) - weight
-                mean = displacement[nodes].mean(axis=0)
-                for k, axis in enumerate(axes):
-                    row[f"{body.name}_f{axis}"] = float(resultant[k])
-                for k, axis in enumerate(axes):
-                    row[f"{body.name}_u{axis}"] = float(mean[k])
-                if body.name in out.track_areas:
-                    row[f"{body.name}_stress"] = (
-                        float(np.linalg.norm(resultant)) / out.track_areas[body.name]
-                    )
-        if out.history is None:
-            out.history = HistoryWriter(out.directory / "history.csv", list(row))
-        out.history.write(row)
-        out.history_step = int(core.step)
 
 
 def _track_areas(areas: Mapping[str, float], tracked: tuple[Body, ...]) -> dict[str, float]:

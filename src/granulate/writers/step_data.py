@@ -1,0 +1,37 @@
+"""What every writer of one output step reads, computed once for the frame and the history row
+of that step."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
+from numpy.typing import NDArray
+
+from granulate import fragments, network, particle_table
+
+if TYPE_CHECKING:
+    from granulate.simulation import Simulation
+
+
+@dataclass(frozen=True)
+class StepData:
+    """The current step of `simulation`: damage, fragments, contacts and particles."""
+
+    simulation: Simulation
+    damage: NDArray[np.float64]  #: phi per node
+    damage_z: NDArray[np.float64]  #: PeriDEM's Damage_Z per node
+    fragments: fragments.Table
+    contacts: network.Table
+    particles: particle_table.Table
+    #: the particles' Love-Weber stresses (N, D, D) [Pa] and volumes [m^3; m^2 in 2D]
+    stresses: tuple[NDArray[np.float64], NDArray[np.float64]]
+
+    @classmethod
+    def of(cls, simulation: Simulation) -> StepData:
+        phi, z = simulation.core.damage()
+        table = simulation.fragment_table()
+        contacts = simulation.contact_table()
+        particles, stresses, volumes = simulation._particles(contacts, phi)
+        return cls(simulation, phi, z, table, contacts, particles, (stresses, volumes))
