@@ -6,7 +6,7 @@ series and checkpoint arrays are hashed, with the run record's timings left out.
 counts must agree with each other too (granulate's determinism promise).
 
     python benchmarks/output_hashes.py --save before.json      # on the old install
-    python benchmarks/output_hashes.py --compare before.json   # on the new one: exit 1 if any differ
+    python benchmarks/output_hashes.py --compare before.json   # the new one: exit 1 if any differ
 
 Every run is cut to a few thousand steps; the whole set takes about 2 minutes on 2 cores.
 """
@@ -46,6 +46,8 @@ CASE_RUNS: dict[str, tuple[Path, int, list[str]]] = {
         ["--peridem-compat"],
     ),
 }
+#: Cases also run in two halves, the second resumed from the first's checkpoint.
+RESUMED = ("pile_2d", "compression_small_set")
 TIMING_KEYS = ("seconds", "threads", "node_steps")  # run.json keys that hold no result
 
 
@@ -85,6 +87,18 @@ def run_case(name: str, threads: int, work: Path) -> dict[str, str]:
     return folder_digests(out)
 
 
+def run_resumed(name: str, threads: int, work: Path) -> dict[str, str]:
+    """The case run to half its steps, then resumed from its checkpoint to the end."""
+    case, steps, extra = CASE_RUNS[name]
+    out = work / f"{name}_resumed_{threads}"
+    environment = {**os.environ, "OMP_NUM_THREADS": str(threads)}
+    base = [sys.executable, "-m", "granulate", "run", str(case), "--out", str(out), "--quiet"]
+    for more in (["--overwrite", "--steps", str(steps // 2)], ["--resume", "--steps", str(steps)]):
+        command = [*base, *more, *extra]
+        subprocess.run(command, check=True, env=environment, cwd=work, stdout=subprocess.DEVNULL)
+    return folder_digests(out)
+
+
 def run_example(script: Path, threads: int, work: Path) -> dict[str, str]:
     """An example script in its smoke mode, in this process with the thread count set."""
     import granulate as gr
@@ -104,6 +118,9 @@ def all_digests(work: Path) -> dict[str, dict[str, str]]:
         for name in CASE_RUNS:
             digests[f"{name}@{threads}"] = run_case(name, threads, work)
             print(f"{name} at {threads} thread(s): {len(digests[f'{name}@{threads}'])} files")
+        for name in RESUMED:
+            digests[f"{name}_resumed@{threads}"] = run_resumed(name, threads, work)
+            print(f"{name}, resumed, at {threads} thread(s)")
         for script in examples:
             digests[f"example_{script.stem}@{threads}"] = run_example(script, threads, work)
             print(f"{script.stem} at {threads} thread(s)")

@@ -26,13 +26,23 @@ from typing import Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from granulate import _core, fragments, network, particle_table, reductions, resources, threads
+from granulate import (
+    _core,
+    checkpoints,
+    fragments,
+    network,
+    particle_table,
+    reductions,
+    resources,
+    threads,
+)
 from granulate._version import __version__
+from granulate.checkpoints import CheckpointPlan
 from granulate.contact import Contact
 from granulate.errors import GranulateWarning, InputError
 from granulate.functions import Constant, Linear, TimeFunction, VelocityRamp
 from granulate.input_errors import check_number, unknown_name
-from granulate.io import HistoryWriter, PvdSeries
+from granulate.io import PvdSeries
 from granulate.io import checkpoint as checkpoint_file
 from granulate.io.run_folder import RunFolder
 from granulate.materials import Material
@@ -103,14 +113,6 @@ class Body:
     def nodes(self) -> NDArray[np.uint32]:
         """Global indices of the body's nodes."""
         return np.arange(self.first_node, self.first_node + self.node_count, dtype=np.uint32)
-
-
-@dataclass
-class _Checkpointing:
-    path: Path
-    every_steps: int | None
-    every_seconds: float | None
-    last_wall_time: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -248,7 +250,7 @@ class Simulation:
         self._output_seconds = 0.0
         self._core_materials: list[Material] = []
         self._setup_digest: str | None = None
-        self._checkpoint: _Checkpointing | None = None
+        self._checkpoint: CheckpointPlan | None = None
         #: Packings added with add_packing (for summaries).
         self.packings: list[Packing] = []
         #: Extra text identifying the set-up (a case file's hash), checked by load_checkpoint.
@@ -1218,9 +1220,9 @@ class Simulation:
             boundaries.append(out.steps_to_next(step))
         if plan.stop:
             boundaries.append(check_every - step % check_every)
-        if self._checkpoint is not None and self._checkpoint.every_steps:
-            every = self._checkpoint.every_steps
-            boundaries.append(every - step % every)
+        to_checkpoint = None if self._checkpoint is None else self._checkpoint.steps_to_next(step)
+        if to_checkpoint is not None:
+            boundaries.append(to_checkpoint)
         return min(boundaries)
 
     def _advance(self, core: _core.Simulation, plan: _RunPlan) -> str | None:
@@ -1439,42 +1441,17 @@ class Simulation:
             if self._output is None:
                 raise InputError("give a checkpoint path, or set output(...) first")
             path = self._output.directory / "checkpoint.npz"
-        self._checkpoint = _Checkpointing(
+        self._checkpoint = CheckpointPlan(
             Path(path), steps, None if minutes is None else 60.0 * minutes, wallclock.perf_counter()
         )
 
-    #: The most bytes a run's checkpoints may write in all: at 1 GB/s, 20 minutes of writing.
-    MOST_CHECKPOINT_BYTES = 1.2e12
-
     def _require_checkpoint_budget(self, steps: int) -> None:
-        """InputError when checkpoints every few steps would make the run mostly writing: each
-        holds the state (about 100 bytes per node and a bit per bond) and replaces the last."""
-        plan = self._checkpoint
-        if plan is None or not plan.every_steps:
-            return
-        count = steps // plan.every_steps
-        size = 100.0 * self.node_count + self.bond_count / 8
-        if count * size > self.MOST_CHECKPOINT_BYTES:
-            raise InputError(
-                f"checkpoints every {plan.every_steps} steps would write {count:,} checkpoints of "
-                f"about {resources.size_text(size)} over this run ("
-                f"{resources.size_text(count * size)}); checkpoint less often (every_steps), or "
-                "every few minutes (every_minutes)"
-            )
+        if self._checkpoint is not None:
+            self._checkpoint.require_budget(steps, self.node_count, self.bond_count)
 
     def _checkpoint_if_due(self) -> None:
-        plan = self._checkpoint
-        if plan is None:
-            return
-        step = self._build().step
-        due = bool(plan.every_steps) and step % plan.every_steps == 0  # type: ignore[operator]
-        now = wallclock.perf_counter()
-        due = due or (
-            plan.every_seconds is not None and now - plan.last_wall_time >= plan.every_seconds
-        )
-        if due:
-            self.save_checkpoint(plan.path)
-            plan.last_wall_time = now
+        if self._checkpoint is not None:
+            self._checkpoint.save_if_due(self)
 
     def _save_on_interrupt(self) -> Path | None:
         if self._checkpoint is not None:
@@ -1532,60 +1509,15 @@ class Simulation:
 
     def save_checkpoint(self, path: str | Path) -> Path:
         """Write the state (positions, velocities, forces, bond states, contact history, time,
-        step) and the output bookkeeping to ``path`` atomically."""
-        core = self._build()
-        out = self._output
-        header = {
-            "granulate": __version__,
-            "fingerprint": self.fingerprint(),
-            "step": int(core.step),
-            "time": float(core.time),
-            "output": None
-            if out is None
-            else {
-                "frames": out.frames,
-                "every": out.every,
-                "history_every": out.history_every,
-                "pvd": out.pvd.entries,
-            },
-        }
-        target = Path(path)
-        target.parent.mkdir(parents=True, exist_ok=True)
-        checkpoint_file.save(target, core.checkpoint(), header)
-        return target
+        step) and the output bookkeeping to ``path`` atomically (granulate.checkpoints)."""
+        return checkpoints.save(self, path)
 
     def load_checkpoint(self, path: str | Path) -> None:
         """Continue from a checkpoint of this same set-up (else InputError): restores the state
         and, when outputs are set, the frame count, the PVD series and history.csv up to the
         checkpoint's step, so that the outputs that follow are those of an uninterrupted run."""
-        core = self._build()
-        state, header = checkpoint_file.load(path)
-        if header.get("fingerprint") != self.fingerprint():
-            raise InputError(
-                f"checkpoint {path} belongs to a different set-up (other nodes, loading, walls, "
-                "time step or case file); run without --resume, or restore the original case"
-            )
-        core.restore(state)
-        self._labels = None  # fragments of the restored bonds
-        out = self._output
-        saved = header.get("output")
-        if out is not None:
-            if (
-                saved is None
-                or saved["every"] != out.every
-                or saved.get("history_every", saved["every"]) != out.history_every
-            ):
-                raise InputError(
-                    f"checkpoint {path} was written with other output settings; keep the "
-                    "output interval of the original run"
-                )
-            out.frames = int(saved["frames"])
-            out.pvd.entries = [(float(t), str(f)) for t, f in saved["pvd"]]
-            history = out.directory / "history.csv"
-            if history.exists():
-                out.history = HistoryWriter.resume(history, int(core.step))
+        checkpoints.load(self, path)
 
-    # ------------------------------------------------------------------ results
     # ------------------------------------------------------------------ results
     @property
     def positions(self) -> NDArray[np.float64]:

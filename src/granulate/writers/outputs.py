@@ -79,6 +79,15 @@ class Outputs:
             self.history.write(row)
             self.history_step = int(sim.core.step)
 
+    def resume(self, frames: int, pvd: list[tuple[float, str]], step: int) -> None:
+        """Continue the outputs of a checkpoint at `step`: its frame count and PVD entries,
+        and history.csv cut back to its rows up to `step`."""
+        self.frames = frames
+        self.pvd.entries = [(float(t), str(f)) for t, f in pvd]
+        history = self.directory / "history.csv"
+        if history.exists():
+            self.history = HistoryWriter.resume(history, step)
+
     def write_run_record(self, sim: Simulation) -> None:
         """run.json: the counts, time step, status and timings of the run so far."""
         atomic_write(self.directory / "run.json", json.dumps(sim.summary(), indent=2).encode())

@@ -1,0 +1,119 @@
+"""Checkpoints of a run: when they are written (every so many steps and/or minutes of wall
+time, and on Ctrl-C or SIGTERM), the budget that keeps a run from becoming mostly writing, and
+what one holds: the core's state (positions, velocities, forces, bond states, contact history,
+time, step) and the output bookkeeping (frames, PVD series), so that a resumed run's outputs
+are those of an uninterrupted one. The file format is granulate.io.checkpoint's."""
+
+from __future__ import annotations
+
+import time as wallclock
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from granulate import resources
+from granulate._version import __version__
+from granulate.errors import InputError
+from granulate.io import checkpoint as checkpoint_file
+
+if TYPE_CHECKING:
+    from granulate.simulation import Simulation
+
+#: The most bytes a run's checkpoints may write in all: at 1 GB/s, 20 minutes of writing.
+MOST_CHECKPOINT_BYTES = 1.2e12
+
+
+@dataclass
+class CheckpointPlan:
+    """Where and how often a run writes its checkpoint (each replaces the last atomically)."""
+
+    path: Path
+    every_steps: int | None
+    every_seconds: float | None
+    last_wall_time: float = 0.0
+
+    def steps_to_next(self, step: int) -> int | None:
+        """Steps from `step` to the next checkpoint by step count (None: by time only)."""
+        if not self.every_steps:
+            return None
+        return self.every_steps - step % self.every_steps
+
+    def require_budget(self, steps: int, nodes: int, bonds: int) -> None:
+        """InputError when checkpoints every few steps would make the run mostly writing: each
+        holds the state (about 100 bytes per node and a bit per bond) and replaces the last."""
+        if not self.every_steps:
+            return
+        count = steps // self.every_steps
+        size = 100.0 * nodes + bonds / 8
+        if count * size > MOST_CHECKPOINT_BYTES:
+            raise InputError(
+                f"checkpoints every {self.every_steps} steps would write {count:,} checkpoints of "
+                f"about {resources.size_text(size)} over this run ("
+                f"{resources.size_text(count * size)}); checkpoint less often (every_steps), or "
+                "every few minutes (every_minutes)"
+            )
+
+    def save_if_due(self, sim: Simulation) -> None:
+        """The checkpoint, at a checkpoint step or when its minutes have passed."""
+        step = sim.core.step
+        due = bool(self.every_steps) and step % self.every_steps == 0  # type: ignore[operator]
+        now = wallclock.perf_counter()
+        due = due or (
+            self.every_seconds is not None and now - self.last_wall_time >= self.every_seconds
+        )
+        if due:
+            save(sim, self.path)
+            self.last_wall_time = now
+
+
+def save(sim: Simulation, path: str | Path) -> Path:
+    """Write sim's state and output bookkeeping to `path` atomically."""
+    core = sim.core
+    out = sim._output
+    header = {
+        "granulate": __version__,
+        "fingerprint": sim.fingerprint(),
+        "step": int(core.step),
+        "time": float(core.time),
+        "output": None
+        if out is None
+        else {
+            "frames": out.frames,
+            "every": out.every,
+            "history_every": out.history_every,
+            "pvd": out.pvd.entries,
+        },
+    }
+    target = Path(path)
+    target.parent.mkdir(parents=True, exist_ok=True)
+    checkpoint_file.save(target, core.checkpoint(), header)
+    return target
+
+
+def load(sim: Simulation, path: str | Path) -> None:
+    """Continue sim from a checkpoint of its same set-up (else InputError): the state and,
+    when outputs are set, the frame count, the PVD series and history.csv up to the
+    checkpoint's step."""
+    core = sim.core
+    state, header = checkpoint_file.load(path)
+    if header.get("fingerprint") != sim.fingerprint():
+        raise InputError(
+            f"checkpoint {path} belongs to a different set-up (other nodes, loading, walls, "
+            "time step or case file); run without --resume, or restore the original case"
+        )
+    core.restore(state)
+    sim._labels = None  # fragments of the restored bonds
+    out = sim._output
+    saved = header.get("output")
+    if out is None:
+        return
+    if (
+        saved is None
+        or saved["every"] != out.every
+        or saved.get("history_every", saved["every"]) != out.history_every
+    ):
+        raise InputError(
+            f"checkpoint {path} was written with other output settings; keep the "
+            "output interval of the original run"
+        )
+    out.resume(int(saved["frames"]), saved["pvd"], int(core.step))
