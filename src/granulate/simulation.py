@@ -14,8 +14,6 @@ energies J per metre.
 from __future__ import annotations
 
 import difflib
-import signal
-import threading
 import time as wallclock
 import warnings
 from collections.abc import Callable, Mapping, Sequence
@@ -34,6 +32,7 @@ from granulate import (
     particle_table,
     reductions,
     resources,
+    run_loop,
     threads,
 )
 from granulate._version import __version__
@@ -47,6 +46,7 @@ from granulate.io import checkpoint as checkpoint_file
 from granulate.io.run_folder import RunFolder
 from granulate.materials import Material
 from granulate.packing import Grain, Packing, Placements, grains_by_kind
+from granulate.run_loop import Progress, RunPlan, RunRecord
 from granulate.shape_sharing import TranslatedShapes
 from granulate.shapes import ReferenceShape, Shape, rotation_matrix
 from granulate.stopping import StopCriterion
@@ -115,59 +115,11 @@ class Body:
         return np.arange(self.first_node, self.first_node + self.node_count, dtype=np.uint32)
 
 
-@dataclass(frozen=True)
-class Progress:
-    """What ``run(progress=...)`` reports after each chunk of steps."""
-
-    step: int
-    target_step: int
-    time: float
-    broken_bonds: int
-    steps_per_second: float
-    wall_seconds: float
-
-
-@dataclass(frozen=True)
-class _RunPlan:
-    """What one run() call asked for, checked."""
-
-    steps: int
-    stop: Sequence[StopCriterion]
-    check_every: int
-    progress: Callable[[Progress], None] | None
-    write_final: bool
-
-
 def _read_only(array: NDArray) -> NDArray:
     """A view of `array` that cannot be written (the core keeps writing the original)."""
     view = array.view()
     view.flags.writeable = False
     return view
-
-
-class _SignalCatcher:
-    """During a run, Ctrl-C (SIGINT) and SIGTERM only set ``caught``: the run finishes its
-    chunk of steps and stops cleanly. A second signal interrupts at once. Outside the main
-    thread (where handlers cannot be installed) nothing changes."""
-
-    def __init__(self) -> None:
-        self.caught = False
-        self._previous: dict[int, object] = {}
-
-    def _handle(self, number: int, frame: object) -> None:
-        if self.caught:
-            raise KeyboardInterrupt
-        self.caught = True
-
-    def __enter__(self) -> _SignalCatcher:
-        if threading.current_thread() is threading.main_thread():
-            for number in (signal.SIGINT, signal.SIGTERM):
-                self._previous[number] = signal.signal(number, self._handle)
-        return self
-
-    def __exit__(self, *exc: object) -> None:
-        for number, handler in self._previous.items():
-            signal.signal(number, handler)  # type: ignore[arg-type]
 
 
 def _component_mask(components: Components, dimension: int) -> int:
@@ -241,10 +193,8 @@ class Simulation:
         self._core: _core.Simulation | None = None
         self._model: _core.Model | None = None
         self._reference: NDArray[np.float64] | None = None
-        self._wall_seconds = 0.0
-        self._steps_run = 0
+        self._record = RunRecord()
         self._precracks: list[tuple[NDArray[np.float64], NDArray[np.float64], Shape | None]] = []
-        self._status = "not run"
         self._tuner: threads.ThreadTuner | None = None
         self._deep_contact_warned = False
         self._output_seconds = 0.0
@@ -1147,47 +1097,16 @@ class Simulation:
                 f"progress must be True, False or a function of a Progress, got {progress!r}"
             )
         callback = None if isinstance(progress, bool) else progress
-        plan = _RunPlan(steps, tuple(stop), check_every, callback, write_final)
+        plan = RunPlan(steps, tuple(stop), check_every, callback, write_final)
         if progress is not True:
-            return self._run_with_outputs(core, plan)
+            return run_loop.run_in_folder(self, plan)
         from granulate.progress import ProgressReporter
 
         reporter = ProgressReporter(steps)
         try:
-            return self._run_with_outputs(core, replace(plan, progress=reporter))
+            return run_loop.run_in_folder(self, replace(plan, progress=reporter))
         finally:
             reporter.close()
-
-    def _run_with_outputs(self, core: _core.Simulation, plan: _RunPlan) -> str | None:
-        """The run, in its output folder when outputs are set: its space checked, its lock held
-        while it writes, and run.json with its status at the end, whatever ends it."""
-        out = self._output
-        if out is None:
-            return self._advance(core, plan)
-        # The frames this run writes: one every `every` steps, the last step's when it falls
-        # between, and step 0's when none is written yet; each about 8 bytes per component of
-        # its fields per node.
-        steps = plan.steps
-        frames = steps // out.every + (steps % out.every > 0) + (out.frames == 0)
-        out.folder.require_space(frames, self.node_count * (12 + 8 * 3 * len(out.fields)))
-        out.folder.start_writing()
-        self._status = "running"
-        try:
-            reason = self._advance(core, plan)
-            self._status = f"stopped: {reason}" if reason else "finished"
-            return reason
-        except KeyboardInterrupt:
-            self._status = "interrupted"
-            raise
-        except BaseException as error:
-            self._status = f"failed: {error}"
-            raise
-        finally:
-            try:
-                out.write_run_record(self)
-            except OSError:
-                pass  # a full disk: the error that stopped the run is the one to report
-            out.folder.stop_writing()
 
     def _run_steps(
         self, core: _core.Simulation, steps: int | None, until: float | None, check_every: int
@@ -1210,81 +1129,6 @@ class Simulation:
         if not (isinstance(check_every, int) and check_every > 0):
             raise InputError(f"check_every must be a positive number of steps, got {check_every}")
         return int(steps)
-
-    def _chunk_end(self, core: _core.Simulation, plan: _RunPlan, target: int, limit: int) -> int:
-        """Steps to the next place the loop must stop at: the run's end, an output or history
-        step, a stop check, a checkpoint, or `limit` (about half a second)."""
-        step, out, check_every = core.step, self._output, plan.check_every
-        boundaries = [target - step, limit]
-        if out is not None:
-            boundaries.append(out.steps_to_next(step))
-        if plan.stop:
-            boundaries.append(check_every - step % check_every)
-        to_checkpoint = None if self._checkpoint is None else self._checkpoint.steps_to_next(step)
-        if to_checkpoint is not None:
-            boundaries.append(to_checkpoint)
-        return min(boundaries)
-
-    def _advance(self, core: _core.Simulation, plan: _RunPlan) -> str | None:
-        """The time loop of run(): chunks of steps between outputs, stop checks and
-        checkpoints, with the thread count the tuner picks."""
-        stop, check_every, progress = plan.stop, plan.check_every, plan.progress
-        out = self._output
-        if out is not None and out.frames == 0:
-            core.run(0)  # the forces of step 0 (prescribed motion, contact), for the frame
-            self._write_output()
-        target = core.step + plan.steps
-        first_step = int(core.step)
-        most = threads.get_num_threads()
-        tuner = self._thread_tuner(most)
-        start = wallclock.perf_counter()
-        chunk_limit = 10
-        signals = _SignalCatcher()
-        reason = None
-        try:
-            with signals:
-                while core.step < target and reason is None:
-                    chunk = self._chunk_end(core, plan, target, chunk_limit)
-                    if tuner is not None:
-                        count = tuner.threads()
-                        chunk = min(chunk, tuner.step_cap() or chunk)
-                        _core.set_num_threads(count)
-                    began = wallclock.perf_counter()
-                    core.run(chunk)
-                    elapsed = wallclock.perf_counter() - began
-                    if tuner is not None:
-                        tuner.record(count, chunk, elapsed)
-                    self._warn_deep_contact(core)
-                    # Aim at chunks of about half a second: responsive to Ctrl-C and progress.
-                    rate = chunk / max(elapsed, 1e-9)
-                    chunk_limit = int(min(10_000, max(1, 0.5 * rate)))
-                    if out is not None and out.is_output_step(core.step):
-                        self._write_output()
-                    if stop and core.step % check_every == 0:
-                        reason = next((r for c in stop if (r := c.check(self)) is not None), None)
-                    self._checkpoint_if_due()
-                    if progress is not None:
-                        progress(
-                            Progress(
-                                int(core.step),
-                                int(target),
-                                float(core.time),
-                                self.broken_bonds(),
-                                rate,
-                                self._wall_seconds + wallclock.perf_counter() - start,
-                            )
-                        )
-                    if signals.caught:
-                        saved = self._save_on_interrupt()
-                        where = f"; checkpoint written to {saved}" if saved else ""
-                        raise KeyboardInterrupt(f"interrupted at step {core.step}{where}")
-        finally:
-            _core.set_num_threads(most)
-            self._wall_seconds += wallclock.perf_counter() - start
-            self._steps_run += int(core.step) - first_step
-        if out is not None:
-            self._write_final_state(frame=plan.write_final or reason is not None)
-        return reason
 
     def _translated_copies(self, outer_layers: bool) -> dict[int, int]:
         """Bodies without a reference shape that are translated copies of an earlier one
@@ -1718,9 +1562,9 @@ class Simulation:
             "time": core.time,
             "threads": threads.get_num_threads(),
             "threads_in_use": self._tuner.current if self._tuner is not None else None,
-            "status": self._status,
-            "steps_run": self._steps_run,
-            "wall_seconds": self._wall_seconds,
+            "status": self._record.status,
+            "steps_run": self._record.steps_run,
+            "wall_seconds": self._record.wall_seconds,
             "peridynamics_seconds": phases.peridynamics,
             "integration_seconds": phases.integration,
             "loading_seconds": phases.loading,

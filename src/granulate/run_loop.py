@@ -1,0 +1,202 @@
+"""The time loop of Simulation.run: chunks of steps between the places the loop must stop at
+(outputs, stop checks, checkpoints, about half a second of steps), the thread count the tuner
+picks for each chunk, progress reports, and a clean end on Ctrl-C or SIGTERM."""
+
+from __future__ import annotations
+
+import signal
+import threading
+import time as wallclock
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+from granulate import _core, threads
+from granulate.stopping import StopCriterion
+
+if TYPE_CHECKING:
+    from granulate.simulation import Simulation
+
+
+@dataclass(frozen=True)
+class Progress:
+    """What ``run(progress=...)`` reports after each chunk of steps."""
+
+    step: int
+    target_step: int
+    time: float
+    broken_bonds: int
+    steps_per_second: float
+    wall_seconds: float
+
+
+@dataclass(frozen=True)
+class RunPlan:
+    """What one run() call asked for, checked."""
+
+    steps: int
+    stop: Sequence[StopCriterion]
+    check_every: int
+    progress: Callable[[Progress], None] | None
+    write_final: bool
+
+
+@dataclass
+class RunRecord:
+    """What a simulation's runs have done in this process (run.json's status and timings)."""
+
+    status: str = "not run"
+    wall_seconds: float = 0.0
+    steps_run: int = 0
+
+
+class SignalCatcher:
+    """During a run, Ctrl-C (SIGINT) and SIGTERM only set ``caught``: the run finishes its
+    chunk of steps and stops cleanly. A second signal interrupts at once. Outside the main
+    thread (where handlers cannot be installed) nothing changes."""
+
+    def __init__(self) -> None:
+        self.caught = False
+        self._previous: dict[int, object] = {}
+
+    def _handle(self, number: int, frame: object) -> None:
+        if self.caught:
+            raise KeyboardInterrupt
+        self.caught = True
+
+    def __enter__(self) -> SignalCatcher:
+        if threading.current_thread() is threading.main_thread():
+            for number in (signal.SIGINT, signal.SIGTERM):
+                self._previous[number] = signal.signal(number, self._handle)
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        for number, handler in self._previous.items():
+            signal.signal(number, handler)  # type: ignore[arg-type]
+
+
+def run_in_folder(sim: Simulation, plan: RunPlan) -> str | None:
+    """The run, in its output folder when outputs are set: its space checked, its lock held
+    while it writes, and run.json with its status at the end, whatever ends it."""
+    out, record = sim._output, sim._record
+    if out is None:
+        return advance(sim, plan)
+    # The frames this run writes: one every `every` steps, the last step's when it falls
+    # between, and step 0's when none is written yet; each about 8 bytes per component of its
+    # fields per node.
+    steps = plan.steps
+    frames = steps // out.every + (steps % out.every > 0) + (out.frames == 0)
+    out.folder.require_space(frames, sim.node_count * (12 + 8 * 3 * len(out.fields)))
+    out.folder.start_writing()
+    record.status = "running"
+    try:
+        reason = advance(sim, plan)
+        record.status = f"stopped: {reason}" if reason else "finished"
+        return reason
+    except KeyboardInterrupt:
+        record.status = "interrupted"
+        raise
+    except BaseException as error:
+        record.status = f"failed: {error}"
+        raise
+    finally:
+        try:
+            out.write_run_record(sim)
+        except OSError:
+            pass  # a full disk: the error that stopped the run is the one to report
+        out.folder.stop_writing()
+
+
+def chunk_end(sim: Simulation, plan: RunPlan, target: int, limit: int) -> int:
+    """Steps to the next place the loop must stop at: the run's end, an output or history
+    step, a stop check, a checkpoint, or `limit` (about half a second)."""
+    step, out, check_every = sim.core.step, sim._output, plan.check_every
+    boundaries = [target - step, limit]
+    if out is not None:
+        boundaries.append(out.steps_to_next(step))
+    if plan.stop:
+        boundaries.append(check_every - step % check_every)
+    to_checkpoint = None if sim._checkpoint is None else sim._checkpoint.steps_to_next(step)
+    if to_checkpoint is not None:
+        boundaries.append(to_checkpoint)
+    return min(boundaries)
+
+
+def advance(sim: Simulation, plan: RunPlan) -> str | None:
+    """The time loop: chunks of steps between outputs, stop checks and checkpoints, with the
+    thread count the tuner picks; the reason a stop criterion gave, or None."""
+    core, out = sim.core, sim._output
+    if out is not None and out.frames == 0:
+        core.run(0)  # the forces of step 0 (prescribed motion, contact), for the frame
+        sim._write_output()
+    target = core.step + plan.steps
+    first_step = int(core.step)
+    most = threads.get_num_threads()
+    start = wallclock.perf_counter()
+    reason = None
+    try:
+        with SignalCatcher() as signals:
+            chunks = _Chunks(sim, plan, sim._thread_tuner(most), start)
+            while core.step < target and reason is None:
+                reason = chunks.run(target)
+                if plan.progress is not None:
+                    plan.progress(chunks.progress(target))
+                if signals.caught:
+                    saved = sim._save_on_interrupt()
+                    where = f"; checkpoint written to {saved}" if saved else ""
+                    raise KeyboardInterrupt(f"interrupted at step {core.step}{where}")
+    finally:
+        _core.set_num_threads(most)
+        sim._record.wall_seconds += wallclock.perf_counter() - start
+        sim._record.steps_run += int(core.step) - first_step
+    if out is not None:
+        sim._write_final_state(frame=plan.write_final or reason is not None)
+    return reason
+
+
+class _Chunks:
+    """The chunks of one run: each up to the next stopping place, about half a second long."""
+
+    def __init__(
+        self, sim: Simulation, plan: RunPlan, tuner: threads.ThreadTuner | None, start: float
+    ) -> None:
+        self.sim, self.plan, self.tuner, self.start = sim, plan, tuner, start
+        self.limit = 10  # steps: the first chunk measures the rate
+        self.rate = 0.0
+
+    def run(self, target: int) -> str | None:
+        """One chunk, then its outputs, stop check and checkpoint; a stop criterion's reason."""
+        sim, plan, tuner = self.sim, self.plan, self.tuner
+        core, out = sim.core, sim._output
+        chunk = chunk_end(sim, plan, target, self.limit)
+        if tuner is not None:
+            count = tuner.threads()
+            chunk = min(chunk, tuner.step_cap() or chunk)
+            _core.set_num_threads(count)
+        began = wallclock.perf_counter()
+        core.run(chunk)
+        elapsed = wallclock.perf_counter() - began
+        if tuner is not None:
+            tuner.record(count, chunk, elapsed)
+        sim._warn_deep_contact(core)
+        # Aim at chunks of about half a second: responsive to Ctrl-C and progress.
+        self.rate = chunk / max(elapsed, 1e-9)
+        self.limit = int(min(10_000, max(1, 0.5 * self.rate)))
+        if out is not None and out.is_output_step(core.step):
+            sim._write_output()
+        reason = None
+        if plan.stop and core.step % plan.check_every == 0:
+            reason = next((r for c in plan.stop if (r := c.check(sim)) is not None), None)
+        sim._checkpoint_if_due()
+        return reason
+
+    def progress(self, target: int) -> Progress:
+        core = self.sim.core
+        return Progress(
+            int(core.step),
+            int(target),
+            float(core.time),
+            self.sim.broken_bonds(),
+            self.rate,
+            self.sim._record.wall_seconds + wallclock.perf_counter() - self.start,
+        )
