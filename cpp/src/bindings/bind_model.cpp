@@ -1,0 +1,97 @@
+// granulate._core's Model: particles, shared shapes and bond families, zero-copy views.
+#include "bindings.hpp"
+
+namespace granulate::bindings {
+
+using namespace nb::literals;
+
+void bind_model(nb::module_& m) {
+  nb::class_<Model>(m, "Model")
+      .def(nb::init<int, PlaneMode>(), "dimension"_a, "plane"_a = PlaneMode::strain)
+      .def("add_material", &Model::add_material, "params"_a)
+      .def(
+          "add_particle",
+          [](Model& self, Points positions, Scalars volumes, index_t material, real mesh_size, real horizon) {
+            return self.add_particle({positions.data(), positions.shape(0) * 3},
+                                     {volumes.data(), volumes.shape(0)}, material, mesh_size, horizon);
+          },
+          "positions"_a, "volumes"_a, "material"_a, "mesh_size"_a, "horizon"_a = 0.0)
+      .def(
+          "add_shape",
+          [](Model& self, Points positions, Scalars volumes, real mesh_size, Scalars surface_offsets,
+             Scalars surface_depths) {
+            return self.add_shape({positions.data(), positions.shape(0) * 3},
+                                  {volumes.data(), volumes.shape(0)}, mesh_size,
+                                  {surface_offsets.data(), surface_offsets.shape(0)},
+                                  {surface_depths.data(), surface_depths.shape(0)});
+          },
+          "positions"_a, "volumes"_a, "mesh_size"_a, "surface_offsets"_a, "surface_depths"_a)
+      .def(
+          "place_shape",
+          [](Model& self, index_t shape, index_t material, Points positions, real scale, real horizon) {
+            return self.add_particle(shape, material, {positions.data(), positions.shape(0) * 3}, scale,
+                                     horizon);
+          },
+          "shape"_a, "material"_a, "positions"_a, "scale"_a, "horizon"_a = 0.0)
+      .def_prop_ro("shape_count", [](const Model& self) { return self.shapes().size(); })
+      .def_prop_ro("family_count", [](const Model& self) { return self.families().size(); })
+      .def("shared_bond_bytes",
+           [](const Model& self) {
+             std::size_t bytes = 0;
+             for (const BondFamilies& f : self.families()) {
+               bytes += f.neighbors.size() * (sizeof(index_t) + sizeof(float) + sizeof(real)) +
+                        f.offsets.size() * sizeof(index_t);
+             }
+             return bytes;
+           })
+      .def("finalize", &Model::finalize, nb::call_guard<nb::gil_scoped_release>())
+      .def_prop_ro("finalized", &Model::finalized)
+      .def_prop_ro("dimension", &Model::dimension)
+      .def_prop_ro("node_count", &Model::node_count)
+      .def_prop_ro("bond_count", &Model::bond_count)
+      .def_prop_ro("particle_count", [](const Model& self) { return self.particles().size(); })
+      .def_prop_ro("material_count", [](const Model& self) { return self.materials().size(); })
+      .def(
+          "particle_horizon", [](const Model& self, index_t p) { return self.particles().at(p).horizon; },
+          "particle"_a)
+      .def(
+          "particle_critical_stretch",
+          [](const Model& self, index_t p) { return self.particles().at(p).critical_stretch; }, "particle"_a)
+      .def_prop_ro("materials", &Model::materials)
+      .def("stable_time_step", &Model::stable_time_step)
+      .def_prop_ro("reference_positions",
+                   [](Model& self) {
+                     return view(const_cast<real*>(self.reference_positions().data()), self.node_count(), 3,
+                                 nb::find(self));
+                   })
+      .def_prop_ro("volumes",
+                   [](Model& self) {
+                     return view(const_cast<real*>(self.volumes().data()), self.node_count(), 0,
+                                 nb::find(self));
+                   })
+      .def_prop_ro("node_density",
+                   [](Model& self) {
+                     return view(const_cast<real*>(self.node_density().data()), self.node_count(), 0,
+                                 nb::find(self));
+                   })
+      .def_prop_ro("node_particle",
+                   [](Model& self) {
+                     return view(const_cast<index_t*>(self.node_particle().data()), self.node_count(), 0,
+                                 nb::find(self));
+                   })
+      .def_prop_ro("bond_offsets",
+                   [](Model& self) {
+                     return view(const_cast<std::size_t*>(self.bond_offsets().data()),
+                                 self.bond_offsets().size(), 0, nb::find(self));
+                   })
+      .def("bond_neighbors", [](const Model& self) {
+        std::vector<index_t> neighbors(self.bond_count());
+        for (index_t i = 0; i < self.node_count(); ++i) {
+          const NodeBonds bonds = self.node_bonds(i);
+          for (index_t b = 0; b < bonds.count; ++b) neighbors[bonds.first + b] = bonds.neighbor(b);
+        }
+        return copy_out(neighbors);
+      });
+}
+
+}  // namespace granulate::bindings

@@ -1,0 +1,227 @@
+// granulate._core's Simulation: loading, contact set-up, the state as zero-copy views, results.
+#include "bindings.hpp"
+
+namespace granulate::bindings {
+
+using namespace nb::literals;
+
+namespace {
+
+// The time step, PeriDEM's damping, time and step, checkpoints, body forces.
+void bind_run_setup(nb::class_<Simulation>& cls) {
+  cls.def(nb::init<std::shared_ptr<Model>>(), "model"_a, nb::call_guard<nb::gil_scoped_release>())
+      .def_prop_rw("time_step", &Simulation::time_step, &Simulation::set_time_step)
+      .def_prop_ro("stable_time_step", &Simulation::stable_time_step)
+      .def_prop_ro("contact_stable_time_step",
+                   [](const Simulation& self) { return self.contact().stable_time_step(self.model()); })
+      .def(
+          "set_peridem_damping",
+          [](Simulation& self, Indices centers, Scalars radii, Indices walls, Scalars betan, Scalars kappa,
+             Scalars contact_radius) {
+            const std::size_t particles = centers.shape(0);
+            const std::size_t pairs = betan.shape(0);
+            if (radii.shape(0) != particles || walls.shape(0) != particles || kappa.shape(0) != pairs ||
+                contact_radius.shape(0) != pairs) {
+              throw InputError("set_peridem_damping: arrays of mismatched lengths");
+            }
+            std::vector<contact::PeridemParticle> p(particles);
+            for (std::size_t k = 0; k < particles; ++k) p[k] = {centers(k), radii(k), walls(k) != 0};
+            std::vector<contact::PeridemPair> q(pairs);
+            for (std::size_t k = 0; k < pairs; ++k) q[k] = {betan(k), kappa(k), contact_radius(k)};
+            self.set_peridem_damping(std::move(p), std::move(q));
+          },
+          "centers"_a, "radii"_a, "walls"_a, "betan"_a, "kappa"_a, "contact_radius"_a,
+          "PeriDEM's centre damping (comparisons only): per particle its centre node, radius and wall "
+          "flag; per material pair (row-major) betan, kappa and Rc")
+      .def_prop_rw(
+          "time", [](const Simulation& self) { return self.state().time; },
+          [](Simulation& self, real t) { self.state().time = t; })
+      .def_prop_rw(
+          "step", [](const Simulation& self) { return self.state().step; },
+          [](Simulation& self, std::uint64_t s) { self.state().step = s; })
+      .def("first_wall_penetration",
+           [](const Simulation& self) {
+             return self.contact().first_wall_penetration(self.model(), self.state());
+           })
+      .def(
+          "first_overlap",
+          [](const Simulation& self, real fraction) {
+            return self.contact().first_overlap(self.model(), self.state(), fraction);
+          },
+          "fraction"_a)
+      .def("checkpoint", &checkpoint_dict,
+           "Everything a run needs to continue bit for bit: a dict of arrays (copies) and numbers.")
+      .def("restore", &restore_dict, "data"_a, "Continue from a dict made by checkpoint().")
+      .def("set_body_acceleration", &Simulation::set_body_acceleration, "acceleration"_a)
+      .def_prop_rw("viscous_damping", &Simulation::viscous_damping, &Simulation::set_viscous_damping);
+}
+
+// Prescribed motion, nodal forces, contact laws, walls, the neighbour skin.
+void bind_loading(nb::class_<Simulation>& cls) {
+  cls.def(
+         "add_displacement",
+         [](Simulation& self, Indices nodes, unsigned components, std::array<real, 3> direction,
+            TimeFunction::Kind kind, real a, real b) {
+           PrescribedMotion motion;
+           motion.nodes = to_vector(nodes);
+           motion.components = static_cast<std::uint8_t>(components & 0b111u);
+           motion.direction = direction;
+           motion.function = make_function(kind, a, b);
+           self.add_prescribed_motion(std::move(motion));
+         },
+         "nodes"_a, "components"_a, "direction"_a, "kind"_a, "a"_a, "b"_a)
+      .def(
+          "add_rotation",
+          [](Simulation& self, Indices nodes, std::array<real, 3> center, std::array<real, 3> axis,
+             TimeFunction::Kind kind, real a, real b) {
+            PrescribedMotion motion;
+            motion.kind = PrescribedMotion::Kind::rotation;
+            motion.nodes = to_vector(nodes);
+            motion.center = center;
+            motion.axis = axis;
+            motion.function = make_function(kind, a, b);
+            self.add_prescribed_motion(std::move(motion));
+          },
+          "nodes"_a, "center"_a, "axis"_a, "kind"_a, "a"_a, "b"_a)
+      .def(
+          "add_nodal_force",
+          [](Simulation& self, Indices nodes, std::array<real, 3> vector, TimeFunction::Kind kind, real a,
+             real b) {
+            NodalForce force;
+            force.nodes = to_vector(nodes);
+            force.vector = vector;
+            force.function = make_function(kind, a, b);
+            self.add_nodal_force(std::move(force));
+          },
+          "nodes"_a, "vector"_a, "kind"_a, "a"_a, "b"_a)
+      .def(
+          "set_contact_law",
+          [](Simulation& self, index_t a, index_t b, const contact::Law& law) {
+            self.contact().set_law(a, b, law);
+          },
+          "material_a"_a, "material_b"_a, "law"_a)
+      .def(
+          "add_wall",
+          [](Simulation& self, Wall wall) {
+            return self.contact().add_wall(std::move(wall), self.model().dimension());
+          },
+          "wall"_a)
+      .def(
+          "set_wall_law",
+          [](Simulation& self, index_t wall, index_t material, const contact::Law& law) {
+            self.contact().set_wall_law(wall, material, law);
+          },
+          "wall"_a, "material"_a, "law"_a)
+      .def("set_contact_skin", [](Simulation& self, real skin) { self.contact().set_skin(skin); }, "skin"_a);
+}
+
+// Wall reactions, the contact network, energies, damage, fragments, timings.
+void bind_results(nb::class_<Simulation>& cls) {
+  cls.def("wall_reactions", [](const Simulation& self) { return self.contact().wall_reactions(); })
+      .def(
+          "contact_network",
+          [](const Simulation& self) {
+            const ContactNetwork net = self.contact().network(self.model(), self.state());
+            nb::dict d;
+            d["particle_a"] = copy_out(net.particle_a);
+            d["node_a"] = copy_out(net.node_a);
+            d["particle_b"] = copy_out(net.particle_b);
+            d["node_b"] = copy_out(net.node_b);
+            d["wall"] = copy_out(net.wall);
+            d["point"] = copy_out(net.point);
+            d["normal"] = copy_out(net.normal);
+            d["force"] = copy_out(net.force);
+            return d;
+          },
+          "The contacts of the last force evaluation (ContactNetwork): a dict of flat arrays (copies).")
+      .def(
+          "bond_force_densities",
+          [](const Simulation& self) { return copy_out(self.bond_force_densities()); },
+          "The bonds' force densities alone at the current state [N/m^3], flat (nodes x 3).")
+      .def_prop_ro("walls", [](const Simulation& self) { return self.contact().walls(); })
+      .def_prop_ro("contact_statistics", [](const Simulation& self) { return self.contact().statistics(); })
+      .def("run", &Simulation::run, "steps"_a, nb::call_guard<nb::gil_scoped_release>())
+      .def("compute_forces", &Simulation::compute_forces, nb::call_guard<nb::gil_scoped_release>())
+      .def("kinetic_energy", &Simulation::kinetic_energy)
+      .def("strain_energy", &Simulation::strain_energy)
+      .def("contact_energy", &Simulation::contact_energy)
+      .def("broken_bonds", &Simulation::broken_bonds)
+      .def("strain_energy_density",
+           [](const Simulation& self) {
+             std::vector<real> density(self.model().node_count());
+             self.strain_energy_density(density.data());
+             return copy_out(density);
+           })
+      .def("damage",
+           [](const Simulation& self) {
+             std::vector<real> phi(self.model().node_count()), z(self.model().node_count());
+             self.damage(phi.data(), z.data());
+             return nb::make_tuple(copy_out(phi), copy_out(z));
+           })
+      .def("fixity", [](const Simulation& self) { return copy_out(self.fixity()); })
+      .def("fragments",
+           [](const Simulation& self) {
+             std::vector<index_t> labels(self.model().node_count());
+             self.fragments(labels.data());
+             return copy_out(labels);
+           })
+      .def_prop_ro("phase_times", &Simulation::phase_times)
+      .def("memory_bytes", &Simulation::memory_bytes);
+}
+
+// The state as zero-copy views, and bonds broken by hand.
+void bind_state(nb::class_<Simulation>& cls) {
+  cls.def_prop_ro("positions",
+                  [](Simulation& self) {
+                    return view(self.state().positions.data(), self.model().node_count(), 3, nb::find(self));
+                  })
+      .def_prop_ro("velocities",
+                   [](Simulation& self) {
+                     return view(self.state().velocities.data(), self.model().node_count(), 3,
+                                 nb::find(self));
+                   })
+      .def_prop_ro("forces",
+                   [](Simulation& self) {
+                     return view(self.state().forces.data(), self.model().node_count(), 3, nb::find(self));
+                   })
+      .def_prop_ro("dilatation",
+                   [](Simulation& self) {
+                     return view(self.state().dilatation.data(), self.model().node_count(), 0,
+                                 nb::find(self));
+                   })
+      .def_prop_ro("bond_intact",
+                   [](Simulation& self) {  // a read-only copy, 1 byte per bond (stored as bits)
+                     nb::object array =
+                         nb::cast(copy_out(self.state().bonds.unpacked(self.model().bond_offsets())),
+                                  nb::rv_policy::move);
+                     array.attr("setflags")("write"_a = false);
+                     return array;
+                   })
+      .def(
+          "break_bonds",
+          [](Simulation& self, nb::ndarray<const std::uint32_t, nb::shape<-1, 2>, nb::c_contig> pairs) {
+            std::vector<std::array<index_t, 2>> list(pairs.shape(0));
+            for (std::size_t k = 0; k < list.size(); ++k) list[k] = {pairs(k, 0), pairs(k, 1)};
+            self.break_bonds(list);
+          },
+          "pairs"_a);
+}
+
+}  // namespace
+
+void bind_simulation(nb::module_& m) {
+  nb::class_<PhaseTimes>(m, "PhaseTimes")
+      .def_ro("peridynamics", &PhaseTimes::peridynamics)
+      .def_ro("contact", &PhaseTimes::contact)
+      .def_ro("contact_search", &PhaseTimes::contact_search)
+      .def_ro("integration", &PhaseTimes::integration)
+      .def_ro("loading", &PhaseTimes::loading);
+
+  nb::class_<Simulation> simulation(m, "Simulation");
+  bind_run_setup(simulation);
+  bind_loading(simulation);
+  bind_results(simulation);
+  bind_state(simulation);
+}
+
+}  // namespace granulate::bindings
