@@ -874,18 +874,40 @@ class Simulation:
 
     # ------------------------------------------------------------------ the core
     def _build(self) -> _core.Simulation:
+        """The core simulation, made on first use: the model (materials, shapes, particles,
+        bonds), contact laws and damping, the time step, loads, initial velocities, precracks."""
         if self._core is not None:
             return self._core
         if not self.bodies:
             raise InputError("the simulation has no body; add one with add_body")
+        model, core_materials = self._build_model()
+        core = _core.Simulation(model)
+        self._set_contact_laws(core, core_materials)
+        self._set_peridem_damping(core, core_materials)
+        self._core_materials = core_materials
+        self._check_start(model, core)
+        self._set_time_step(core)
+        core.set_body_acceleration(tuple(self._gravity))
+        core.viscous_damping = self._viscous_damping
+        self._apply_loads(core)
+        self._set_initial_velocities(model, core)
+        self._model = model
+        self._core = core
+        self._reference = model.reference_positions
+        for crack in self._precracks:
+            self._break_crossing_bonds(*crack)
+        return core
+
+    def _build_model(self) -> tuple[_core.Model, list[Material]]:
+        """The finalized core model and its materials, in core order. One core material per
+        Material; each particle carries its own horizon (absolute, or horizon_factor times its
+        mesh size), so particles of any size share one material."""
         model = _core.Model(self.dimension, getattr(_core.PlaneMode, self.plane))
         # Lattices' and conforming discretisations' outer layers carry surface points only for
         # the surface law (the node-sphere law sees those nodes at themselves: no anchors).
         outer_layers = self._uses_surface_law()
         copy_of = self._translated_copies(outer_layers)
         self._require_memory_for_model(copy_of)
-        # One core material per Material; each particle carries its own horizon (absolute, or
-        # horizon_factor times its mesh size), so particles of any size share one material.
         material_ids: dict[int, int] = {}
         core_materials: list[Material] = []
         shape_ids: dict[int, int] = {}
@@ -920,24 +942,24 @@ class Simulation:
                 shape_ids[id(reference)], material_ids[key], positions, body.scale, horizon
             )
         model.finalize()
-        core = _core.Simulation(model)
-        self._set_contact_laws(core, core_materials)
-        self._set_peridem_damping(core, core_materials)
-        self._core_materials = core_materials
-        self._check_start(model, core)
+        return model, core_materials
+
+    def _set_time_step(self, core: _core.Simulation) -> None:
+        """dt as given (warned above the stable estimate), or dt_safety times that estimate."""
         if self._dt is None:
             core.time_step = self._dt_safety * core.stable_time_step
-        else:
-            if self._dt > core.stable_time_step:
-                warnings.warn(
-                    f"time step {self._dt:.4g} s exceeds the stable estimate "
-                    f"{core.stable_time_step:.4g} s; the run may become unstable",
-                    GranulateWarning,
-                    stacklevel=3,
-                )
-            core.time_step = self._dt
-        core.set_body_acceleration(tuple(self._gravity))
-        core.viscous_damping = self._viscous_damping
+            return
+        if self._dt > core.stable_time_step:
+            warnings.warn(
+                f"time step {self._dt:.4g} s exceeds the stable estimate "
+                f"{core.stable_time_step:.4g} s; the run may become unstable",
+                GranulateWarning,
+                stacklevel=4,
+            )
+        core.time_step = self._dt
+
+    def _apply_loads(self, core: _core.Simulation) -> None:
+        """The prescribed displacements and rotations and the force densities, in order."""
         for kind, args in self._loads:
             if kind == "displacement":
                 nodes, mask, direction, function = args
@@ -948,6 +970,9 @@ class Simulation:
             else:
                 nodes, vector, function = args
                 core.add_nodal_force(nodes, tuple(vector), *function.core())
+
+    def _set_initial_velocities(self, model: _core.Model, core: _core.Simulation) -> None:
+        """Each body's initial velocity: v + omega x (X - its centroid)."""
         velocities = core.velocities
         X = model.reference_positions
         volumes = model.volumes
@@ -957,12 +982,6 @@ class Simulation:
             arm = X[sl] - centroid
             omega = np.array([0.0, 0.0, spin]) if np.isscalar(spin) else np.asarray(spin)
             velocities[sl] = linear + np.cross(omega, arm)
-        self._model = model
-        self._core = core
-        self._reference = model.reference_positions
-        for crack in self._precracks:
-            self._break_crossing_bonds(*crack)
-        return core
 
     def _check_start(self, model: _core.Model, core: _core.Simulation) -> None:
         """Refuse particles that start outside their container (inside an obstacle) or
