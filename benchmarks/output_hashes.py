@@ -77,25 +77,32 @@ def folder_digests(folder: Path) -> dict[str, str]:
     }
 
 
-def run_case(name: str, threads: int, work: Path) -> dict[str, str]:
-    case, steps, extra = CASE_RUNS[name]
-    out = work / f"{name}_{threads}"
-    command = [sys.executable, "-m", "granulate", "run", str(case), "--out", str(out)]
-    command += ["--steps", str(steps), "--quiet", "--overwrite", *extra]
+def _granulate_run(name: str, out: Path, threads: int, work: Path, *arguments: str) -> None:
+    """`granulate run` of case `name` into `out` with OMP_NUM_THREADS = threads."""
+    case, _steps, extra = CASE_RUNS[name]
+    command = [sys.executable, "-m", "granulate", "run", str(case), "--out", str(out), "--quiet"]
     environment = {**os.environ, "OMP_NUM_THREADS": str(threads)}
-    subprocess.run(command, check=True, env=environment, cwd=work, stdout=subprocess.DEVNULL)
+    subprocess.run(
+        [*command, *arguments, *extra],
+        check=True,
+        env=environment,
+        cwd=work,
+        stdout=subprocess.DEVNULL,
+    )
+
+
+def run_case(name: str, threads: int, work: Path) -> dict[str, str]:
+    out = work / f"{name}_{threads}"
+    _granulate_run(name, out, threads, work, "--steps", str(CASE_RUNS[name][1]), "--overwrite")
     return folder_digests(out)
 
 
 def run_resumed(name: str, threads: int, work: Path) -> dict[str, str]:
     """The case run to half its steps, then resumed from its checkpoint to the end."""
-    case, steps, extra = CASE_RUNS[name]
+    steps = CASE_RUNS[name][1]
     out = work / f"{name}_resumed_{threads}"
-    environment = {**os.environ, "OMP_NUM_THREADS": str(threads)}
-    base = [sys.executable, "-m", "granulate", "run", str(case), "--out", str(out), "--quiet"]
-    for more in (["--overwrite", "--steps", str(steps // 2)], ["--resume", "--steps", str(steps)]):
-        command = [*base, *more, *extra]
-        subprocess.run(command, check=True, env=environment, cwd=work, stdout=subprocess.DEVNULL)
+    _granulate_run(name, out, threads, work, "--steps", str(steps // 2), "--overwrite")
+    _granulate_run(name, out, threads, work, "--steps", str(steps), "--resume")
     return folder_digests(out)
 
 

@@ -35,8 +35,6 @@ def registries(monkeypatch: pytest.MonkeyPatch) -> None:
     """The registries as shipped, restored after the test."""
     monkeypatch.setattr(writers.registry, "FRAME_WRITERS", list(writers.FRAME_WRITERS))
     monkeypatch.setattr(writers.registry, "HISTORY_SECTIONS", list(writers.HISTORY_SECTIONS))
-    monkeypatch.setattr(writers.outputs, "FRAME_WRITERS", writers.registry.FRAME_WRITERS)
-    monkeypatch.setattr(writers.outputs, "HISTORY_SECTIONS", writers.registry.HISTORY_SECTIONS)
 
 
 def falling_disc(out: Path) -> gr.Simulation:

@@ -161,13 +161,14 @@ class _Chunks:
         self, sim: Simulation, plan: RunPlan, tuner: threads.ThreadTuner | None, start: float
     ) -> None:
         self.sim, self.plan, self.tuner, self.start = sim, plan, tuner, start
+        self.core = sim.core
         self.limit = 10  # steps: the first chunk measures the rate
         self.rate = 0.0
 
     def run(self, target: int) -> str | None:
         """One chunk, then its outputs, stop check and checkpoint; a stop criterion's reason."""
-        sim, plan, tuner = self.sim, self.plan, self.tuner
-        core, out = sim.core, sim._output
+        sim, plan, tuner, core = self.sim, self.plan, self.tuner, self.core
+        out = sim._output
         chunk = chunk_end(sim, plan, target, self.limit)
         if tuner is not None:
             count = tuner.threads()
@@ -191,7 +192,7 @@ class _Chunks:
         return reason
 
     def progress(self, target: int) -> Progress:
-        core = self.sim.core
+        core = self.core
         return Progress(
             int(core.step),
             int(target),

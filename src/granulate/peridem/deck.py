@@ -51,10 +51,6 @@ class Deck:
     # Particle_Generation
     particles: list[dict[str, Any]] = field(default_factory=list)
     zone_of: list[int] = field(default_factory=list)  #: each particle p<i>'s zone
-    deck_bodies: dict[int, dict[str, Any]] = field(default_factory=dict)
-    #: Every zone has its particles (a zone whose mesh failed has none, so later ids do not
-    #: resolve: consequences of a reported problem, not problems of their own).
-    numbered: bool = True
     # Contact
     pairs: list[dict[str, Any]] = field(default_factory=list)
     peridem_pairs: list[dict[str, Any]] = field(default_factory=list)
@@ -78,6 +74,18 @@ class Deck:
     def block(self, key: str, where: str = "deck", parent: dict[str, Any] | None = None):
         """The block `key` of `parent` (the deck's top level by default)."""
         return self.problems.block(self.data if parent is None else parent, key, where)
+
+    @property
+    def deck_bodies(self) -> dict[int, dict[str, Any]]:
+        """The bodies of PeriDEM's built-in meshes by zone (the entries of `bodies`)."""
+        return {b["zone"]: b["body"] for b in self.bodies}
+
+    @property
+    def numbered(self) -> bool:
+        """Every zone has its particles (a zone whose mesh failed has none, so later ids do
+        not resolve: consequences of a reported problem, not problems of their own)."""
+        bodies = self.deck_bodies
+        return all(f"zone_{z}" in self.grains or z in bodies for z in self.zones)
 
     @property
     def named(self) -> set[str]:

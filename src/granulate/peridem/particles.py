@@ -17,10 +17,8 @@ def translate_particles(d: Deck) -> None:
     d.problems.unknown("Particle_Generation", generation, {"From_File", "File_Data_Type"})
     placed_zones = [z for z in d.zones if z not in d.geometry_particle]
     rows, rotations = _read_rows(d, generation, placed_zones) if placed_zones else (None, None)
-    d.deck_bodies = {b["zone"]: b["body"] for b in d.bodies}
     for z in d.zones:
         _zone_particles(d, z, rows, rotations)
-    d.numbered = all(f"zone_{z}" in d.grains or z in d.deck_bodies for z in d.zones)
     if rows is not None:
         unknown = sorted({int(v) + 1 for v in rows[:, 0]} - set(placed_zones))
         if unknown:
@@ -73,8 +71,9 @@ def _zone_particles(d: Deck, z: int, rows: np.ndarray | None, rotations: Any) ->
     """Zone z's particles, named p<i> in turn: its built body, its one particle placed as
     meshed, or its rows of the CSV."""
     name = f"zone_{z}"
-    if z in d.deck_bodies:
-        d.deck_bodies[z]["name"] = f"p{len(d.zone_of)}"
+    bodies = d.deck_bodies
+    if z in bodies:
+        bodies[z]["name"] = f"p{len(d.zone_of)}"
         d.zone_of.append(z)
         return
     if name not in d.grains:

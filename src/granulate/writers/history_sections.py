@@ -104,7 +104,11 @@ class TrackedBodies:
             return row
         sim = data.simulation
         model = sim.model
-        forces, displacement = sim.core.forces, sim.displacements
+        forces, positions, reference = (
+            sim.core.forces,
+            sim.core.positions,
+            model.reference_positions,
+        )
         volumes, density, gravity = model.volumes, model.node_density, sim.gravity
         axes = "xyz"[: sim.dimension]
         for body in outputs.tracked:
@@ -112,7 +116,7 @@ class TrackedBodies:
             v = volumes[nodes]
             weight = reductions.dot(v, density[nodes]) * gravity
             resultant = reductions.weighted_sum(v, forces[nodes]) - weight
-            mean = displacement[nodes].mean(axis=0)
+            mean = (positions[nodes] - reference[nodes]).mean(axis=0)
             for k, axis in enumerate(axes):
                 row[f"{body.name}_f{axis}"] = float(resultant[k])
             for k, axis in enumerate(axes):

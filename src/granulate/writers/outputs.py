@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING
 
 from granulate.io import HistoryWriter, PvdSeries, atomic_write
 from granulate.io.run_folder import RunFolder
-from granulate.writers.registry import FRAME_WRITERS, HISTORY_SECTIONS
+from granulate.writers import registry
 from granulate.writers.step_data import StepData
 
 if TYPE_CHECKING:
@@ -65,14 +65,14 @@ class Outputs:
             return
         data = StepData.of(sim)
         if frame:
-            for writer in FRAME_WRITERS:
+            for writer in registry.FRAME_WRITERS:
                 writer.write(data, self)
             self.frames += 1
             self.frame_step = int(sim.core.step)
             self.write_run_record(sim)
         if history:
             row: dict[str, float | int] = {}
-            for section in HISTORY_SECTIONS:
+            for section in registry.HISTORY_SECTIONS:
                 row.update(section.columns(data, self))
             if self.history is None:
                 self.history = HistoryWriter(self.directory / "history.csv", list(row))
