@@ -11,6 +11,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+import numpy as np
+
 from granulate import resources
 from granulate._version import __version__
 from granulate.errors import InputError
@@ -31,6 +33,29 @@ class CheckpointPlan:
     every_steps: int | None
     every_seconds: float | None
     last_wall_time: float = 0.0
+
+    @classmethod
+    def create(
+        cls,
+        steps: int | None,
+        minutes: float | None,
+        path: str | Path | None,
+        output_directory: Path | None,
+    ) -> CheckpointPlan:
+        """The plan Simulation.checkpoint_every asks for, checked (InputError): `path`, or
+        checkpoint.npz in the output directory."""
+        if steps is not None and not (isinstance(steps, int) and steps > 0):
+            raise InputError(f"checkpoint interval must be a positive number of steps, got {steps}")
+        if minutes is not None and not (np.isfinite(minutes) and minutes > 0):
+            raise InputError(
+                f"checkpoint interval must be a positive number of minutes, got {minutes}"
+            )
+        if path is None:
+            if output_directory is None:
+                raise InputError("give a checkpoint path, or set output(...) first")
+            path = output_directory / "checkpoint.npz"
+        seconds = None if minutes is None else 60.0 * minutes
+        return cls(Path(path), steps, seconds, wallclock.perf_counter())
 
     def steps_to_next(self, step: int) -> int | None:
         """Steps from `step` to the next checkpoint by step count (None: by time only)."""
@@ -102,7 +127,7 @@ def load(sim: Simulation, path: str | Path) -> None:
             "time step or case file); run without --resume, or restore the original case"
         )
     core.restore(state)
-    sim._labels = None  # fragments of the restored bonds
+    sim.analysis.forget_fragments()  # the labels of the bonds before the restore
     out = sim._output
     saved = header.get("output")
     if out is None:

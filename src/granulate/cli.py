@@ -137,7 +137,7 @@ def _check(path: Path, compat: bool = False) -> int:
     )
     for packing in sim.packings:
         print(f"  packing: {packing.summary()}")
-    print(f"  walls: {', '.join(name for name, _ in sim._walls) or 'none'}")
+    print(f"  walls: {', '.join(name for name, _ in sim.walls) or 'none'}")
     print(f"  dt {sim.dt:.4g} s (stable estimate {sim.stable_dt:.4g} s); {steps} steps to the end")
     print(
         f"  estimated memory {memory / 1e6:.1f} MB; estimated time {duration(steps / rate)} "

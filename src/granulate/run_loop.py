@@ -11,7 +11,11 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
+import numpy as np
+
 from granulate import _core, threads
+from granulate.errors import InputError
+from granulate.input_errors import check_number
 from granulate.stopping import StopCriterion
 
 if TYPE_CHECKING:
@@ -73,6 +77,28 @@ class SignalCatcher:
     def __exit__(self, *exc: object) -> None:
         for number, handler in self._previous.items():
             signal.signal(number, handler)  # type: ignore[arg-type]
+
+
+def steps_to_run(
+    core: _core.Simulation, steps: int | None, until: float | None, check_every: int
+) -> int:
+    """The number of steps a run(steps, until=...) takes from the core's time: ceil((until -
+    t) / dt) for a time; InputError for bad arguments."""
+    if (steps is None) == (until is None):
+        raise InputError("give either steps or until")
+    if steps is not None:
+        check_number("run: steps", steps, integer=True)
+    if until is not None:
+        check_number("run: until", until)
+        if not np.isfinite(until):
+            raise InputError(f"until must be a finite time, got {until}")
+        steps = max(0, int(np.ceil((until - core.time) / core.time_step - 1e-9)))
+    assert steps is not None
+    if steps < 0:
+        raise InputError(f"steps must be non-negative, got {steps}")
+    if not (isinstance(check_every, int) and check_every > 0):
+        raise InputError(f"check_every must be a positive number of steps, got {check_every}")
+    return int(steps)
 
 
 def run_in_folder(sim: Simulation, plan: RunPlan) -> str | None:

@@ -4,17 +4,23 @@ what the frames and rows hold (the registered writers, registry.py)."""
 from __future__ import annotations
 
 import json
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+import numpy as np
+
+from granulate.errors import InputError
 from granulate.io import HistoryWriter, PvdSeries, atomic_write
 from granulate.io.run_folder import RunFolder
 from granulate.writers import registry
 from granulate.writers.step_data import StepData
+from granulate.writers.vtu_frame import FIELDS
 
 if TYPE_CHECKING:
-    from granulate.simulation import Body, Simulation
+    from granulate.assembly import Body
+    from granulate.simulation import Simulation
 
 
 @dataclass
@@ -34,6 +40,43 @@ class Outputs:
     frames: int = 0
     frame_step: int = -1  # the step of the last frame written (-1: none in this process)
     history_step: int = -1  # likewise for the last history row
+
+    @classmethod
+    def plan(
+        cls,
+        directory: Path,
+        every: int,
+        history_every: int | None,
+        fields: Sequence[str],
+        tracked: tuple[Body, ...],
+        track_areas: Mapping[str, float],
+        wall_names: Sequence[str],
+        *,
+        overwrite: bool,
+        resume: bool,
+    ) -> Outputs:
+        """The outputs Simulation.output asks for, checked (InputError), in their folder
+        (RunFolder: a run already there is refused unless `overwrite` or `resume`)."""
+        if not (isinstance(every, int) and every > 0):
+            raise InputError(f"output interval must be a positive number of steps, got {every!r}")
+        history_every = every if history_every is None else history_every
+        if not (isinstance(history_every, int) and history_every > 0):
+            raise InputError(
+                f"history interval must be a positive number of steps, got {history_every!r}"
+            )
+        clashing = sorted({b.name for b in tracked} & set(wall_names))
+        if clashing:
+            raise InputError(
+                f"tracked bodies {clashing} are named like walls: their history.csv columns "
+                "(<name>_fx, ...) would overwrite each other; rename them"
+            )
+        areas = _track_areas(track_areas, tracked)
+        unknown = [f for f in fields if f not in FIELDS]
+        if unknown:
+            raise InputError(f"unknown output fields {unknown}; choose from {', '.join(FIELDS)}")
+        folder = RunFolder(directory, overwrite=overwrite, resume=resume)
+        pvd = PvdSeries(directory / "simulation.pvd")
+        return cls(directory, every, tuple(fields), pvd, history_every, folder, tracked, areas)
 
     def is_output_step(self, step: int) -> bool:
         """Whether `step` writes a frame or a history row."""
@@ -91,3 +134,27 @@ class Outputs:
     def write_run_record(self, sim: Simulation) -> None:
         """run.json: the counts, time step, status and timings of the run so far."""
         atomic_write(self.directory / "run.json", json.dumps(sim.summary(), indent=2).encode())
+
+
+def _track_areas(areas: Mapping[str, float], tracked: tuple[Body, ...]) -> dict[str, float]:
+    """Simulation.output's track_areas, checked: tracked bodies' names, positive areas."""
+    names = {b.name for b in tracked}
+    if not isinstance(areas, Mapping):
+        raise InputError(f"track_areas must map tracked bodies' names to areas, got {areas!r}")
+    checked = {}
+    for name, area in areas.items():
+        if name not in names:
+            raise InputError(
+                f"track_areas names {name!r}, which is not tracked; track it too "
+                f"(tracked: {sorted(names) or 'none'})"
+            )
+        if (
+            isinstance(area, bool)
+            or not isinstance(area, (int, float))
+            or not (np.isfinite(area) and area > 0)
+        ):
+            raise InputError(
+                f"track_areas[{name!r}] must be a positive area [m^2; m in 2D], got {area!r}"
+            )
+        checked[name] = float(area)
+    return checked

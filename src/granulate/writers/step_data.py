@@ -33,5 +33,5 @@ class StepData:
         phi, z = simulation.core.damage()
         table = simulation.fragment_table()
         contacts = simulation.contact_table()
-        particles, stresses, volumes = simulation._particles(contacts, phi)
+        particles, stresses, volumes = simulation.analysis.particles(contacts, phi)
         return cls(simulation, phi, z, table, contacts, particles, (stresses, volumes))

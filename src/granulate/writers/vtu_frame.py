@@ -11,6 +11,21 @@ if TYPE_CHECKING:
     from granulate.writers.outputs import Outputs
     from granulate.writers.step_data import StepData
 
+#: The point fields a frame can hold (Simulation.output(fields=...)); all by default.
+FIELDS = (
+    "Displacement",
+    "Velocity",
+    "Force_Density",
+    "Force",
+    "Damage",
+    "Damage_Z",
+    "Dilatation",
+    "Particle_ID",
+    "Fragment_ID",
+    "Fixity",
+    "Nodal_Volume",
+)
+
 
 class VtuFrame:
     """The node frame: positions and the fields of ``Simulation.output(fields=...)``."""
@@ -28,7 +43,7 @@ class VtuFrame:
             "Damage_Z": lambda: data.damage_z,
             "Dilatation": lambda: core.dilatation,
             "Particle_ID": lambda: model.node_particle,
-            "Fragment_ID": sim._fragment_labels,
+            "Fragment_ID": sim.analysis.fragment_labels,
             "Fixity": lambda: core.fixity(),
             "Nodal_Volume": lambda: volumes,
         }

@@ -1,0 +1,136 @@
+"""Measures of a built simulation's current state: fragments (pieces held together by intact
+bonds) and their table, particles broken, the particle table (motion, damage, coordination,
+Love-Weber stress), the contact network and particle stresses, and the gravity energy. Each
+reads the core's live state when called; the fragment labels are kept for one step and bond
+count. The formulas are in granulate.fragments, granulate.particle_table and
+granulate.network."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Literal
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from granulate import _core, fragments, network, particle_table, reductions
+from granulate.assembly import Body
+from granulate.errors import InputError
+
+
+class Analysis:
+    """The measures of one core simulation with `particles` particles (Simulation.analysis)."""
+
+    def __init__(self, core: _core.Simulation, model: _core.Model, particles: int) -> None:
+        self._core, self._model = core, model
+        self._dimension, self._particles = model.dimension, particles
+        self._labels: tuple[tuple[int, int], NDArray[np.uint32]] | None = None
+
+    def fragment_labels(self) -> NDArray[np.uint32]:
+        """Each node's piece: its smallest node (computed once per step and bond count)."""
+        core = self._core
+        key = (int(core.step), int(core.broken_bonds()))
+        if self._labels is None or self._labels[0] != key:
+            self._labels = (key, core.fragments())
+        return self._labels[1]
+
+    def forget_fragments(self) -> None:
+        """Drop the kept labels (the bonds were restored from a checkpoint)."""
+        self._labels = None
+
+    def fragments(self, min_nodes: int) -> list[NDArray[np.uint32]]:
+        """Pieces of at least `min_nodes` nodes, largest first, as node indices."""
+        labels = self.fragment_labels()
+        order = np.argsort(labels, kind="stable")
+        _roots, starts, counts = np.unique(labels[order], return_index=True, return_counts=True)
+        pieces = [
+            order[s : s + c].astype(np.uint32)
+            for s, c in zip(starts, counts, strict=True)
+            if c >= min_nodes
+        ]
+        return sorted(pieces, key=lambda piece: (-len(piece), int(piece[0])))
+
+    def fragment_table(self) -> fragments.Table:
+        """One row per fragment, debris included (granulate.fragments.fragment_table)."""
+        core, model = self._core, self._model
+        return fragments.fragment_table(
+            self.fragment_labels(),
+            model.node_particle,
+            core.positions,
+            core.velocities,
+            model.volumes,
+            model.node_density,
+            self._dimension,
+        )
+
+    def fully_broken_particles(self, bodies: Sequence[Body]) -> int:
+        """Bodies with at least one bond and none intact."""
+        intact = np.asarray(self._core.bond_intact)
+        offsets = np.asarray(self._model.bond_offsets)
+        count = 0
+        for body in bodies:
+            begin, end = offsets[body.first_node], offsets[body.first_node + body.node_count]
+            if end > begin and not intact[begin:end].any():
+                count += 1
+        return count
+
+    def gravity_energy(self, gravity: NDArray[np.float64]) -> float:
+        """-sum m_i g . x_i [J; J/m in 2D], zero at the origin."""
+        model = self._model
+        mass = np.asarray(model.node_density) * np.asarray(model.volumes)
+        moment = reductions.weighted_sum(mass, self._core.positions)  # sum_i m_i x_i
+        return -reductions.dot(moment, gravity)
+
+    def contact_table(self) -> network.Table:
+        """One row per contact of the last force evaluation (granulate.network)."""
+        return network.contact_table(self._core.contact_network())
+
+    def particles(
+        self, contacts: network.Table, damage: ArrayLike | None
+    ) -> tuple[particle_table.Table, NDArray, NDArray]:
+        """The particle table, the particles' Love-Weber stresses (N, D, D) [Pa] and their
+        volumes [m^3; m^2 in 2D]: what a frame's table and a history row both need. `damage`:
+        phi per node (the core's, when None)."""
+        core, count = self._core, self._particles
+        owner, volumes, table = self._motion()
+        phi = core.damage()[0] if damage is None else np.asarray(damage)
+        particle_volume = np.bincount(owner, volumes, count)
+        table["particle"] = np.arange(count)
+        table["time"] = np.full(count, float(core.time))
+        table["damage"] = np.bincount(owner, volumes * phi, count) / particle_volume
+        table["coordination"] = network.coordination(contacts, count)
+        centres = np.column_stack([table[axis] for axis in "xyz"])
+        stresses = network.love_weber_stresses(contacts, centres, particle_volume, self._dimension)
+        particle_table.add_stresses(table, stresses, self._dimension)
+        return table, stresses, particle_volume
+
+    def _motion(self) -> tuple[NDArray, NDArray, particle_table.Table]:
+        """Each node's particle, each node's volume, and the particles' motion columns
+        (granulate.particle_table.motion)."""
+        model, core = self._model, self._core
+        owner, volumes = np.asarray(model.node_particle), np.asarray(model.volumes)
+        mass = np.asarray(model.node_density) * volumes
+        motion = particle_table.motion(
+            owner, mass, core.positions, core.velocities, self._particles
+        )
+        return owner, volumes, motion
+
+    def particle_stresses(
+        self, method: Literal["contacts", "bonds"], contacts: network.Table | None
+    ) -> NDArray:
+        """Each particle's mean stress (particles, D, D) [Pa; tension positive], Love-Weber
+        from its contacts or from its bond forces (granulate.network)."""
+        core, count = self._core, self._particles
+        owner, volumes, table = self._motion()
+        centres = np.column_stack([table[axis] for axis in "xyz"])
+        if method == "contacts":
+            network_table = self.contact_table() if contacts is None else contacts
+            return network.love_weber_stresses(
+                network_table, centres, np.bincount(owner, volumes, count), self._dimension
+            )
+        if method == "bonds":
+            bonds = np.asarray(core.bond_force_densities()).reshape(-1, 3)
+            return network.internal_stresses(
+                bonds, core.positions, volumes, owner, centres, self._dimension
+            )
+        raise InputError(f"particle_stresses: method must be 'contacts' or 'bonds', got {method!r}")

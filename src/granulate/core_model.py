@@ -1,0 +1,178 @@
+"""An Assembly turned into the core's frozen Model: one core material per Material, one core
+shape per reference shape (and per body not a translated copy of an earlier one), each
+particle placed with its own horizon; the memory check before any bond is built; and
+pre-cracks, bonds broken across a plane once the bonds exist."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+import numpy as np
+from numpy.typing import NDArray
+
+from granulate import _core, resources
+from granulate.assembly import Assembly, Body
+from granulate.errors import InputError
+from granulate.materials import Material
+from granulate.shape_sharing import TranslatedShapes
+from granulate.shapes import ReferenceShape, Shape
+
+#: The most horizon / mesh size accepted: peridynamic horizons are 3-4 mesh sizes; at 20 a node
+#: has about 1,300 bonds in 2D and 34,000 in 3D.
+MOST_HORIZON_FACTOR = 20.0
+
+
+def build_model(
+    assembly: Assembly, plane: str, outer_layers: bool
+) -> tuple[_core.Model, list[Material]]:
+    """The finalized core model and its materials, in core order. Each particle carries its own
+    horizon (absolute, or horizon_factor times its mesh size), so particles of any size share
+    one material. With `outer_layers` (the surface law), lattices' and conforming
+    discretisations' outer layers carry surface points (the node-sphere law sees those nodes at
+    themselves: no anchors)."""
+    model = _core.Model(assembly.dimension, getattr(_core.PlaneMode, plane))
+    copy_of = _translated_copies(assembly, outer_layers)
+    _require_memory_for_model(assembly, plane, copy_of)
+    material_ids: dict[int, int] = {}
+    core_materials: list[Material] = []
+    shape_ids: dict[int, int] = {}
+    shape_of_body: dict[int, int] = {}  # bodies without a reference shape
+    for body, positions, volumes, surface in zip(
+        assembly.bodies, assembly.positions, assembly.volumes, assembly.surfaces, strict=True
+    ):
+        horizon = body.material.resolved_horizon(body.mesh_size)
+        key = id(body.material)
+        if key not in material_ids:
+            material_ids[key] = model.add_material(body.material.core_params(body.mesh_size))
+            core_materials.append(body.material)
+        if body.reference is None:
+            original = copy_of.get(body.index)
+            if original is None:
+                surface_arrays = _surface_arrays(surface, outer_layers)
+                shape = model.add_shape(positions, volumes, body.mesh_size, *surface_arrays)
+            else:
+                shape = shape_of_body[original]
+            shape_of_body[body.index] = shape
+            model.place_shape(shape, material_ids[key], positions, 1.0, horizon)
+            continue
+        reference = body.reference
+        if id(reference) not in shape_ids:
+            shape_ids[id(reference)] = model.add_shape(
+                reference.positions,
+                reference.volumes,
+                reference.mesh_size,
+                *_surface_arrays(reference, outer_layers),
+            )
+        model.place_shape(
+            shape_ids[id(reference)], material_ids[key], positions, body.scale, horizon
+        )
+    model.finalize()
+    return model, core_materials
+
+
+def _translated_copies(assembly: Assembly, outer_layers: bool) -> dict[int, int]:
+    """Bodies without a reference shape that are translated copies of an earlier one
+    (shape_sharing.py): body index -> the earlier body's index. They share its core shape and
+    bond family."""
+    copies, copy_of = TranslatedShapes(), {}
+    for body, positions, volumes, surface in zip(
+        assembly.bodies, assembly.positions, assembly.volumes, assembly.surfaces, strict=True
+    ):
+        if body.reference is not None:
+            continue
+        surface_arrays = _surface_arrays(surface, outer_layers)
+        original = copies.find(positions, volumes, body.mesh_size, surface_arrays)
+        if original is None:
+            copies.remember(body.index, positions, volumes, body.mesh_size, surface_arrays)
+        else:
+            copy_of[body.index] = original
+    return copy_of
+
+
+def _require_memory_for_model(assembly: Assembly, plane: str, copy_of: Mapping[int, int]) -> None:
+    """InputError before the bonds are built when the model would not fit in memory: every
+    node's state, and one bond family per reference shape and horizon ratio (particles placed
+    from one shape share it) or per body not a translated copy of an earlier one
+    (`copy_of`)."""
+    families: dict[tuple[int, float], float] = {}
+    for body in assembly.bodies:
+        ratio = body.material.resolved_horizon(body.mesh_size) / body.mesh_size
+        _check_material_for(body, ratio * body.mesh_size, assembly.dimension, plane)
+        own = -1 - copy_of.get(body.index, body.index)
+        key = (id(body.reference) if body.reference is not None else own, ratio)
+        family = body.node_count * resources.bonds_per_node(assembly.dimension, ratio)
+        families[key] = family
+    nodes, bonds = float(assembly.node_count), float(sum(families.values()))
+    resources.require_memory(
+        resources.simulation_bytes(nodes, bonds),
+        f"the model ({nodes:,.0f} nodes, about {bonds:,.0f} bonds)",
+        "use fewer or coarser particles, or a smaller horizon_factor",
+    )
+
+
+def _check_material_for(body: Body, horizon: float, dimension: int, plane: str) -> None:
+    """InputError for a material a body cannot use as given: a horizon far beyond its mesh
+    size (an absolute horizon in the wrong unit bonds every node to every other), or PMB with a
+    Poisson ratio it cannot have (1/4; 1/3 in plane stress)."""
+    ratio = horizon / body.mesh_size
+    if ratio > MOST_HORIZON_FACTOR:
+        raise InputError(
+            f"body {body.name!r}: the horizon {horizon:.4g} m is {ratio:.0f} times its mesh "
+            f"size {body.mesh_size:.4g} m (at most {MOST_HORIZON_FACTOR:.0f}; usually "
+            "3-4): give horizon_factor, or the horizon in metres"
+        )
+    material = body.material
+    if material.model != "pmb":
+        return
+    K, G = material.elastic_moduli()
+    nu = (3 * K - 2 * G) / (2 * (3 * K + G))
+    allowed = 1 / 3 if (dimension == 2 and plane == "stress") else 0.25
+    if abs(nu - allowed) > 1e-3:
+        raise InputError(
+            f"body {body.name!r}: model 'pmb' has Poisson ratio {allowed:.4g} here, but the "
+            f"material's constants give {nu:.4g}; use model 'lps', or constants with "
+            f"poisson_ratio {allowed:.4g}"
+        )
+
+
+def _surface_arrays(
+    reference: ReferenceShape | None, outer_layers: bool
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """A shape's surface offsets (flat, 3 per node) and depths for the core; empty arrays where
+    it has none (all depths 0: empty too). With ``outer_layers`` (the surface law) a lattice's
+    or conforming discretisation's outer layer, which only that law uses."""
+    if reference is None:
+        return np.zeros(0), np.zeros(0)
+    layer = reference.outer_layer_of if outer_layers else None
+    if layer is not None:
+        return np.ascontiguousarray(layer[0]).reshape(-1), np.ascontiguousarray(layer[1])
+    if reference.surface is None:
+        return np.zeros(0), np.zeros(0)
+    return np.ascontiguousarray(reference.surface, dtype=np.float64).reshape(-1), np.zeros(0)
+
+
+def break_crossing_bonds(
+    core: _core.Simulation,
+    model: _core.Model,
+    point: NDArray[np.float64],
+    normal: NDArray[np.float64],
+    region: Shape | None,
+) -> int:
+    """Break the bonds from the side (X - point) . normal < 0 to the other whose midpoint lies
+    in `region` (all, when None), in the reference configuration; returns how many broke."""
+    X = model.reference_positions
+    side = (X - point) @ normal
+    offsets = model.bond_offsets
+    owner = np.repeat(
+        np.arange(len(offsets) - 1, dtype=np.uint32), np.diff(offsets).astype(np.int64)
+    )
+    neighbor = model.bond_neighbors()
+    crossing = (side[owner] < 0) & (side[neighbor] >= 0)
+    if region is not None:
+        crossing &= region.contains(0.5 * (X[owner] + X[neighbor]))
+    pairs = np.ascontiguousarray(
+        np.column_stack([owner[crossing], neighbor[crossing]]), dtype=np.uint32
+    )
+    before = core.broken_bonds()
+    core.break_bonds(pairs)
+    return core.broken_bonds() - before
