@@ -168,11 +168,36 @@ class ContactModel {
   /// A grid search at positions_at_build_, which the caller fills with every node's contact
   /// position (contact_position); bonds and time from `state`; `finish`: then finish_lists.
   void rebuild(const Model& model, const State& state, std::uint64_t broken_bonds, bool finish = true);
+  /// The particles a rebuild searches: per particle, whether another particle's bounding sphere
+  /// (or its own broken bonds) and whether a wall is within reach.
+  struct NearParticles {
+    std::vector<std::uint8_t> particle, wall;
+  };
+  /// The broad phase of a rebuild: bounding spheres of the particles at positions_at_build_.
+  NearParticles near_particles(const Model& model, const State& state, std::uint64_t broken_bonds,
+                               real reach) const;
+  /// The node-pair lists (pair_offsets_, pair_partner_): a grid search over the nodes that take
+  /// part of the particles near another or broken, within each pair's reach plus the skin.
+  void search_node_pairs(const Model& model, const State& state, const std::vector<std::uint8_t>& near,
+                         real reach);
+  /// The node-wall lists (wall_offsets_, wall_entry_): the surfaces within a node's contact
+  /// radius, its list offset and the skin, for the nodes of particles near a wall.
+  void search_node_walls(const Model& model, const State& state, const std::vector<std::uint8_t>& near);
   /// After bonds broke (and nothing moved half the skin): the pairs of newly_broken_ into the
   /// lists.
   void update_after_breaks(const Model& model, const State& state, std::uint64_t broken_bonds, real moved);
   /// Slots, reduced masses, slot laws and scratch, from the lists and the bodies.
   void finish_lists(const Model& model);
+  /// slots_ (pairs of bodies in the lists, sorted, then pairs of a body and a wall, sorted) and
+  /// each entry's slot (pair_slot_, wall_slot_).
+  void find_slots(const Model& model);
+  /// Each slot's law (slot_law_index_ into resolved_laws_): one per pair of particles, or of a
+  /// particle and a wall, however many fragments the particles broke into.
+  void resolve_slot_laws();
+  /// The collisions in progress carried from `old_slots` (their first `old_particle_slots`
+  /// between particles) to the same pairs' new slots; the slots' stiffness reset.
+  void carry_over_collisions(const std::vector<std::array<index_t, 2>>& old_slots,
+                             std::size_t old_particle_slots);
   /// The lists and their friction springs as they were before a rebuild.
   struct KeptLists {
     std::vector<index_t> pair_offsets, pair_partner, pair_spring, wall_offsets;

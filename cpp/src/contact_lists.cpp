@@ -1,0 +1,636 @@
+// The contact neighbour lists: when they are rebuilt, the broad phase over particles, the node-pair
+// and node-wall searches, updates after bonds break, the friction springs carried over, groups.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+
+#include "contact_vectors.hpp"
+#include "granulate/cell_grid.hpp"
+#include "granulate/contact/contact_model.hpp"
+
+namespace granulate {
+using namespace contact_vectors;
+
+namespace {
+
+/// Gives back all of a vector's spare memory, for the arrays made anew at each list build: a
+/// copy per build, where the growth of the build would keep up to twice their size.
+template <class T>
+void fit(std::vector<T>& v) {
+  if (v.capacity() > v.size()) v.shrink_to_fit();
+}
+
+bool intact_bond(const Model& model, const State& state, index_t i, index_t j) {
+  const NodeBonds bonds = model.node_bonds(i);
+  const index_t b = bonds.find(j);
+  return b != bonds.count && state.bonds.intact(i, b);
+}
+
+}  // namespace
+
+real ContactModel::largest_displacement(const Model& model, const State& state) const {
+  const std::int64_t n = model.node_count();
+  real worst = 0;
+#pragma omp parallel for schedule(static) reduction(max : worst)
+  for (std::int64_t i = 0; i < n; ++i) {
+    const index_t node = static_cast<index_t>(i);
+    const real* y = &state.positions[3 * node];
+    const vec3 x = centres_.moved(node) ? centres_.at_list(model, state, node) : vec3{y[0], y[1], y[2]};
+    real d2 = 0;
+    for (int k = 0; k < 3; ++k) {
+      const real d = x[k] - positions_at_build_[3 * i + k];
+      d2 += d * d;
+    }
+    worst = std::max(worst, d2);
+  }
+  return std::sqrt(worst);
+}
+
+bool ContactModel::needs_rebuild(const Model& model, const State& state, real& moved) const {
+  moved = 0;
+  if (!built_) return true;
+  const real half_skin = 0.5 * skin_;
+  for (const Wall& wall : walls_) {
+    if (wall.motion_bound(time_at_build_, state.time) > half_skin) return true;
+  }
+  moved = largest_displacement(model, state);
+  return moved > half_skin;
+}
+
+bool ContactModel::takes_part(const Model& model, const State& state, index_t i) const {
+  if (!surface_particle(model.node_particle()[i]) || on_surface(model, i)) return true;
+  const NodeBonds bonds = model.node_bonds(i);
+  for (index_t b = 0; b < bonds.count; ++b) {
+    if (!state.bonds.intact(i, b)) return true;  // on a crack face
+  }
+  return false;
+}
+
+bool ContactModel::surface_entry(const Model& model, index_t i, std::size_t e) const {
+  if (!any_surface_) return false;
+  const index_t j = pair_partner_[e];
+  return slot_law(pair_slot_[e]).surface && node_body_[i] != node_body_[j] &&
+         (on_surface(model, i) || on_surface(model, j));
+}
+
+bool ContactModel::breaks_open_new_nodes(const Model& model) const {
+  if (taking_part_.empty()) return false;  // every node takes part already
+  for (const auto& [i, j] : newly_broken_) {
+    for (const index_t k : {i, j}) {
+      if (!taking_part_[k] && surface_particle(model.node_particle()[k])) return true;
+    }
+  }
+  return false;
+}
+
+void ContactModel::update_after_breaks(const Model& model, const State& state, std::uint64_t broken_bonds,
+                                       real moved) {
+  // Bonds broke, nothing moved far: no grid search. The lists gain every newly unbonded pair
+  // that could come within its Rc before the next rebuild: a node moves at most skin/2 from
+  // where the lists were built before that, so a pair now at d stays beyond d - skin - 2 w (w:
+  // the largest displacement since the build so far). A pair left out now stays out of reach
+  // until the next rebuild (w only grows), so only the bonds broken since the last update are
+  // candidates. Then the bodies are labelled again.
+  label_bodies(model, state, broken_bonds);
+  const index_t n = model.node_count();
+  const auto& node_material = model.node_material();
+  const real extra = skin_ + 2 * moved;
+  std::vector<std::array<index_t, 2>> added;  // (node, partner), both ways
+  for (const auto& [i, j] : newly_broken_) {
+    const index_t m = node_material[i];  // a bond joins two nodes of one particle
+    if (!law_set_[m * material_count_ + m]) continue;
+    const real limit = pair_reach(model, i, j, node_body_[i] == node_body_[j]) + extra;
+    const vec3 xi = centres_.at_list(model, state, i);
+    const vec3 xj = centres_.at_list(model, state, j);
+    const real dx = xj[0] - xi[0], dy = xj[1] - xi[1], dz = xj[2] - xi[2];
+    if (dx * dx + dy * dy + dz * dz > limit * limit) continue;
+    const index_t* listed = pair_partner_.data();
+    if (std::binary_search(listed + pair_offsets_[i], listed + pair_offsets_[i + 1], j)) continue;
+    added.push_back({i, j});
+    added.push_back({j, i});
+  }
+  newly_broken_.clear();
+  if (!added.empty()) {
+    std::sort(added.begin(), added.end());
+    added.erase(std::unique(added.begin(), added.end()), added.end());
+    std::vector<index_t> offsets(static_cast<std::size_t>(n) + 1, 0);
+    for (const auto& [i, j] : added) ++offsets[i + 1];
+    for (index_t i = 0; i < n; ++i) offsets[i + 1] += offsets[i] + (pair_offsets_[i + 1] - pair_offsets_[i]);
+    // Merge the (sorted) new partners in; listed entries keep their friction springs.
+    std::vector<index_t> partners(offsets[n]), springs(offsets[n], no_spring);
+    auto next = added.begin();
+    for (index_t i = 0; i < n; ++i) {
+      index_t old = pair_offsets_[i], out = offsets[i];
+      auto copy_old = [&] {
+        springs[out] = pair_spring_[old];
+        partners[out++] = pair_partner_[old++];
+      };
+      while (next != added.end() && (*next)[0] == i) {
+        while (old < pair_offsets_[i + 1] && pair_partner_[old] < (*next)[1]) copy_old();
+        partners[out++] = (*next)[1];
+        ++next;
+      }
+      while (old < pair_offsets_[i + 1]) copy_old();
+    }
+    pair_offsets_ = std::move(offsets);
+    pair_partner_ = std::move(partners);
+    pair_spring_ = std::move(springs);
+  }
+  finish_lists(model);
+  broken_at_build_ = broken_bonds;
+  ++statistics_.list_updates;
+  statistics_.list_entries = pair_partner_.size();
+}
+
+void ContactModel::label_bodies(const Model& model, const State& state, std::uint64_t broken_bonds) {
+  if (bodies_labelled_ && broken_bonds == broken_at_labelling_) return;
+  bodies_labelled_ = true;
+  broken_at_labelling_ = broken_bonds;
+  const index_t n = model.node_count();
+  node_body_.resize(n);
+  if (broken_bonds == 0) {  // every particle is whole: the bodies are the particles
+    for (index_t i = 0; i < n; ++i) node_body_[i] = model.node_particle()[i];
+  } else {  // fragments, numbered in the order of their smallest node
+    model.fragments(state.bonds, node_body_.data());
+    std::vector<index_t> number(n, 0);
+    index_t next = 0;
+    for (index_t i = 0; i < n; ++i) {
+      if (node_body_[i] == i) number[i] = next++;
+      node_body_[i] = number[node_body_[i]];
+    }
+  }
+  const index_t count = n == 0 ? 0 : *std::max_element(node_body_.begin(), node_body_.end()) + 1;
+  body_mass_.assign(count, 0);
+  body_kinematic_.assign(count, 1);
+  body_material_.assign(count, 0);
+  body_particle_.assign(count, 0);
+  body_node_offsets_.assign(static_cast<std::size_t>(count) + 1, 0);
+  for (index_t i = 0; i < n; ++i) {
+    body_mass_[node_body_[i]] += model.node_density()[i] * model.volumes()[i];
+    if (node_kinematic_.empty() || !node_kinematic_[i]) body_kinematic_[node_body_[i]] = 0;
+    body_material_[node_body_[i]] = model.node_material()[i];
+    body_particle_[node_body_[i]] = model.node_particle()[i];
+    ++body_node_offsets_[node_body_[i] + 1];
+  }
+  for (index_t b = 0; b < count; ++b) body_node_offsets_[b + 1] += body_node_offsets_[b];
+  body_nodes_.resize(n);
+  std::vector<index_t> fill(body_node_offsets_.begin(), body_node_offsets_.end() - 1);
+  for (index_t i = 0; i < n; ++i) body_nodes_[fill[node_body_[i]]++] = i;
+}
+
+void ContactModel::carry_over_springs(const KeptLists& kept, index_t n) {
+  // A merge walk per node: both lists are sorted by partner, wall entries by (wall, surface);
+  // new entries have no spring.
+  pair_spring_.assign(pair_partner_.size(), no_spring);
+  wall_spring_.assign(wall_entry_.size(), no_spring);
+  auto walk = [](const auto& old_offsets, const auto& old_keys, const std::vector<index_t>& old_springs,
+                 const auto& offsets, const auto& keys, std::vector<index_t>& new_springs, index_t node) {
+    if (old_offsets.size() <= node + 1 || old_springs.size() != old_keys.size()) return;
+    index_t old = old_offsets[node];
+    for (index_t e = offsets[node]; e < offsets[node + 1]; ++e) {
+      while (old < old_offsets[node + 1] && old_keys[old] < keys[e]) ++old;
+      if (old < old_offsets[node + 1] && old_keys[old] == keys[e]) new_springs[e] = old_springs[old];
+    }
+  };
+#pragma omp parallel for schedule(static)
+  for (std::int64_t ii = 0; ii < static_cast<std::int64_t>(n); ++ii) {
+    const index_t i = static_cast<index_t>(ii);
+    walk(kept.pair_offsets, kept.pair_partner, kept.pair_spring, pair_offsets_, pair_partner_, pair_spring_,
+         i);
+    walk(kept.wall_offsets, kept.wall_entry, kept.wall_spring, wall_offsets_, wall_entry_, wall_spring_, i);
+  }
+  compact_springs();
+}
+
+void ContactModel::compact_springs() {
+  std::size_t held = 0;
+  for (const index_t s : pair_spring_) held += s != no_spring;
+  for (const index_t s : wall_spring_) held += s != no_spring;
+  std::vector<vec3> springs;
+  springs.reserve(held);
+  auto take = [&](index_t& s) {
+    if (s == no_spring) return;
+    springs.push_back(springs_[s]);
+    s = static_cast<index_t>(springs.size() - 1);
+  };
+  for (index_t& s : pair_spring_) take(s);
+  for (index_t& s : wall_spring_) take(s);
+  springs_ = std::move(springs);
+  free_springs_.clear();
+  release_excess(free_springs_);
+}
+
+void ContactModel::assign_springs() {
+  auto update = [&](index_t& spring, bool touching) {
+    if (touching && spring == no_spring) {
+      if (free_springs_.empty()) {
+        spring = static_cast<index_t>(springs_.size());
+        springs_.push_back({0, 0, 0});
+      } else {
+        spring = free_springs_.back();
+        free_springs_.pop_back();
+        springs_[spring] = {0, 0, 0};
+      }
+    } else if (!touching && spring != no_spring) {  // apart: the spring is released
+      free_springs_.push_back(spring);
+      spring = no_spring;
+    }
+  };
+  for (std::size_t e = 0; e < pair_spring_.size(); ++e) update(pair_spring_[e], pair_stiffness_[e] > 0);
+  for (std::size_t e = 0; e < wall_spring_.size(); ++e) update(wall_spring_[e], wall_entry_stiffness_[e] > 0);
+}
+
+void ContactModel::group_contact_nodes(const Model& model) {
+  const index_t n = model.node_count();
+  const index_t bodies = static_cast<index_t>(body_mass_.size());
+  body_contact_offsets_.assign(static_cast<std::size_t>(bodies) + 1, 0);
+  auto has_entries = [&](index_t i) {
+    return pair_offsets_[i] != pair_offsets_[i + 1] || wall_offsets_[i] != wall_offsets_[i + 1];
+  };
+  for (index_t i = 0; i < n; ++i) {
+    if (has_entries(i)) ++body_contact_offsets_[node_body_[i] + 1];
+  }
+  for (index_t b = 0; b < bodies; ++b) body_contact_offsets_[b + 1] += body_contact_offsets_[b];
+  contact_nodes_.resize(body_contact_offsets_[bodies]);
+  std::vector<index_t> fill(body_contact_offsets_.begin(), body_contact_offsets_.end() - 1);
+  for (index_t i = 0; i < n; ++i) {
+    if (has_entries(i)) contact_nodes_[fill[node_body_[i]]++] = i;
+  }
+  body_touch_.assign(bodies, not_touching);
+  touching_bodies_.clear();
+  slot_touch_.assign(slots_.size(), not_touching);
+  wall_damping_.assign(walls_.size(), {0, 0, 0, 0, 0, 0});
+}
+
+void ContactModel::finish_lists(const Model& model) {
+  // Everything that follows from the lists and the bodies: slots, reduced masses, the laws of
+  // the slots, the collision history carried over by slot, and the per-entry scratch.
+  const std::vector<std::array<index_t, 2>> old_slots = slots_;
+  const std::size_t old_particle_slots = particle_slot_count_;
+  find_slots(model);
+  resolve_slot_laws();
+  carry_over_collisions(old_slots, old_particle_slots);
+  group_contact_nodes(model);
+  find_groups(model);
+  pair_stiffness_.assign(pair_partner_.size(), 0);
+  wall_entry_stiffness_.assign(wall_entry_.size(), 0);
+  wall_points_.assign(wall_entry_.size(), {});
+  wall_entry_reaction_.assign(wall_entry_.size(), {0, 0, 0, 0, 0, 0});
+  for (auto* v : {&pair_offsets_, &pair_partner_, &pair_slot_, &pair_spring_, &wall_offsets_, &wall_slot_,
+                  &wall_spring_, &slot_law_index_, &slot_touch_, &contact_nodes_, &body_contact_offsets_})
+    fit(*v);
+  fit(pair_stiffness_);
+  fit(slots_);
+  fit(slot_stiffness_);
+  fit(wall_entry_);
+}
+
+void ContactModel::find_slots(const Model& model) {
+  // One slot per pair of bodies that appear in the lists, in sorted order, then one per pair of
+  // a body and a wall.
+  const index_t n = model.node_count();
+  const auto& node_body = node_body_;
+  // Bucketed by the first body (a counting sort), so the sorts are per body and small, and an
+  // entry finds its slot among its first body's few slots (fragments make many entries).
+  const index_t bodies = static_cast<index_t>(body_mass_.size());
+  std::vector<index_t> bucket(static_cast<std::size_t>(bodies) + 1, 0);
+  for (index_t i = 0; i < n; ++i) {
+    for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
+      ++bucket[std::min(node_body[i], node_body[pair_partner_[e]]) + 1];
+    }
+  }
+  for (index_t a = 0; a < bodies; ++a) bucket[a + 1] += bucket[a];
+  std::vector<index_t> second(bucket.back()), filled(bucket.begin(), bucket.end() - 1);
+  for (index_t i = 0; i < n; ++i) {
+    for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
+      const index_t p = node_body[i], q = node_body[pair_partner_[e]];
+      const index_t a = std::min(p, q), b = std::max(p, q);
+      if (filled[a] > bucket[a] && second[filled[a] - 1] == b) continue;  // as the entry before
+      second[filled[a]++] = b;
+    }
+  }
+  slots_.clear();
+  std::vector<index_t> body_slots(static_cast<std::size_t>(bodies) + 1, 0);  // slots of first body a
+  for (index_t a = 0; a < bodies; ++a) {
+    const auto begin = second.begin() + bucket[a], end = second.begin() + filled[a];
+    std::sort(begin, end);
+    const auto last = std::unique(begin, end);
+    for (auto it = begin; it != last; ++it) slots_.push_back({a, *it});
+    body_slots[a + 1] = static_cast<index_t>(slots_.size());
+  }
+  const std::size_t particle_slots = slots_.size();
+  particle_slot_count_ = particle_slots;
+  pair_slot_.resize(pair_partner_.size());
+#pragma omp parallel for schedule(static)
+  for (std::int64_t ii = 0; ii < static_cast<std::int64_t>(n); ++ii) {
+    const index_t i = static_cast<index_t>(ii);
+    for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
+      const index_t p = node_body[i], q = node_body[pair_partner_[e]];
+      const index_t a = std::min(p, q);
+      const std::array<index_t, 2> key{a, std::max(p, q)};
+      pair_slot_[e] = static_cast<index_t>(
+          std::lower_bound(slots_.begin() + body_slots[a], slots_.begin() + body_slots[a + 1], key) -
+          slots_.begin());
+    }
+  }
+  std::vector<std::array<index_t, 2>> wall_keys;
+  for (index_t i = 0; i < n; ++i) {
+    for (index_t e = wall_offsets_[i]; e < wall_offsets_[i + 1]; ++e)
+      wall_keys.push_back({node_body[i], wall_entry_[e][0]});
+  }
+  std::sort(wall_keys.begin(), wall_keys.end());
+  wall_keys.erase(std::unique(wall_keys.begin(), wall_keys.end()), wall_keys.end());
+  slots_.insert(slots_.end(), wall_keys.begin(), wall_keys.end());
+  wall_slot_.resize(wall_entry_.size());
+  for (index_t i = 0; i < n; ++i) {
+    for (index_t e = wall_offsets_[i]; e < wall_offsets_[i + 1]; ++e) {
+      const std::array<index_t, 2> key{node_body[i], wall_entry_[e][0]};
+      wall_slot_[e] = static_cast<index_t>(
+          particle_slots + (std::lower_bound(wall_keys.begin(), wall_keys.end(), key) - wall_keys.begin()));
+    }
+  }
+}
+
+void ContactModel::resolve_slot_laws() {
+  const std::size_t particle_slots = particle_slot_count_;
+  // The laws of the slots: one per pair of particles (or particle and wall) that the slots
+  // meet, however many fragments the particles broke into.
+  slot_law_index_.resize(slots_.size());
+  resolved_laws_.clear();
+  std::map<std::array<index_t, 3>, index_t> law_of;  // (kind: 0 particles, 1 wall; p; q or wall)
+  for (std::size_t s = 0; s < slots_.size(); ++s) {
+    const bool wall = s >= particle_slots;
+    const index_t p = body_particle_[slots_[s][0]], q = wall ? slots_[s][1] : body_particle_[slots_[s][1]];
+    const auto [found, added] =
+        law_of.try_emplace({wall ? 1u : 0u, p, q}, static_cast<index_t>(resolved_laws_.size()));
+    if (added) resolved_laws_.push_back(wall ? wall_law(q, p) : pair_law(p, q));
+    slot_law_index_[s] = found->second;
+  }
+}
+
+void ContactModel::carry_over_collisions(const std::vector<std::array<index_t, 2>>& old_slots,
+                                         std::size_t old_particle_slots) {
+  const std::size_t particle_slots = particle_slot_count_;
+  slot_stiffness_.assign(slots_.size(), 0);
+  // The collisions carry over by slot. Old and new slots are sorted within their two parts
+  // (particle pairs, walls): merge walks.
+  std::vector<index_t> old_of_new(slots_.size(), contact::CollisionStore::none);
+  auto carry_over = [&](std::size_t slot, std::size_t slot_end, std::size_t old, std::size_t old_end) {
+    for (; slot < slot_end && old < old_end; ++slot) {
+      while (old < old_end && old_slots[old] < slots_[slot]) ++old;
+      if (old < old_end && old_slots[old] == slots_[slot]) old_of_new[slot] = static_cast<index_t>(old);
+    }
+  };
+  carry_over(0, particle_slots, 0, old_particle_slots);
+  carry_over(particle_slots, slots_.size(), old_particle_slots, old_slots.size());
+  collisions_.renumber(old_of_new);
+}
+
+void ContactModel::find_groups(const Model& model) {
+  // A node's probe entries: partners that carry surface points of another body, under the
+  // surface law; one group per such body, in the order of first appearance.
+  const index_t n = model.node_count();
+  groups_.clear();
+  if (!any_surface_) {
+    // No particle uses the surface law: none of its per-node or per-entry tables.
+    std::vector<index_t>().swap(entry_group_);
+    std::vector<index_t>().swap(group_offsets_);
+    std::vector<index_t>().swap(surface_slot_);
+    std::vector<index_t>().swap(entry_target_);
+    surface_nodes_.clear();
+    probes_.clear();
+    return;
+  }
+  entry_group_.assign(pair_partner_.size(), no_group);
+  group_offsets_.assign(static_cast<std::size_t>(n) + 1, 0);
+  for (index_t i = 0; i < n; ++i) {
+    const std::size_t first = groups_.size();
+    for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
+      const index_t j = pair_partner_[e];
+      if (node_body_[j] == node_body_[i] || !slot_law(pair_slot_[e]).surface || !on_surface(model, j))
+        continue;
+      std::size_t g = first;
+      while (g < groups_.size() && groups_[g].body != node_body_[j]) ++g;
+      if (g == groups_.size()) groups_.push_back({i, node_body_[j], pair_slot_[e]});
+      entry_group_[e] = static_cast<index_t>(g);
+    }
+    group_offsets_[i + 1] = static_cast<index_t>(groups_.size());
+  }
+  // The surface points that probes may reach: every node with entries that carries one.
+  surface_nodes_.clear();
+  surface_slot_.assign(n, no_group);
+  for (index_t i = 0; i < n; ++i) {
+    if (pair_offsets_[i] == pair_offsets_[i + 1] || !on_surface(model, i) ||
+        !surface_particle(model.node_particle()[i]))
+      continue;
+    surface_slot_[i] = static_cast<index_t>(surface_nodes_.size());
+    surface_nodes_.push_back(i);
+  }
+  surface_points_.resize(surface_nodes_.size());
+  surface_sizes_.resize(surface_nodes_.size());
+  // Each entry (i, j) of a node i with a surface point: the group of j that probes i's body.
+  entry_target_.assign(pair_partner_.size(), no_group);
+#pragma omp parallel for schedule(static)
+  for (std::int64_t ii = 0; ii < static_cast<std::int64_t>(n); ++ii) {
+    const index_t i = static_cast<index_t>(ii);
+    if (surface_slot_[i] == no_group) continue;
+    for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
+      const index_t j = pair_partner_[e];
+      if (node_body_[j] != node_body_[i]) entry_target_[e] = target_group(i, j);
+    }
+  }
+  probes_.assign(groups_.size(), {});
+}
+
+index_t ContactModel::target_group(index_t i, index_t j) const {
+  const index_t* begin = pair_partner_.data() + pair_offsets_[j];
+  const index_t* end = pair_partner_.data() + pair_offsets_[j + 1];
+  const index_t* at = std::lower_bound(begin, end, i);
+  return at == end || *at != i ? no_group : entry_group_[static_cast<std::size_t>(at - pair_partner_.data())];
+}
+
+void ContactModel::rebuild(const Model& model, const State& state, std::uint64_t broken_bonds, bool finish) {
+  if (skin_ < 0) skin_ = 0.5 * max_contact_radius_;
+  const KeptLists kept{std::move(pair_offsets_), std::move(pair_partner_), std::move(pair_spring_),
+                       std::move(wall_offsets_), std::move(wall_entry_),   std::move(wall_spring_)};
+  const real reach = largest_pair_reach(model) + skin_;
+  newly_broken_.clear();  // the search finds every unbonded pair
+  label_bodies(model, state, broken_bonds);
+  const NearParticles near = near_particles(model, state, broken_bonds, reach);
+  search_node_pairs(model, state, near.particle, reach);
+  search_node_walls(model, state, near.wall);
+  carry_over_springs(kept, model.node_count());
+  if (finish) finish_lists(model);
+
+  time_at_build_ = state.time;
+  broken_at_build_ = broken_bonds;
+  built_ = true;
+  ++statistics_.rebuilds;
+  statistics_.list_entries = pair_partner_.size();
+}
+
+ContactModel::NearParticles ContactModel::near_particles(const Model& model, const State& state,
+                                                         std::uint64_t broken_bonds, real reach) const {
+  const std::vector<real>& x = positions_at_build_;
+  const auto& particles = model.particles();
+  const std::size_t particle_count = particles.size();
+  // Broad phase: bounding spheres of particles; a particle takes part when another particle's
+  // sphere or a wall is within reach, or when it has broken bonds (fragments may touch).
+  std::vector<real> centres(3 * particle_count, 0), radii(particle_count, 0);
+  for (std::size_t p = 0; p < particle_count; ++p) {
+    const Particle& particle = particles[p];
+    for (index_t i = particle.first_node; i < particle.first_node + particle.node_count; ++i) {
+      for (int k = 0; k < 3; ++k) centres[3 * p + k] += x[3 * i + k];
+    }
+    for (int k = 0; k < 3; ++k) centres[3 * p + k] /= particle.node_count;
+    for (index_t i = particle.first_node; i < particle.first_node + particle.node_count; ++i) {
+      real d2 = 0;
+      for (int k = 0; k < 3; ++k)
+        d2 += (x[3 * i + k] - centres[3 * p + k]) * (x[3 * i + k] - centres[3 * p + k]);
+      radii[p] = std::max(radii[p], std::sqrt(d2));
+    }
+  }
+  NearParticles near{std::vector<std::uint8_t>(particle_count, 0),
+                     std::vector<std::uint8_t>(particle_count, 0)};
+  std::vector<std::uint8_t>& near_particle = near.particle;
+  std::vector<std::uint8_t>& near_wall = near.wall;
+  if (any_law_) {
+    const real largest = *std::max_element(radii.begin(), radii.end());
+    const CellGrid centre_grid =
+        CellGrid::build(centres, 0, static_cast<index_t>(particle_count), 2 * largest + reach);
+    for (std::size_t p = 0; p < particle_count; ++p) {
+      centre_grid.for_each_within(centres, static_cast<index_t>(p), 2 * largest + reach, dimension_,
+                                  [&](index_t q, real r2) {
+                                    if (std::sqrt(r2) <= radii[p] + radii[q] + reach) near_particle[p] = 1;
+                                  });
+      if (broken_bonds > 0 && !near_particle[p]) {
+        const Particle& particle = particles[p];
+        if (state.bonds.broken(model.bond_offsets(), particle.first_node,
+                               particle.first_node + particle.node_count) > 0)
+          near_particle[p] = 1;
+      }
+    }
+  }
+  std::vector<WallContact> found;
+  for (std::size_t p = 0; p < particle_count; ++p) {
+    for (std::size_t w = 0; w < walls_.size(); ++w) {
+      const auto centre = walls_[w].to_reference(&centres[3 * p], state.time);
+      for (std::size_t s = 0; s < walls_[w].surfaces.size(); ++s) {
+        found.clear();
+        walls_[w].contacts(s, centre, radii[p] + reach, dimension_, found);
+        if (!found.empty()) near_wall[p] = 1;
+      }
+    }
+  }
+  return near;
+}
+
+void ContactModel::search_node_pairs(const Model& model, const State& state,
+                                     const std::vector<std::uint8_t>& near_particle, real reach) {
+  const std::vector<real>& x = positions_at_build_;
+  const index_t n = model.node_count();
+  const auto& particles = model.particles();
+  const auto& node_particle = model.node_particle();
+  const auto& node_material = model.node_material();
+  const std::size_t particle_count = particles.size();
+  // Node pairs: a grid over the nodes that take part (takes_part) of particles near another
+  // particle or broken.
+  std::vector<index_t> searched;
+  const std::vector<std::uint8_t>& surface = surface_particles_;
+  if (any_surface_) {
+    taking_part_.assign(n, 0);
+  } else {
+    std::vector<std::uint8_t>().swap(taking_part_);  // every node takes part
+  }
+  for (std::size_t p = 0; p < particle_count; ++p) {
+    if (!near_particle[p]) continue;
+    for (index_t i = particles[p].first_node; i < particles[p].first_node + particles[p].node_count; ++i) {
+      if (surface[p] && !takes_part(model, state, i)) continue;
+      if (surface[p]) taking_part_[i] = 1;
+      searched.push_back(i);
+    }
+  }
+  const CellGrid grid = CellGrid::build(x, searched, reach);
+  pair_offsets_.assign(n + 1, 0);
+  auto accept = [&](index_t i, index_t j, real r2) {
+    const index_t mi = node_material[i], mj = node_material[j];
+    if (!law_set_[mi * material_count_ + mj]) return false;
+    const real limit = pair_reach(model, i, j, node_body_[i] == node_body_[j]) + skin_;
+    if (r2 > limit * limit) return false;
+    return node_particle[i] != node_particle[j] || !intact_bond(model, state, i, j);
+  };
+  // One search: each thread keeps its nodes' partners, then copies them into place.
+  const std::int64_t searched_count = static_cast<std::int64_t>(searched.size());
+#pragma omp parallel
+  {
+    std::vector<index_t> found_partners;
+    std::vector<std::array<index_t, 2>> found_nodes;  // (node, first of its partners)
+#pragma omp for schedule(static)
+    for (std::int64_t a = 0; a < searched_count; ++a) {
+      const index_t i = searched[a];
+      const std::size_t first = found_partners.size();
+      grid.for_each_within(x, i, reach, dimension_, [&](index_t j, real r2) {
+        if (accept(i, j, r2)) found_partners.push_back(j);
+      });
+      std::sort(found_partners.begin() + static_cast<std::ptrdiff_t>(first), found_partners.end());
+      pair_offsets_[i + 1] = static_cast<index_t>(found_partners.size() - first);
+      found_nodes.push_back({i, static_cast<index_t>(first)});
+    }
+#pragma omp single
+    {
+      for (index_t i = 0; i < n; ++i) pair_offsets_[i + 1] += pair_offsets_[i];
+      pair_partner_.resize(pair_offsets_[n]);
+    }
+    for (const auto& [i, first] : found_nodes) {
+      std::copy_n(found_partners.begin() + first, pair_offsets_[i + 1] - pair_offsets_[i],
+                  pair_partner_.begin() + pair_offsets_[i]);
+    }
+  }
+}
+
+void ContactModel::search_node_walls(const Model& model, const State& state,
+                                     const std::vector<std::uint8_t>& near_wall) {
+  const std::vector<real>& x = positions_at_build_;
+  const index_t n = model.node_count();
+  const auto& particles = model.particles();
+  const auto& node_particle = model.node_particle();
+  const auto& node_material = model.node_material();
+  const std::size_t particle_count = particles.size();
+  // Node-wall candidates.
+  wall_offsets_.assign(n + 1, 0);
+  std::vector<std::vector<std::array<index_t, 2>>> per_node(n);
+  std::vector<index_t> wall_nodes;
+  for (std::size_t p = 0; p < particle_count; ++p) {
+    if (!near_wall[p]) continue;
+    for (index_t i = particles[p].first_node; i < particles[p].first_node + particles[p].node_count; ++i) {
+      wall_nodes.push_back(i);
+    }
+  }
+  const std::int64_t wall_node_count = static_cast<std::int64_t>(wall_nodes.size());
+#pragma omp parallel for schedule(static)
+  for (std::int64_t a = 0; a < wall_node_count; ++a) {
+    const index_t i = wall_nodes[a];
+    std::vector<WallContact> local;
+    for (std::size_t w = 0; w < walls_.size(); ++w) {
+      if (!wall_law_set_[w * material_count_ + node_material[i]]) continue;
+      // x is the list position, list_offset out from the contact centre.
+      const real radius = wall_law(static_cast<index_t>(w), node_particle[i]).contact_radius;
+      const real limit = radius + list_offset(model, i, radius) + skin_;
+      const auto p = walls_[w].to_reference(&x[3 * i], state.time);
+      for (std::size_t s = 0; s < walls_[w].surfaces.size(); ++s) {
+        local.clear();
+        walls_[w].contacts(s, p, limit, dimension_, local);
+        if (!local.empty()) per_node[i].push_back({static_cast<index_t>(w), static_cast<index_t>(s)});
+      }
+    }
+  }
+  for (index_t i = 0; i < n; ++i)
+    wall_offsets_[i + 1] = wall_offsets_[i] + static_cast<index_t>(per_node[i].size());
+  wall_entry_.clear();
+  wall_entry_.reserve(wall_offsets_[n]);
+  for (index_t i = 0; i < n; ++i)
+    wall_entry_.insert(wall_entry_.end(), per_node[i].begin(), per_node[i].end());
+}
+
+}  // namespace granulate

@@ -1,0 +1,582 @@
+// One contact step (add_forces) and its measuring phases: where contact sees each node, the
+// geometry of a node pair and a node-wall contact, distances, springs and probes, each pair of
+// bodies' stiffness, the touching bodies' rigid motion, normals and spring sums; spring energy.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "contact_vectors.hpp"
+#include "granulate/contact/contact_model.hpp"
+
+namespace granulate {
+using namespace contact_vectors;
+
+namespace {
+
+/// Inverse of an inertia tensor (xx, yy, zz, xy, xz, yz); in 2D only the zz part (a planar body
+/// turns about z). Zero for a body without rotational inertia (one node, or nodes on a line).
+std::array<real, 6> inverse_inertia(const std::array<real, 6>& m, int dimension) {
+  if (dimension == 2) return {0, 0, m[2] > 0 ? 1 / m[2] : 0.0, 0, 0, 0};
+  const real cxx = m[1] * m[2] - m[5] * m[5], cyy = m[0] * m[2] - m[4] * m[4],
+             czz = m[0] * m[1] - m[3] * m[3];
+  const real cxy = m[4] * m[5] - m[3] * m[2], cxz = m[3] * m[5] - m[4] * m[1],
+             cyz = m[3] * m[4] - m[0] * m[5];
+  const real det = m[0] * cxx + m[3] * cxy + m[4] * cxz;
+  const real scale = (m[0] + m[1] + m[2]) / 3;
+  if (!(det > 1e-9 * scale * scale * scale)) return {0, 0, 0, 0, 0, 0};
+  return {cxx / det, cyy / det, czz / det, cxy / det, cxz / det, cyz / det};
+}
+
+/// Rigid-body motion of a body from its nodes (one pass, moments about its first node, so far
+/// from the origin nothing cancels): centre c, velocity V = sum m v / M, inertia
+/// I = sum m (|r|^2 1 - r r^T) and angular momentum L = sum m r x (v - V) about c, omega = I^-1 L.
+BodyMotion measure_body(const Model& model, const State& state, const index_t* nodes, index_t count,
+                        int dimension) {
+  const auto& x = state.positions;
+  const auto& v = state.velocities;
+  const vec origin{x[3 * nodes[0]], x[3 * nodes[0] + 1], x[3 * nodes[0] + 2]};
+  real mass = 0;
+  vec first{0, 0, 0}, momentum{0, 0, 0}, spin{0, 0, 0};
+  std::array<real, 6> second{0, 0, 0, 0, 0, 0};  // sum m r r^T: xx, yy, zz, xy, xz, yz
+  for (index_t slot = 0; slot < count; ++slot) {
+    const index_t i = nodes[slot];
+    const real m = model.node_density()[i] * model.volumes()[i];
+    const vec r{x[3 * i] - origin[0], x[3 * i + 1] - origin[1], x[3 * i + 2] - origin[2]};
+    const vec p{m * v[3 * i], m * v[3 * i + 1], m * v[3 * i + 2]};
+    mass += m;
+    const vec rp = cross(r, p);
+    for (int k = 0; k < 3; ++k) {
+      first[k] += m * r[k];
+      momentum[k] += p[k];
+      spin[k] += rp[k];
+    }
+    second[0] += m * r[0] * r[0];
+    second[1] += m * r[1] * r[1];
+    second[2] += m * r[2] * r[2];
+    second[3] += m * r[0] * r[1];
+    second[4] += m * r[0] * r[2];
+    second[5] += m * r[1] * r[2];
+  }
+  BodyMotion motion;
+  const vec d{first[0] / mass, first[1] / mass, first[2] / mass};  // centre - origin
+  for (int k = 0; k < 3; ++k) {
+    motion.centre[k] = origin[k] + d[k];
+    motion.velocity[k] = momentum[k] / mass;
+  }
+  // Second moments about the centre, then the inertia tensor.
+  const std::array<real, 6> s{second[0] - mass * d[0] * d[0], second[1] - mass * d[1] * d[1],
+                              second[2] - mass * d[2] * d[2], second[3] - mass * d[0] * d[1],
+                              second[4] - mass * d[0] * d[2], second[5] - mass * d[1] * d[2]};
+  const std::array<real, 6> inertia{s[1] + s[2], s[0] + s[2], s[0] + s[1], -s[3], -s[4], -s[5]};
+  const vec moment = cross(d, momentum);  // L about c: sum m r x v - M d x V
+  const vec angular_momentum{spin[0] - moment[0], spin[1] - moment[1], spin[2] - moment[2]};
+  motion.inverse_inertia = inverse_inertia(inertia, dimension);
+  motion.angular_velocity = symmetric_times(motion.inverse_inertia, angular_momentum);
+  return motion;
+}
+
+/// Outward unit normal of the surface at node i, in the current configuration: the opposite of
+/// the influence-weighted sum of its intact bonds, sum_j w_ij (y_j - y_i), which points into
+/// the body from a surface node. Zero when that sum is under 10 % of sum_j w_ij |x_j - x_i|
+/// (reference lengths): inside the body, or a node without bonds.
+vec surface_normal(const Model& model, const State& state, index_t i) {
+  const NodeBonds bonds = model.node_bonds(i);
+  const real* y = state.positions.data();
+  vec sum{0, 0, 0};
+  real scale = 0;
+  for (index_t b = 0; b < bonds.count; ++b) {
+    if (!state.bonds.intact(i, b)) continue;
+    const index_t j = bonds.neighbor(b);
+    const real w = bonds.weight(b);
+    for (int c = 0; c < 3; ++c) sum[c] -= w * (y[3 * j + c] - y[3 * i + c]);
+    scale += w * bonds.length(b);
+  }
+  const real norm = std::sqrt(dot(sum, sum));
+  if (!(norm > 0.1 * scale)) return {0, 0, 0};
+  return {sum[0] / norm, sum[1] / norm, sum[2] / norm};
+}
+
+/// The contact point with the largest spring of a node-wall entry's points (the friction point).
+std::size_t deepest_point(const WallContact* points, std::size_t count) {
+  std::size_t best = 0;
+  for (std::size_t k = 1; k < count; ++k) {
+    if (points[k].distance < points[best].distance) best = k;
+  }
+  return best;
+}
+
+}  // namespace
+
+vec3 ContactModel::contact_position(const Model& model, const State& state, index_t i) const {
+  if (!centres_.moved(i))
+    return {state.positions[3 * i], state.positions[3 * i + 1], state.positions[3 * i + 2]};
+  return centres_.at_centre(model, state, i);
+}
+
+vec3 ContactModel::contact_velocity(const Model& model, const State& state, index_t i) const {
+  if (!centres_.moved(i))
+    return {state.velocities[3 * i], state.velocities[3 * i + 1], state.velocities[3 * i + 2]};
+  return centres_.centre_velocity(model, state, i);
+}
+
+const contact::SurfacePoint& ContactModel::surface_point(index_t j) const {
+  return surface_points_[surface_slot_[j]];
+}
+
+real ContactModel::probe_stiffness(const Model& model, index_t i, index_t target,
+                                   const contact::PairLaw& law) const {
+  // Per unit area the contact is as stiff as the sphere law's node pairs of the finer mesh,
+  // kn min(V_i, V_t)^2 per (finer h)^(d-1); a probe carries its own node's share of the surface,
+  // h_i^(d-1), and its side's share of the contact.
+  const real hi = particle_side_[model.node_particle()[i]].mesh_size;
+  const real ht = particle_side_[model.node_particle()[target]].mesh_size;
+  const real share = ht * ht / (hi * hi + ht * ht);
+  const real area =
+      dimension_ == 2 ? hi / std::min(hi, ht) : (hi * hi) / (std::min(hi, ht) * std::min(hi, ht));
+  return share * area * contact::pair_stiffness(law, model.volumes()[i], model.volumes()[target]);
+}
+
+real ContactModel::node_radius(const contact::Law& law, const Model& model, index_t i, index_t j,
+                               real contact_radius) const {
+  const auto& owner = model.node_particle();
+  return contact::node_share(law, particle_side_[owner[i]], particle_side_[owner[j]], contact_radius);
+}
+
+real ContactModel::entry_stiffness(const Model& model, index_t i, index_t e) const {
+  return contact::pair_stiffness(slot_law(pair_slot_[e]), model.volumes()[i],
+                                 model.volumes()[pair_partner_[e]]);
+}
+
+real ContactModel::wall_spring_stiffness(const Model& model, index_t i, index_t e) const {
+  return contact::pair_stiffness(slot_law(wall_slot_[e]), model.volumes()[i], model.volumes()[i]);
+}
+
+ContactModel::PairGeometry ContactModel::pair_geometry(const Model& model, const State& state, index_t i,
+                                                       index_t e) const {
+  const index_t j = pair_partner_[e];
+  const contact::Law& law = laws_[model.node_material()[i] * material_count_ + model.node_material()[j]];
+  const real contact_radius = slot_law(pair_slot_[e]).contact_radius;
+  const vec3 xi = contact_position(model, state, i), xj = contact_position(model, state, j);
+  const vec d{xj[0] - xi[0], xj[1] - xi[1], xj[2] - xi[2]};  // as in A
+  const real distance = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+  PairGeometry g;
+  g.normal = {d[0] / distance, d[1] / distance, d[2] / distance};
+  g.overlap = contact_radius - distance;
+  g.lever_i = node_radius(law, model, i, j, contact_radius) - 0.5 * g.overlap;
+  g.lever_j = node_radius(law, model, j, i, contact_radius) - 0.5 * g.overlap;
+  return g;
+}
+
+ContactModel::WallGeometry ContactModel::wall_geometry(const Model& model, index_t i, index_t e) const {
+  // Friction acts at the deepest point: p = c_i - lever n, n from the wall towards the node.
+  const contact::PairLaw& resolved = slot_law(wall_slot_[e]);
+  const WallPoints& points = wall_points_[e];
+  const WallContact& deepest = points.points[deepest_point(points.points.data(), points.count)];
+  const real lever = resolved.contact_radius - 0.5 * (resolved.contact_radius - deepest.distance);
+  WallGeometry g;
+  g.normal = deepest.normal;
+  g.arm = {-lever * g.normal[0], -lever * g.normal[1], -lever * g.normal[2]};
+  g.stiffness = wall_spring_stiffness(model, i, e);
+  return g;
+}
+
+vec3 ContactModel::pair_surface_normal(index_t i, index_t j, const vec3& line) const {
+  // The mean of the two surfaces' normals, n_i - n_j (n_j points out of the other body), where
+  // both nodes lie on surfaces that face each other (|n_i - n_j| > 1, within 90 degrees of the
+  // line of the nodes); the line itself otherwise.
+  auto normal = [&](index_t node) {
+    const auto at = std::lower_bound(touching_nodes_.begin(), touching_nodes_.end(), node);
+    if (at == touching_nodes_.end() || *at != node) return vec{0, 0, 0};  // not measured: the line
+    return touching_normals_[static_cast<std::size_t>(at - touching_nodes_.begin())];
+  };
+  const vec ni = normal(i), nj = normal(j);
+  const vec sum{ni[0] - nj[0], ni[1] - nj[1], ni[2] - nj[2]};
+  const real norm = std::sqrt(dot(sum, sum));
+  if (!(norm > 1.0) || !(dot(sum, line) > 0)) return line;
+  return {sum[0] / norm, sum[1] / norm, sum[2] / norm};
+}
+
+bool ContactModel::slot_in_contact(std::size_t slot) const {
+  const index_t touch = slot_touch_[slot];
+  if (touch == not_touching) return false;
+  const vec& sum = slot_surface_normal_[touch];
+  return dot(sum, sum) > 0 && slot_force_[touch] > 0;
+}
+
+vec3 ContactModel::slot_contact_point(index_t touch) const {
+  const real force = slot_force_[touch];
+  return {slot_point_[touch][0] / force, slot_point_[touch][1] / force, slot_point_[touch][2] / force};
+}
+
+void ContactModel::add_forces(const Model& model, State& state, std::uint64_t broken_bonds) {
+  if (!active()) return;
+  const auto search_start = std::chrono::steady_clock::now();
+  if (!centres_.found()) centres_.find(model, state, centring_depths(model), surface_particles_);
+  real moved = 0;  // largest node displacement since the build
+  // A crack that opens nodes which took no part in contact needs a search: they may face
+  // another body now.
+  if (needs_rebuild(model, state, moved) ||
+      (broken_bonds != broken_at_build_ && breaks_open_new_nodes(model))) {
+    centres_.fill_positions(model, state, positions_at_build_);
+    rebuild(model, state, broken_bonds);
+  } else if (broken_bonds != broken_at_build_) {
+    update_after_breaks(model, state, broken_bonds, moved);
+  }
+  search_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - search_start).count();
+  const real dt = has_last_time_ ? state.time - last_time_ : 0.0;
+  last_time_ = state.time;
+  has_last_time_ = true;
+  if (any_surface_) measure_surface_points(model, state);  // A: the lists' surface points
+  measure_contacts(model, state);         //    distances, springs, probes, wall contact points
+  sum_slot_stiffness();                   // B: K per pair of bodies; the touching bodies
+  measure_bodies(model, state);           //    rigid-body motion of the touching bodies
+  measure_surface_normals(model, state);  //    outward normals of the nodes in contact
+  sum_slot_springs(model, state);         //    spring force, normal and contact point per slot
+  sum_probe_springs();                    //    the same for the surface probes
+  slot_dashpots(state, dt);               //    the body dashpots, as loads on the bodies
+  slot_rolling_resistance(state, dt);     //    the rolling torques, as couples on the bodies
+  slot_redirects();                       //    each collision's force turned to the surface normal
+  if (any_surface_) probe_frictions(model, state, dt);  // C: the surface probes' friction
+  node_forces(model, state, dt);                        //    springs, friction, fragment dashpots, per node
+  probe_couples(state);                                 //    the probes' friction couples, as loads
+  body_loads(model, state);  // E: dashpots and friction couples as rigid-body loads
+  sum_wall_reactions();      // D: wall reactions
+}
+
+void ContactModel::measure_surface_points(const Model& model, const State& state) {
+  // The surface points of the nodes with list entries, once per step, for every probe that
+  // reaches them (surface_slot_ numbers them in node order).
+  const std::int64_t count = static_cast<std::int64_t>(surface_nodes_.size());
+#pragma omp parallel for schedule(static)
+  for (std::int64_t k = 0; k < count; ++k) {
+    const index_t j = surface_nodes_[k];
+    const SurfaceCentres::Seen seen = centres_.seen(model, j);
+    contact::SurfacePoint& point = surface_points_[k];
+    const vec3 a = SurfaceCentres::anchored_vector(seen, state.positions, j);
+    const real size = std::sqrt(dot(a, a));
+    const real* y = state.positions.data();
+    for (int c = 0; c < 3; ++c) {
+      point.normal[c] = a[c] / size;
+      point.position[c] = y[3 * j + c] + seen.surface_length * point.normal[c];
+    }
+    point.curvature = seen.anchor->curvature / seen.mesh_size;
+    surface_sizes_[k] = size;
+  }
+}
+
+void ContactModel::measure_contacts(const Model& model, const State& state) {
+  // The only geometry pass: distance and spring stiffness of every pair entry in contact, and the
+  // contact points (normals in the world frame) of every wall entry, and the nodes in contact with
+  // another body. The later passes read these.
+  const auto& volume = model.volumes();
+  const std::int64_t n = model.node_count();
+  const real t = state.time;
+  touching_nodes_.clear();
+#pragma omp parallel
+  {
+    std::vector<WallContact> found;  // scratch of this thread
+    ProbeScratch probe_scratch;
+    std::vector<index_t> touching_nodes;
+    real deepest = 0;  // overlap / Rc
+#pragma omp for schedule(static) nowait
+    for (std::int64_t ii = 0; ii < n; ++ii) {
+      const index_t i = static_cast<index_t>(ii);
+      if (pair_offsets_[i] == pair_offsets_[i + 1] && wall_offsets_[i] == wall_offsets_[i + 1]) continue;
+      vec3 xi{0, 0, 0};
+      bool have_xi = false;  // the contact centre, where a sphere pair or a wall needs it
+      auto centre = [&]() -> const vec3& {
+        if (!have_xi) xi = contact_position(model, state, i), have_xi = true;
+        return xi;
+      };
+      bool touching = false;
+      for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
+        const index_t j = pair_partner_[e];
+        const contact::PairLaw& law = slot_law(pair_slot_[e]);
+        if (surface_entry(model, i, e)) {
+          pair_stiffness_[e] = 0;  // the surface law (measure_probes) decides
+          continue;
+        }
+        centre();
+        const vec3 xj = contact_position(model, state, j);
+        const real dx = xj[0] - xi[0], dy = xj[1] - xi[1], dz = xj[2] - xi[2];
+        const real distance = std::sqrt(dx * dx + dy * dy + dz * dz);
+        pair_stiffness_[e] = distance < law.contact_radius && distance > 0
+                                 ? static_cast<float>(contact::pair_stiffness(law, volume[i], volume[j]))
+                                 : 0.0f;
+        touching = touching || (pair_stiffness_[e] > 0 && !law.node_pair && node_body_[i] != node_body_[j]);
+        if (pair_stiffness_[e] > 0 && !law.node_pair)
+          deepest = std::max(deepest, 1 - distance / law.contact_radius);
+      }
+      if (touching) touching_nodes.push_back(i);
+      deepest = std::max(deepest, measure_probes(model, state, i, probe_scratch));
+      for (index_t e = wall_offsets_[i]; e < wall_offsets_[i + 1]; ++e) {
+        const Wall& wall = walls_[wall_entry_[e][0]];
+        const contact::PairLaw& law = slot_law(wall_slot_[e]);
+        found.clear();
+        wall.contacts(wall_entry_[e][1], wall.to_reference(centre().data(), t), law.contact_radius,
+                      dimension_, found);
+        WallPoints& points = wall_points_[e];
+        points.count = static_cast<std::uint8_t>(std::min(found.size(), points.points.size()));
+        for (std::size_t k = 0; k < points.count; ++k) {
+          points.points[k] = {found[k].distance, wall.rotate_to_world(found[k].normal, t)};
+        }
+        wall_entry_stiffness_[e] = static_cast<real>(points.count) * wall_spring_stiffness(model, i, e);
+      }
+    }
+#pragma omp critical
+    {
+      touching_nodes_.insert(touching_nodes_.end(), touching_nodes.begin(), touching_nodes.end());
+      statistics_.deepest_overlap = std::max(statistics_.deepest_overlap, deepest);
+    }
+  }
+  std::sort(touching_nodes_.begin(), touching_nodes_.end());  // the same for any thread count
+}
+
+real ContactModel::measure_probes(const Model& model, const State& state, index_t i, ProbeScratch& scratch) {
+  // Node i's probes of other bodies' surfaces (contact/surface_law.hpp): each group's points
+  // in reach that face the probe, their sums, then the gap, its gradient and the push, then
+  // each probe entry's share of the probe's stiffness (its in-contact flag). Returns the
+  // deepest overlap over Rc. A group with no point in reach is apart (push 0) and costs one
+  // distance per entry.
+  const auto [group_begin, group_end] = groups_of(i);
+  if (group_begin == group_end) return 0;
+  const bool surface = on_surface(model, i);
+  const vec3 p = centres_.at_surface(model, state, i);
+  const index_t first = pair_offsets_[i], last = pair_offsets_[i + 1];
+  scratch.points.assign(last - first, nullptr);  // the points in reach (null: none)
+  scratch.weights.assign(last - first, 0.0);
+  // The distance of each group's nearest point in reach (-1: none yet).
+  scratch.nearest.assign(group_end - group_begin, -1);
+  for (index_t e = first; e < last; ++e) {  // the points in reach, and each group's nearest
+    const index_t g = entry_group_[e];
+    if (g == no_group) continue;
+    const index_t j = pair_partner_[e];
+    const real support = contact::surface_support_factor * particle_side_[model.node_particle()[j]].mesh_size;
+    const contact::SurfacePoint& point = surface_point(j);
+    const vec d{p[0] - point.position[0], p[1] - point.position[1], p[2] - point.position[2]};
+    const real distance = std::sqrt(dot(d, d));
+    if (!(distance < support)) continue;
+    scratch.points[e - first] = &point;
+    real& best = scratch.nearest[g - group_begin];
+    if (best < 0) {  // the group's first point in reach: set the probe up
+      ProbeState& probe = probes_[g];
+      probe = ProbeState{};
+      const contact::PairLaw& law = slot_law(pair_slot_[e]);
+      const contact::Law& own = laws_[model.node_material()[i] * material_count_ + model.node_material()[j]];
+      probe.point = p;
+      probe.support = support;
+      probe.radius = surface ? 0.0 : node_radius(own, model, i, j, law.contact_radius);
+      probe.stiffness = probe_stiffness(model, i, j, law);
+      probe.contact_radius = law.contact_radius;
+    }
+    if (best < 0 || distance < best) {
+      best = distance;
+      probes_[g].facing = point.normal;
+    }
+  }
+  for (index_t e = first; e < last; ++e) {
+    const contact::SurfacePoint* point = scratch.points[e - first];
+    if (point == nullptr) continue;
+    ProbeState& probe = probes_[entry_group_[e]];
+    if (!contact::faces(*point, probe.facing)) continue;
+    const contact::PointTerms t = contact::point_terms(*point, p, probe.support);
+    scratch.weights[e - first] = t.weight;
+    probe.sums.add(t);
+  }
+  real deepest = 0;
+  for (index_t g = group_begin; g < group_end; ++g) {
+    ProbeState& probe = probes_[g];
+    probe.push = probe.taper = 0;
+    if (scratch.nearest[g - group_begin] < 0 || !probe.sums.reached()) continue;
+    const real overlap = probe.radius - probe.sums.gap();
+    if (!(overlap > 0)) continue;
+    probe.gradient = probe.sums.gradient();
+    probe.push = probe.stiffness * overlap * contact::surface_taper(probe.sums.weight);
+    probe.taper = 0.5 * probe.stiffness * overlap * overlap * contact::surface_taper_slope(probe.sums.weight);
+    probe.friction = probe.foot = {0, 0, 0};
+    // The overlap that carries force (a probe tapered past the edge of its points does not).
+    deepest = std::max(deepest, probe.push / (probe.stiffness * probe.contact_radius));
+  }
+  for (index_t e = first; e < last; ++e) {
+    const index_t g = entry_group_[e];
+    if (g == no_group) continue;
+    const ProbeState& probe = probes_[g];
+    pair_stiffness_[e] =
+        probe.push == 0
+            ? 0.0f
+            : static_cast<float>(probe.stiffness * scratch.weights[e - first] / probe.sums.weight);
+  }
+  return deepest;
+}
+
+real ContactModel::surface_share(const ProbeState& probe, const contact::SurfacePoint& point) const {
+  if (!contact::faces(point, probe.facing)) return 0;
+  const vec d{probe.point[0] - point.position[0], probe.point[1] - point.position[1],
+              probe.point[2] - point.position[2]};
+  return contact::surface_weight(std::sqrt(dot(d, d)) / probe.support) / probe.sums.weight;
+}
+
+void ContactModel::sum_slot_stiffness() {
+  // K per pair of bodies, summed in entry order: each node pair of the sphere law is listed
+  // twice; a surface probe's entries share its stiffness.
+  std::fill(slot_stiffness_.begin(), slot_stiffness_.end(), 0.0);
+  std::uint64_t touching = 0, wall_touching = 0;
+  for (std::size_t e = 0; e < pair_stiffness_.size(); ++e) {
+    const bool probe = probe_entry(e);
+    slot_stiffness_[pair_slot_[e]] += (probe ? 1.0 : 0.5) * pair_stiffness_[e];
+    touching += pair_stiffness_[e] > 0 && !probe ? 1 : 0;
+  }
+  touching /= 2;
+  for (const ProbeState& probe : probes_) touching += probe.push > 0 ? 1 : 0;
+  for (std::size_t e = 0; e < wall_entry_stiffness_.size(); ++e) {
+    slot_stiffness_[wall_slot_[e]] += wall_entry_stiffness_[e];
+    wall_touching += wall_entry_stiffness_[e] > 0 ? 1 : 0;
+  }
+  statistics_.node_contacts = touching;
+  statistics_.wall_contacts = wall_touching;
+  assign_springs();
+  // The touching bodies (in a collision, or in a gap of one) and the slots in contact, numbered
+  // in slot order.
+  for (const index_t b : touching_bodies_) body_touch_[b] = not_touching;
+  touching_bodies_.clear();
+  auto touch = [&](index_t body) {
+    if (body_touch_[body] != not_touching) return;
+    body_touch_[body] = static_cast<index_t>(touching_bodies_.size());
+    touching_bodies_.push_back(body);
+  };
+  index_t in_contact = 0;
+  for (std::size_t slot = 0; slot < slots_.size(); ++slot) {
+    slot_touch_[slot] = slot_stiffness_[slot] > 0 ? in_contact++ : not_touching;
+    if (slot_stiffness_[slot] == 0 && !(collisions_.approach(slot) > 0)) continue;
+    touch(slots_[slot][0]);
+    if (slot < particle_slot_count_) touch(slots_[slot][1]);
+  }
+  body_motion_.resize(touching_bodies_.size());
+  body_load_.resize(touching_bodies_.size());
+  release_excess(body_motion_);
+  release_excess(body_load_);
+  slot_force_.assign(in_contact, 0.0);
+  slot_normal_.assign(in_contact, vec3{0, 0, 0});
+  slot_point_.assign(in_contact, vec3{0, 0, 0});
+  slot_surface_normal_.assign(in_contact, vec3{0, 0, 0});
+  slot_load_.assign(in_contact, vec3{0, 0, 0});
+  release_excess(slot_force_);
+  for (auto* v : {&slot_normal_, &slot_point_, &slot_surface_normal_, &slot_load_}) release_excess(*v);
+}
+
+void ContactModel::measure_bodies(const Model& model, const State& state) {
+  const std::int64_t count = static_cast<std::int64_t>(touching_bodies_.size());
+#pragma omp parallel for schedule(dynamic, 16)
+  for (std::int64_t k = 0; k < count; ++k) {
+    const index_t b = touching_bodies_[k];
+    body_load_[k] = {0, 0, 0, 0, 0, 0};
+    body_motion_[k] = measure_body(model, state, body_nodes_.data() + body_node_offsets_[b],
+                                   body_node_offsets_[b + 1] - body_node_offsets_[b], dimension_);
+  }
+}
+
+void ContactModel::measure_surface_normals(const Model& model, const State& state) {
+  // The surface normal of every node in a node pair in contact between two bodies (listed by
+  // measure_contacts, in node order, for the look-ups of pair_surface_normal), in parallel.
+  touching_normals_.resize(touching_nodes_.size());
+  release_excess(touching_nodes_);
+  release_excess(touching_normals_);
+  const std::int64_t count = static_cast<std::int64_t>(touching_nodes_.size());
+#pragma omp parallel for schedule(static)
+  for (std::int64_t k = 0; k < count; ++k)
+    touching_normals_[k] = surface_normal(model, state, touching_nodes_[k]);
+}
+
+void ContactModel::sum_slot_springs(const Model& model, const State& state) {
+  // Spring force, spring-weighted normal (from the first body to the second, or from the wall to
+  // the particle) and spring-weighted contact point per slot, summed in node order.
+  for (const index_t i : contact_nodes_) {
+    const vec3 xi = contact_position(model, state, i);
+    for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
+      const index_t j = pair_partner_[e];
+      const std::size_t slot = pair_slot_[e];
+      if (pair_stiffness_[e] == 0 || probe_entry(e) || node_body_[i] == node_body_[j] ||
+          node_body_[i] != slots_[slot][0])
+        continue;
+      const index_t touch = slot_touch_[slot];
+      const PairGeometry g = pair_geometry(model, state, i, e);
+      const real spring = contact::normal_force(entry_stiffness(model, i, e), g.overlap);
+      const vec surface = slot_law(slot).node_pair ? g.normal : pair_surface_normal(i, j, g.normal);
+      slot_force_[touch] += spring;
+      for (int k = 0; k < 3; ++k) {
+        slot_normal_[touch][k] += spring * g.normal[k];
+        slot_point_[touch][k] += spring * (xi[k] + g.lever_i * g.normal[k]);
+        slot_surface_normal_[touch][k] += spring * surface[k];
+      }
+    }
+    for (index_t e = wall_offsets_[i]; e < wall_offsets_[i + 1]; ++e) {
+      const std::size_t slot = wall_slot_[e];
+      if (wall_entry_stiffness_[e] == 0) continue;
+      const index_t touch = slot_touch_[slot];
+      const contact::PairLaw& law = slot_law(slot);
+      const WallPoints& points = wall_points_[e];
+      for (std::size_t k = 0; k < points.count; ++k) {
+        const real overlap = law.contact_radius - points.points[k].distance;
+        const real spring = contact::normal_force(wall_spring_stiffness(model, i, e), overlap);
+        const real lever = law.contact_radius - 0.5 * overlap;
+        slot_force_[touch] += spring;
+        for (int c = 0; c < 3; ++c) {
+          slot_normal_[touch][c] += spring * points.points[k].normal[c];
+          slot_surface_normal_[touch][c] += spring * points.points[k].normal[c];
+          slot_point_[touch][c] += spring * (xi[c] - lever * points.points[k].normal[c]);
+        }
+      }
+    }
+  }
+}
+
+void ContactModel::sum_probe_springs() {
+  // The surface probes' pushes, in group order: the force k delta |G| along the surface's normal
+  // (from the slot's first body to its second), at the probe point.
+  for (std::size_t g = 0; g < groups_.size(); ++g) {
+    const ProbeState& probe = probes_[g];
+    if (probe.push == 0) continue;
+    const std::size_t slot = groups_[g].slot;
+    const index_t touch = slot_touch_[slot];
+    const real size = std::sqrt(dot(probe.gradient, probe.gradient));
+    const real force = probe.push * size;
+    // G points out of the target body; the slot's normal from its first body to its second.
+    const real sign = groups_[g].body == slots_[slot][0] ? 1.0 : -1.0;
+    slot_force_[touch] += force;
+    for (int k = 0; k < 3; ++k) {
+      const real along = sign * probe.gradient[k] / size;
+      slot_normal_[touch][k] += force * along;
+      slot_surface_normal_[touch][k] += force * along;
+      slot_point_[touch][k] += force * probe.point[k];
+    }
+  }
+}
+
+real ContactModel::spring_energy(const Model& model, const State& state) const {
+  if (!built_) return 0;
+  real energy = 0;
+  for (const index_t i : contact_nodes_) {
+    for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
+      if (pair_partner_[e] < i) continue;        // each pair once: the lists hold both directions
+      if (surface_entry(model, i, e)) continue;  // the probes below
+      const real overlap = pair_geometry(model, state, i, e).overlap;
+      if (overlap > 0) energy += 0.5 * entry_stiffness(model, i, e) * overlap * overlap;
+    }
+    for (index_t e = wall_offsets_[i]; e < wall_offsets_[i + 1]; ++e) {
+      const contact::PairLaw& law = slot_law(wall_slot_[e]);
+      const WallPoints& points = wall_points_[e];
+      for (std::size_t k = 0; k < points.count; ++k) {
+        const real overlap = law.contact_radius - points.points[k].distance;
+        if (overlap > 0) energy += 0.5 * wall_spring_stiffness(model, i, e) * overlap * overlap;
+      }
+    }
+  }
+  // The surface probes, from their last evaluation: k delta^2 tau / 2 = P^2 / (2 k tau).
+  for (const ProbeState& probe : probes_) {
+    if (probe.push > 0)
+      energy += 0.5 * probe.push * probe.push / (probe.stiffness * contact::surface_taper(probe.sums.weight));
+  }
+  return energy;
+}
+
+}  // namespace granulate
