@@ -9,6 +9,17 @@ counts must agree with each other too (granulate's determinism promise).
     python benchmarks/output_hashes.py --compare before.json   # the new one: exit 1 if any differ
 
 Every run is cut to a few thousand steps; the whole set takes about 2 minutes on 2 cores.
+
+A refactor of the C++ core is checked on builds without floating-point contraction. The default
+build (-march=native) lets GCC fuse a*b + c into one FMA wherever its inlining brings the two
+together, and that follows the code's layout: moving functions between files (or within one)
+changes a few last bits without changing any arithmetic (seen when contact_model.cpp was split:
+<= 6.4e-15 relative in two example smokes). Build both versions with the contraction off, point
+PYTHONPATH at each, and compare those:
+
+    cmake -S OLD -B old_build -G Ninja -DCMAKE_BUILD_TYPE=Release -DSKBUILD=ON \
+        -DCMAKE_CXX_FLAGS=-ffp-contract=off -Dnanobind_DIR=$(python -m nanobind --cmake_dir)
+    ninja -C old_build   # then copy the installed granulate package beside its _core*.so
 """
 
 from __future__ import annotations
