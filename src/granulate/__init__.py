@@ -37,6 +37,7 @@ from granulate.packing import (
     pack,
     read_placements,
 )
+from granulate.reference_shapes import ReferenceShape
 from granulate.results import Frame, Results
 from granulate.shapes import (
     Box,
@@ -48,7 +49,6 @@ from granulate.shapes import (
     Ellipsoid,
     Polygon,
     Rectangle,
-    ReferenceShape,
     RegularPolygon,
     Shape,
     Sphere,

@@ -21,7 +21,8 @@ from granulate.errors import InputError
 from granulate.input_errors import check_number
 from granulate.materials import Material
 from granulate.packing import Grain, Packing, Placements, grains_by_kind
-from granulate.shapes import ReferenceShape, Shape, rotation_matrix
+from granulate.reference_shapes import ReferenceShape
+from granulate.shapes import Shape, rotation_matrix
 
 #: A body's initial motion: its linear velocity and its spin (about z in 2D, a vector in 3D).
 InitialVelocity = tuple["Body", NDArray[np.float64], float | NDArray[np.float64]]

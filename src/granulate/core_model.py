@@ -14,8 +14,9 @@ from granulate import _core, resources
 from granulate.assembly import Assembly, Body
 from granulate.errors import InputError
 from granulate.materials import Material
+from granulate.reference_shapes import ReferenceShape
 from granulate.shape_sharing import TranslatedShapes
-from granulate.shapes import ReferenceShape, Shape
+from granulate.shapes import Shape
 
 #: The most horizon / mesh size accepted: peridynamic horizons are 3-4 mesh sizes; at 20 a node
 #: has about 1,300 bonds in 2D and 34,000 in 3D.

@@ -24,7 +24,7 @@ from granulate import resources
 from granulate.errors import InputError
 from granulate.io.files import existing_file
 from granulate.io.table import read_table
-from granulate.shapes import Shape, _points
+from granulate.shapes.base import Shape, _points
 
 #: Element kinds we take volumes from, per dimension, with their node count.
 AREA_CELLS = {"triangle": 3, "quad": 4}

@@ -36,7 +36,8 @@ from granulate.errors import InputError
 from granulate.input_errors import checked_arguments
 from granulate.io.table import read_table
 from granulate.materials import Material
-from granulate.shapes import ReferenceShape, Shape
+from granulate.reference_shapes import ReferenceShape
+from granulate.shapes import Shape
 
 
 # ----------------------------------------------------------------------- size distributions

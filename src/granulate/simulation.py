@@ -47,8 +47,9 @@ from granulate.io import checkpoint as checkpoint_file
 from granulate.loading import Components, Loading
 from granulate.materials import Material
 from granulate.packing import Grain, Packing, Placements
+from granulate.reference_shapes import ReferenceShape
 from granulate.run_loop import Progress, RunPlan, RunRecord
-from granulate.shapes import ReferenceShape, Shape
+from granulate.shapes import Shape
 from granulate.stopping import StopCriterion
 from granulate.walls import Surface, Wall
 from granulate.writers.outputs import Outputs

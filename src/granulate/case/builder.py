@@ -33,6 +33,7 @@ from granulate.case.shape_specs import ShapeRef
 from granulate.errors import InputError
 from granulate.io.files import existing_file
 from granulate.materials import Material
+from granulate.reference_shapes import ReferenceShape
 from granulate.simulation import Body, Simulation
 
 
@@ -84,7 +85,7 @@ class CaseContext:
                 values = g.sizes.model_dump()
                 sizes = _SIZES[values.pop("distribution")](**values)
             if g.mesh is not None:
-                source: shapes.Shape | shapes.ReferenceShape = shapes.ReferenceShape.from_mesh(
+                source: shapes.Shape | ReferenceShape = ReferenceShape.from_mesh(
                     str(self.path(g.mesh.file)),
                     dimension=g.mesh.dimension,
                     mesh_size=g.mesh.mesh_size,
