@@ -225,7 +225,8 @@ def main(argv: list[str] | None = None) -> int:
         warnings.showwarning = previous
 
 
-def _main(argv: list[str] | None) -> int:
+def _parser() -> argparse.ArgumentParser:
+    """The command line: global options and one sub-parser per command."""
     parser = argparse.ArgumentParser(prog="granulate", description=__doc__.splitlines()[0])
     parser.add_argument("--version", action="version", version=f"granulate {__version__}")
     parser.add_argument("--debug", action="store_true", help="show tracebacks of errors")
@@ -272,6 +273,52 @@ def _main(argv: list[str] | None) -> int:
     render.add_argument("directory", type=Path)
     render.add_argument("--frame", type=int, help="only this frame (default: all)")
     render.add_argument("--gif", action="store_true", help="also an animated GIF of the run")
+    return parser
+
+
+def _dispatch(options: argparse.Namespace) -> int:
+    """Run the command `options` name; its exit code."""
+    if options.command == "info":
+        return _info()
+    if options.command == "schema":
+        return _schema(options.json)
+    if options.command == "check":
+        return _check(options.case, options.peridem_compat)
+    if options.command == "convert":
+        return _convert(options.deck, options.output, options.peridem_compat, options.overwrite)
+    if options.command == "run":
+        if options.case.suffix == ".py":
+            return _run_script(options.case, options.args)
+        if options.args:
+            raise InputError(f"unexpected arguments {options.args} after the case file")
+        return _run_case(
+            options.case,
+            options.out,
+            options.resume,
+            options.overwrite,
+            options.quiet,
+            options.steps,
+            options.peridem_compat,
+        )
+    if options.command == "bench":
+        from granulate import bench as benchmarks
+
+        if options.contended:
+            return benchmarks.contended(options.case, options.quick, options.json, options.out)
+        return benchmarks.main(options.case, options.quick, None, options.json, options.out)
+    from granulate import plots
+
+    if options.command == "plot":
+        for written in plots.plot_history(options.directory):
+            print(written)
+        return 0
+    for written in plots.render(options.directory, frame=options.frame, gif=options.gif):
+        print(written)
+    return 0
+
+
+def _main(argv: list[str] | None) -> int:
+    parser = _parser()
     options, extra = parser.parse_known_args(argv)
     if extra and not (options.command == "run" and options.case.suffix == ".py"):
         parser.error(f"unrecognized arguments: {' '.join(extra)}")
@@ -280,43 +327,7 @@ def _main(argv: list[str] | None) -> int:
     try:
         if options.threads is not None:
             threads.set_num_threads(options.threads)
-        if options.command == "info":
-            return _info()
-        if options.command == "schema":
-            return _schema(options.json)
-        if options.command == "check":
-            return _check(options.case, options.peridem_compat)
-        if options.command == "convert":
-            return _convert(options.deck, options.output, options.peridem_compat, options.overwrite)
-        if options.command == "run":
-            if options.case.suffix == ".py":
-                return _run_script(options.case, options.args)
-            if options.args:
-                raise InputError(f"unexpected arguments {options.args} after the case file")
-            return _run_case(
-                options.case,
-                options.out,
-                options.resume,
-                options.overwrite,
-                options.quiet,
-                options.steps,
-                options.peridem_compat,
-            )
-        if options.command == "bench":
-            from granulate import bench as benchmarks
-
-            if options.contended:
-                return benchmarks.contended(options.case, options.quick, options.json, options.out)
-            return benchmarks.main(options.case, options.quick, None, options.json, options.out)
-        from granulate import plots
-
-        if options.command == "plot":
-            for written in plots.plot_history(options.directory):
-                print(written)
-            return 0
-        for written in plots.render(options.directory, frame=options.frame, gif=options.gif):
-            print(written)
-        return 0
+        return _dispatch(options)
     except InputError as error:
         if options.debug:
             raise

@@ -9,14 +9,18 @@ from __future__ import annotations
 
 import os
 import zlib
+from base64 import b64decode
 from collections.abc import Mapping
 from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass
 from pathlib import Path
+from xml.etree import ElementTree
 from xml.sax.saxutils import quoteattr
 
 import numpy as np
 from numpy.typing import NDArray
 
+from granulate.errors import InputError
 from granulate.io.atomic import atomic_write
 
 _BLOCK = 1 << 16
@@ -224,74 +228,52 @@ _NUMPY_TYPES = {
 }
 
 
-def read_vtu_point_data(
-    path: str | os.PathLike[str],
-) -> tuple[NDArray[np.float64], dict[str, NDArray[np.generic]]]:
-    """Points and point data of a .vtu file: appended data (raw or base64, plain or with VTK's
-    zlib blocks, UInt32 or UInt64 headers) or inline ASCII arrays; this writer's frames and
-    PeriDEM's output files. Raises InputError naming the problem otherwise."""
-    import base64
-    import xml.etree.ElementTree as ElementTree
+@dataclass(frozen=True)
+class _Appended:
+    """A VTU file's appended data: its bytes (after the "_"), their encoding, the block header's
+    integer type and whether the arrays are zlib blocks (VTK's vtkZLibDataCompressor)."""
 
-    from granulate.errors import InputError
+    data: bytes
+    base64: bool
+    header: str  # "<u4" or "<u8"
+    compressed: bool
 
-    source = Path(path)
-    try:
-        data = source.read_bytes()
-    except OSError as error:
-        raise InputError(f"cannot read {source}: {error}") from None
-    start = data.find(b"<AppendedData")
-    appended = b""
-    encoding = "raw"
-    if start >= 0:
-        tag_end = data.index(b">", start)
-        encoding = "base64" if b'encoding="base64"' in data[start:tag_end] else "raw"
-        body_start = data.index(b"_", tag_end) + 1
-        body_end = data.rfind(b"</AppendedData>")
-        appended = data[body_start:body_end]
-        if encoding == "base64":
-            appended = appended.strip()
-        xml_text = data[:start] + b"</VTKFile>"
-    else:
-        xml_text = data
-    try:
-        root = ElementTree.fromstring(xml_text)
-    except ElementTree.ParseError as error:
-        raise InputError(f"{source} is not a VTU file: {error}") from None
-    header = "<u8" if root.get("header_type") == "UInt64" else "<u4"
-    header_size = np.dtype(header).itemsize
-    compressed = root.get("compressor") == "vtkZLibDataCompressor"
-    if root.get("compressor") not in (None, "vtkZLibDataCompressor"):
-        raise InputError(f"{source}: compressor {root.get('compressor')} is not supported")
+    def decode(self, chunk: bytes) -> bytes:
+        return b64decode(chunk) if self.base64 else chunk
 
-    def decode(chunk: bytes) -> bytes:
-        return base64.b64decode(chunk) if encoding == "base64" else chunk
+    def array_bytes(self, offset: int) -> bytes:
+        """The bytes of the array at `offset`: [size] data, or zlib blocks."""
+        return self._zlib_blocks(offset) if self.compressed else self._plain(offset)
 
-    def appended_bytes(offset: int) -> bytes:
-        if not compressed:
-            if encoding == "base64":  # header and data encoded together
-                size_chars = 4 * -(-header_size // 3)
-                size = int(
-                    np.frombuffer(
-                        decode(appended[offset : offset + size_chars])[:header_size], header
-                    )[0]
-                )
-                chars = 4 * -(-(header_size + size) // 3)
-                return decode(appended[offset : offset + chars])[header_size : header_size + size]
-            size = int(np.frombuffer(appended[offset : offset + header_size], header)[0])
-            return appended[offset + header_size : offset + header_size + size]
-        # zlib blocks: [count, block size, last size, compressed sizes...] then the blocks.
-        head_chars = 3 * header_size
-        if encoding == "base64":
-            first = decode(appended[offset : offset + 4 * -(-head_chars // 3)])
+    def _plain(self, offset: int) -> bytes:
+        header_size = np.dtype(self.header).itemsize
+        appended = self.data
+        if self.base64:  # header and data encoded together
+            size_chars = 4 * -(-header_size // 3)
+            head = self.decode(appended[offset : offset + size_chars])[:header_size]
+            size = int(np.frombuffer(head, self.header)[0])
+            chars = 4 * -(-(header_size + size) // 3)
+            return self.decode(appended[offset : offset + chars])[header_size : header_size + size]
+        size = int(np.frombuffer(appended[offset : offset + header_size], self.header)[0])
+        return appended[offset + header_size : offset + header_size + size]
+
+    def _zlib_blocks(self, offset: int) -> bytes:
+        """[count, block size, last size, compressed sizes...] then the blocks."""
+        header, header_size = self.header, np.dtype(self.header).itemsize
+        appended = self.data
+        if self.base64:
+            head_chars = 3 * header_size
+            first = self.decode(appended[offset : offset + 4 * -(-head_chars // 3)])
             count = int(np.frombuffer(first[:header_size], header)[0])
             table_bytes = (3 + count) * header_size
             table_chars = 4 * -(-table_bytes // 3)
             table = np.frombuffer(
-                decode(appended[offset : offset + table_chars])[:table_bytes], header
+                self.decode(appended[offset : offset + table_chars])[:table_bytes], header
             )
             blocks_chars = 4 * -(-int(table[3:].sum()) // 3)
-            payload = decode(appended[offset + table_chars : offset + table_chars + blocks_chars])
+            payload = self.decode(
+                appended[offset + table_chars : offset + table_chars + blocks_chars]
+            )
         else:
             count = int(np.frombuffer(appended[offset : offset + header_size], header)[0])
             table = np.frombuffer(appended[offset : offset + (3 + count) * header_size], header)
@@ -303,24 +285,65 @@ def read_vtu_point_data(
             position += int(size)
         return b"".join(out)
 
-    def array(element: ElementTree.Element) -> NDArray[np.generic]:
-        kind = element.get("type", "")
-        if kind not in _NUMPY_TYPES:
-            raise InputError(
-                f"{source}: array {element.get('Name')!r} of type {kind!r} is not supported"
-            )
-        fmt = element.get("format", "ascii")
-        if fmt == "appended":
-            values = np.frombuffer(
-                appended_bytes(int(element.get("offset", "0"))), _NUMPY_TYPES[kind]
-            )
-        elif fmt == "ascii":
-            values = np.array((element.text or "").split(), dtype=_NUMPY_TYPES[kind])
-        else:
-            raise InputError(f"{source}: {fmt!r} arrays are not supported (use appended or ascii)")
-        components = int(element.get("NumberOfComponents", "1"))
-        return values.reshape(-1, components) if components > 1 else values.copy()
 
+def _split_appended(data: bytes) -> tuple[bytes, bytes, bool]:
+    """A VTU file's XML (closed after its AppendedData is cut off), the appended bytes and
+    whether they are base64."""
+    start = data.find(b"<AppendedData")
+    if start < 0:
+        return data, b"", False
+    tag_end = data.index(b">", start)
+    base64 = b'encoding="base64"' in data[start:tag_end]
+    body_start = data.index(b"_", tag_end) + 1
+    body_end = data.rfind(b"</AppendedData>")
+    appended = data[body_start:body_end]
+    return data[:start] + b"</VTKFile>", appended.strip() if base64 else appended, base64
+
+
+def _data_array(element: ElementTree.Element, appended: _Appended, source: Path) -> NDArray:
+    """The values of one DataArray (appended or ASCII), (n, components) when it has several."""
+    kind = element.get("type", "")
+    if kind not in _NUMPY_TYPES:
+        raise InputError(
+            f"{source}: array {element.get('Name')!r} of type {kind!r} is not supported"
+        )
+    fmt = element.get("format", "ascii")
+    if fmt == "appended":
+        values = np.frombuffer(
+            appended.array_bytes(int(element.get("offset", "0"))), _NUMPY_TYPES[kind]
+        )
+    elif fmt == "ascii":
+        values = np.array((element.text or "").split(), dtype=_NUMPY_TYPES[kind])
+    else:
+        raise InputError(f"{source}: {fmt!r} arrays are not supported (use appended or ascii)")
+    components = int(element.get("NumberOfComponents", "1"))
+    return values.reshape(-1, components) if components > 1 else values.copy()
+
+
+def read_vtu_point_data(
+    path: str | os.PathLike[str],
+) -> tuple[NDArray[np.float64], dict[str, NDArray[np.generic]]]:
+    """Points and point data of a .vtu file: appended data (raw or base64, plain or with VTK's
+    zlib blocks, UInt32 or UInt64 headers) or inline ASCII arrays; this writer's frames and
+    PeriDEM's output files. Raises InputError naming the problem otherwise."""
+    source = Path(path)
+    try:
+        data = source.read_bytes()
+    except OSError as error:
+        raise InputError(f"cannot read {source}: {error}") from None
+    xml_text, appended_data, base64 = _split_appended(data)
+    try:
+        root = ElementTree.fromstring(xml_text)
+    except ElementTree.ParseError as error:
+        raise InputError(f"{source} is not a VTU file: {error}") from None
+    if root.get("compressor") not in (None, "vtkZLibDataCompressor"):
+        raise InputError(f"{source}: compressor {root.get('compressor')} is not supported")
+    appended = _Appended(
+        appended_data,
+        base64,
+        "<u8" if root.get("header_type") == "UInt64" else "<u4",
+        root.get("compressor") == "vtkZLibDataCompressor",
+    )
     piece = root.find("UnstructuredGrid/Piece")
     if piece is None:
         raise InputError(f"{source} has no UnstructuredGrid piece")
@@ -328,9 +351,10 @@ def read_vtu_point_data(
     if points_element is None:
         raise InputError(f"{source} has no points")
     try:
-        points = np.asarray(array(points_element), dtype=np.float64).reshape(-1, 3)
+        points = np.asarray(_data_array(points_element, appended, source), dtype=np.float64)
+        points = points.reshape(-1, 3)
         point_data = {
-            element.get("Name", ""): array(element)
+            element.get("Name", ""): _data_array(element, appended, source)
             for element in piece.findall("PointData/DataArray")
         }
     except (ValueError, IndexError, zlib.error) as error:
