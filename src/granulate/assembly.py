@@ -239,10 +239,6 @@ class Assembly:
         name: str | None,
     ) -> Body:
         """A body from its nodes (Simulation.add_body_from_nodes)."""
-        if not isinstance(material, Material):
-            raise InputError(
-                f"material must be a granulate.Material, got {type(material).__name__}"
-            )
         p = np.asarray(positions, dtype=np.float64)
         if p.ndim != 2 or p.shape[1] not in (self.dimension, 3):
             raise InputError(

@@ -32,14 +32,19 @@ def build_model(
     discretisations' outer layers carry surface points (the node-sphere law sees those nodes at
     themselves: no anchors)."""
     model = _core.Model(assembly.dimension, getattr(_core.PlaneMode, plane))
-    copy_of = _translated_copies(assembly, outer_layers)
+    # Surface data of the bodies without a reference shape (theirs are their shapes').
+    surfaces = [
+        _surface_arrays(surface, outer_layers) if body.reference is None else None
+        for body, surface in zip(assembly.bodies, assembly.surfaces, strict=True)
+    ]
+    copy_of = _translated_copies(assembly, surfaces)
     _require_memory_for_model(assembly, plane, copy_of)
     material_ids: dict[int, int] = {}
     core_materials: list[Material] = []
     shape_ids: dict[int, int] = {}
     shape_of_body: dict[int, int] = {}  # bodies without a reference shape
-    for body, positions, volumes, surface in zip(
-        assembly.bodies, assembly.positions, assembly.volumes, assembly.surfaces, strict=True
+    for body, positions, volumes, surface_arrays in zip(
+        assembly.bodies, assembly.positions, assembly.volumes, surfaces, strict=True
     ):
         horizon = body.material.resolved_horizon(body.mesh_size)
         key = id(body.material)
@@ -49,7 +54,7 @@ def build_model(
         if body.reference is None:
             original = copy_of.get(body.index)
             if original is None:
-                surface_arrays = _surface_arrays(surface, outer_layers)
+                assert surface_arrays is not None
                 shape = model.add_shape(positions, volumes, body.mesh_size, *surface_arrays)
             else:
                 shape = shape_of_body[original]
@@ -71,17 +76,19 @@ def build_model(
     return model, core_materials
 
 
-def _translated_copies(assembly: Assembly, outer_layers: bool) -> dict[int, int]:
+def _translated_copies(
+    assembly: Assembly, surfaces: list[tuple[NDArray[np.float64], NDArray[np.float64]] | None]
+) -> dict[int, int]:
     """Bodies without a reference shape that are translated copies of an earlier one
-    (shape_sharing.py): body index -> the earlier body's index. They share its core shape and
+    (shape_sharing.py), given each body's surface data (`surfaces`, None for those with a
+    reference shape): body index -> the earlier body's index. They share its core shape and
     bond family."""
     copies, copy_of = TranslatedShapes(), {}
-    for body, positions, volumes, surface in zip(
-        assembly.bodies, assembly.positions, assembly.volumes, assembly.surfaces, strict=True
+    for body, positions, volumes, surface_arrays in zip(
+        assembly.bodies, assembly.positions, assembly.volumes, surfaces, strict=True
     ):
-        if body.reference is not None:
+        if surface_arrays is None:
             continue
-        surface_arrays = _surface_arrays(surface, outer_layers)
         original = copies.find(positions, volumes, body.mesh_size, surface_arrays)
         if original is None:
             copies.remember(body.index, positions, volumes, body.mesh_size, surface_arrays)

@@ -5,7 +5,7 @@ background damping act on every node and are the core's own settings."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -158,7 +158,7 @@ class Loading:
         parts: list[bytes | str] = []
         for load in self.loads:
             parts.append(load.kind)
-            for value in vars(load).values():
+            for value in (getattr(load, f.name) for f in fields(load)):
                 is_array = isinstance(value, np.ndarray)
                 parts.append(value.tobytes() if is_array else repr(value))
         return parts

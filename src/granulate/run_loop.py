@@ -154,7 +154,7 @@ def advance(sim: Simulation, plan: RunPlan) -> str | None:
     core, out = sim.core, sim._output
     if out is not None and out.frames == 0:
         core.run(0)  # the forces of step 0 (prescribed motion, contact), for the frame
-        sim._write_output()
+        out.write_step(sim)
     target = core.step + plan.steps
     first_step = int(core.step)
     most = threads.get_num_threads()
@@ -176,7 +176,7 @@ def advance(sim: Simulation, plan: RunPlan) -> str | None:
         sim._record.wall_seconds += wallclock.perf_counter() - start
         sim._record.steps_run += int(core.step) - first_step
     if out is not None:
-        sim._write_final_state(frame=plan.write_final or reason is not None)
+        out.write_final(sim, frame=plan.write_final or reason is not None)
     return reason
 
 
@@ -210,7 +210,7 @@ class _Chunks:
         self.rate = chunk / max(elapsed, 1e-9)
         self.limit = int(min(10_000, max(1, 0.5 * self.rate)))
         if out is not None and out.is_output_step(core.step):
-            sim._write_output()
+            out.write_step(sim)
         reason = None
         if plan.stop and core.step % plan.check_every == 0:
             reason = next((r for c in plan.stop if (r := c.check(sim)) is not None), None)

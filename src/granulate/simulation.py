@@ -13,7 +13,6 @@ energies J per metre.
 
 from __future__ import annotations
 
-import time as wallclock
 import warnings
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import replace
@@ -123,7 +122,6 @@ class Simulation:
         self._record = RunRecord()
         self._precracks: list[tuple[NDArray[np.float64], NDArray[np.float64], Shape | None]] = []
         self._tuner: threads.ThreadTuner | None = None
-        self._output_seconds = 0.0
         self._core_materials: list[Material] = []
         self._setup_digest: str | None = None
         self._checkpoint: CheckpointPlan | None = None
@@ -279,9 +277,6 @@ class Simulation:
             name=name,
         )
 
-    def _vector(self, value: ArrayLike, name: str) -> NDArray[np.float64]:
-        return self._assembly.vector(value, name)
-
     @property
     def reference_positions(self) -> NDArray[np.float64]:
         """(n, 3) reference positions X of all nodes [m], read-only."""
@@ -362,7 +357,7 @@ class Simulation:
 
     @gravity.setter
     def gravity(self, value: ArrayLike) -> None:
-        self._gravity = self._vector(value, "gravity")
+        self._gravity = self._assembly.vector(value, "gravity")
         if self._core is not None:
             self._core.set_body_acceleration(tuple(self._gravity))
 
@@ -492,16 +487,12 @@ class Simulation:
             every,
             history_every,
             fields,
-            tuple(self._body(b) for b in track),
+            tuple(self._assembly.body(b) for b in track),
             track_areas or {},
             self._interactions.wall_names,
             overwrite=overwrite,
             resume=resume,
         )
-
-    def _body(self, body: Body | str) -> Body:
-        """A body of this simulation, or the one of that name (InputError otherwise)."""
-        return self._assembly.body(body)
 
     # ------------------------------------------------------------------ the core
     def _build(self) -> _core.Simulation:
@@ -819,7 +810,8 @@ class Simulation:
         first look at its state) the pre-crack is kept and applied when it is, and None is
         returned, so contact, walls and loading can still be set; after, the bonds break at
         once and their number is returned."""
-        crack = (self._vector(point, "point"), self._vector(normal, "normal"), region)
+        vector = self._assembly.vector
+        crack = (vector(point, "point"), vector(normal, "normal"), region)
         if region is not None and not isinstance(region, Shape):
             raise InputError(f"precrack: region must be a shape, got {type(region).__name__}")
         if self._core is None:
@@ -922,24 +914,5 @@ class Simulation:
 
     @property
     def output_seconds(self) -> float:
-        """Wall-clock seconds spent writing outputs so far."""
-        return self._output_seconds
-
-    def _write_output(self) -> None:
-        """The frame and history row the current step writes (Outputs.write_step), timed."""
-        assert self._output is not None
-        start = wallclock.perf_counter()
-        try:
-            self._output.write_step(self)
-        finally:
-            self._output_seconds += wallclock.perf_counter() - start
-
-    def _write_final_state(self, frame: bool) -> None:
-        """The end of a run: with ``frame``, the frame and history row of the last step when
-        it was not an output step (run() then writes run.json with the run's status)."""
-        assert self._output is not None
-        start = wallclock.perf_counter()
-        try:
-            self._output.write_final(self, frame)
-        finally:
-            self._output_seconds += wallclock.perf_counter() - start
+        """Wall-clock seconds spent writing outputs so far (by the current output(...))."""
+        return 0.0 if self._output is None else self._output.seconds

@@ -112,7 +112,7 @@ class TrackedBodies:
         volumes, density, gravity = model.volumes, model.node_density, sim.gravity
         axes = "xyz"[: sim.dimension]
         for body in outputs.tracked:
-            nodes = slice(body.first_node, body.first_node + body.node_count)
+            nodes = body.node_slice
             v = volumes[nodes]
             weight = reductions.dot(v, density[nodes]) * gravity
             resultant = reductions.weighted_sum(v, forces[nodes]) - weight

@@ -4,6 +4,7 @@ what the frames and rows hold (the registered writers, registry.py)."""
 from __future__ import annotations
 
 import json
+import time as wallclock
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -40,6 +41,7 @@ class Outputs:
     frames: int = 0
     frame_step: int = -1  # the step of the last frame written (-1: none in this process)
     history_step: int = -1  # likewise for the last history row
+    seconds: float = 0.0  # wall-clock seconds spent writing frames and rows
 
     @classmethod
     def plan(
@@ -106,6 +108,13 @@ class Outputs:
         """The frame and the history row of the current step, as asked, from one StepData."""
         if not (frame or history):
             return
+        start = wallclock.perf_counter()
+        try:
+            self._write(sim, frame, history)
+        finally:
+            self.seconds += wallclock.perf_counter() - start
+
+    def _write(self, sim: Simulation, frame: bool, history: bool) -> None:
         data = StepData.of(sim)
         if frame:
             for writer in registry.FRAME_WRITERS:
