@@ -20,6 +20,7 @@ from granulate.io import checkpoint as checkpoint_file
 
 if TYPE_CHECKING:
     from granulate.simulation import Simulation
+    from granulate.writers.outputs import Outputs
 
 #: The most bytes a run's checkpoints may write in all: at 1 GB/s, 20 minutes of writing.
 MOST_CHECKPOINT_BYTES = 1.2e12
@@ -78,7 +79,7 @@ class CheckpointPlan:
                 "every few minutes (every_minutes)"
             )
 
-    def save_if_due(self, sim: Simulation) -> None:
+    def save_if_due(self, sim: Simulation, outputs: Outputs | None) -> None:
         """The checkpoint, at a checkpoint step or when its minutes have passed."""
         step = sim.core.step
         due = bool(self.every_steps) and step % self.every_steps == 0  # type: ignore[operator]
@@ -87,14 +88,14 @@ class CheckpointPlan:
             self.every_seconds is not None and now - self.last_wall_time >= self.every_seconds
         )
         if due:
-            save(sim, self.path)
+            save(sim, self.path, outputs)
             self.last_wall_time = now
 
 
-def save(sim: Simulation, path: str | Path) -> Path:
-    """Write sim's state and output bookkeeping to `path` atomically."""
+def save(sim: Simulation, path: str | Path, outputs: Outputs | None) -> Path:
+    """Write sim's state and the bookkeeping of its `outputs` to `path` atomically."""
     core = sim.core
-    out = sim._output
+    out = outputs
     header = {
         "granulate": __version__,
         "fingerprint": sim.fingerprint(),
@@ -115,9 +116,9 @@ def save(sim: Simulation, path: str | Path) -> Path:
     return target
 
 
-def load(sim: Simulation, path: str | Path) -> None:
+def load(sim: Simulation, path: str | Path, outputs: Outputs | None) -> None:
     """Continue sim from a checkpoint of its same set-up (else InputError): the state and,
-    when outputs are set, the frame count, the PVD series and history.csv up to the
+    when `outputs` are set, their frame count, PVD series and history.csv up to the
     checkpoint's step."""
     core = sim.core
     state, header = checkpoint_file.load(path)
@@ -128,7 +129,7 @@ def load(sim: Simulation, path: str | Path) -> None:
         )
     core.restore(state)
     sim.analysis.forget_fragments()  # the labels of the bonds before the restore
-    out = sim._output
+    out = outputs
     saved = header.get("output")
     if out is None:
         return
@@ -142,3 +143,17 @@ def load(sim: Simulation, path: str | Path) -> None:
             "output interval of the original run"
         )
     out.resume(int(saved["frames"]), saved["pvd"], int(core.step))
+
+
+def save_on_interrupt(
+    sim: Simulation, plan: CheckpointPlan | None, outputs: Outputs | None
+) -> Path | None:
+    """The checkpoint a run interrupted by Ctrl-C or SIGTERM leaves: at the plan's path, else in
+    the output folder; None (nothing written) when neither is set."""
+    if plan is not None:
+        path = plan.path
+    elif outputs is not None:
+        path = outputs.directory / "checkpoint.npz"
+    else:
+        return None
+    return save(sim, path, outputs)

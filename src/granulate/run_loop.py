@@ -13,13 +13,15 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from granulate import _core, threads
+from granulate import _core, checkpoints, threads
 from granulate.errors import InputError
 from granulate.input_errors import check_number
 from granulate.stopping import StopCriterion
 
 if TYPE_CHECKING:
+    from granulate.checkpoints import CheckpointPlan
     from granulate.simulation import Simulation
+    from granulate.writers.outputs import Outputs
 
 
 @dataclass(frozen=True)
@@ -43,6 +45,19 @@ class RunPlan:
     check_every: int
     progress: Callable[[Progress], None] | None
     write_final: bool
+
+
+@dataclass(frozen=True)
+class LoopParts:
+    """What the loop drives besides the simulation's public API (its core, stop criteria and
+    writers read that): Simulation.run hands these over, so the loop reads no private member of
+    Simulation and a test can give its own."""
+
+    outputs: Outputs | None
+    record: RunRecord
+    checkpoints: CheckpointPlan | None
+    tuner: threads.ThreadTuner | None  # None: the thread count stays as it is
+    after_chunk: Callable[[], None]  # e.g. Interactions.warn_deep_contact
 
 
 @dataclass
@@ -101,12 +116,12 @@ def steps_to_run(
     return int(steps)
 
 
-def run_in_folder(sim: Simulation, plan: RunPlan) -> str | None:
+def run_in_folder(sim: Simulation, plan: RunPlan, parts: LoopParts) -> str | None:
     """The run, in its output folder when outputs are set: its space checked, its lock held
     while it writes, and run.json with its status at the end, whatever ends it."""
-    out, record = sim._output, sim._record
+    out, record = parts.outputs, parts.record
     if out is None:
-        return advance(sim, plan)
+        return advance(sim, plan, parts)
     # The frames this run writes: one every `every` steps, the last step's when it falls
     # between, and step 0's when none is written yet; each about 8 bytes per component of its
     # fields per node.
@@ -116,7 +131,7 @@ def run_in_folder(sim: Simulation, plan: RunPlan) -> str | None:
     out.folder.start_writing()
     record.status = "running"
     try:
-        reason = advance(sim, plan)
+        reason = advance(sim, plan, parts)
         record.status = f"stopped: {reason}" if reason else "finished"
         return reason
     except KeyboardInterrupt:
@@ -133,25 +148,25 @@ def run_in_folder(sim: Simulation, plan: RunPlan) -> str | None:
         out.folder.stop_writing()
 
 
-def chunk_end(sim: Simulation, plan: RunPlan, target: int, limit: int) -> int:
-    """Steps to the next place the loop must stop at: the run's end, an output or history
-    step, a stop check, a checkpoint, or `limit` (about half a second)."""
-    step, out, check_every = sim.core.step, sim._output, plan.check_every
+def chunk_end(step: int, plan: RunPlan, parts: LoopParts, target: int, limit: int) -> int:
+    """Steps from `step` to the next place the loop must stop at: the run's end, an output or
+    history step, a stop check, a checkpoint, or `limit` (about half a second)."""
+    out, check_every = parts.outputs, plan.check_every
     boundaries = [target - step, limit]
     if out is not None:
         boundaries.append(out.steps_to_next(step))
     if plan.stop:
         boundaries.append(check_every - step % check_every)
-    to_checkpoint = None if sim._checkpoint is None else sim._checkpoint.steps_to_next(step)
+    to_checkpoint = None if parts.checkpoints is None else parts.checkpoints.steps_to_next(step)
     if to_checkpoint is not None:
         boundaries.append(to_checkpoint)
     return min(boundaries)
 
 
-def advance(sim: Simulation, plan: RunPlan) -> str | None:
+def advance(sim: Simulation, plan: RunPlan, parts: LoopParts) -> str | None:
     """The time loop: chunks of steps between outputs, stop checks and checkpoints, with the
     thread count the tuner picks; the reason a stop criterion gave, or None."""
-    core, out = sim.core, sim._output
+    core, out = sim.core, parts.outputs
     if out is not None and out.frames == 0:
         core.run(0)  # the forces of step 0 (prescribed motion, contact), for the frame
         out.write_step(sim)
@@ -162,19 +177,19 @@ def advance(sim: Simulation, plan: RunPlan) -> str | None:
     reason = None
     try:
         with SignalCatcher() as signals:
-            chunks = _Chunks(sim, plan, sim._thread_tuner(most), start)
+            chunks = _Chunks(sim, plan, parts, start)
             while core.step < target and reason is None:
                 reason = chunks.run(target)
                 if plan.progress is not None:
                     plan.progress(chunks.progress(target))
                 if signals.caught:
-                    saved = sim._save_on_interrupt()
+                    saved = checkpoints.save_on_interrupt(sim, parts.checkpoints, out)
                     where = f"; checkpoint written to {saved}" if saved else ""
                     raise KeyboardInterrupt(f"interrupted at step {core.step}{where}")
     finally:
         _core.set_num_threads(most)
-        sim._record.wall_seconds += wallclock.perf_counter() - start
-        sim._record.steps_run += int(core.step) - first_step
+        parts.record.wall_seconds += wallclock.perf_counter() - start
+        parts.record.steps_run += int(core.step) - first_step
     if out is not None:
         out.write_final(sim, frame=plan.write_final or reason is not None)
     return reason
@@ -183,19 +198,17 @@ def advance(sim: Simulation, plan: RunPlan) -> str | None:
 class _Chunks:
     """The chunks of one run: each up to the next stopping place, about half a second long."""
 
-    def __init__(
-        self, sim: Simulation, plan: RunPlan, tuner: threads.ThreadTuner | None, start: float
-    ) -> None:
-        self.sim, self.plan, self.tuner, self.start = sim, plan, tuner, start
+    def __init__(self, sim: Simulation, plan: RunPlan, parts: LoopParts, start: float) -> None:
+        self.sim, self.plan, self.parts, self.start = sim, plan, parts, start
         self.core = sim.core
         self.limit = 10  # steps: the first chunk measures the rate
         self.rate = 0.0
 
     def run(self, target: int) -> str | None:
         """One chunk, then its outputs, stop check and checkpoint; a stop criterion's reason."""
-        sim, plan, tuner, core = self.sim, self.plan, self.tuner, self.core
-        out = sim._output
-        chunk = chunk_end(sim, plan, target, self.limit)
+        sim, plan, parts, core = self.sim, self.plan, self.parts, self.core
+        out, tuner = parts.outputs, parts.tuner
+        chunk = chunk_end(int(core.step), plan, parts, target, self.limit)
         if tuner is not None:
             count = tuner.threads()
             chunk = min(chunk, tuner.step_cap() or chunk)
@@ -205,7 +218,7 @@ class _Chunks:
         elapsed = wallclock.perf_counter() - began
         if tuner is not None:
             tuner.record(count, chunk, elapsed)
-        sim._warn_deep_contact(core)
+        parts.after_chunk()
         # Aim at chunks of about half a second: responsive to Ctrl-C and progress.
         self.rate = chunk / max(elapsed, 1e-9)
         self.limit = int(min(10_000, max(1, 0.5 * self.rate)))
@@ -214,7 +227,8 @@ class _Chunks:
         reason = None
         if plan.stop and core.step % plan.check_every == 0:
             reason = next((r for c in plan.stop if (r := c.check(sim)) is not None), None)
-        sim._checkpoint_if_due()
+        if parts.checkpoints is not None:
+            parts.checkpoints.save_if_due(sim, out)
         return reason
 
     def progress(self, target: int) -> Progress:
@@ -225,5 +239,5 @@ class _Chunks:
             float(core.time),
             self.sim.broken_bonds(),
             self.rate,
-            self.sim._record.wall_seconds + wallclock.perf_counter() - self.start,
+            self.parts.record.wall_seconds + wallclock.perf_counter() - self.start,
         )

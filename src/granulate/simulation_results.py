@@ -1,0 +1,244 @@
+"""Simulation's view of the run: the state as NumPy views, energies and counts, fragments, the
+particle and contact tables, stresses and the run's summary.
+
+The measures themselves live in granulate.analysis (on the core's arrays) and in
+granulate.fragments, granulate.network and granulate.particle_table; this is the front door to
+them. ``SimulationResults`` is a part of ``granulate.Simulation``, not a class to use alone.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Literal
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from granulate import _core, core_model, fragments, network, particle_table, threads
+from granulate._version import __version__
+from granulate.analysis import Analysis
+from granulate.assembly import Assembly, Body
+from granulate.errors import InputError
+from granulate.interactions import Interactions
+from granulate.run_loop import RunRecord
+from granulate.shapes import Shape
+from granulate.writers.outputs import Outputs
+
+
+def read_only(array: NDArray) -> NDArray:
+    """A view of `array` that cannot be written (the core keeps writing the original)."""
+    view = array.view()
+    view.flags.writeable = False
+    return view
+
+
+class SimulationResults:
+    """The results half of Simulation's API (see granulate.simulation.Simulation)."""
+
+    # What Simulation provides (made in its __init__ and _build).
+    dimension: int
+    case_fingerprint: str
+    bodies: list[Body]
+    _assembly: Assembly
+    _interactions: Interactions
+    _core: _core.Simulation | None
+    _model: _core.Model | None
+    _analysis: Analysis | None
+    _reference: NDArray[np.float64] | None
+    _gravity: NDArray[np.float64]
+    _precracks: list[tuple[NDArray[np.float64], NDArray[np.float64], Shape | None]]
+    _tuner: threads.ThreadTuner | None
+    _record: RunRecord
+    _output: Outputs | None
+    _build: Callable[[], _core.Simulation]
+
+    @property
+    def positions(self) -> NDArray[np.float64]:
+        """(n, 3) current positions x [m]: a live, writable view. Writing moves nodes before
+        or between runs (bonds stretch accordingly; contact lists follow); the forces are
+        recomputed at the next step."""
+        return self._build().positions
+
+    @property
+    def velocities(self) -> NDArray[np.float64]:
+        """(n, 3) velocities v [m/s]: a live, writable view (set initial or changed velocities
+        before or between runs; prescribed nodes keep their prescribed motion)."""
+        return self._build().velocities
+
+    @property
+    def forces(self) -> NDArray[np.float64]:
+        """(n, 3) net force densities f [N/m^3] of the last step: a live, read-only view (the
+        next step starts from them)."""
+        return read_only(self._build().forces)
+
+    @property
+    def displacements(self) -> NDArray[np.float64]:
+        """(n, 3) displacements x - X [m] (a copy)."""
+        core = self._build()
+        return core.positions - self._reference
+
+    @property
+    def volumes(self) -> NDArray[np.float64]:
+        """(n,) nodal volumes [m^3; m^2 in 2D], read-only."""
+        self._build()
+        assert self._model is not None
+        return read_only(self._model.volumes)
+
+    @property
+    def damage(self) -> NDArray[np.float64]:
+        """(n,) damage phi = 1 - intact / initial influence-weighted volume of the bonds."""
+        return self._build().damage()[0]
+
+    @property
+    def damage_z(self) -> NDArray[np.float64]:
+        """(n,) PeriDEM's Damage_Z: max over a node's bonds of |stretch| / s0."""
+        return self._build().damage()[1]
+
+    @property
+    def time(self) -> float:
+        return self._build().time
+
+    @property
+    def step(self) -> int:
+        return self._build().step
+
+    def kinetic_energy(self) -> float:
+        """sum 1/2 rho V |v|^2 [J; J/m in 2D]."""
+        return self._build().kinetic_energy()
+
+    def strain_energy(self) -> float:
+        """sum W_i V_i over intact bonds [J; J/m in 2D]."""
+        return self._build().strain_energy()
+
+    def broken_bonds(self) -> int:
+        """Number of broken bonds, each counted once."""
+        return self._build().broken_bonds()
+
+    def wall_displacement(self, name: str) -> float:
+        """Distance the named wall has moved (translation) or angle it has turned [m or rad]."""
+        core = self._build()
+        names = self._interactions.wall_names
+        for label, wall in zip(names, core.walls, strict=True):
+            if label == name:
+                return float(wall.displacement(core.time))
+        raise InputError(f"no wall named {name!r}; walls: {', '.join(names) or 'none'}")
+
+    def fully_broken_particles(self) -> int:
+        """Number of particles none of whose bonds is intact (with at least one bond)."""
+        return self.analysis.fully_broken_particles(self.bodies)
+
+    def precrack(
+        self, point: ArrayLike, normal: ArrayLike, *, region: Shape | None = None
+    ) -> int | None:
+        """Break the bonds that cross the plane through ``point`` with ``normal`` (in the reference
+        configuration), only those whose midpoint lies in ``region`` if given: a pre-crack or a
+        notch without removing material. Before the simulation is built (the first run, or the
+        first look at its state) the pre-crack is kept and applied when it is, and None is
+        returned, so contact, walls and loading can still be set; after, the bonds break at
+        once and their number is returned."""
+        vector = self._assembly.vector
+        crack = (vector(point, "point"), vector(normal, "normal"), region)
+        if region is not None and not isinstance(region, Shape):
+            raise InputError(f"precrack: region must be a shape, got {type(region).__name__}")
+        if self._core is None:
+            self._precracks.append(crack)
+            return None
+        return core_model.break_crossing_bonds(self._core, self.model, *crack)
+
+    def fragments(self, min_nodes: int = 1) -> list[NDArray[np.uint32]]:
+        """Pieces held together by intact bonds, largest first, each as its node indices.
+
+        Fragments smaller than ``min_nodes`` (dust, single detached nodes) are left out.
+        """
+        return self.analysis.fragments(min_nodes)
+
+    def gravity_energy(self) -> float:
+        """Potential energy in the gravity field, -sum m_i g . x_i [J; J/m in 2D] (zero at the
+        origin)."""
+        return self.analysis.gravity_energy(self._gravity)
+
+    def fragment_table(self) -> fragments.Table:
+        """One row per fragment (debris included, flagged) of the current state: its id,
+        parent particle, nodes, mass, volume, centre of mass, velocity and equivalent diameter
+        (granulate.fragments; ``pandas.DataFrame(table)`` makes it a data frame)."""
+        return self.analysis.fragment_table()
+
+    @property
+    def analysis(self) -> Analysis:
+        """The measures of the current state (granulate.analysis.Analysis), built on first
+        access: fragments, the particle and contact tables, particle stresses."""
+        self._build()
+        assert self._analysis is not None
+        return self._analysis
+
+    @property
+    def node_count(self) -> int:
+        return self._assembly.node_count
+
+    @property
+    def bond_count(self) -> int:
+        """Bonds, each counted once per end (as LAMMPS counts them)."""
+        self._build()
+        assert self._model is not None
+        return self._model.bond_count
+
+    def summary(self) -> dict[str, float | int]:
+        """Counts, time step and timings of the run so far: ``steps`` is the current step,
+        ``steps_run`` and ``wall_seconds`` the steps advanced and the wall time taken by this
+        process's runs (after a resume, only the resumed part)."""
+        core = self._build()
+        phases = core.phase_times
+        return {
+            "granulate": __version__,
+            "case_fingerprint": self.case_fingerprint,
+            "dimension": self.dimension,
+            "bodies": len(self.bodies),
+            "nodes": self.node_count,
+            "bonds": self.bond_count,
+            "dt": core.time_step,
+            "stable_dt": core.stable_time_step,
+            "steps": core.step,
+            "time": core.time,
+            "threads": threads.get_num_threads(),
+            "threads_in_use": self._tuner.current if self._tuner is not None else None,
+            "status": self._record.status,
+            "steps_run": self._record.steps_run,
+            "wall_seconds": self._record.wall_seconds,
+            "peridynamics_seconds": phases.peridynamics,
+            "integration_seconds": phases.integration,
+            "loading_seconds": phases.loading,
+            "contact_seconds": phases.contact,
+            "neighbor_list_rebuilds": core.contact_statistics.rebuilds,
+        }
+
+    def particle_table(
+        self, contacts: network.Table | None = None, damage: ArrayLike | None = None
+    ) -> particle_table.Table:
+        """One row per particle of the current state (granulate.particle_table): time, centre
+        of mass [m], velocity [m/s], angular velocity [rad/s], mass [kg; kg/m in 2D], radius
+        of gyration [m], volume-weighted mean damage, coordination and Love-Weber stress [Pa]
+        (granulate.network), from `contacts` (default: ``contact_table()``)."""
+        contacts = self.contact_table() if contacts is None else contacts
+        return self.analysis.particles(contacts, damage)[0]
+
+    def contact_table(self) -> network.Table:
+        """One row per contact of the last force evaluation (pairs of particles or of their
+        fragments, and particles on walls): the bodies, contact point [m], normal, force on
+        the first body [N; N/m in 2D], normal and tangential force (granulate.network; wall
+        k is ``list(sim.wall_reactions())[k]``)."""
+        return self.analysis.contact_table()
+
+    def particle_stresses(
+        self,
+        method: Literal["contacts", "bonds"] = "contacts",
+        contacts: network.Table | None = None,
+    ) -> NDArray:
+        """Each particle's mean stress, (particles, D, D) [Pa; tension positive]: Love-Weber
+        from its contacts (`contacts`: the current contact table, made when not given), or from
+        its bond forces (granulate.network; the two agree for a particle at rest)."""
+        return self.analysis.particle_stresses(method, contacts)
+
+    @property
+    def output_seconds(self) -> float:
+        """Wall-clock seconds spent writing outputs so far (by the current output(...))."""
+        return 0.0 if self._output is None else self._output.seconds
