@@ -115,69 +115,85 @@ void ContactModel::node_forces(const Model& model, State& state, real dt) {
 #pragma omp parallel for schedule(static)
   for (std::int64_t k = 0; k < count; ++k) {
     const index_t i = contact_nodes_[k];
-    vec at_centre{0, 0, 0}, at_surface{0, 0, 0}, on_vector{0, 0, 0};
-    for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
-      if (pair_stiffness_[e] == 0 || probe_entry(e)) continue;
-      const vec force = pair_force(model, state, i, e, dt);
-      for (int c = 0; c < 3; ++c) at_centre[c] += force[c];
-    }
-    vec at_node{0, 0, 0};  // friction, with its couple as a rigid-body load
-    for (index_t e = wall_offsets_[i]; e < wall_offsets_[i + 1]; ++e) {
-      wall_entry_reaction_[e] = {0, 0, 0, 0, 0, 0};
-      if (wall_entry_stiffness_[e] == 0) continue;
-      vec on_centre, on_node;
-      wall_force(model, state, i, e, dt, on_centre, on_node);
-      for (int c = 0; c < 3; ++c) {
-        at_centre[c] += on_centre[c];
-        at_node[c] += on_node[c];
-      }
-    }
-    const auto [group_begin, group_end] = groups_of(i);
-    for (index_t g = group_begin; g < group_end; ++g) {
-      const ProbeState& probe = probes_[g];
-      if (probe.push == 0) continue;  // apart (its other fields may be an earlier step's)
-      for (int c = 0; c < 3; ++c) {
-        at_surface[c] += probe.push * probe.gradient[c] - probe.taper * probe.sums.spread[c];
-        at_node[c] += probe.friction[c];
-      }
-    }
-    const SurfaceAnchor* anchor = centres_.anchor(model, i);
-    if (anchor != nullptr && !surface_slot_.empty() && surface_slot_[i] != no_group) {
-      const contact::SurfacePoint& own = surface_point(i);
-      const real size = surface_sizes_[surface_slot_[i]];
-      for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
-        const index_t g = entry_target_[e];
-        if (g == no_group || probes_[g].push == 0) continue;
-        vec on_point, on_normal, on_friction;
-        target_forces(own, size, g, on_point, on_normal, on_friction);
-        for (int c = 0; c < 3; ++c) {
-          at_surface[c] += on_point[c];
-          on_vector[c] += on_normal[c];
-          at_node[c] += on_friction[c];
-        }
-      }
-    }
+    const NodeContactForces forces = gather_node_forces(model, state, i, dt);
     vec total{0, 0, 0};
-    for (int c = 0; c < 3; ++c) total[c] = at_centre[c] + at_surface[c] + at_node[c];
-    if (anchor != nullptr) {
-      // The levers of the forces on the centre and on the surface point (both on the normal).
-      const SurfaceCentres::Seen seen = centres_.seen(model, i);
-      vec along{0, 0, 0};
-      for (int c = 0; c < 3; ++c)
-        along[c] = seen.centre_length * at_centre[c] + seen.surface_length * at_surface[c];
-      if (along != vec{0, 0, 0}) {
-        const vec lever = centres_.lever(state, seen, i, 1.0, along);
-        for (int c = 0; c < 3; ++c) on_vector[c] += lever[c];
-      }
-      anchor_forces_[k] = on_vector;
+    for (int c = 0; c < 3; ++c) total[c] = forces.at_centre[c] + forces.at_surface[c] + forces.at_node[c];
+    if (const SurfaceAnchor* anchor = centres_.anchor(model, i); anchor != nullptr) {
+      anchor_forces_[k] = anchored_vector_force(model, state, i, forces);
       real weights = 0;
       for (std::size_t a = 0; a < anchor->nodes.size() && anchor->nodes[a] != SurfaceAnchor::no_anchor; ++a)
         weights += anchor->weights[a];
-      for (int c = 0; c < 3; ++c) total[c] -= weights * on_vector[c];
+      for (int c = 0; c < 3; ++c) total[c] -= weights * anchor_forces_[k][c];
     }
     for (int c = 0; c < 3; ++c) state.forces[3 * i + c] += total[c] / model.volumes()[i];
   }
-  if (!centres_.any()) return;
+  if (centres_.any()) spread_anchor_forces(model, state);
+}
+
+ContactModel::NodeContactForces ContactModel::gather_node_forces(const Model& model, State& state, index_t i,
+                                                                 real dt) {
+  NodeContactForces forces;
+  auto& [at_centre, at_surface, at_node, on_vector] = forces;
+  for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
+    if (pair_stiffness_[e] == 0 || probe_entry(e)) continue;
+    const vec force = pair_force(model, state, i, e, dt);
+    for (int c = 0; c < 3; ++c) at_centre[c] += force[c];
+  }
+  for (index_t e = wall_offsets_[i]; e < wall_offsets_[i + 1]; ++e) {
+    wall_entry_reaction_[e] = {0, 0, 0, 0, 0, 0};
+    if (wall_entry_stiffness_[e] == 0) continue;
+    vec on_centre, on_node;
+    wall_force(model, state, i, e, dt, on_centre, on_node);
+    for (int c = 0; c < 3; ++c) {
+      at_centre[c] += on_centre[c];
+      at_node[c] += on_node[c];
+    }
+  }
+  const auto [group_begin, group_end] = groups_of(i);
+  for (index_t g = group_begin; g < group_end; ++g) {
+    const ProbeState& probe = probes_[g];
+    if (probe.push == 0) continue;  // apart (its other fields may be an earlier step's)
+    for (int c = 0; c < 3; ++c) {
+      at_surface[c] += probe.push * probe.gradient[c] - probe.taper * probe.sums.spread[c];
+      at_node[c] += probe.friction[c];
+    }
+  }
+  if (centres_.anchor(model, i) == nullptr || surface_slot_.empty() || surface_slot_[i] == no_group) {
+    return forces;
+  }
+  const contact::SurfacePoint& own = surface_point(i);
+  const real size = surface_sizes_[surface_slot_[i]];
+  for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
+    const index_t g = entry_target_[e];
+    if (g == no_group || probes_[g].push == 0) continue;
+    vec on_point, on_normal, on_friction;
+    target_forces(own, size, g, on_point, on_normal, on_friction);
+    for (int c = 0; c < 3; ++c) {
+      at_surface[c] += on_point[c];
+      on_vector[c] += on_normal[c];
+      at_node[c] += on_friction[c];
+    }
+  }
+  return forces;
+}
+
+vec3 ContactModel::anchored_vector_force(const Model& model, const State& state, index_t i,
+                                         const NodeContactForces& forces) const {
+  // The levers of the forces on the centre and on the surface point (both on the normal).
+  const SurfaceCentres::Seen seen = centres_.seen(model, i);
+  vec on_vector = forces.on_vector;
+  vec along{0, 0, 0};
+  for (int c = 0; c < 3; ++c)
+    along[c] = seen.centre_length * forces.at_centre[c] + seen.surface_length * forces.at_surface[c];
+  if (along != vec{0, 0, 0}) {
+    const vec lever = centres_.lever(state, seen, i, 1.0, along);
+    for (int c = 0; c < 3; ++c) on_vector[c] += lever[c];
+  }
+  return on_vector;
+}
+
+void ContactModel::spread_anchor_forces(const Model& model, State& state) const {
+  const std::int64_t count = static_cast<std::int64_t>(contact_nodes_.size());
   for (std::int64_t k = 0; k < count; ++k) {
     const index_t i = contact_nodes_[k];
     const SurfaceAnchor* anchor = centres_.anchor(model, i);

@@ -347,6 +347,11 @@ void Model::build_bond_schedule() {
   // - Larger particles numbered otherwise (a mesh file numbered at random, say) would need a
   //   colour per range: their nodes gather instead (each evaluates all its bonds and writes only
   //   its own sums), twice the bond evaluations but parallel.
+  cut_bond_blocks();
+  colour_bond_blocks();
+}
+
+void Model::cut_bond_blocks() {
   const index_t n = node_count();
   std::size_t forward_total = 0;
   std::vector<std::size_t> particle_forward(particles_.size(), 0);
@@ -389,10 +394,14 @@ void Model::build_bond_schedule() {
     close_block(last);
   }
   close_block(n);
+}
 
+void Model::colour_bond_blocks() {
   // Greedy colouring in block order: a block takes the smallest colour that no block touching
   // one of its nodes (itself or, unless it gathers, a forward neighbour) has yet; colours past
   // 64 are not shared.
+  const index_t n = node_count();
+  BondSchedule& s = bond_schedule_;
   const index_t blocks = static_cast<index_t>(s.block_starts.size() - 1);
   std::vector<std::uint64_t> taken_at(n, 0);  // bit c: a block of colour c touches the node
   std::vector<index_t> colour(blocks, 0);

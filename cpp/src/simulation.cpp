@@ -302,27 +302,28 @@ std::vector<real> Simulation::bond_force_densities() const {
 
 void Simulation::compute_forces() {
   update_kinematic_nodes();
-  const Model& m = *model_;
-  const auto& materials = m.materials();
-  const auto& node_material = m.node_material();
-  const auto& lps_coefficients = m.lps_coefficients();
-  const auto& density = m.node_density();
-  const auto& x = state_.positions;
-  auto& f = state_.forces;
-  auto& intact = state_.bonds;
-  auto& theta = state_.dilatation;
-  const std::int64_t n = m.node_count();
-  const auto g = body_acceleration_;
+  const std::uint64_t newly_broken = sum_dilatation_and_break_bonds();  // pass 1
+  start_node_forces();
+  add_bond_forces(state_.forces.data());  // pass 2
+  broken_bond_copies_ += newly_broken;
+  add_contact_forces();
+  add_nodal_forces();
+  forces_current_ = true;
+}
 
-  const BondSchedule& schedule = m.bond_schedule();
-  const auto& volume = m.volumes();
-
+std::uint64_t Simulation::sum_dilatation_and_break_bonds() {
   // Pass 1: stretch, irreversible breaking, sum_j w r e at both ends. A bond breaks at the end
   // that evaluates it; its other copy is cleared below, before any loop reads it (when both
   // ends gather, both see bitwise the same stretch and each clears its own).
-  const real* const positions = x.data();
-  const real* const volumes = volume.data();
-  real* const dilatation_sums = theta.data();
+  const Model& m = *model_;
+  const auto& materials = m.materials();
+  const auto& node_material = m.node_material();
+  auto& intact = state_.bonds;
+  const std::int64_t n = m.node_count();
+  const BondSchedule& schedule = m.bond_schedule();
+  const real* const positions = state_.positions.data();
+  const real* const volumes = m.volumes().data();
+  real* const dilatation_sums = state_.dilatation.data();
   std::vector<std::array<index_t, 2>> broken;  // (evaluating node, neighbour)
 #pragma omp parallel
   {
@@ -359,10 +360,21 @@ void Simulation::compute_forces() {
     const NodeBonds bonds = m.node_bonds(j);
     BondStates::clear(intact.node(j), bonds.find(i));
   }
-  const std::uint64_t newly_broken = 2 * broken.size();
   contact_.bonds_broke(m, broken);
+  return 2 * broken.size();
+}
 
+void Simulation::start_node_forces() {
   // Dilatation and pressure of LPS nodes; body forces and damping start each node's sum.
+  const Model& m = *model_;
+  const auto& materials = m.materials();
+  const auto& node_material = m.node_material();
+  const auto& lps_coefficients = m.lps_coefficients();
+  const auto& density = m.node_density();
+  auto& f = state_.forces;
+  auto& theta = state_.dilatation;
+  const std::int64_t n = m.node_count();
+  const auto g = body_acceleration_;
 #pragma omp parallel for schedule(static)
   for (std::int64_t ii = 0; ii < n; ++ii) {
     const index_t i = static_cast<index_t>(ii);
@@ -377,16 +389,18 @@ void Simulation::compute_forces() {
     f[3 * i + 1] = density[i] * (g[1] - viscous_damping_ * vi[1]);
     f[3 * i + 2] = density[i] * (g[2] - viscous_damping_ * vi[2]);
   }
+}
 
-  add_bond_forces(f.data());  // pass 2
-  broken_bond_copies_ += newly_broken;
-
+void Simulation::add_contact_forces() {
   const auto contact_start = clock_type::now();
-  contact_.add_forces(m, state_, broken_bond_copies_);
-  peridem_damping_.add_forces(m, state_);
+  contact_.add_forces(*model_, state_, broken_bond_copies_);
+  peridem_damping_.add_forces(*model_, state_);
   phase_times_.contact += seconds_since(contact_start);
   phase_times_.contact_search = contact_.search_seconds();
+}
 
+void Simulation::add_nodal_forces() {
+  auto& f = state_.forces;
   const real t = state_.time;
   for (const NodalForce& load : nodal_forces_) {
     const real scale = load.function.value(t);
@@ -394,7 +408,6 @@ void Simulation::compute_forces() {
       for (int c = 0; c < 3; ++c) f[3 * i + c] += scale * load.vector[c];
     }
   }
-  forces_current_ = true;
 }
 
 void Simulation::run(std::uint64_t steps) {

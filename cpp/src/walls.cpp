@@ -335,6 +335,75 @@ real Wall::motion_bound(real t0, real t1) const {
   return 2.0 * extent * std::sin(std::min(change, std::numbers::pi) / 2.0);  // chord of the farthest point
 }
 
+namespace {
+
+/// The faces of a box container within `reach` of p (one entry per face).
+void box_inside_contacts(const WallSurface& s, const std::array<real, 3>& p, real reach, int dimension,
+                         std::vector<WallContact>& out) {
+  for (int k = 0; k < dimension; ++k) {
+    const real below = p[k] - s.lower[k], above = s.upper[k] - p[k];
+    if (below < reach) {
+      WallContact c{below, {0, 0, 0}};
+      c.normal[k] = 1;
+      out.push_back(c);
+    }
+    if (above < reach) {
+      WallContact c{above, {0, 0, 0}};
+      c.normal[k] = -1;
+      out.push_back(c);
+    }
+  }
+}
+
+/// A box obstacle within `reach` of p: the nearest point of its surface, or, for p inside it,
+/// the nearest face to push it out through.
+void box_outside_contact(const WallSurface& s, const std::array<real, 3>& p, real reach, int dimension,
+                         std::vector<WallContact>& out) {
+  vec q{}, outside{};
+  bool is_outside = false;
+  for (int k = 0; k < 3; ++k) {
+    q[k] = k < dimension ? std::clamp(p[k], s.lower[k], s.upper[k]) : p[k];
+    outside[k] = p[k] - q[k];
+    is_outside = is_outside || outside[k] != 0;
+  }
+  if (is_outside) {
+    const real d = norm(outside);
+    if (d < reach) out.push_back({d, {outside[0] / d, outside[1] / d, outside[2] / d}});
+    return;
+  }
+  WallContact c{std::numeric_limits<real>::lowest(), {0, 0, 0}};
+  for (int k = 0; k < dimension; ++k) {
+    const real to_lower = p[k] - s.lower[k], to_upper = s.upper[k] - p[k];
+    if (-to_lower > c.distance) {
+      c = {-to_lower, {0, 0, 0}};
+      c.normal[k] = -1;
+    }
+    if (-to_upper > c.distance) {
+      c = {-to_upper, {0, 0, 0}};
+      c.normal[k] = 1;
+    }
+  }
+  out.push_back(c);
+}
+
+/// A circle (cylinder) seen from inside or outside, within `reach` of p.
+void circle_contact(const WallSurface& s, const std::array<real, 3>& p, real reach,
+                    std::vector<WallContact>& out) {
+  vec r{p[0] - s.point[0], p[1] - s.point[1], p[2] - s.point[2]};
+  const real along = dot(r, s.normal);
+  for (int k = 0; k < 3; ++k) r[k] -= along * s.normal[k];
+  const real rho = norm(r);
+  if (!(rho > 0)) return;  // on the axis: no defined normal, and far from the surface
+  const vec radial{r[0] / rho, r[1] / rho, r[2] / rho};
+  if (s.kind == WallSurface::Kind::circle_inside) {
+    if (s.radius - rho < reach) out.push_back({s.radius - rho, {-radial[0], -radial[1], -radial[2]}});
+  } else if (rho - s.radius < reach) {
+    out.push_back({rho - s.radius, radial});
+  }
+}
+
+}  // namespace
+
 void Wall::contacts(std::size_t surface, const std::array<real, 3>& p, real reach, int dimension,
                     std::vector<WallContact>& out) const {
   const WallSurface& s = surfaces[surface];
@@ -344,64 +413,10 @@ void Wall::contacts(std::size_t surface, const std::array<real, 3>& p, real reac
       if (d < reach) out.push_back({d, s.normal});
       break;
     }
-    case WallSurface::Kind::box_inside:
-      for (int k = 0; k < dimension; ++k) {
-        const real below = p[k] - s.lower[k], above = s.upper[k] - p[k];
-        if (below < reach) {
-          WallContact c{below, {0, 0, 0}};
-          c.normal[k] = 1;
-          out.push_back(c);
-        }
-        if (above < reach) {
-          WallContact c{above, {0, 0, 0}};
-          c.normal[k] = -1;
-          out.push_back(c);
-        }
-      }
-      break;
-    case WallSurface::Kind::box_outside: {
-      vec q{}, outside{};
-      bool is_outside = false;
-      for (int k = 0; k < 3; ++k) {
-        q[k] = k < dimension ? std::clamp(p[k], s.lower[k], s.upper[k]) : p[k];
-        outside[k] = p[k] - q[k];
-        is_outside = is_outside || outside[k] != 0;
-      }
-      if (is_outside) {
-        const real d = norm(outside);
-        if (d < reach) out.push_back({d, {outside[0] / d, outside[1] / d, outside[2] / d}});
-      } else {  // inside the obstacle: pushed out through the nearest face
-        WallContact c{std::numeric_limits<real>::lowest(), {0, 0, 0}};
-        for (int k = 0; k < dimension; ++k) {
-          const real to_lower = p[k] - s.lower[k], to_upper = s.upper[k] - p[k];
-          if (-to_lower > c.distance) {
-            c = {-to_lower, {0, 0, 0}};
-            c.normal[k] = -1;
-          }
-          if (-to_upper > c.distance) {
-            c = {-to_upper, {0, 0, 0}};
-            c.normal[k] = 1;
-          }
-        }
-        out.push_back(c);
-      }
-      break;
-    }
+    case WallSurface::Kind::box_inside: box_inside_contacts(s, p, reach, dimension, out); break;
+    case WallSurface::Kind::box_outside: box_outside_contact(s, p, reach, dimension, out); break;
     case WallSurface::Kind::circle_inside:
-    case WallSurface::Kind::circle_outside: {
-      vec r{p[0] - s.point[0], p[1] - s.point[1], p[2] - s.point[2]};
-      const real along = dot(r, s.normal);
-      for (int k = 0; k < 3; ++k) r[k] -= along * s.normal[k];
-      const real rho = norm(r);
-      if (!(rho > 0)) break;  // on the axis: no defined normal, and far from the surface
-      const vec radial{r[0] / rho, r[1] / rho, r[2] / rho};
-      if (s.kind == WallSurface::Kind::circle_inside) {
-        if (s.radius - rho < reach) out.push_back({s.radius - rho, {-radial[0], -radial[1], -radial[2]}});
-      } else if (rho - s.radius < reach) {
-        out.push_back({rho - s.radius, radial});
-      }
-      break;
-    }
+    case WallSurface::Kind::circle_outside: circle_contact(s, p, reach, out); break;
     case WallSurface::Kind::triangles: {
       WallContact c;
       if (triangle_mesh_contact(s, p, reach, c) && c.distance < reach) out.push_back(c);

@@ -203,6 +203,8 @@ class Model {
   void require_not_finalized(const char* what) const;
   void build_bonds();
   void build_bond_schedule();
+  void cut_bond_blocks();     // BondSchedule's blocks and which particles gather
+  void colour_bond_blocks();  // their colours (blocks of a colour share no node)
   BondFamilies build_family(index_t shape, real horizon, InfluenceKind influence) const;
 
   int dimension_;

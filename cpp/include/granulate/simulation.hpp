@@ -97,8 +97,19 @@ class Simulation {
   void restore(const State& state, const ContactCheckpoint& contact);
 
  private:
-  /// Adds the bond forces (pass 2 of compute_forces) to `forces` (nodes x 3).
+  // The phases of compute_forces, in order.
+  /// Pass 1 of the bonds: each node's dilatation sum; bonds past their critical stretch break
+  /// (both copies) and contact is told. Returns the bond copies broken.
+  std::uint64_t sum_dilatation_and_break_bonds();
+  /// LPS dilatation theta_i and pressure A_i theta_i; each node's force density started with
+  /// rho (g - gamma v).
+  void start_node_forces();
+  /// Adds the bond forces (pass 2) to `forces` (nodes x 3).
   void add_bond_forces(real* forces) const;
+  /// Contact (node pairs, walls, dashpots, friction) and PeriDEM's damping, timed.
+  void add_contact_forces();
+  /// The nodal force densities f(t) b.
+  void add_nodal_forces();
   void apply_prescribed_motion(bool positions_too);
   void check_stability() const;
   std::shared_ptr<Model> model_;

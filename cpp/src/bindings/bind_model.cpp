@@ -5,9 +5,11 @@ namespace granulate::bindings {
 
 using namespace nb::literals;
 
-void bind_model(nb::module_& m) {
-  nb::class_<Model>(m, "Model")
-      .def(nb::init<int, PlaneMode>(), "dimension"_a, "plane"_a = PlaneMode::strain)
+namespace {
+
+/// Building a model: materials, shapes, particles, finalize.
+void bind_building(nb::class_<Model>& model) {
+  model.def(nb::init<int, PlaneMode>(), "dimension"_a, "plane"_a = PlaneMode::strain)
       .def("add_material", &Model::add_material, "params"_a)
       .def(
           "add_particle",
@@ -44,8 +46,12 @@ void bind_model(nb::module_& m) {
              }
              return bytes;
            })
-      .def("finalize", &Model::finalize, nb::call_guard<nb::gil_scoped_release>())
-      .def_prop_ro("finalized", &Model::finalized)
+      .def("finalize", &Model::finalize, nb::call_guard<nb::gil_scoped_release>());
+}
+
+/// What a model holds: counts, per-particle values and zero-copy views of its arrays.
+void bind_contents(nb::class_<Model>& model) {
+  model.def_prop_ro("finalized", &Model::finalized)
       .def_prop_ro("dimension", &Model::dimension)
       .def_prop_ro("node_count", &Model::node_count)
       .def_prop_ro("bond_count", &Model::bond_count)
@@ -92,6 +98,14 @@ void bind_model(nb::module_& m) {
         }
         return copy_out(neighbors);
       });
+}
+
+}  // namespace
+
+void bind_model(nb::module_& m) {
+  nb::class_<Model> model(m, "Model");
+  bind_building(model);
+  bind_contents(model);
 }
 
 }  // namespace granulate::bindings

@@ -367,6 +367,20 @@ class ContactModel {
   vec3 pair_surface_normal(index_t i, index_t j, const vec3& line) const;
   void measure_surface_normals(const Model& model, const State& state);
   void node_forces(const Model& model, State& state, real dt);
+  /// A contact node's forces (N): on its contact centre, on its surface point, on the node
+  /// itself (friction) and on its anchored vector A.
+  struct NodeContactForces {
+    vec3 at_centre{0, 0, 0}, at_surface{0, 0, 0}, at_node{0, 0, 0}, on_vector{0, 0, 0};
+  };
+  /// Node i's contact forces from its pair, wall and probe entries and as other bodies' probe
+  /// target; advances its friction springs and sets its wall entries' reactions.
+  NodeContactForces gather_node_forces(const Model& model, State& state, index_t i, real dt);
+  /// The force on an anchored node's vector A: `forces.on_vector` and the levers of the forces
+  /// on its centre and surface point (both lie on its normal).
+  vec3 anchored_vector_force(const Model& model, const State& state, index_t i,
+                             const NodeContactForces& forces) const;
+  /// Each anchored contact node's vector force to its anchors, w_k each (node order).
+  void spread_anchor_forces(const Model& model, State& state) const;
   /// The friction couples of the surface probes, as loads on their bodies (in group order).
   void probe_couples(const State& state);
   void body_loads(const Model& model, State& state);
