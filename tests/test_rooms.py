@@ -1,5 +1,5 @@
 """Each room behind Simulation used alone: the assembly, the core model made from it, the
-loading, the interactions and the analysis (ARCHITECTURE.md)."""
+loading, the interactions, the analysis and the run loop (ARCHITECTURE.md)."""
 
 from __future__ import annotations
 
@@ -7,11 +7,13 @@ import numpy as np
 import pytest
 
 import granulate as gr
-from granulate import _core, core_model
+from granulate import _core, core_model, run_loop
 from granulate.analysis import Analysis
 from granulate.assembly import Assembly
+from granulate.checkpoints import CheckpointPlan
 from granulate.interactions import Interactions, core_law
 from granulate.loading import Loading, component_mask
+from granulate.run_loop import LoopParts, RunPlan, RunRecord
 
 ROCK = gr.Material(density=2000, youngs_modulus=1e8, poisson_ratio=0.25, fracture_energy=5.0)
 H = 2e-4
@@ -116,3 +118,24 @@ def test_analysis_counts_pieces_and_the_gravity_energy() -> None:
     expected = -float(np.sum(mass * (core.positions @ g)))
     assert analysis.gravity_energy(g) == pytest.approx(expected, rel=1e-14)
     assert analysis.fully_broken_particles(assembly.bodies) == 0
+
+
+def test_the_run_loop_drives_the_parts_it_is_given(tmp_path) -> None:
+    """run_loop reads the simulation's public API and the LoopParts it is handed: its own run
+    record, checkpoint plan and after-chunk check, not the simulation's."""
+    sim = gr.Simulation(2)
+    sim.add_body(gr.Disc((0, 0), 1e-3), ROCK, H)
+    chunks = []
+    plan = CheckpointPlan.create(40, None, tmp_path / "loop.npz", None)
+    record = RunRecord()
+    parts = LoopParts(None, record, plan, None, lambda: chunks.append(sim.step))
+    steps = run_loop.steps_to_run(sim.core, 100, None, 100)
+    run_plan = RunPlan(steps, (), 100, None, write_final=True)
+    assert run_loop.run_in_folder(sim, run_plan, parts) is None
+    assert (sim.step, record.steps_run, sim.summary()["steps_run"]) == (100, 100, 0)
+    assert chunks and chunks[-1] == 100 and chunks == sorted(set(chunks))
+    assert 40 in chunks and 80 in chunks  # the loop stops at the plan's checkpoint steps
+    restored = gr.Simulation(2)
+    restored.add_body(gr.Disc((0, 0), 1e-3), ROCK, H)
+    restored.load_checkpoint(tmp_path / "loop.npz")
+    assert restored.step == 80

@@ -26,14 +26,9 @@ from granulate.functions import (
 from granulate.materials import Material
 from granulate.meshes import SurfaceMesh, read_mesh
 from granulate.packing import (
-    Fixed,
     Grain,
-    LogNormal,
-    Normal,
     Packing,
     Placements,
-    Sieve,
-    Uniform,
     pack,
     read_placements,
 )
@@ -58,6 +53,7 @@ from granulate.shapes import (
     lattice,
 )
 from granulate.simulation import FIELDS, Body, Progress, Simulation
+from granulate.size_distributions import Fixed, LogNormal, Normal, Sieve, Uniform
 from granulate.threads import get_num_threads, set_num_threads
 from granulate.walls import (
     BoxContainer,

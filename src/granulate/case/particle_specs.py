@@ -7,7 +7,7 @@ from typing import Annotated, Literal
 
 from pydantic import BaseModel, Field, model_validator
 
-from granulate import functions, packing
+from granulate import functions, size_distributions
 from granulate.case.shape_specs import ShapeRef
 from granulate.case.spec_types import Finite, NonNegative, Positive, Spec
 from granulate.input_errors import NOT_BOOL
@@ -107,11 +107,11 @@ SizeSpec = Annotated[
     Field(discriminator="distribution"),
 ]
 _SIZES = {
-    "fixed": packing.Fixed,
-    "uniform": packing.Uniform,
-    "normal": packing.Normal,
-    "lognormal": packing.LogNormal,
-    "sieve": packing.Sieve,
+    "fixed": size_distributions.Fixed,
+    "uniform": size_distributions.Uniform,
+    "normal": size_distributions.Normal,
+    "lognormal": size_distributions.LogNormal,
+    "sieve": size_distributions.Sieve,
 }
 
 
