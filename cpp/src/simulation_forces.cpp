@@ -1,0 +1,268 @@
+// The forces of one step (Simulation::compute_forces): the bond passes (dilatation and breaking,
+// then the pair forces, over BondSchedule's coloured blocks), body forces and damping, contact,
+// nodal force densities.
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+
+#include "bond_extension.hpp"
+#include "granulate/peridynamics/critical_stretch.hpp"
+#include "granulate/peridynamics/lps.hpp"
+#include "granulate/peridynamics/pmb.hpp"
+#include "granulate/simulation.hpp"
+
+namespace granulate {
+
+namespace {
+
+/// Adds V_j J beta r e of node i's forward bonds to i's sum and V_i J beta r e to j's (the sums
+/// of w r e in the dilatation); with Gather, of all i's bonds to i's sum only. With CanBreak, a
+/// bond past the critical stretch breaks instead: its bit at i is cleared and (i, j) is
+/// appended to `broken` (by the lower-numbered end only, when both ends evaluate it).
+template <bool CanBreak, bool Gather>
+void add_dilatation_terms(index_t i, const NodeBonds& bonds, std::uint8_t* bond_bits,
+                          CriticalStretch criterion, const real* x, const real* volumes, real* sums,
+                          std::vector<std::array<index_t, 2>>& broken) {
+  const real volume_i = volumes[i];
+  real sum = 0;
+  for (index_t b = Gather ? 0 : bonds.forward; b < bonds.count; ++b) {
+    if (!BondStates::intact(bond_bits, b)) continue;
+    const index_t j = bonds.neighbor(b);
+    const real r = bonds.length(b);
+    const real e = bond_extension(i, j, r, x);
+    if constexpr (CanBreak) {
+      if (criterion.breaks(e / r)) [[unlikely]] {
+        BondStates::clear(bond_bits, b);
+        if (!Gather || j > i) broken.push_back({i, j});
+        continue;
+      }
+    }
+    const real term = lps::dilatation_term(bonds.influence_weight(b), r, e);
+    sum += volumes[j] * term;
+    if constexpr (!Gather) sums[j] += volume_i * term;
+  }
+  sums[i] += sum;
+}
+
+/// Runs body(i) for every node, colour by colour, the blocks of a colour in parallel (inside an
+/// omp parallel region). Each bond is evaluated once, at its lower-numbered end, and its terms are
+/// added to both ends; the colours keep concurrent blocks on disjoint nodes (see BondSchedule), so
+/// there are no atomics and the sums do not depend on the thread count. Nodes of a particle that
+/// gathers evaluate all their bonds and write only their own sums.
+template <class Body>
+void for_each_node_in_colours(const BondSchedule& schedule, Body&& body) {
+  for (std::size_t c = 0; c + 1 < schedule.colour_offsets.size(); ++c) {
+    const std::int64_t first = schedule.colour_offsets[c], last = schedule.colour_offsets[c + 1];
+#pragma omp for schedule(dynamic, 1)
+    for (std::int64_t k = first; k < last; ++k) {
+      const index_t block = schedule.blocks[k];
+      for (index_t i = schedule.block_starts[block]; i < schedule.block_starts[block + 1]; ++i) body(i);
+    }
+  }
+}
+
+/// What the pair-force loop reads and writes, as raw pointers (kept in registers).
+struct PairForceArrays {
+  const real* positions;
+  const real* volumes;
+  const real* pressures;
+  const lps::NodeCoefficients* coefficients;
+  const real* pmb_stiffness;
+  real* forces;
+};
+
+/// Adds the pair forces of node i's forward bonds to both ends: w_ij s y/|y| to i and
+/// -w_ji s y/|y| to j, with s the LPS (Lps) or PMB scalar force state of the bond without its
+/// weight and w_ij = J beta_ij V_j; with Gather, of all i's bonds to i only.
+template <bool Lps, bool Gather>
+void add_pair_forces(index_t i, const NodeBonds& bonds, const std::uint8_t* bond_bits, PairForceArrays a) {
+  const real* const x = a.positions;
+  real* const f = a.forces;
+  const real pressure_i = Lps ? a.pressures[i] : 0;
+  const real deviatoric_i = Lps ? a.coefficients[i].deviatoric_stiffness : 0;
+  const real stiffness_i = Lps ? 0 : a.pmb_stiffness[i];
+  const real volume_i = a.volumes[i];
+  const real* const xi = x + 3 * std::size_t{i};
+  real fx = 0, fy = 0, fz = 0;
+  for (index_t b = Gather ? 0 : bonds.forward; b < bonds.count; ++b) {
+    if (!BondStates::intact(bond_bits, b)) continue;
+    const index_t j = bonds.neighbor(b);
+    const real* const xj = x + 3 * std::size_t{j};  // one base register for the three components
+    const real dx = xj[0] - xi[0], dy = xj[1] - xi[1], dz = xj[2] - xi[2];
+    const real length = std::sqrt(dx * dx + dy * dy + dz * dz);
+    if (!(length > 0)) continue;
+    const real r = bonds.length(b);
+    const real omega = bonds.influence_weight(b);
+    const real e = length - r;
+    real scalar;
+    if constexpr (Lps) {
+      scalar = lps::pair_force(omega, r, e, pressure_i, a.pressures[j], deviatoric_i,
+                               a.coefficients[j].deviatoric_stiffness);
+    } else {
+      scalar = pmb::pair_force(stiffness_i + a.pmb_stiffness[j], omega, e / r);
+    }
+    const real over = scalar / length;
+    const real gx = over * dx, gy = over * dy, gz = over * dz;
+    const real volume_j = a.volumes[j];
+    fx += volume_j * gx;
+    fy += volume_j * gy;
+    fz += volume_j * gz;
+    if constexpr (!Gather) {
+      real* const fj = f + 3 * std::size_t{j};
+      fj[0] -= volume_i * gx;
+      fj[1] -= volume_i * gy;
+      fj[2] -= volume_i * gz;
+    }
+  }
+  real* const fi = f + 3 * std::size_t{i};
+  fi[0] += fx;
+  fi[1] += fy;
+  fi[2] += fz;
+}
+
+}  // namespace
+
+void Simulation::add_bond_forces(real* forces) const {
+  // Pass 2: pair forces, w_ij s y/|y| on i and -w_ji s y/|y| on j (w_ij = J beta V_j), from the
+  // pressures of pass 1.
+  const Model& m = *model_;
+  const BondSchedule& schedule = m.bond_schedule();
+  const PairForceArrays arrays{state_.positions.data(),     m.volumes().data(),       pressure_.data(),
+                               m.lps_coefficients().data(), m.pmb_stiffness().data(), forces};
+#pragma omp parallel
+  for_each_node_in_colours(schedule, [&](index_t i) {
+    const NodeBonds bonds = m.node_bonds(i);
+    const bool lps = m.materials()[m.node_material()[i]].params.model == ForceModel::lps;
+    const bool gathers = schedule.particle_gathers[m.node_particle()[i]];
+    const std::uint8_t* const bits = state_.bonds.node(i);
+    if (lps && !gathers) {
+      add_pair_forces<true, false>(i, bonds, bits, arrays);
+    } else if (!gathers) {
+      add_pair_forces<false, false>(i, bonds, bits, arrays);
+    } else if (lps) {
+      add_pair_forces<true, true>(i, bonds, bits, arrays);
+    } else {
+      add_pair_forces<false, true>(i, bonds, bits, arrays);
+    }
+  });
+}
+
+std::vector<real> Simulation::bond_force_densities() const {
+  std::vector<real> forces(state_.positions.size(), 0.0);
+  if (forces_current_) add_bond_forces(forces.data());
+  return forces;
+}
+
+void Simulation::compute_forces() {
+  update_kinematic_nodes();
+  const std::uint64_t newly_broken = sum_dilatation_and_break_bonds();  // pass 1
+  start_node_forces();
+  add_bond_forces(state_.forces.data());  // pass 2
+  broken_bond_copies_ += newly_broken;
+  add_contact_forces();
+  add_nodal_forces();
+  forces_current_ = true;
+}
+
+std::uint64_t Simulation::sum_dilatation_and_break_bonds() {
+  // Pass 1: stretch, irreversible breaking, sum_j w r e at both ends. A bond breaks at the end
+  // that evaluates it; its other copy is cleared below, before any loop reads it (when both
+  // ends gather, both see bitwise the same stretch and each clears its own).
+  const Model& m = *model_;
+  const auto& materials = m.materials();
+  const auto& node_material = m.node_material();
+  auto& intact = state_.bonds;
+  const std::int64_t n = m.node_count();
+  const BondSchedule& schedule = m.bond_schedule();
+  const real* const positions = state_.positions.data();
+  const real* const volumes = m.volumes().data();
+  real* const dilatation_sums = state_.dilatation.data();
+  std::vector<std::array<index_t, 2>> broken;  // (evaluating node, neighbour)
+#pragma omp parallel
+  {
+#pragma omp for schedule(static)
+    for (std::int64_t i = 0; i < n; ++i) dilatation_sums[i] = 0;
+    std::vector<std::array<index_t, 2>> broken_here;
+    for_each_node_in_colours(schedule, [&](index_t i) {
+      const Material& material = materials[node_material[i]];
+      const NodeBonds bonds = m.node_bonds(i);
+      const CriticalStretch criterion{m.particles()[m.node_particle()[i]].critical_stretch,
+                                      material.params.break_in_compression};
+      const bool breaks = material.params.fracture, gathers = schedule.particle_gathers[m.node_particle()[i]];
+      std::uint8_t* const bits = intact.node(i);
+      if (breaks && !gathers) {
+        add_dilatation_terms<true, false>(i, bonds, bits, criterion, positions, volumes, dilatation_sums,
+                                          broken_here);
+      } else if (!gathers) {
+        add_dilatation_terms<false, false>(i, bonds, bits, criterion, positions, volumes, dilatation_sums,
+                                           broken_here);
+      } else if (breaks) {
+        add_dilatation_terms<true, true>(i, bonds, bits, criterion, positions, volumes, dilatation_sums,
+                                         broken_here);
+      } else {
+        add_dilatation_terms<false, true>(i, bonds, bits, criterion, positions, volumes, dilatation_sums,
+                                          broken_here);
+      }
+    });
+    if (!broken_here.empty()) {
+#pragma omp critical(granulate_broken_bonds)
+      broken.insert(broken.end(), broken_here.begin(), broken_here.end());
+    }
+  }
+  for (const auto& [i, j] : broken) {
+    const NodeBonds bonds = m.node_bonds(j);
+    BondStates::clear(intact.node(j), bonds.find(i));
+  }
+  contact_.bonds_broke(m, broken);
+  return 2 * broken.size();
+}
+
+void Simulation::start_node_forces() {
+  // Dilatation and pressure of LPS nodes; body forces and damping start each node's sum.
+  const Model& m = *model_;
+  const auto& materials = m.materials();
+  const auto& node_material = m.node_material();
+  const auto& lps_coefficients = m.lps_coefficients();
+  const auto& density = m.node_density();
+  auto& f = state_.forces;
+  auto& theta = state_.dilatation;
+  const std::int64_t n = m.node_count();
+  const auto g = body_acceleration_;
+#pragma omp parallel for schedule(static)
+  for (std::int64_t ii = 0; ii < n; ++ii) {
+    const index_t i = static_cast<index_t>(ii);
+    if (materials[node_material[i]].params.model == ForceModel::lps) {
+      theta[i] *= lps_coefficients[i].dilatation_scale;
+      pressure_[i] = lps_coefficients[i].dilatation_coupling * theta[i];
+    } else {
+      theta[i] = 0;
+    }
+    const real* vi = &state_.velocities[3 * i];
+    f[3 * i] = density[i] * (g[0] - viscous_damping_ * vi[0]);
+    f[3 * i + 1] = density[i] * (g[1] - viscous_damping_ * vi[1]);
+    f[3 * i + 2] = density[i] * (g[2] - viscous_damping_ * vi[2]);
+  }
+}
+
+void Simulation::add_contact_forces() {
+  const auto contact_start = std::chrono::steady_clock::now();
+  contact_.add_forces(*model_, state_, broken_bond_copies_);
+  peridem_damping_.add_forces(*model_, state_);
+  phase_times_.contact +=
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - contact_start).count();
+  phase_times_.contact_search = contact_.search_seconds();
+}
+
+void Simulation::add_nodal_forces() {
+  auto& f = state_.forces;
+  const real t = state_.time;
+  for (const NodalForce& load : nodal_forces_) {
+    const real scale = load.function.value(t);
+    for (index_t i : load.nodes) {
+      for (int c = 0; c < 3; ++c) f[3 * i + c] += scale * load.vector[c];
+    }
+  }
+}
+
+}  // namespace granulate
