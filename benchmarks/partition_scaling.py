@@ -1,0 +1,205 @@
+"""How whole-grain decomposition would scale (issue 17): partitions of a 10^5-grain 3D packing,
+their measured ghosts, and a model of the communication share of a step, on paper.
+
+    python benchmarks/partition_scaling.py                   # 10^5 grains, R/h = 6, K = 2 ... 2048
+    python benchmarks/partition_scaling.py --json out.json   # the table as JSON too
+
+No distributed run is made (the MPI engine does not exist yet). The packing (granulate.pack,
+lattice sites in a cube, radii 0.9-1.1 mm) is cut into K ranks by recursive coordinate bisection
+of whole grains (granulate.parallel), and each rank's ghosts are the other ranks' grains whose
+bounding spheres come within `--reach` of its own: all twelve lattice neighbours, as many as a
+dense pile's contact candidates. A step then needs, per rank:
+
+- compute: its nodes / the node-steps per second of one core, measured here on a small 3D
+  assembly of the same spheres (conforming, R/h = 6; contact, gravity, no output);
+- one exchange: the positions and velocities (48 bytes) of the ghost grains' nodes that can
+  touch its own, those within --shell mesh sizes of their surface, one message per
+  neighbouring rank (latency + bytes / bandwidth);
+- one reduction (the stability check's minimum): 2 log2(K) latencies.
+
+The network is an assumption, printed with the table: latency 1.5 us and 0.39 GB/s per rank (a
+100 Gb/s link shared by 32 ranks, every neighbour on another node: the pessimistic case). No
+overlap of communication with computation is assumed.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import time
+from pathlib import Path
+
+import numpy as np
+
+import granulate as gr
+from granulate.parallel import bisect, ghosts, near_pairs
+
+RADIUS = 1e-3
+MATERIAL = gr.Material(density=1200, bulk_modulus=2.16e7, shear_modulus=1.296e7, fracture_energy=50)
+
+
+def packing(count: int) -> gr.Packing:
+    """`count` spheres of radius 0.9-1.1 mm on face-centred cubic sites of a cube."""
+    side = 2.2e-3 * np.sqrt(2) * (np.ceil((count / 4) ** (1 / 3)) + 1)  # sites, and a margin
+    coarse = gr.Grain(gr.Sphere((0, 0, 0), RADIUS), MATERIAL, RADIUS, gr.Uniform(0.9e-3, 1.1e-3))
+    return gr.pack(gr.Box((0, 0, 0), (side, side, side)), [coarse], count, method="lattice", seed=1)
+
+
+def grain_nodes(nodes_across_radius: int) -> np.ndarray:
+    """A conforming sphere's nodes at unit radius, (nodes, 3)."""
+    sphere = gr.ReferenceShape.from_shape(
+        gr.Sphere((0, 0, 0), RADIUS), RADIUS / nodes_across_radius, discretization="conforming"
+    )
+    return np.asarray(sphere.positions)[:, :3] / RADIUS
+
+
+def exchanged_nodes(
+    centres: np.ndarray,
+    radii: np.ndarray,
+    owner: np.ndarray,
+    pairs,
+    unit_nodes: np.ndarray,
+    reach: float,
+) -> np.ndarray:
+    """(ranks,) the ghost nodes each rank needs: of each ghost grain, the nodes within `reach`
+    of the bounding sphere of one of the rank's grains near it."""
+    first, last = pairs
+    crossing = owner[first] != owner[last]
+    ghost = np.concatenate([last[crossing], first[crossing]])
+    own = np.concatenate([first[crossing], last[crossing]])
+    rank = owner[own]
+    order = np.lexsort((ghost, rank))
+    ghost, own, rank = ghost[order], own[order], rank[order]
+    group_start = np.flatnonzero(np.r_[True, (np.diff(rank) != 0) | (np.diff(ghost) != 0)])
+    counts = np.zeros(owner.max() + 1, dtype=np.int64)
+    chunk = 4096  # groups at a time: (pairs, nodes) booleans
+    for begin in range(0, len(group_start), chunk):
+        groups = group_start[begin : begin + chunk]
+        end = group_start[begin + chunk] if begin + chunk < len(group_start) else len(ghost)
+        rows = slice(groups[0], end)
+        nodes = centres[ghost[rows], None, :] + radii[ghost[rows], None, None] * unit_nodes
+        gap = np.linalg.norm(nodes - centres[own[rows], None, :], axis=2) - radii[own[rows], None]
+        near = np.logical_or.reduceat(gap <= reach, groups - groups[0], axis=0)
+        np.add.at(counts, rank[groups], near.sum(axis=1))
+    return counts
+
+
+def node_steps_per_second(nodes_across_radius: int, steps: int = 300) -> tuple[float, float]:
+    """One core's node-steps per second on 27 touching spheres in a box under gravity, and the
+    share of the bond passes (peridynamics) in the step."""
+    gr.set_num_threads(1)
+    sim = gr.Simulation(3, gravity=(0, -9.81, 0))
+    sim.contact = gr.Contact(restitution=0.5, friction=0.3)
+    sphere = gr.ReferenceShape.from_shape(
+        gr.Sphere((0, 0, 0), RADIUS), RADIUS / nodes_across_radius, discretization="conforming"
+    )
+    for index in np.ndindex(3, 3, 3):
+        sim.add_particle(sphere, MATERIAL, position=tuple(2.0e-3 * np.array(index) + 1.2e-3))
+    sim.add_wall(gr.BoxContainer((0, 0, 0), (6.4e-3, 8e-3, 6.4e-3)), name="box")
+    sim.run(20)
+    before = sim.summary()["peridynamics_seconds"]
+    start = time.perf_counter()
+    sim.run(steps)
+    seconds = time.perf_counter() - start
+    bonds = sim.summary()["peridynamics_seconds"] - before
+    return sim.node_count * steps / seconds, bonds / seconds
+
+
+def rank_table(
+    centres: np.ndarray, radii: np.ndarray, reach: float, ranks: int, unit_nodes: np.ndarray
+) -> dict[str, float]:
+    """One partition, per rank: grains, ghost grains, ghost nodes to receive and neighbouring
+    ranks; the rank that receives the most ghost nodes per owned node is the one reported."""
+    partition = bisect(centres, np.ones(len(centres)), ranks)
+    pairs = near_pairs(centres, radii, reach)
+    needed = ghosts(partition, pairs)
+    owned = np.bincount(partition.owner, minlength=ranks)
+    ghost_grains = np.array([len(g) for g in needed])
+    ghost_nodes = exchanged_nodes(centres, radii, partition.owner, pairs, unit_nodes, reach)
+    ghost_nodes = np.pad(ghost_nodes, (0, ranks - len(ghost_nodes)))
+    neighbours = np.array([len(np.unique(partition.owner[g])) for g in needed])
+    worst = int(np.argmax(ghost_nodes / owned))
+    return {
+        "ranks": ranks,
+        "grains_per_rank": float(owned.mean()),
+        "ghost_grains_mean": float(ghost_grains.mean()),
+        "ghost_grains_over_owned_max": float(np.max(ghost_grains / owned)),
+        "owned_nodes": int(owned[worst] * len(unit_nodes)),
+        "ghost_nodes": int(ghost_nodes[worst]),
+        "neighbours_max": int(neighbours.max()),
+        "neighbours_mean": float(neighbours.mean()),
+        "candidates_per_grain": 2 * len(pairs[0]) / len(centres),
+    }
+
+
+def modelled(
+    row: dict, rate: float, bond_share: float, latency: float, bandwidth: float
+) -> dict[str, float]:
+    """That rank's step: compute, one exchange of its ghost nodes' positions and velocities,
+    one reduction; the share of communication in the step, without overlap and with the
+    exchange hidden behind the bond passes (which need no ghost)."""
+    compute = row["owned_nodes"] / rate
+    ghost_bytes = 48.0 * row["ghost_nodes"]
+    exchange = row["neighbours_max"] * latency + ghost_bytes / bandwidth
+    reduction = 2 * np.log2(row["ranks"]) * latency
+    exposed = max(0.0, exchange - bond_share * compute) + reduction
+    return {
+        "ghost_bytes_per_step": ghost_bytes,
+        "compute_s": compute,
+        "communication_s": exchange + reduction,
+        "communication_share": (exchange + reduction) / (compute + exchange + reduction),
+        "exposed_share": exposed / (compute + exposed),
+    }
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--grains", type=int, default=100_000)
+    parser.add_argument("--nodes-across-radius", type=int, default=6)
+    parser.add_argument("--reach", type=float, default=0.5e-3, help="broad-phase reach [m]")
+    parser.add_argument("--latency", type=float, default=1.5e-6, help="[s]")
+    parser.add_argument("--bandwidth", type=float, default=12.5e9 / 32, help="per rank [B/s]")
+    parser.add_argument("--largest", type=int, default=2048, help="ranks: 2, 4, ... this")
+    parser.add_argument("--json", type=Path, default=None)
+    args = parser.parse_args()
+
+    start = time.perf_counter()
+    pack = packing(args.grains)
+    unit_nodes = grain_nodes(args.nodes_across_radius)
+    rate, bond_share = node_steps_per_second(args.nodes_across_radius)
+    print(
+        f"{pack.summary()}; packed in {time.perf_counter() - start:.1f} s\n"
+        f"{len(unit_nodes)} nodes per grain (R/h = {args.nodes_across_radius}); one core: "
+        f"{rate / 1e6:.2f} M node-steps/s, bond passes {100 * bond_share:.0f} % of the step "
+        f"(measured)\nnetwork assumed: latency {args.latency * 1e6:.1f} us, "
+        f"{args.bandwidth / 1e9:.2f} GB/s per rank"
+    )
+    print(
+        f"{'ranks':>6} {'grains/rank':>11} {'nodes/rank':>10} {'ghost nodes':>11} "
+        f"{'neighbours':>10} {'exchange kB':>11} {'compute ms':>10} {'comm ms':>8} "
+        f"{'comm %':>6} {'hidden %':>8} {'partition s':>11}"
+    )
+    rows = []
+    ranks = 2
+    while ranks <= min(args.largest, args.grains):
+        began = time.perf_counter()
+        row = rank_table(pack.positions, pack.radii, args.reach, ranks, unit_nodes)
+        row["partition_seconds"] = time.perf_counter() - began
+        row |= modelled(row, rate, bond_share, args.latency, args.bandwidth)
+        rows.append(row)
+        print(
+            f"{ranks:6d} {row['grains_per_rank']:11.1f} {row['owned_nodes']:10d} "
+            f"{row['ghost_nodes']:11d} {row['neighbours_max']:10d} "
+            f"{row['ghost_bytes_per_step'] / 1e3:11.1f} {1e3 * row['compute_s']:10.2f} "
+            f"{1e3 * row['communication_s']:8.3f} {100 * row['communication_share']:6.1f} "
+            f"{100 * row['exposed_share']:8.1f} {row['partition_seconds']:11.2f}"
+        )
+        ranks *= 2
+    print(f"broad phase: {rows[0]['candidates_per_grain']:.1f} candidate partners per grain")
+    if args.json is not None:
+        settings = vars(args) | {"json": None, "rate": rate, "bond_share": bond_share}
+        args.json.write_text(json.dumps({"arguments": settings, "rows": rows}, indent=1))
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,98 @@
+"""Whole grains over ranks (granulate.parallel.partition): the recursive coordinate bisection
+balances the work and cuts space into compact blocks, the broad phase finds exactly the pairs
+of grains in reach, and each rank's ghosts are exactly the other ranks' grains near its own."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import granulate as gr
+from granulate.parallel import bisect, ghosts, near_pairs
+
+
+def grains(count: int, dimension: int, seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
+    """Random centres in a box of side 50 mm and radii from 0.5 to 2 mm (they may overlap:
+    the partition only looks at centres and bounding spheres)."""
+    rng = np.random.default_rng(seed)
+    return rng.uniform(0, 0.05, (count, dimension)), rng.uniform(0.5e-3, 2e-3, count)
+
+
+def brute_force_pairs(centres: np.ndarray, radii: np.ndarray, reach: float) -> np.ndarray:
+    distance = np.linalg.norm(centres[:, None] - centres[None], axis=2)
+    close = np.triu(distance <= radii[:, None] + radii[None] + reach, 1)
+    return np.argwhere(close)
+
+
+@pytest.mark.parametrize("dimension", [2, 3])
+@pytest.mark.parametrize("reach", [0.0, 0.3e-3, 3e-3])
+def test_near_pairs_are_the_pairs_in_reach(dimension: int, reach: float) -> None:
+    centres, radii = grains(1500, dimension)
+    first, last = near_pairs(centres, radii, reach)
+    expected = brute_force_pairs(centres, radii, reach)
+    assert len(expected) > 100
+    np.testing.assert_array_equal(np.column_stack([first, last]), expected)
+
+
+@pytest.mark.parametrize("dimension", [2, 3])
+@pytest.mark.parametrize("ranks", [1, 2, 3, 7, 16])
+def test_bisection_gives_every_rank_its_share_of_the_work(dimension: int, ranks: int) -> None:
+    centres, radii = grains(2000, dimension)
+    work = (radii / radii.min()) ** dimension  # nodes grow as the grain's volume
+    partition = bisect(centres, work, ranks)
+    assert partition.owner.shape == (2000,)
+    assert set(np.unique(partition.owner)) == set(range(ranks))
+    loads = partition.loads(work)
+    assert loads.sum() == pytest.approx(work.sum(), rel=1e-12)
+    levels = int(np.ceil(np.log2(ranks)))
+    assert np.all(np.abs(loads - work.sum() / ranks) <= levels * work.max() + 1e-12 * work.sum())
+
+
+def test_bisection_of_a_cubic_lattice_gives_cubic_blocks() -> None:
+    """8 x 8 x 8 equal grains on 8 ranks: each rank gets one 4 x 4 x 4 octant."""
+    axis = np.arange(8) * 2.5e-3
+    centres = np.stack(np.meshgrid(axis, axis, axis, indexing="ij"), axis=-1).reshape(-1, 3)
+    partition = bisect(centres, np.ones(len(centres)), 8)
+    for rank in range(8):
+        block = np.round(centres[partition.grains_of(rank)] / 2.5e-3).astype(int)
+        assert len(block) == 64
+        assert np.all(block.max(axis=0) - block.min(axis=0) == 3)
+
+
+def test_bisection_does_not_depend_on_the_order_of_the_grains() -> None:
+    centres, radii = grains(1000, 3)
+    permutation = np.random.default_rng(1).permutation(1000)
+    first = bisect(centres, radii**3, 6).owner
+    again = bisect(centres, radii**3, 6).owner
+    permuted = bisect(centres[permutation], radii[permutation] ** 3, 6).owner
+    np.testing.assert_array_equal(first, again)
+    np.testing.assert_array_equal(permuted, first[permutation])
+
+
+@pytest.mark.parametrize("dimension", [2, 3])
+def test_ghosts_are_the_other_ranks_grains_in_reach(dimension: int) -> None:
+    centres, radii = grains(1200, dimension)
+    reach = 0.5e-3
+    partition = bisect(centres, np.ones(1200), 5)
+    needed = ghosts(partition, near_pairs(centres, radii, reach))
+    distance = np.linalg.norm(centres[:, None] - centres[None], axis=2)
+    close = distance <= radii[:, None] + radii[None] + reach
+    for rank in range(5):
+        own = partition.owner == rank
+        expected = np.flatnonzero(close[own].any(axis=0) & ~own)
+        assert len(expected) > 0
+        np.testing.assert_array_equal(needed[rank], expected)
+
+
+def test_bad_partition_input_is_refused() -> None:
+    centres, radii = grains(10, 2)
+    with pytest.raises(gr.InputError, match="at least one grain"):
+        bisect(centres, np.ones(10), 11)
+    with pytest.raises(gr.InputError, match="ranks"):
+        bisect(centres, np.ones(10), 0)
+    with pytest.raises(gr.InputError, match="positive number per grain"):
+        bisect(centres, -np.ones(10), 2)
+    with pytest.raises(gr.InputError, match="shape"):
+        bisect(centres[:, :1], np.ones(10), 2)
+    with pytest.raises(gr.InputError, match="reach"):
+        near_pairs(centres, radii, -1.0)
