@@ -20,6 +20,12 @@ dense pile's contact candidates. A step then needs, per rank:
 The network is an assumption, printed with the table: latency 1.5 us and 0.39 GB/s per rank (a
 100 Gb/s link shared by 32 ranks, every neighbour on another node: the pessimistic case). No
 overlap of communication with computation is assumed.
+
+A second table splits one body at node level (`--block N`: an N^3 simple-cubic block, horizon
+3.015 spacings, LAMMPS' lattice): the same bisection over its nodes, and as halo each rank's
+nodes of other ranks within one horizon (its bonds' partners). An LPS step exchanges twice:
+positions (24 bytes) before the dilatation pass and the dilatations (8 bytes) before the force
+pass; compute is one core's node-steps per second on a 20^3 block of that lattice (measured).
 """
 
 from __future__ import annotations
@@ -152,6 +158,74 @@ def modelled(
     }
 
 
+def lps_node_steps_per_second(steps: int = 30) -> float:
+    """One core's node-steps per second of LPS on a 20^3 simple-cubic block (no contact)."""
+    gr.set_num_threads(1)
+    sim = gr.Simulation(3)
+    rock = gr.Material(
+        density=2200,
+        bulk_modulus=14.9e9,
+        shear_modulus=14.0e9,
+        horizon_factor=3.015,
+        fracture=False,
+    )
+    sim.add_body(gr.Box((0, 0, 0), (10e-3, 10e-3, 10e-3)), rock, 0.5e-3)
+    sim.run(2)
+    start = time.perf_counter()
+    sim.run(steps)
+    return sim.node_count * steps / (time.perf_counter() - start)
+
+
+def single_body(args: argparse.Namespace) -> list[dict[str, float]]:
+    """The node-level split of one N^3 block: per rank nodes, halo nodes, neighbouring ranks,
+    and the modelled share of the two exchanges in an LPS step."""
+    side = np.arange(args.block, dtype=float)
+    nodes = np.stack(np.meshgrid(side, side, side, indexing="ij"), axis=-1).reshape(-1, 3)
+    pairs = near_pairs(nodes, np.zeros(len(nodes)), 3.015)
+    rate = lps_node_steps_per_second()
+    print(
+        f"\none body: {len(nodes):,} nodes, {2 * len(pairs[0]) / len(nodes):.1f} bonds per node; "
+        f"one core: {rate / 1e6:.2f} M node-steps/s of LPS (measured)"
+    )
+    print(
+        f"{'ranks':>6} {'nodes/rank':>10} {'halo nodes':>10} {'neighbours':>10} "
+        f"{'exchange kB':>11} {'compute ms':>10} {'comm ms':>8} {'comm %':>6}"
+    )
+    rows = []
+    ranks = 2
+    while ranks <= args.largest_split:
+        partition = bisect(nodes, np.ones(len(nodes)), ranks)
+        halo = ghosts(partition, pairs)
+        owned = np.bincount(partition.owner, minlength=ranks)
+        worst = int(np.argmax([len(h) / o for h, o in zip(halo, owned, strict=True)]))
+        neighbours = len(np.unique(partition.owner[halo[worst]]))
+        exchanged = 32.0 * len(halo[worst])
+        compute = owned[worst] / rate
+        communication = (
+            2 * neighbours * args.latency
+            + exchanged / args.bandwidth
+            + 2 * np.log2(ranks) * args.latency
+        )
+        row = {
+            "ranks": ranks,
+            "nodes_per_rank": int(owned[worst]),
+            "halo_nodes": len(halo[worst]),
+            "neighbours": neighbours,
+            "exchange_bytes": exchanged,
+            "compute_s": compute,
+            "communication_s": communication,
+            "communication_share": communication / (compute + communication),
+        }
+        rows.append(row)
+        print(
+            f"{ranks:6d} {row['nodes_per_rank']:10d} {row['halo_nodes']:10d} {neighbours:10d} "
+            f"{exchanged / 1e3:11.1f} {1e3 * compute:10.2f} {1e3 * communication:8.3f} "
+            f"{100 * row['communication_share']:6.1f}"
+        )
+        ranks *= 2
+    return rows
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--grains", type=int, default=100_000)
@@ -160,6 +234,8 @@ def main() -> None:
     parser.add_argument("--latency", type=float, default=1.5e-6, help="[s]")
     parser.add_argument("--bandwidth", type=float, default=12.5e9 / 32, help="per rank [B/s]")
     parser.add_argument("--largest", type=int, default=2048, help="ranks: 2, 4, ... this")
+    parser.add_argument("--block", type=int, default=100, help="one body: N^3 nodes (0: none)")
+    parser.add_argument("--largest-split", type=int, default=64, help="its ranks: 2 ... this")
     parser.add_argument("--json", type=Path, default=None)
     args = parser.parse_args()
 
@@ -196,9 +272,11 @@ def main() -> None:
         )
         ranks *= 2
     print(f"broad phase: {rows[0]['candidates_per_grain']:.1f} candidate partners per grain")
+    body = single_body(args) if args.block else []
     if args.json is not None:
         settings = vars(args) | {"json": None, "rate": rate, "bond_share": bond_share}
-        args.json.write_text(json.dumps({"arguments": settings, "rows": rows}, indent=1))
+        result = {"arguments": settings, "grains": rows, "one_body": body}
+        args.json.write_text(json.dumps(result, indent=1))
 
 
 if __name__ == "__main__":
