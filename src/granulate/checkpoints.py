@@ -95,19 +95,18 @@ class CheckpointPlan:
 def save(sim: Simulation, path: str | Path, outputs: Outputs | None) -> Path:
     """Write sim's state and the bookkeeping of its `outputs` to `path` atomically."""
     core = sim.core
-    out = outputs
     header = {
         "granulate": __version__,
         "fingerprint": sim.fingerprint(),
         "step": int(core.step),
         "time": float(core.time),
         "output": None
-        if out is None
+        if outputs is None
         else {
-            "frames": out.frames,
-            "every": out.every,
-            "history_every": out.history_every,
-            "pvd": out.pvd.entries,
+            "frames": outputs.frames,
+            "every": outputs.every,
+            "history_every": outputs.history_every,
+            "pvd": outputs.pvd.entries,
         },
     }
     target = Path(path)
@@ -129,20 +128,19 @@ def load(sim: Simulation, path: str | Path, outputs: Outputs | None) -> None:
         )
     core.restore(state)
     sim.analysis.forget_fragments()  # the labels of the bonds before the restore
-    out = outputs
     saved = header.get("output")
-    if out is None:
+    if outputs is None:
         return
     if (
         saved is None
-        or saved["every"] != out.every
-        or saved.get("history_every", saved["every"]) != out.history_every
+        or saved["every"] != outputs.every
+        or saved.get("history_every", saved["every"]) != outputs.history_every
     ):
         raise InputError(
             f"checkpoint {path} was written with other output settings; keep the "
             "output interval of the original run"
         )
-    out.resume(int(saved["frames"]), saved["pvd"], int(core.step))
+    outputs.resume(int(saved["frames"]), saved["pvd"], int(core.step))
 
 
 def save_on_interrupt(
