@@ -63,6 +63,7 @@ def exchanged_nodes(
     centres: np.ndarray,
     radii: np.ndarray,
     owner: np.ndarray,
+    ranks: int,
     pairs,
     unit_nodes: np.ndarray,
     reach: float,
@@ -77,7 +78,7 @@ def exchanged_nodes(
     order = np.lexsort((ghost, rank))
     ghost, own, rank = ghost[order], own[order], rank[order]
     group_start = np.flatnonzero(np.r_[True, (np.diff(rank) != 0) | (np.diff(ghost) != 0)])
-    counts = np.zeros(owner.max() + 1, dtype=np.int64)
+    counts = np.zeros(ranks, dtype=np.int64)
     chunk = 4096  # groups at a time: (pairs, nodes) booleans
     for begin in range(0, len(group_start), chunk):
         groups = group_start[begin : begin + chunk]
@@ -111,18 +112,31 @@ def node_steps_per_second(nodes_across_radius: int, steps: int = 300) -> tuple[f
     return sim.node_count * steps / seconds, bonds / seconds
 
 
+def communication_seconds(
+    exchanges: int, neighbours: int, sent_bytes: float, ranks: int, args: argparse.Namespace
+) -> tuple[float, float]:
+    """A step's exchanges with `neighbours` ranks (a message each), `sent_bytes` in all, and
+    its one reduction (2 log2 ranks latencies): (exchange seconds, reduction seconds)."""
+    exchange = exchanges * neighbours * args.latency + sent_bytes / args.bandwidth
+    return exchange, 2 * np.log2(ranks) * args.latency
+
+
 def rank_table(
-    centres: np.ndarray, radii: np.ndarray, reach: float, ranks: int, unit_nodes: np.ndarray
+    centres: np.ndarray,
+    radii: np.ndarray,
+    pairs,
+    ranks: int,
+    unit_nodes: np.ndarray,
+    reach: float,
 ) -> dict[str, float]:
     """One partition, per rank: grains, ghost grains, ghost nodes to receive and neighbouring
-    ranks; the rank that receives the most ghost nodes per owned node is the one reported."""
+    ranks, from the grains' `pairs` in reach (near_pairs); the rank that receives the most ghost
+    nodes per owned node is the one reported."""
     partition = bisect(centres, np.ones(len(centres)), ranks)
-    pairs = near_pairs(centres, radii, reach)
     needed = ghosts(partition, pairs)
     owned = np.bincount(partition.owner, minlength=ranks)
     ghost_grains = np.array([len(g) for g in needed])
-    ghost_nodes = exchanged_nodes(centres, radii, partition.owner, pairs, unit_nodes, reach)
-    ghost_nodes = np.pad(ghost_nodes, (0, ranks - len(ghost_nodes)))
+    ghost_nodes = exchanged_nodes(centres, radii, partition.owner, ranks, pairs, unit_nodes, reach)
     neighbours = np.array([len(np.unique(partition.owner[g])) for g in needed])
     worst = int(np.argmax(ghost_nodes / owned))
     return {
@@ -139,15 +153,16 @@ def rank_table(
 
 
 def modelled(
-    row: dict, rate: float, bond_share: float, latency: float, bandwidth: float
+    row: dict, rate: float, bond_share: float, args: argparse.Namespace
 ) -> dict[str, float]:
     """That rank's step: compute, one exchange of its ghost nodes' positions and velocities,
     one reduction; the share of communication in the step, without overlap and with the
     exchange hidden behind the bond passes (which need no ghost)."""
     compute = row["owned_nodes"] / rate
     ghost_bytes = 48.0 * row["ghost_nodes"]
-    exchange = row["neighbours_max"] * latency + ghost_bytes / bandwidth
-    reduction = 2 * np.log2(row["ranks"]) * latency
+    exchange, reduction = communication_seconds(
+        1, row["neighbours_max"], ghost_bytes, row["ranks"], args
+    )
     exposed = max(0.0, exchange - bond_share * compute) + reduction
     return {
         "ghost_bytes_per_step": ghost_bytes,
@@ -201,11 +216,7 @@ def single_body(args: argparse.Namespace) -> list[dict[str, float]]:
         neighbours = len(np.unique(partition.owner[halo[worst]]))
         exchanged = 32.0 * len(halo[worst])
         compute = owned[worst] / rate
-        communication = (
-            2 * neighbours * args.latency
-            + exchanged / args.bandwidth
-            + 2 * np.log2(ranks) * args.latency
-        )
+        communication = sum(communication_seconds(2, neighbours, exchanged, ranks, args))
         row = {
             "ranks": ranks,
             "nodes_per_rank": int(owned[worst]),
@@ -256,12 +267,13 @@ def main() -> None:
         f"{'comm %':>6} {'hidden %':>8} {'partition s':>11}"
     )
     rows = []
+    pairs = near_pairs(pack.positions, pack.radii, args.reach)  # the same for every partition
     ranks = 2
     while ranks <= min(args.largest, args.grains):
         began = time.perf_counter()
-        row = rank_table(pack.positions, pack.radii, args.reach, ranks, unit_nodes)
+        row = rank_table(pack.positions, pack.radii, pairs, ranks, unit_nodes, args.reach)
         row["partition_seconds"] = time.perf_counter() - began
-        row |= modelled(row, rate, bond_share, args.latency, args.bandwidth)
+        row |= modelled(row, rate, bond_share, args)
         rows.append(row)
         print(
             f"{ranks:6d} {row['grains_per_rank']:11.1f} {row['owned_nodes']:10d} "

@@ -115,10 +115,11 @@ void ContactModel::node_forces(const Model& model, State& state, real dt) {
 #pragma omp parallel for schedule(static)
   for (std::int64_t k = 0; k < count; ++k) {
     const index_t i = contact_nodes_[k];
-    const NodeContactForces forces = gather_node_forces(model, state, i, dt);
+    const SurfaceAnchor* anchor = centres_.anchor(model, i);
+    const NodeContactForces forces = gather_node_forces(model, state, i, anchor != nullptr, dt);
     vec total{0, 0, 0};
     for (int c = 0; c < 3; ++c) total[c] = forces.at_centre[c] + forces.at_surface[c] + forces.at_node[c];
-    if (const SurfaceAnchor* anchor = centres_.anchor(model, i); anchor != nullptr) {
+    if (anchor != nullptr) {
       anchor_forces_[k] = anchored_vector_force(model, state, i, forces);
       real weights = 0;
       for (std::size_t a = 0; a < anchor->nodes.size() && anchor->nodes[a] != SurfaceAnchor::no_anchor; ++a)
@@ -131,7 +132,7 @@ void ContactModel::node_forces(const Model& model, State& state, real dt) {
 }
 
 ContactModel::NodeContactForces ContactModel::gather_node_forces(const Model& model, State& state, index_t i,
-                                                                 real dt) {
+                                                                 bool anchored, real dt) {
   NodeContactForces forces;
   auto& [at_centre, at_surface, at_node, on_vector] = forces;
   for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
@@ -158,7 +159,7 @@ ContactModel::NodeContactForces ContactModel::gather_node_forces(const Model& mo
       at_node[c] += probe.friction[c];
     }
   }
-  if (centres_.anchor(model, i) == nullptr || surface_slot_.empty() || surface_slot_[i] == no_group) {
+  if (!anchored || surface_slot_.empty() || surface_slot_[i] == no_group) {
     return forces;
   }
   const contact::SurfacePoint& own = surface_point(i);

@@ -131,8 +131,8 @@ def near_pairs(
         firsts.append(np.minimum(i[close], j[close]))
         lasts.append(np.maximum(i[close], j[close]))
     first, last = np.concatenate(firsts), np.concatenate(lasts)
-    order = np.lexsort((last, first))
-    return first[order], last[order]
+    by_pair = np.lexsort((last, first))
+    return first[by_pair], last[by_pair]
 
 
 def _half_neighbourhood(dimension: int) -> NDArray[np.int64]:

@@ -372,9 +372,10 @@ class ContactModel {
   struct NodeContactForces {
     vec3 at_centre{0, 0, 0}, at_surface{0, 0, 0}, at_node{0, 0, 0}, on_vector{0, 0, 0};
   };
-  /// Node i's contact forces from its pair, wall and probe entries and as other bodies' probe
-  /// target; advances its friction springs and sets its wall entries' reactions.
-  NodeContactForces gather_node_forces(const Model& model, State& state, index_t i, real dt);
+  /// Node i's contact forces from its pair, wall and probe entries and, when it is `anchored`
+  /// (carries a surface point), as other bodies' probe target; advances its friction springs
+  /// and sets its wall entries' reactions.
+  NodeContactForces gather_node_forces(const Model& model, State& state, index_t i, bool anchored, real dt);
   /// The force on an anchored node's vector A: `forces.on_vector` and the levers of the forces
   /// on its centre and surface point (both lie on its normal).
   vec3 anchored_vector_force(const Model& model, const State& state, index_t i,
