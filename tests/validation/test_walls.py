@@ -1,6 +1,6 @@
 """Particles against rigid walls (DESIGN.md section 3, "Walls"): a block sliding on a floor
-stops at the Coulomb distance, particles at rest load the floor with their weight, rotating
-drums and cylinders carry grains up by friction, a floor read from an STL file, a flexible wall
+stops at the Coulomb distance, particles at rest load the floor with their weight, a grain in
+a turning drum rolls as a rigid one does, a floor read from an STL file, a flexible wall
 made of a constrained particle. Helpers shared with the pair tests: test_contact.py."""
 
 from __future__ import annotations
@@ -83,29 +83,60 @@ def test_particles_at_rest_load_the_floor_with_their_weight(dimension: int) -> N
     assert abs(load / weight - 1) < 0.01, f"floor load {load / weight:.4f} x weight"
 
 
+def rigid_rolling_peak(dimension: int, rate: float, drum: float, radius: float) -> float:
+    """The highest angle [degrees] a rigid disc (sphere) starting at rest at the bottom of a drum
+    turning at `rate` reaches, rolling without slip and without rolling resistance: friction
+    first spins it up, conserving its angular momentum about the contact point, so it rolls off
+    at v = rate drum k / (1 + k) (k = I / (m R^2): 1/2 for a disc, 2/5 for a sphere); then
+    (1 + k) v^2 / 2 = g L (1 - cos theta), L = drum - radius."""
+    k = 0.5 if dimension == 2 else 0.4
+    speed = rate * drum * k / (1 + k)
+    return float(np.degrees(np.arccos(1 - (1 + k) * speed**2 / (2 * 9.81 * (drum - radius)))))
+
+
+def drum_angles(dimension: int, friction: float, nodes_across_radius: int, until: float):
+    """A disc (sphere) of radius 1 mm set on the bottom of a drum of radius 10 mm turning
+    counter-clockwise at 2 rad/s, under the surface law: its angle from the bottom [degrees,
+    positive towards +x] every 2 ms."""
+    radius, drum = 1e-3, 10e-3
+    sim = gr.Simulation(dimension, gravity=(0, -9.81, 0)[:dimension])
+    sim.contact = gr.Contact(restitution=0.3, friction=friction, pair_law="surface")
+    h = radius / nodes_across_radius
+    if dimension == 2:
+        grain = sim.add_body(gr.Disc((0, radius - drum), radius), SOFT, h)
+        wall = gr.CircleContainer((0, 0), drum)
+    else:
+        grain = sim.add_body(gr.Sphere((0, radius - drum, 0), radius), SOFT, h)
+        wall = gr.CircleContainer((0, 0, 0), drum, axis=(0, 0, 1))
+    sim.add_wall(gr.Wall((wall,), motion=gr.Rotation.steady(2.0)), name="drum")
+    angles = []
+    while sim.time < until:
+        sim.run(until=sim.time + 0.002)
+        x, y = body_centre(sim, grain)[:2]
+        angles.append(float(np.degrees(np.arctan2(x, -y))))
+    return np.array(angles)
+
+
 @pytest.mark.validation
-def test_rotating_drum_carries_a_particle_up_by_friction(full: bool) -> None:
-    """A disc at the bottom of a drum turning counter-clockwise rides up the rising side with
-    friction, and stays at the bottom without it: at 2 rad/s past 10 degrees in 0.15 s
-    (--full; measured 16.8); the smoke test turns the drum at 8 rad/s for 0.04 s: past 5
-    degrees (measured 7.5). Without friction: within 2 degrees of the bottom (measured 0.0)."""
-    rate, until, angle = (2.0, 0.15, 10.0) if full else (8.0, 0.04, 5.0)
-
-    def final_angle(friction: float) -> float:
-        sim = gr.Simulation(2, gravity=(0, -9.81))
-        sim.contact = gr.Contact(restitution=0.3, friction=friction)
-        disc = sim.add_body(gr.Disc((0, -8.85e-3), 1e-3), SOFT, 0.25e-3)
-        sim.add_wall(
-            gr.Wall((gr.CircleContainer((0, 0), 10e-3),), motion=gr.Rotation.steady(rate)),
-            name="drum",
-        )
-        sim.run(until=until)
-        x, y, _ = body_centre(sim, disc)
-        return float(np.degrees(np.arctan2(x, -y)))  # 0 at the bottom, positive towards +x
-
-    with_friction, frictionless = final_angle(0.8), final_angle(0.0)
-    assert with_friction > angle, f"carried only {with_friction:.1f} degrees"
-    assert abs(frictionless) < 2.0, f"frictionless disc moved {frictionless:.1f} degrees"
+@pytest.mark.parametrize("dimension", [2, 3])
+def test_a_grain_in_a_turning_drum_rolls_as_a_rigid_one_does(dimension: int, full: bool) -> None:
+    """Friction spins a grain at the bottom of a turning drum up until it rolls on the drum's
+    surface; it then swings about the bottom like a pendulum, up to the rigid-rolling peak
+    (rigid_rolling_peak: 1.574 degrees for the disc, 1.304 for the sphere, 58-62 ms in).
+    The deformable grain's flattened contact resists rolling a little, less as h falls:
+    measured peak / rigid 1.53 (disc and sphere at R/h = 4), 1.15 (disc, R/h = 8; sphere,
+    R/h = 6), 1.038 (disc, R/h = 12), 1.036 (disc, R/h = 16), 1.098 (sphere, R/h = 8).
+    Asserted: within 20 % at R/h = 8 (disc) and 6 (sphere), within 6 % and 12 % at 12 and 8
+    (--full); and without friction the grain stays within 0.5 degrees of the bottom. On the
+    node spheres of pair_law "granulate" the staircase of the grain's outer nodes catches on
+    the drum: both grains are dragged up 11.5 degrees in 0.1 s (7.3 and 8.8 times the peak)."""
+    coarse, fine = (8, 12) if dimension == 2 else (6, 8)
+    peak = drum_angles(dimension, 0.8, fine if full else coarse, until=0.07).max()
+    theory = rigid_rolling_peak(dimension, 2.0, 10e-3, 1e-3)
+    tolerance = (0.06 if dimension == 2 else 0.12) if full else 0.20
+    assert peak / theory == pytest.approx(1.0, abs=tolerance), f"peak {peak:.3f} degrees"
+    frictionless = drum_angles(dimension, 0.0, 4, until=0.02)
+    assert np.abs(frictionless).max() < 0.5, f"frictionless grain moved {frictionless.max():.2f}"
 
 
 @pytest.mark.validation
@@ -173,21 +204,3 @@ def test_flexible_wall_made_of_a_constrained_particle_carries_a_disc() -> None:
     assert abs(np.mean(loads) / weight - 1) < 0.02, (
         f"slab load {np.mean(loads) / weight:.4f} x weight"
     )
-
-
-@pytest.mark.validation
-def test_rotating_cylinder_carries_a_sphere_up_by_friction(full: bool) -> None:
-    """3D: a sphere in a cylinder turning about z rides up the rising side with friction: at
-    2 rad/s past 10 degrees in 0.1 s (--full; measured 10.8). The smoke test turns the drum at
-    8 rad/s for 0.03 s: past 4 degrees (measured 5.0; 0.0 without friction)."""
-    rate, until, angle = (2.0, 0.1, 10.0) if full else (8.0, 0.03, 4.0)
-    sim = gr.Simulation(3, gravity=(0, -9.81, 0))
-    sim.contact = gr.Contact(restitution=0.3, friction=0.8)
-    sphere = sim.add_body(gr.Sphere((0, -8.8e-3, 0), 1e-3), SOFT, 0.25e-3)
-    drum = gr.Wall(
-        (gr.CircleContainer((0, 0, 0), 10e-3, axis=(0, 0, 1)),), motion=gr.Rotation.steady(rate)
-    )
-    sim.add_wall(drum, name="drum")
-    sim.run(until=until)
-    x, y, _ = body_centre(sim, sphere)
-    assert np.degrees(np.arctan2(x, -y)) > angle
