@@ -12,7 +12,11 @@ node moved by the vector between their first nodes. The shared family's referenc
 then those of the first body; the copy's own differ from them by at most 2 TOLERANCE h: a
 strain of at most 2e-10 at rest. Round-off leaves about 1e-14 h between the copies of a lattice
 near the origin, and 2e-12 h for coordinates of 1 m at h = 0.1 mm; bodies farther from exact
-copies are given shapes of their own.
+copies are given shapes of their own. Their surface data must match too: depths within
+``TOLERANCE`` mesh sizes, and offsets (unit normals under the surface law, from central
+differences of the shape's signed distance over h/1000, which round-off leaves eps |x| /
+(h/1000) apart: 4e-12 for millimetre coordinates at h = 0.1 mm, 2e-9 at 1 m) within
+``OFFSET_TOLERANCE``, which moves a surface point (at most h deep) by at most 1e-8 h.
 """
 
 from __future__ import annotations
@@ -24,6 +28,8 @@ from numpy.typing import NDArray
 
 #: Largest deviation from an exact translated copy [mesh sizes].
 TOLERANCE = 1e-10
+#: Largest difference between the surface offsets of copies [-].
+OFFSET_TOLERANCE = 1e-8
 
 
 @dataclass(frozen=True)
@@ -54,7 +60,7 @@ class TranslatedShapes:
             if (
                 np.max(np.abs(positions[-1] - known.positions[-1] - shift)) <= tolerance
                 and np.array_equal(known.volumes, volumes)
-                and all(np.array_equal(a, b) for a, b in zip(known.surface, surface, strict=True))
+                and _same_surface(known.surface, surface, tolerance)
                 and np.max(np.abs(positions - known.positions - shift)) <= tolerance
             ):
                 return known.body
@@ -71,3 +77,19 @@ class TranslatedShapes:
         """Record body number `body` with these nodes."""
         known = _Known(body, positions, volumes, surface)
         self._known.setdefault((len(positions), mesh_size), []).append(known)
+
+
+def _same_surface(
+    known: tuple[NDArray[np.float64], NDArray[np.float64]],
+    surface: tuple[NDArray[np.float64], NDArray[np.float64]],
+    depth_tolerance: float,
+) -> bool:
+    """Offsets within OFFSET_TOLERANCE and depths within `depth_tolerance` [m] of an earlier
+    body's (both empty where a body has none)."""
+    (known_offsets, known_depths), (offsets, depths) = known, surface
+    if known_offsets.shape != offsets.shape or known_depths.shape != depths.shape:
+        return False
+    return bool(
+        np.all(np.abs(offsets - known_offsets) <= OFFSET_TOLERANCE)
+        and np.all(np.abs(depths - known_depths) <= depth_tolerance)
+    )
