@@ -95,6 +95,7 @@ def main(argv: list[str] | None = None) -> dict[str, float]:
         "nodes": sim.node_count,
         "steps": summary["steps"],
         "final_stress": float(stress[-1]),
+        "peak_stress": float(np.max(stress)),
         "coordination": float(history["coordination"][-1]),
         "broken_bonds": sim.broken_bonds(),
     }
