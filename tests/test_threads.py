@@ -134,7 +134,7 @@ def falling_discs() -> gr.Simulation:
 
 def test_switching_thread_counts_mid_run_changes_no_bit(monkeypatch: pytest.MonkeyPatch) -> None:
     """A run whose picker alternates 1 and 2 threads every chunk (chunks of 7 steps) ends with
-    the same bits as a run on 1 fixed thread."""
+    the same bits as a run on 1 fixed thread, and reports the time it spent at each count."""
     counts = iter([1, 2] * 10_000)
     monkeypatch.setattr(threads.ThreadTuner, "threads", lambda self: next(counts))
     monkeypatch.setattr(threads.ThreadTuner, "step_cap", lambda self: 7)
@@ -150,5 +150,8 @@ def test_switching_thread_counts_mid_run_changes_no_bit(monkeypatch: pytest.Monk
     finally:
         gr.set_num_threads(previous)
     assert switching.broken_bonds() > 0
+    assert fixed.seconds_at_threads is None  # the user's count: no picker
+    assert set(switching.seconds_at_threads) == {1, 2}
+    assert all(seconds > 0 for seconds in switching.seconds_at_threads.values())
     for name in ("positions", "velocities", "forces"):
         np.testing.assert_array_equal(getattr(fixed, name), getattr(switching, name))

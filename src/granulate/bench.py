@@ -100,8 +100,9 @@ def _timed(sim, steps: int, case: str, threads: int, extra: dict | None = None) 
             <= BOND_BUDGET * sim.bond_count + NODE_BUDGET * sim.node_count,
         },
     }
-    if sim._tuner is not None:  # the adaptive policy: run time at each thread count
-        result["seconds_at_threads"] = {c: round(t, 3) for c, t in sim._tuner.seconds_at.items()}
+    seconds_at = sim.seconds_at_threads
+    if seconds_at is not None:  # the adaptive policy: run time at each thread count
+        result["seconds_at_threads"] = {c: round(t, 3) for c, t in seconds_at.items()}
     result.update(extra or {})
     return result
 

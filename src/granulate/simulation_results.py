@@ -211,6 +211,12 @@ class SimulationResults:
             "neighbor_list_rebuilds": core.contact_statistics.rebuilds,
         }
 
+    @property
+    def seconds_at_threads(self) -> dict[int, float] | None:
+        """The run time [s] the adaptive thread policy measured at each thread count it tried
+        (granulate.threads), or None before a run or under a fixed thread count."""
+        return None if self._tuner is None else dict(self._tuner.seconds_at)
+
     def particle_table(
         self, contacts: network.Table | None = None, damage: ArrayLike | None = None
     ) -> particle_table.Table:
