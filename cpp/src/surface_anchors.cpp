@@ -32,26 +32,12 @@ std::array<real, 3> solve(std::array<vec, 3> columns, const vec& target, int dim
   return w;
 }
 
-/// Relative differences below this are round-off: a lattice's equal distances and equally good
-/// spans computed from absolute coordinates differ by eps |x| / h, which would otherwise let a
-/// body's position pick its anchors.
-constexpr real tie = 1e-9;
-
-/// The nodes within `radius` of node a, nearest first (distances within `tie` of each other
-/// count as equal: ties by index), at most `count`.
+/// The nodes within `radius` of node a, nearest first (ties by index), at most `count`.
 std::vector<index_t> nearest(const CellGrid& grid, const std::vector<real>& x, index_t a, real radius,
                              int dimension, std::size_t count) {
   std::vector<std::pair<real, index_t>> near;
   grid.for_each_within(x, a, radius, dimension, [&](index_t j, real r2) { near.push_back({r2, j}); });
   std::sort(near.begin(), near.end());
-  const real close = tie * radius * radius;
-  for (std::size_t start = 0; start < near.size();) {  // each run of equal distances by index
-    std::size_t end = start + 1;
-    while (end < near.size() && near[end].first - near[start].first <= close) ++end;
-    std::sort(near.begin() + start, near.begin() + end,
-              [](const auto& p, const auto& q) { return p.second < q.second; });
-    start = end;
-  }
   std::vector<index_t> nodes;
   for (std::size_t k = 0; k < near.size() && k < count; ++k) nodes.push_back(near[k].second);
   return nodes;
@@ -59,8 +45,7 @@ std::vector<index_t> nearest(const CellGrid& grid, const std::vector<real>& x, i
 
 /// The d candidates whose bond directions from a span best: the largest |det| of the unit
 /// vectors (1 when orthogonal; in 2D with (0, 0, 1) as third column), the first such in
-/// nearest-first order (a later one must be larger by more than `tie`); empty if none exceeds
-/// 0.2.
+/// nearest-first order; empty if none exceeds 0.2.
 std::vector<index_t> best_span(const std::vector<real>& x, index_t a, const std::vector<index_t>& candidates,
                                int dimension) {
   std::vector<vec> unit;
@@ -78,12 +63,12 @@ std::vector<index_t> best_span(const std::vector<real>& x, index_t a, const std:
     for (std::size_t q = p + 1; q < n; ++q) {
       if (dimension == 2) {
         const real s = std::abs(det3(unit[p], unit[q], z));
-        if (s > best + tie) best = s, chosen = {candidates[p], candidates[q]};
+        if (s > best) best = s, chosen = {candidates[p], candidates[q]};
         continue;
       }
       for (std::size_t r = q + 1; r < n; ++r) {
         const real s = std::abs(det3(unit[p], unit[q], unit[r]));
-        if (s > best + tie) best = s, chosen = {candidates[p], candidates[q], candidates[r]};
+        if (s > best) best = s, chosen = {candidates[p], candidates[q], candidates[r]};
       }
     }
   }
