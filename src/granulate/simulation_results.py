@@ -71,6 +71,12 @@ class SimulationResults:
         next step starts from them)."""
         return read_only(self._build().forces)
 
+    def bond_forces(self) -> NDArray[np.float64]:
+        """(n, 3) the bond force densities b [N/m^3] at the current positions: the peridynamic
+        part of ``forces``, so ``forces - bond_forces()`` is what contact, walls, gravity and
+        loads put on each node. A new array, from one pass over the bonds."""
+        return np.asarray(self._build().bond_force_densities()).reshape(-1, 3)
+
     @property
     def displacements(self) -> NDArray[np.float64]:
         """(n, 3) displacements x - X [m] (a copy)."""

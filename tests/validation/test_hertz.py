@@ -105,8 +105,7 @@ def disc_contact_half_width(
     sim.run(until=2 * approach * RADIUS / speed)
     reactions = sim.wall_reactions()
     load = 0.5 * (reactions["top"][1] - reactions["floor"][1])
-    bonds = np.asarray(sim.analysis._core.bond_force_densities()).reshape(-1, 3)
-    contact = (sim.forces[:, 1] - bonds[:, 1]) * sim.volumes
+    contact = (sim.forces[:, 1] - sim.bond_forces()[:, 1]) * sim.volumes
     lower = sim.positions[:, 1] < RADIUS
     x, f = sim.positions[lower, 0], contact[lower]
     measured = 2 * np.sqrt(np.sum(f * x**2) / np.sum(f))
