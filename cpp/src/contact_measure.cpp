@@ -167,17 +167,43 @@ ContactModel::PairGeometry ContactModel::pair_geometry(const Model& model, const
   return g;
 }
 
-ContactModel::WallGeometry ContactModel::wall_geometry(const Model& model, index_t i, index_t e) const {
-  // Friction acts at the deepest point: p = c_i - lever n, n from the wall towards the node.
-  const contact::PairLaw& resolved = slot_law(wall_slot_[e]);
+ContactModel::WallGeometry ContactModel::wall_geometry(const Model& model, const State& state, index_t i,
+                                                       index_t e) const {
+  // Friction acts at the deepest point of the deepest sphere: p = c - (r - overlap / 2) m, m from
+  // the wall towards the node.
   const WallPoints& points = wall_points_[e];
-  const WallContact& deepest = points.points[deepest_point(points.points.data(), points.count)];
-  const real lever = resolved.contact_radius - 0.5 * (resolved.contact_radius - deepest.distance);
+  const WallSpheres spheres = wall_spheres(model, state, i, e);
+  std::size_t deepest = deepest_point(points.points.data(), points.count);
+  if (points.osculating > 0) {
+    auto overlap = [&](std::size_t k) {
+      return spheres.radius[sphere_of(points, k)] - points.points[k].distance;
+    };
+    deepest = 0;
+    for (std::size_t k = 1; k < points.count; ++k)
+      if (overlap(k) > overlap(deepest)) deepest = k;
+  }
+  const int sphere = sphere_of(points, deepest);
+  const real radius = spheres.radius[sphere];
+  const real lever = radius - 0.5 * (radius - points.points[deepest].distance);
   WallGeometry g;
-  g.normal = deepest.normal;
-  g.arm = {-lever * g.normal[0], -lever * g.normal[1], -lever * g.normal[2]};
-  g.stiffness = wall_spring_stiffness(model, i, e);
+  g.normal = points.points[deepest].normal;
+  const vec arm{-lever * g.normal[0], -lever * g.normal[1], -lever * g.normal[2]};
+  for (int c = 0; c < 3; ++c) g.point[c] = spheres.centre[sphere][c] + arm[c];
+  g.stiffness = points.osculating > 0 ? wall_entry_stiffness_[e] : wall_spring_stiffness(model, i, e);
   return g;
+}
+
+ContactModel::WallSpheres ContactModel::wall_spheres(const Model& model, const State& state, index_t i,
+                                                     index_t e) const {
+  const WallPoints& points = wall_points_[e];
+  WallSpheres spheres;
+  spheres.centre[0] = contact_position(model, state, i);
+  spheres.radius[0] = slot_law(wall_slot_[e]).contact_radius;
+  if (points.osculating > 0) {
+    spheres.centre[1] = centres_.point(state, centres_.seen(model, i), i, points.centre_length);
+    spheres.radius[1] = points.radius;
+  }
+  return spheres;
 }
 
 vec3 ContactModel::pair_surface_normal(index_t i, index_t j, const vec3& line) const {
@@ -270,7 +296,6 @@ void ContactModel::measure_contacts(const Model& model, const State& state) {
   // another body. The later passes read these.
   const auto& volume = model.volumes();
   const std::int64_t n = model.node_count();
-  const real t = state.time;
   touching_nodes_.clear();
 #pragma omp parallel
   {
@@ -309,19 +334,8 @@ void ContactModel::measure_contacts(const Model& model, const State& state) {
       }
       if (touching) touching_nodes.push_back(i);
       deepest = std::max(deepest, measure_probes(model, state, i, probe_scratch));
-      for (index_t e = wall_offsets_[i]; e < wall_offsets_[i + 1]; ++e) {
-        const Wall& wall = walls_[wall_entry_[e][0]];
-        const contact::PairLaw& law = slot_law(wall_slot_[e]);
-        found.clear();
-        wall.contacts(wall_entry_[e][1], wall.to_reference(centre().data(), t), law.contact_radius,
-                      dimension_, found);
-        WallPoints& points = wall_points_[e];
-        points.count = static_cast<std::uint8_t>(std::min(found.size(), points.points.size()));
-        for (std::size_t k = 0; k < points.count; ++k) {
-          points.points[k] = {found[k].distance, wall.rotate_to_world(found[k].normal, t)};
-        }
-        wall_entry_stiffness_[e] = static_cast<real>(points.count) * wall_spring_stiffness(model, i, e);
-      }
+      for (index_t e = wall_offsets_[i]; e < wall_offsets_[i + 1]; ++e)
+        measure_wall_points(model, state, i, e, centre(), found);
     }
 #pragma omp critical
     {
@@ -330,6 +344,62 @@ void ContactModel::measure_contacts(const Model& model, const State& state) {
     }
   }
   std::sort(touching_nodes_.begin(), touching_nodes_.end());  // the same for any thread count
+}
+
+void ContactModel::measure_wall_points(const Model& model, const State& state, index_t i, index_t e,
+                                       const vec3& centre, std::vector<WallContact>& found) {
+  // A contact sphere touches where the wall is within rho of its centre. On a round particle
+  // the node's osculating sphere (radius r) touches where the wall is within r of its centre,
+  // each point weighted by its share w (surface_law.hpp) of the contact about the sphere's
+  // nearest point, and the contact sphere keeps the rest, 1 - min(1, sum w): a contact
+  // narrower than the points' spacing is carried by the osculating spheres, as by the circle
+  // they share, a contact that has flattened over several points by each point's own sphere.
+  // Walls that give only their nearest feature (polygons, triangle meshes) keep the contact
+  // spheres: the feature nearest to a centre deep in the particle need not be the one under
+  // the node.
+  const Wall& wall = walls_[wall_entry_[e][0]];
+  const WallSurface::Kind kind = wall.surfaces[wall_entry_[e][1]].kind;
+  const SurfaceCentres::Seen seen = centres_.seen(model, i);
+  WallPoints& points = wall_points_[e];
+  points.count = points.osculating = 0;
+  real share = 0;
+  if (seen.osculating_radius > 0 && kind != WallSurface::Kind::polygon &&
+      kind != WallSurface::Kind::triangles) {
+    points.radius = seen.osculating_radius;
+    points.centre_length = seen.surface_length - seen.osculating_radius;
+    const vec3 a = SurfaceCentres::anchored_vector(seen, state.positions, i);
+    const real size = std::sqrt(dot(a, a));
+    const vec3 sphere = centres_.point(state, seen, i, points.centre_length);
+    const real support = contact::surface_support_factor * seen.mesh_size;
+    found.clear();
+    wall.contacts(wall_entry_[e][1], wall.to_reference(sphere.data(), state.time), points.radius, dimension_,
+                  found);
+    for (const WallContact& contact : found) {
+      if (points.count == points.points.size()) break;
+      const vec3 m = wall.rotate_to_world(contact.normal, state.time);
+      const vec3 chord{a[0] / size + m[0], a[1] / size + m[1], a[2] / size + m[2]};
+      const real weight = contact::osculating_scale(dimension_) *
+                          contact::surface_weight(points.radius * std::sqrt(dot(chord, chord)) / support);
+      if (weight == 0) continue;
+      points.points[points.count] = {contact.distance, m};
+      points.weights[points.count++] = weight;
+      share += weight;
+    }
+    points.osculating = points.count;
+  }
+  const real rest = points.osculating > 0 ? std::max(0.0, 1 - share) : 1.0;
+  if (rest > 0) {
+    found.clear();
+    wall.contacts(wall_entry_[e][1], wall.to_reference(centre.data(), state.time),
+                  slot_law(wall_slot_[e]).contact_radius, dimension_, found);
+    for (const WallContact& contact : found) {
+      if (points.count == points.points.size()) break;
+      points.points[points.count] = {contact.distance, wall.rotate_to_world(contact.normal, state.time)};
+      points.weights[points.count++] = rest;
+      share += rest;
+    }
+  }
+  wall_entry_stiffness_[e] = share * wall_spring_stiffness(model, i, e);
 }
 
 real ContactModel::measure_probes(const Model& model, const State& state, index_t i, ProbeScratch& scratch) {
@@ -513,17 +583,19 @@ void ContactModel::sum_slot_springs(const Model& model, const State& state) {
       const std::size_t slot = wall_slot_[e];
       if (wall_entry_stiffness_[e] == 0) continue;
       const index_t touch = slot_touch_[slot];
-      const contact::PairLaw& law = slot_law(slot);
       const WallPoints& points = wall_points_[e];
+      const WallSpheres spheres = wall_spheres(model, state, i, e);
       for (std::size_t k = 0; k < points.count; ++k) {
-        const real overlap = law.contact_radius - points.points[k].distance;
-        const real spring = contact::normal_force(wall_spring_stiffness(model, i, e), overlap);
-        const real lever = law.contact_radius - 0.5 * overlap;
+        const int sphere = sphere_of(points, k);
+        const real overlap = spheres.radius[sphere] - points.points[k].distance;
+        const real spring =
+            contact::normal_force(points.weights[k] * wall_spring_stiffness(model, i, e), overlap);
+        const real lever = spheres.radius[sphere] - 0.5 * overlap;
         slot_force_[touch] += spring;
         for (int c = 0; c < 3; ++c) {
           slot_normal_[touch][c] += spring * points.points[k].normal[c];
           slot_surface_normal_[touch][c] += spring * points.points[k].normal[c];
-          slot_point_[touch][c] += spring * (xi[c] - lever * points.points[k].normal[c]);
+          slot_point_[touch][c] += spring * (spheres.centre[sphere][c] - lever * points.points[k].normal[c]);
         }
       }
     }
@@ -563,11 +635,13 @@ real ContactModel::spring_energy(const Model& model, const State& state) const {
       if (overlap > 0) energy += 0.5 * entry_stiffness(model, i, e) * overlap * overlap;
     }
     for (index_t e = wall_offsets_[i]; e < wall_offsets_[i + 1]; ++e) {
-      const contact::PairLaw& law = slot_law(wall_slot_[e]);
       const WallPoints& points = wall_points_[e];
+      const real contact_radius = slot_law(wall_slot_[e]).contact_radius;
       for (std::size_t k = 0; k < points.count; ++k) {
-        const real overlap = law.contact_radius - points.points[k].distance;
-        if (overlap > 0) energy += 0.5 * wall_spring_stiffness(model, i, e) * overlap * overlap;
+        const real overlap =
+            (sphere_of(points, k) == 1 ? points.radius : contact_radius) - points.points[k].distance;
+        if (overlap > 0)
+          energy += 0.5 * points.weights[k] * wall_spring_stiffness(model, i, e) * overlap * overlap;
       }
     }
   }

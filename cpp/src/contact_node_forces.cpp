@@ -143,12 +143,7 @@ ContactModel::NodeContactForces ContactModel::gather_node_forces(const Model& mo
   for (index_t e = wall_offsets_[i]; e < wall_offsets_[i + 1]; ++e) {
     wall_entry_reaction_[e] = {0, 0, 0, 0, 0, 0};
     if (wall_entry_stiffness_[e] == 0) continue;
-    vec on_centre, on_node;
-    wall_force(model, state, i, e, dt, on_centre, on_node);
-    for (int c = 0; c < 3; ++c) {
-      at_centre[c] += on_centre[c];
-      at_node[c] += on_node[c];
-    }
+    wall_force(model, state, i, e, dt, forces);
   }
   const auto [group_begin, group_end] = groups_of(i);
   for (index_t g = group_begin; g < group_end; ++g) {
@@ -356,26 +351,29 @@ ContactNetwork ContactModel::network(const Model& model, const State& state) con
 }
 
 void ContactModel::wall_force(const Model& model, const State& state, index_t i, index_t e, real dt,
-                              vec3& on_centre, vec3& on_node) {
-  // Springs at every contact point of the entry, on the node's contact centre; friction at the
-  // deepest point p, on the node with its couple (p - x_i) x F_t (friction_couple), from the
+                              NodeContactForces& forces) {
+  // Springs at every contact point of the entry, on the centre of its sphere; friction at the
+  // deepest point p, on the node with its couple (p - x_i) x F_t (contact_couple), from the
   // slip of p moving with the node and its body's rotation. The wall takes the opposite force
-  // at p.
-  const vec xi = contact_position(model, state, i);
+  // at p. An osculating sphere's springs act on the node too, their couple (o - y_i) x F on the
+  // body putting them at the sphere's centre o (contact_couple): a round particle's surface
+  // deforms under the load where it is applied, and a circle's push passes through its centre.
   const Wall& wall = walls_[wall_entry_[e][0]];
   const contact::Law& law = wall_laws_[wall_entry_[e][0] * material_count_ + model.node_material()[i]];
-  const contact::PairLaw& resolved = slot_law(wall_slot_[e]);
   const WallPoints& points = wall_points_[e];
-  const WallGeometry g = wall_geometry(model, i, e);
-  on_centre = on_node = {0, 0, 0};
+  const WallSpheres spheres = wall_spheres(model, state, i, e);
+  const WallGeometry g = wall_geometry(model, state, i, e);
+  const real k = wall_spring_stiffness(model, i, e);
+  std::array<vec, 2> on_sphere{};
   real push_total = 0;
   for (std::size_t point = 0; point < points.count; ++point) {
-    const real push =
-        contact::normal_force(g.stiffness, resolved.contact_radius - points.points[point].distance);
+    const int sphere = sphere_of(points, point);
+    const real push = contact::normal_force(points.weights[point] * k,
+                                            spheres.radius[sphere] - points.points[point].distance);
     push_total += push;
-    for (int c = 0; c < 3; ++c) on_centre[c] += push * points.points[point].normal[c];
+    for (int c = 0; c < 3; ++c) on_sphere[sphere][c] += push * points.points[point].normal[c];
   }
-  const vec point{xi[0] + g.arm[0], xi[1] + g.arm[1], xi[2] + g.arm[2]};
+  const vec& point = g.point;
   const vec wall_velocity = wall.velocity_at(point.data(), state.time);
   const real* x = state.positions.data();
   const vec lever{point[0] - x[3 * i], point[1] - x[3 * i + 1], point[2] - x[3 * i + 2]};
@@ -396,17 +394,21 @@ void ContactModel::wall_force(const Model& model, const State& state, index_t i,
     contact::tangential_force(law.tangential_stiffness_ratio * g.stiffness, law.friction, push_total,
                               g.normal.data(), slip, dt, springs_[wall_spring_[e]].data(), friction);
   }
-  on_node = {friction[0], friction[1], friction[2]};
-  const vec force{on_centre[0] + on_node[0], on_centre[1] + on_node[1], on_centre[2] + on_node[2]};
+  vec force{0, 0, 0};
+  for (int c = 0; c < 3; ++c) force[c] = on_sphere[0][c] + on_sphere[1][c] + friction[c];
   const vec torque =
       cross({point[0] - wall.center[0], point[1] - wall.center[1], point[2] - wall.center[2]}, force);
+  for (int c = 0; c < 3; ++c) {
+    forces.at_node[c] += friction[c] + on_sphere[1][c];
+    forces.at_centre[c] += on_sphere[0][c];
+  }
   wall_entry_reaction_[e] = {-force[0], -force[1], -force[2], -torque[0], -torque[1], -torque[2]};
 }
 
-vec3 ContactModel::friction_couple(const Model& model, const State& state, index_t i) const {
+vec3 ContactModel::contact_couple(const Model& model, const State& state, index_t i) const {
   // The couple of node i's friction forces about the point they are applied at (the contact
   // centre for node pairs, the node for walls), from the springs as pass C left them
-  // (F_t = -kt xi, capped or not).
+  // (F_t = -kt xi, capped or not), and of its osculating wall springs, (o - y_i) x F.
   vec couple{0, 0, 0};
   const auto& node_material = model.node_material();
   for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
@@ -421,20 +423,36 @@ vec3 ContactModel::friction_couple(const Model& model, const State& state, index
     for (int c = 0; c < 3; ++c) couple[c] += moment[c];
   }
   for (index_t e = wall_offsets_[i]; e < wall_offsets_[i + 1]; ++e) {
+    if (wall_points_[e].osculating > 0) {
+      const vec moment = osculating_couple(model, state, i, e);
+      for (int c = 0; c < 3; ++c) couple[c] += moment[c];
+    }
     if (wall_spring_[e] == no_spring) continue;
     const contact::Law& law = wall_laws_[wall_entry_[e][0] * material_count_ + node_material[i]];
     if (law.peridem_friction || law.friction == 0) continue;
-    const WallGeometry g = wall_geometry(model, i, e);
+    const WallGeometry g = wall_geometry(model, state, i, e);
     const real kt = law.tangential_stiffness_ratio * g.stiffness;
     const vec& xi = springs_[wall_spring_[e]];
-    const vec centre = contact_position(model, state, i);
     const real* x = state.positions.data();
-    const vec lever{centre[0] + g.arm[0] - x[3 * i], centre[1] + g.arm[1] - x[3 * i + 1],
-                    centre[2] + g.arm[2] - x[3 * i + 2]};  // p - x_i
+    const vec lever{g.point[0] - x[3 * i], g.point[1] - x[3 * i + 1], g.point[2] - x[3 * i + 2]};  // p - x_i
     const vec moment = cross(lever, {-kt * xi[0], -kt * xi[1], -kt * xi[2]});
     for (int c = 0; c < 3; ++c) couple[c] += moment[c];
   }
   return couple;
+}
+
+vec3 ContactModel::osculating_couple(const Model& model, const State& state, index_t i, index_t e) const {
+  const WallPoints& points = wall_points_[e];
+  const real k = wall_spring_stiffness(model, i, e);
+  vec push{0, 0, 0};
+  for (std::size_t point = 0; point < points.osculating; ++point) {
+    const real force =
+        contact::normal_force(points.weights[point] * k, points.radius - points.points[point].distance);
+    for (int c = 0; c < 3; ++c) push[c] += force * points.points[point].normal[c];
+  }
+  const vec centre = wall_spheres(model, state, i, e).centre[1];
+  const real* x = state.positions.data();
+  return cross({centre[0] - x[3 * i], centre[1] - x[3 * i + 1], centre[2] - x[3 * i + 2]}, push);
 }
 
 void ContactModel::sum_wall_reactions() {

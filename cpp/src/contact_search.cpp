@@ -187,7 +187,14 @@ void ContactModel::search_node_walls(const Model& model, const State& state,
       if (!wall_law_set_[w * material_count_ + node_material[i]]) continue;
       // x is the list position, list_offset out from the contact centre.
       const real radius = wall_law(static_cast<index_t>(w), node_particle[i]).contact_radius;
-      const real limit = radius + list_offset(model, i, radius) + skin_;
+      real limit = radius + list_offset(model, i, radius) + skin_;
+      // An osculating sphere weighs the points whose chord to the wall is below the support a:
+      // the surface point then lies within a^2 / (2 r) of the wall.
+      const real r = centres_.seen(model, i).osculating_radius;
+      if (r > 0) {
+        const real support = contact::surface_support_factor * particles[node_particle[i]].mesh_size;
+        limit = std::max(limit, support * support / (2 * r) + skin_);
+      }
       const auto p = walls_[w].to_reference(&x[3 * i], state.time);
       for (std::size_t s = 0; s < walls_[w].surfaces.size(); ++s) {
         local.clear();

@@ -245,7 +245,7 @@ real ContactModel::damping_ratio(std::size_t slot, contact::Collision& collision
 }
 
 void ContactModel::body_loads(const Model& model, State& state) {
-  // Dashpot forces at contact points and the friction couples, as rigid-body loads: every node of
+  // Dashpot forces at contact points and the contact couples, as rigid-body loads: every node of
   // the body gets rho_i (F / M + alpha x (x_i - c)), alpha = I^-1 tau. They add up to F and tau.
   const auto& x = state.positions;
   auto& f = state.forces;
@@ -256,7 +256,7 @@ void ContactModel::body_loads(const Model& model, State& state) {
     const index_t b = touching_bodies_[touch];
     std::array<real, 6> total = body_load_[touch];
     for (index_t k = body_contact_offsets_[b]; k < body_contact_offsets_[b + 1]; ++k) {
-      const vec couple = friction_couple(model, state, contact_nodes_[k]);
+      const vec couple = contact_couple(model, state, contact_nodes_[k]);
       for (int c = 0; c < 3; ++c) total[3 + c] += couple[c];
     }
     if (total == std::array<real, 6>{0, 0, 0, 0, 0, 0}) continue;

@@ -12,6 +12,8 @@ void SurfaceCentres::find(const Model& model, const State& state, std::vector<re
   depth_ = std::move(depth);
   surface_ = outer_layers;
   any_ = std::any_of(depth_.begin(), depth_.end(), [](real s) { return s > 0; });
+  round_.assign(surface_.size(), 0);
+  for (index_t p = 0; p < round_.size(); ++p) round_[p] = surface_[p] && depth_[p] > 0 && is_round(model, p);
   // Which nodes are seen at anchors (1 byte each: most nodes have none, and contact asks for
   // every node every step); under the surface law, which look them up many times per step, a
   // pointer per node as well.
@@ -34,6 +36,13 @@ void SurfaceCentres::find(const Model& model, const State& state, std::vector<re
       if (b != bonds.count && !state.bonds.intact(i, b)) detach(i);  // the bond broke
     }
   }
+}
+
+bool SurfaceCentres::is_round(const Model& model, index_t p) {
+  const auto& anchors = model.shapes()[model.particles()[p].shape].anchors.anchors;
+  return !anchors.empty() && std::all_of(anchors.begin(), anchors.end(), [](const SurfaceAnchor& a) {
+    return a.curvature * round_radius_min <= 1 && a.curvature * round_radius_max >= 1;
+  });
 }
 
 void SurfaceCentres::detach(index_t i) {

@@ -1,16 +1,18 @@
-"""Why a resolved disc rolling on a wall loses speed: it rolls as the polygon of its surface
-points (the open blocker of the surface law's rolling test, ARCHITECTURE.md "The surface law").
+"""Why a resolved disc rolling on a wall loses speed on the node spheres: it rolls as the
+polygon of its surface points (ARCHITECTURE.md, "The surface law").
 
 A conforming disc of radius R at R/h nodes per radius (soft material of the friction tests, 1
 mm, g = 9.81) lands on a floor for 3 ms, is set sliding at v0 = 0.1 m/s without spin (friction
-0.3), and is followed for 30 ms. The wall sees each surface node through its own small contact
-sphere, so under a stiff contact (the default kn leaves an overlap of about 4e-8 m under the
-disc's weight) the disc's centre drops by the polygon's sagitta h^2 / (8 R) between two nodes
-and lands on the next one with an impact. A rigid polygon of vertex angle alpha = h / R and
-inertia 3/2 m R^2 about a vertex keeps (1/2 + cos alpha) / (3/2) ~ 1 - alpha^2 / 3 of its
-speed per vertex: a drag that grows with v^2 and falls with h. With a damping contact (e = 0.1)
-that loss shows as a steady slowing; with an elastic one (e = 1, the rolling test's) the
-landings pump the disc into hops instead.
+0.3), and is followed for 30 ms. On the node spheres (the default law) the wall sees each
+surface node through its own small contact sphere, so under a stiff contact (the default kn
+leaves an overlap of about 4e-8 m under the disc's weight) the disc's centre drops by the
+polygon's sagitta h^2 / (8 R) between two nodes and lands on the next one with an impact. A
+rigid polygon of vertex angle alpha = h / R and inertia 3/2 m R^2 about a vertex keeps (1/2 +
+cos alpha) / (3/2) ~ 1 - alpha^2 / 3 of its speed per vertex: a drag that grows with v^2 and
+falls with h. With a damping contact (e = 0.1) that loss shows as a steady slowing; with an
+elastic one (e = 1) the landings pump the disc into hops instead. Under the surface law (--law
+surface) the wall sees the disc, a round particle, through its points' osculating spheres,
+which agree on its circle: it rolls steadily and its centre stays at its resting height.
 
 Prints, per 3 ms window after the launch: the fraction of samples (every 10 steps) in which the
 disc flies (its vertical velocity changed by exactly -g dt), its centre's lowest and highest

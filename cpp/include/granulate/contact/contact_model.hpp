@@ -411,19 +411,34 @@ class ContactModel {
   /// The force pair_force gave node i of entry e in the last evaluation, from the springs as it
   /// left them (F_t = -kt xi), without the fragment dashpot (entries between two bodies only).
   vec3 evaluated_pair_force(const Model& model, const State& state, index_t i, index_t e) const;
-  /// A node-wall entry in contact: the deepest point's normal (towards the node), the arm
-  /// p - x_i of its contact point and the spring stiffness kn V_i^2.
+  /// A node-wall entry in contact: the deepest point's normal (towards the node), its contact
+  /// point p and the spring stiffness (kn V_i^2; times the weights' sum on a round particle).
   struct WallGeometry {
-    vec3 normal{0, 0, 0}, arm{0, 0, 0};
+    vec3 normal{0, 0, 0}, point{0, 0, 0};
     real stiffness = 0;
   };
-  WallGeometry wall_geometry(const Model& model, index_t i, index_t e) const;
-  /// Forces of node i's wall entry e: the springs on its contact centre, friction on the node
-  /// (updates the spring; sets the entry's reaction).
-  void wall_force(const Model& model, const State& state, index_t i, index_t e, real dt, vec3& on_centre,
-                  vec3& on_node);
-  /// Sum of (p - c_i) x F_t over node i's friction forces, from the springs.
-  vec3 friction_couple(const Model& model, const State& state, index_t i) const;
+  WallGeometry wall_geometry(const Model& model, const State& state, index_t i, index_t e) const;
+  /// The two spheres through which node i's wall entry e sees the wall: [0] its contact sphere
+  /// (centre c_i, radius rho), [1] its osculating sphere (centre o_i, radius 1 / kappa; unset
+  /// off a round particle).
+  struct WallSpheres {
+    std::array<vec3, 2> centre{};
+    std::array<real, 2> radius{0, 0};
+  };
+  WallSpheres wall_spheres(const Model& model, const State& state, index_t i, index_t e) const;
+  /// Node i's wall entry e's points, measured (wall_points_[e]) from its contact sphere or, on a
+  /// round particle and a wall of planes, boxes or circles, from its osculating sphere.
+  void measure_wall_points(const Model& model, const State& state, index_t i, index_t e, const vec3& centre,
+                           std::vector<WallContact>& found);
+  /// Forces of node i's wall entry e: the springs on its sphere's centre, friction on the node
+  /// (updates the spring; sets the entry's reaction), added to `forces`.
+  void wall_force(const Model& model, const State& state, index_t i, index_t e, real dt,
+                  NodeContactForces& forces);
+  /// Sum of (p - c_i) x F_t over node i's friction forces, from the springs, and of (o - y_i) x
+  /// F over its osculating wall springs (osculating_couple): loads on its body.
+  vec3 contact_couple(const Model& model, const State& state, index_t i) const;
+  /// (o - y_i) x F of the springs F of node i's osculating wall entry e, whose sphere's centre is o.
+  vec3 osculating_couple(const Model& model, const State& state, index_t i, index_t e) const;
   /// Contact radius of node i in a contact of law `law` with node j (its share of the pair's Rc).
   real node_radius(const contact::Law& law, const Model& model, index_t i, index_t j,
                    real contact_radius) const;
@@ -524,11 +539,19 @@ class ContactModel {
   // Scratch, per entry: the spring stiffness k of the pair in contact, 0 if apart (single
   // precision, 4 bytes: list entries outnumber nodes when grains shatter).
   std::vector<float> pair_stiffness_;
-  /// Contact points of a wall entry (at most one per box face), normals in the world frame.
+  /// Contact points of a wall entry (at most one per box face), normals in the world frame, of
+  /// the node's spheres (WallSpheres; the osculating one radius r = 1 / kappa, centred
+  /// centre_length along the normal), each point's spring weighted by `weights`
+  /// (measure_wall_points).
   struct WallPoints {
     std::uint8_t count = 0;
+    std::uint8_t osculating = 0;  ///< the first `osculating` points are the osculating sphere's
+    real radius = 0, centre_length = 0;
     std::array<WallContact, 6> points{};
+    std::array<real, 6> weights{};
   };
+  /// Which sphere of WallSpheres point k of an entry belongs to.
+  static int sphere_of(const WallPoints& points, std::size_t k) { return k < points.osculating ? 1 : 0; }
   std::vector<WallPoints> wall_points_;
   std::vector<real> wall_entry_stiffness_;
   std::vector<std::array<real, 6>> wall_entry_reaction_;

@@ -18,6 +18,12 @@
 // it stretches with the neighbourhood), which needs no square root per node and step. A node
 // whose bond to one of its anchors breaks is detached: it is seen at itself from then on, and
 // carries no surface point.
+//
+// A particle under the surface law whose surface is curved everywhere (every surface point's
+// curvature radius 1/kappa between 2 h and 50 h: a disc, a sphere, an ellipse) is round:
+// walls see each of its surface points through its osculating sphere, centre o_i = s_i - n_i /
+// kappa_i (at length d_i - 1/kappa_i along the normal), instead of its contact sphere, so that
+// a rolling disc meets the wall on its circle rather than on the polygon of its points.
 #pragma once
 
 #include <array>
@@ -67,6 +73,7 @@ class SurfaceCentres {
     const SurfaceAnchor* anchor = nullptr;
     index_t first = 0;
     real mesh_size = 0, surface_length = 0, centre_length = 0;
+    real osculating_radius = 0;  ///< 1 / kappa_i [m] on a round particle, else 0
     bool along_normal = false;
   };
   Seen seen(const Model& model, index_t i) const;
@@ -104,14 +111,20 @@ class SurfaceCentres {
 
   std::size_t memory_bytes() const {
     return depth_.capacity() * sizeof(real) + anchors_.capacity() * sizeof(const SurfaceAnchor*) +
-           anchored_.capacity() + surface_.capacity();
+           anchored_.capacity() + surface_.capacity() + round_.capacity();
   }
+
+  /// The bounds of a round particle's curvature radii, over its h (see above).
+  static constexpr real round_radius_min = 2, round_radius_max = 50;
 
  private:
   /// The factor f of the linear form y_i + f A_i outside the surface law: length / ((h/2) |o_i|).
   static real linear_scale(const Seen& s, real length);
   static real length_of(const vec3& a);
   void detach(index_t i);
+  /// Whether every surface point of particle p's shape has a curvature radius within the round
+  /// bounds.
+  static bool is_round(const Model& model, index_t p);
   /// Node i's anchors from the shape (none for an outer-layer node of a particle not under the
   /// surface law).
   const SurfaceAnchor* lookup(const Model& model, index_t i) const;
@@ -120,6 +133,7 @@ class SurfaceCentres {
   bool any_ = false;
   std::vector<real> depth_;                    // per particle
   std::vector<std::uint8_t> surface_;          // per particle: under the surface law
+  std::vector<std::uint8_t> round_;            // per particle: round (see above)
   std::vector<std::uint8_t> anchored_;         // per node: seen at its anchors (0 once detached)
   std::vector<const SurfaceAnchor*> anchors_;  // per node under the surface law: lookup(), kept
 };
@@ -145,6 +159,7 @@ inline SurfaceCentres::Seen SurfaceCentres::seen(const Model& model, index_t i) 
   s.along_normal = surface_[p] != 0;
   s.surface_length = s.anchor->depth * particle.mesh_size;
   s.centre_length = (s.anchor->depth - 0.5 * depth_[p] * s.anchor->reach) * particle.mesh_size;
+  if (round_[p]) s.osculating_radius = particle.mesh_size / s.anchor->curvature;
   return s;
 }
 

@@ -35,6 +35,7 @@
 
 #include <array>
 #include <cmath>
+#include <numbers>
 
 #include "granulate/types.hpp"
 
@@ -95,6 +96,16 @@ inline real surface_weight_slope(real q) {
   if (!(q < 1)) return 0;
   const real u = 1 - q;
   return -20 * q * u * u * u;
+}
+
+/// A round particle's surface point's share of a wall contact (contact/surface_centres.hpp):
+/// its osculating sphere meets the wall at the chord c = r |n + m| from the point (r = 1 /
+/// kappa, n its normal, m the wall's towards the particle), and w = c_d W(c / a) with a = 1.5 h
+/// and c_d = 1 in 2D, 7 / (2.25 pi) in 3D, the integral of W over the line (plane) divided by
+/// h (h^2): with points h apart, sum_k w_k is about 1 around the contact however the particle
+/// has turned.
+inline real osculating_scale(int dimension) {
+  return dimension == 2 ? 1.0 : 7.0 / (2.25 * std::numbers::pi);
 }
 
 /// The terms of one surface point for a probe at p: its weight w, distance d, gradient u of d,
