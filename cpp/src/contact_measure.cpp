@@ -167,12 +167,11 @@ ContactModel::PairGeometry ContactModel::pair_geometry(const Model& model, const
   return g;
 }
 
-ContactModel::WallGeometry ContactModel::wall_geometry(const Model& model, const State& state, index_t i,
-                                                       index_t e) const {
+ContactModel::WallGeometry ContactModel::wall_geometry(const Model& model, index_t i, index_t e,
+                                                       const WallSpheres& spheres) const {
   // Friction acts at the deepest point of the deepest sphere: p = c - (r - overlap / 2) m, m from
   // the wall towards the node.
   const WallPoints& points = wall_points_[e];
-  const WallSpheres spheres = wall_spheres(model, state, i, e);
   std::size_t deepest = deepest_point(points.points.data(), points.count);
   if (points.osculating > 0) {
     auto overlap = [&](std::size_t k) {
@@ -200,8 +199,8 @@ ContactModel::WallSpheres ContactModel::wall_spheres(const Model& model, const S
   spheres.centre[0] = contact_position(model, state, i);
   spheres.radius[0] = slot_law(wall_slot_[e]).contact_radius;
   if (points.osculating > 0) {
-    spheres.centre[1] = centres_.point(state, centres_.seen(model, i), i, points.centre_length);
-    spheres.radius[1] = points.radius;
+    spheres.centre[1] = points.osculating_centre;
+    spheres.radius[1] = points.osculating_radius;
   }
   return spheres;
 }
@@ -365,21 +364,21 @@ void ContactModel::measure_wall_points(const Model& model, const State& state, i
   real share = 0;
   if (seen.osculating_radius > 0 && kind != WallSurface::Kind::polygon &&
       kind != WallSurface::Kind::triangles) {
-    points.radius = seen.osculating_radius;
-    points.centre_length = seen.surface_length - seen.osculating_radius;
+    const real r = points.osculating_radius = seen.osculating_radius;
     const vec3 a = SurfaceCentres::anchored_vector(seen, state.positions, i);
     const real size = std::sqrt(dot(a, a));
-    const vec3 sphere = centres_.point(state, seen, i, points.centre_length);
+    const real scale = (seen.surface_length - r) / size;  // o = y + (d - r) n
+    for (int c = 0; c < 3; ++c) points.osculating_centre[c] = state.positions[3 * i + c] + scale * a[c];
     const real support = contact::surface_support_factor * seen.mesh_size;
     found.clear();
-    wall.contacts(wall_entry_[e][1], wall.to_reference(sphere.data(), state.time), points.radius, dimension_,
-                  found);
+    wall.contacts(wall_entry_[e][1], wall.to_reference(points.osculating_centre.data(), state.time), r,
+                  dimension_, found);
     for (const WallContact& contact : found) {
       if (points.count == points.points.size()) break;
       const vec3 m = wall.rotate_to_world(contact.normal, state.time);
       const vec3 chord{a[0] / size + m[0], a[1] / size + m[1], a[2] / size + m[2]};
       const real weight = contact::osculating_scale(dimension_) *
-                          contact::surface_weight(points.radius * std::sqrt(dot(chord, chord)) / support);
+                          contact::surface_weight(r * std::sqrt(dot(chord, chord)) / support);
       if (weight == 0) continue;
       points.points[points.count] = {contact.distance, m};
       points.weights[points.count++] = weight;
@@ -638,8 +637,8 @@ real ContactModel::spring_energy(const Model& model, const State& state) const {
       const WallPoints& points = wall_points_[e];
       const real contact_radius = slot_law(wall_slot_[e]).contact_radius;
       for (std::size_t k = 0; k < points.count; ++k) {
-        const real overlap =
-            (sphere_of(points, k) == 1 ? points.radius : contact_radius) - points.points[k].distance;
+        const real overlap = (sphere_of(points, k) == 1 ? points.osculating_radius : contact_radius) -
+                             points.points[k].distance;
         if (overlap > 0)
           energy += 0.5 * points.weights[k] * wall_spring_stiffness(model, i, e) * overlap * overlap;
       }

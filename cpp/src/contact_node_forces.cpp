@@ -362,7 +362,7 @@ void ContactModel::wall_force(const Model& model, const State& state, index_t i,
   const contact::Law& law = wall_laws_[wall_entry_[e][0] * material_count_ + model.node_material()[i]];
   const WallPoints& points = wall_points_[e];
   const WallSpheres spheres = wall_spheres(model, state, i, e);
-  const WallGeometry g = wall_geometry(model, state, i, e);
+  const WallGeometry g = wall_geometry(model, i, e, spheres);
   const real k = wall_spring_stiffness(model, i, e);
   std::array<vec, 2> on_sphere{};
   real push_total = 0;
@@ -430,7 +430,7 @@ vec3 ContactModel::contact_couple(const Model& model, const State& state, index_
     if (wall_spring_[e] == no_spring) continue;
     const contact::Law& law = wall_laws_[wall_entry_[e][0] * material_count_ + node_material[i]];
     if (law.peridem_friction || law.friction == 0) continue;
-    const WallGeometry g = wall_geometry(model, state, i, e);
+    const WallGeometry g = wall_geometry(model, i, e, wall_spheres(model, state, i, e));
     const real kt = law.tangential_stiffness_ratio * g.stiffness;
     const vec& xi = springs_[wall_spring_[e]];
     const real* x = state.positions.data();
@@ -446,11 +446,11 @@ vec3 ContactModel::osculating_couple(const Model& model, const State& state, ind
   const real k = wall_spring_stiffness(model, i, e);
   vec push{0, 0, 0};
   for (std::size_t point = 0; point < points.osculating; ++point) {
-    const real force =
-        contact::normal_force(points.weights[point] * k, points.radius - points.points[point].distance);
+    const real force = contact::normal_force(points.weights[point] * k,
+                                             points.osculating_radius - points.points[point].distance);
     for (int c = 0; c < 3; ++c) push[c] += force * points.points[point].normal[c];
   }
-  const vec centre = wall_spheres(model, state, i, e).centre[1];
+  const vec& centre = points.osculating_centre;
   const real* x = state.positions.data();
   return cross({centre[0] - x[3 * i], centre[1] - x[3 * i + 1], centre[2] - x[3 * i + 2]}, push);
 }

@@ -12,8 +12,11 @@ void SurfaceCentres::find(const Model& model, const State& state, std::vector<re
   depth_ = std::move(depth);
   surface_ = outer_layers;
   any_ = std::any_of(depth_.begin(), depth_.end(), [](real s) { return s > 0; });
+  std::vector<std::uint8_t> round_shape(model.shapes().size());
+  for (std::size_t s = 0; s < round_shape.size(); ++s) round_shape[s] = is_round(model.shapes()[s]);
   round_.assign(surface_.size(), 0);
-  for (index_t p = 0; p < round_.size(); ++p) round_[p] = surface_[p] && depth_[p] > 0 && is_round(model, p);
+  for (index_t p = 0; p < round_.size(); ++p)
+    round_[p] = surface_[p] && depth_[p] > 0 && round_shape[model.particles()[p].shape];
   // Which nodes are seen at anchors (1 byte each: most nodes have none, and contact asks for
   // every node every step); under the surface law, which look them up many times per step, a
   // pointer per node as well.
@@ -38,8 +41,8 @@ void SurfaceCentres::find(const Model& model, const State& state, std::vector<re
   }
 }
 
-bool SurfaceCentres::is_round(const Model& model, index_t p) {
-  const auto& anchors = model.shapes()[model.particles()[p].shape].anchors.anchors;
+bool SurfaceCentres::is_round(const Shape& shape) {
+  const auto& anchors = shape.anchors.anchors;
   return !anchors.empty() && std::all_of(anchors.begin(), anchors.end(), [](const SurfaceAnchor& a) {
     return a.curvature * round_radius_min <= 1 && a.curvature * round_radius_max >= 1;
   });

@@ -417,15 +417,15 @@ class ContactModel {
     vec3 normal{0, 0, 0}, point{0, 0, 0};
     real stiffness = 0;
   };
-  WallGeometry wall_geometry(const Model& model, const State& state, index_t i, index_t e) const;
   /// The two spheres through which node i's wall entry e sees the wall: [0] its contact sphere
-  /// (centre c_i, radius rho), [1] its osculating sphere (centre o_i, radius 1 / kappa; unset
-  /// off a round particle).
+  /// (centre c_i, radius rho), [1] its osculating sphere (centre o_i, radius 1 / kappa, as
+  /// measure_wall_points found them; unset off a round particle).
   struct WallSpheres {
     std::array<vec3, 2> centre{};
     std::array<real, 2> radius{0, 0};
   };
   WallSpheres wall_spheres(const Model& model, const State& state, index_t i, index_t e) const;
+  WallGeometry wall_geometry(const Model& model, index_t i, index_t e, const WallSpheres& spheres) const;
   /// Node i's wall entry e's points, measured (wall_points_[e]) from its contact sphere or, on a
   /// round particle and a wall of planes, boxes or circles, from its osculating sphere.
   void measure_wall_points(const Model& model, const State& state, index_t i, index_t e, const vec3& centre,
@@ -540,13 +540,13 @@ class ContactModel {
   // precision, 4 bytes: list entries outnumber nodes when grains shatter).
   std::vector<float> pair_stiffness_;
   /// Contact points of a wall entry (at most one per box face), normals in the world frame, of
-  /// the node's spheres (WallSpheres; the osculating one radius r = 1 / kappa, centred
-  /// centre_length along the normal), each point's spring weighted by `weights`
+  /// the node's spheres (WallSpheres), each point's spring weighted by `weights`
   /// (measure_wall_points).
   struct WallPoints {
     std::uint8_t count = 0;
-    std::uint8_t osculating = 0;  ///< the first `osculating` points are the osculating sphere's
-    real radius = 0, centre_length = 0;
+    std::uint8_t osculating = 0;      ///< the first `osculating` points are the osculating sphere's
+    real osculating_radius = 0;       ///< r = 1 / kappa [m]
+    vec3 osculating_centre{0, 0, 0};  ///< o = s - r n at this step's positions
     std::array<WallContact, 6> points{};
     std::array<real, 6> weights{};
   };

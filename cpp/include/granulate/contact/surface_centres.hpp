@@ -122,9 +122,8 @@ class SurfaceCentres {
   static real linear_scale(const Seen& s, real length);
   static real length_of(const vec3& a);
   void detach(index_t i);
-  /// Whether every surface point of particle p's shape has a curvature radius within the round
-  /// bounds.
-  static bool is_round(const Model& model, index_t p);
+  /// Whether every surface point of the shape has a curvature radius within the round bounds.
+  static bool is_round(const Shape& shape);
   /// Node i's anchors from the shape (none for an outer-layer node of a particle not under the
   /// surface law).
   const SurfaceAnchor* lookup(const Model& model, index_t i) const;
