@@ -252,6 +252,7 @@ void ContactModel::add_forces(const Model& model, State& state, std::uint64_t br
   last_time_ = state.time;
   has_last_time_ = true;
   if (any_surface_) measure_surface_points(model, state);  // A: the lists' surface points
+  if (any_surface_) measure_body_rotations(model, state);  //    round bodies' rotations, for walls
   measure_contacts(model, state);         //    distances, springs, probes, wall contact points
   sum_slot_stiffness();                   // B: K per pair of bodies; the touching bodies
   measure_bodies(model, state);           //    rigid-body motion of the touching bodies
@@ -266,6 +267,65 @@ void ContactModel::add_forces(const Model& model, State& state, std::uint64_t br
   probe_couples(state);                                 //    the probes' friction couples, as loads
   body_loads(model, state);  // E: dashpots and friction couples as rigid-body loads
   sum_wall_reactions();      // D: wall reactions
+}
+
+namespace {
+
+/// B = sum m (y - c)(X - C)^T of a body (contact/body_rotation.hpp), from moments about its
+/// first node in both frames, so far from the origin nothing cancels:
+/// sum m (y - y_0)(X - X_0)^T - M d D^T, d = c - y_0, D = C - X_0.
+contact::matrix3 body_moment(const Model& model, const State& state, const index_t* nodes, index_t count) {
+  const real* y = state.positions.data();
+  const real* X = model.reference_positions().data();
+  const index_t first = nodes[0];
+  real mass = 0;
+  vec d{0, 0, 0}, D{0, 0, 0};
+  contact::matrix3 moment{};
+  for (index_t slot = 0; slot < count; ++slot) {
+    const index_t i = nodes[slot];
+    const real m = model.node_density()[i] * model.volumes()[i];
+    const vec a{y[3 * i] - y[3 * first], y[3 * i + 1] - y[3 * first + 1], y[3 * i + 2] - y[3 * first + 2]};
+    const vec b{X[3 * i] - X[3 * first], X[3 * i + 1] - X[3 * first + 1], X[3 * i + 2] - X[3 * first + 2]};
+    mass += m;
+    for (int r = 0; r < 3; ++r) {
+      d[r] += m * a[r];
+      D[r] += m * b[r];
+      for (int c = 0; c < 3; ++c) moment[3 * r + c] += m * a[r] * b[c];
+    }
+  }
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) moment[3 * r + c] -= d[r] * D[c] / mass;
+  return moment;
+}
+
+}  // namespace
+
+void ContactModel::measure_body_rotations(const Model& model, const State& state) {
+  // The rotation of every body of a round particle that has wall entries: its osculating
+  // spheres' normals turn with it (measure_wall_points).
+  const index_t n = model.node_count();
+  body_rotated_.assign(body_mass_.size(), 0);
+  body_rotation_.resize(body_mass_.size());
+  rotated_bodies_.clear();
+  for (index_t i = 0; i < n; ++i) {
+    const index_t b = node_body_[i];
+    if (wall_offsets_[i] == wall_offsets_[i + 1] || body_rotated_[b] != 0) continue;
+    if (centres_.seen(model, i).osculating_radius > 0) {
+      body_rotated_[b] = 1;
+      rotated_bodies_.push_back(b);
+    }
+  }
+  const std::int64_t count = static_cast<std::int64_t>(rotated_bodies_.size());
+#pragma omp parallel for schedule(dynamic, 16)
+  for (std::int64_t k = 0; k < count; ++k) {
+    const index_t b = rotated_bodies_[k];
+    const auto rotation =
+        contact::best_rotation(body_moment(model, state, body_nodes_.data() + body_node_offsets_[b],
+                                           body_node_offsets_[b + 1] - body_node_offsets_[b]),
+                               dimension_);
+    body_rotated_[b] = rotation ? 1 : 0;
+    if (rotation) body_rotation_[b] = *rotation;
+  }
 }
 
 void ContactModel::measure_surface_points(const Model& model, const State& state) {
@@ -365,10 +425,9 @@ void ContactModel::measure_wall_points(const Model& model, const State& state, i
   if (seen.osculating_radius > 0 && kind != WallSurface::Kind::polygon &&
       kind != WallSurface::Kind::triangles) {
     const real r = points.osculating_radius = seen.osculating_radius;
-    const vec3 a = SurfaceCentres::anchored_vector(seen, state.positions, i);
-    const real size = std::sqrt(dot(a, a));
-    const real scale = (seen.surface_length - r) / size;  // o = y + (d - r) n
-    for (int c = 0; c < 3; ++c) points.osculating_centre[c] = state.positions[3 * i + c] + scale * a[c];
+    const vec3 n = osculating_normal(model, state, seen, i);
+    for (int c = 0; c < 3; ++c)  // o = y + (d - r) n
+      points.osculating_centre[c] = state.positions[3 * i + c] + (seen.surface_length - r) * n[c];
     const real support = contact::surface_support_factor * seen.mesh_size;
     found.clear();
     wall.contacts(wall_entry_[e][1], wall.to_reference(points.osculating_centre.data(), state.time), r,
@@ -376,7 +435,7 @@ void ContactModel::measure_wall_points(const Model& model, const State& state, i
     for (const WallContact& contact : found) {
       if (points.count == points.points.size()) break;
       const vec3 m = wall.rotate_to_world(contact.normal, state.time);
-      const vec3 chord{a[0] / size + m[0], a[1] / size + m[1], a[2] / size + m[2]};
+      const vec3 chord{n[0] + m[0], n[1] + m[1], n[2] + m[2]};
       const real weight = contact::osculating_scale(dimension_) *
                           contact::surface_weight(r * std::sqrt(dot(chord, chord)) / support);
       if (weight == 0) continue;
@@ -399,6 +458,19 @@ void ContactModel::measure_wall_points(const Model& model, const State& state, i
     }
   }
   wall_entry_stiffness_[e] = share * wall_spring_stiffness(model, i, e);
+}
+
+vec3 ContactModel::osculating_normal(const Model& model, const State& state, const SurfaceCentres::Seen& seen,
+                                     index_t i) const {
+  // R n_0, the reference normal turned with the body, where the body has a rotation; the
+  // anchored normal A / |A| otherwise.
+  const index_t b = node_body_[i];
+  const bool turned = body_rotated_[b] != 0;
+  const vec3 a =
+      SurfaceCentres::anchored_vector(seen, turned ? model.reference_positions() : state.positions, i);
+  const real size = std::sqrt(dot(a, a));
+  const vec3 n{a[0] / size, a[1] / size, a[2] / size};
+  return turned ? contact::rotate(body_rotation_[b], n) : n;
 }
 
 real ContactModel::measure_probes(const Model& model, const State& state, index_t i, ProbeScratch& scratch) {

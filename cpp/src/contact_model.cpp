@@ -289,12 +289,13 @@ std::size_t ContactModel::memory_bytes() const {
          bytes(wall_entry_stiffness_) + bytes(wall_entry_reaction_) + bytes(springs_) + bytes(free_springs_) +
          bytes(pair_spring_) + bytes(wall_spring_) + bytes(contact_nodes_) + bytes(body_contact_offsets_) +
          bytes(body_touch_) + bytes(touching_bodies_) + bytes(slot_touch_) + bytes(body_motion_) +
-         bytes(body_load_) + bytes(slot_force_) + bytes(slot_normal_) + bytes(slot_point_) +
-         bytes(slot_load_) + bytes(damping_tables_) + bytes(wall_damping_tables_) +
-         bytes(slot_surface_normal_) + bytes(touching_nodes_) + bytes(touching_normals_) +
-         centres_.memory_bytes() + bytes(anchor_forces_) + bytes(entry_group_) + bytes(entry_target_) +
-         bytes(taking_part_) + bytes(surface_nodes_) + bytes(surface_slot_) + bytes(surface_points_) +
-         bytes(surface_sizes_) + bytes(groups_) + bytes(group_offsets_) + bytes(probes_);
+         bytes(body_rotation_) + bytes(body_rotated_) + bytes(rotated_bodies_) + bytes(body_load_) +
+         bytes(slot_force_) + bytes(slot_normal_) + bytes(slot_point_) + bytes(slot_load_) +
+         bytes(damping_tables_) + bytes(wall_damping_tables_) + bytes(slot_surface_normal_) +
+         bytes(touching_nodes_) + bytes(touching_normals_) + centres_.memory_bytes() + bytes(anchor_forces_) +
+         bytes(entry_group_) + bytes(entry_target_) + bytes(taking_part_) + bytes(surface_nodes_) +
+         bytes(surface_slot_) + bytes(surface_points_) + bytes(surface_sizes_) + bytes(groups_) +
+         bytes(group_offsets_) + bytes(probes_);
 }
 
 std::array<index_t, 2> ContactModel::first_wall_penetration(const Model& model, const State& state) const {

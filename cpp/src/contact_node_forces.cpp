@@ -355,9 +355,10 @@ void ContactModel::wall_force(const Model& model, const State& state, index_t i,
   // Springs at every contact point of the entry, on the centre of its sphere; friction at the
   // deepest point p, on the node with its couple (p - x_i) x F_t (contact_couple), from the
   // slip of p moving with the node and its body's rotation. The wall takes the opposite force
-  // at p. An osculating sphere's springs act on the node too, their couple (o - y_i) x F on the
-  // body putting them at the sphere's centre o (contact_couple): a round particle's surface
-  // deforms under the load where it is applied, and a circle's push passes through its centre.
+  // at p. An osculating sphere's springs act on the node too, and the rest of their energy's
+  // derivative, through the body's rotation that turns o about y_i, is a couple on the body
+  // (osculating_couple): a round particle's surface deforms under the load where it is
+  // applied, and a circle's push passes through its centre.
   const Wall& wall = walls_[wall_entry_[e][0]];
   const contact::Law& law = wall_laws_[wall_entry_[e][0] * material_count_ + model.node_material()[i]];
   const WallPoints& points = wall_points_[e];
@@ -442,17 +443,52 @@ vec3 ContactModel::contact_couple(const Model& model, const State& state, index_
 }
 
 vec3 ContactModel::osculating_couple(const Model& model, const State& state, index_t i, index_t e) const {
+  // -dE/dtheta of the entry's energy for a rotation theta of the body, which turns each
+  // osculating sphere's normal n (o = y + (d - r) n): E = k/2 [sum_j w_j delta_j^2 + rest
+  // sum_c delta_c^2], rest = 1 - sum_j w_j while positive (the contact sphere's points c).
+  // delta_j turns with o: (o - y) x F_j, F_j = k w_j delta_j m_j. w_j = c_d W(r |n + m_j| / a)
+  // turns with n: dw_j/dtheta = c_d W' (r / a) (n x m_j) / |n + m_j|.
   const WallPoints& points = wall_points_[e];
   const real k = wall_spring_stiffness(model, i, e);
-  vec push{0, 0, 0};
-  for (std::size_t point = 0; point < points.osculating; ++point) {
-    const real force = contact::normal_force(points.weights[point] * k,
-                                             points.osculating_radius - points.points[point].distance);
-    for (int c = 0; c < 3; ++c) push[c] += force * points.points[point].normal[c];
-  }
+  const SurfaceCentres::Seen seen = centres_.seen(model, i);
+  const real r = points.osculating_radius;
+  const real support = contact::surface_support_factor * seen.mesh_size;
   const vec& centre = points.osculating_centre;
   const real* x = state.positions.data();
-  return cross({centre[0] - x[3 * i], centre[1] - x[3 * i + 1], centre[2] - x[3 * i + 2]}, push);
+  const vec arm{centre[0] - x[3 * i], centre[1] - x[3 * i + 1], centre[2] - x[3 * i + 2]};
+  const real length = seen.surface_length - r;  // o - y = (d - r) n
+  const vec n{arm[0] / length, arm[1] / length, arm[2] / length};
+  vec push{0, 0, 0}, weight_turn{0, 0, 0};  // sum_j F_j, and -dE/dtheta through the weights
+  real share = 0, rest_energy = 0;
+  vec share_turn{0, 0, 0};  // d(sum_j w_j)/dtheta
+  for (std::size_t point = 0; point < points.count; ++point) {
+    const vec& m = points.points[point].normal;
+    if (point >= points.osculating) {
+      const real overlap = slot_law(wall_slot_[e]).contact_radius - points.points[point].distance;
+      rest_energy += 0.5 * k * overlap * overlap;
+      continue;
+    }
+    const real overlap = r - points.points[point].distance;
+    const real force = contact::normal_force(points.weights[point] * k, overlap);
+    for (int c = 0; c < 3; ++c) push[c] += force * m[c];
+    share += points.weights[point];
+    const vec chord{n[0] + m[0], n[1] + m[1], n[2] + m[2]};
+    const real size = std::sqrt(dot(chord, chord));
+    if (!(size > 0)) continue;
+    const real slope = contact::osculating_scale(dimension_) *
+                       contact::surface_weight_slope(r * size / support) * r / (support * size);
+    const vec turn = cross(n, m);
+    for (int c = 0; c < 3; ++c) {
+      weight_turn[c] -= 0.5 * k * overlap * overlap * slope * turn[c];
+      share_turn[c] += slope * turn[c];
+    }
+  }
+  vec couple = cross(arm, push);
+  for (int c = 0; c < 3; ++c) {
+    couple[c] += weight_turn[c];
+    if (share < 1) couple[c] += rest_energy * share_turn[c];
+  }
+  return couple;
 }
 
 void ContactModel::sum_wall_reactions() {

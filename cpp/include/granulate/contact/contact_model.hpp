@@ -8,6 +8,7 @@
 #include <span>
 #include <vector>
 
+#include "granulate/contact/body_rotation.hpp"
 #include "granulate/contact/collisions.hpp"
 #include "granulate/contact/contact_law.hpp"
 #include "granulate/contact/power_law_damping.hpp"
@@ -430,14 +431,23 @@ class ContactModel {
   /// round particle and a wall of planes, boxes or circles, from its osculating sphere.
   void measure_wall_points(const Model& model, const State& state, index_t i, index_t e, const vec3& centre,
                            std::vector<WallContact>& found);
+  /// The rotation R of every body of a round particle with wall entries (body_rotation.hpp).
+  void measure_body_rotations(const Model& model, const State& state);
+  /// The unit normal n of a round particle's node i that places its osculating sphere: R n_0,
+  /// its reference normal turned with its body, or A_i / |A_i| if the body has no rotation.
+  /// Through R the spheres have a potential whose derivative is a couple on the body.
+  vec3 osculating_normal(const Model& model, const State& state, const SurfaceCentres::Seen& seen,
+                         index_t i) const;
   /// Forces of node i's wall entry e: the springs on its sphere's centre, friction on the node
   /// (updates the spring; sets the entry's reaction), added to `forces`.
   void wall_force(const Model& model, const State& state, index_t i, index_t e, real dt,
                   NodeContactForces& forces);
-  /// Sum of (p - c_i) x F_t over node i's friction forces, from the springs, and of (o - y_i) x
-  /// F over its osculating wall springs (osculating_couple): loads on its body.
+  /// Sum of (p - c_i) x F_t over node i's friction forces, from the springs, and its
+  /// osculating wall entries' couples (osculating_couple): loads on its body.
   vec3 contact_couple(const Model& model, const State& state, index_t i) const;
-  /// (o - y_i) x F of the springs F of node i's osculating wall entry e, whose sphere's centre is o.
+  /// Minus the derivative of node i's wall entry e's energy for a rotation of its body, which
+  /// turns its osculating sphere about y_i: (o - y_i) x F of the springs F, plus the turn of
+  /// their weights and of the contact sphere's rest.
   vec3 osculating_couple(const Model& model, const State& state, index_t i, index_t e) const;
   /// Contact radius of node i in a contact of law `law` with node j (its share of the pair's Rc).
   real node_radius(const contact::Law& law, const Model& model, index_t i, index_t j,
@@ -553,6 +563,11 @@ class ContactModel {
   /// Which sphere of WallSpheres point k of an entry belongs to.
   static int sphere_of(const WallPoints& points, std::size_t k) { return k < points.osculating ? 1 : 0; }
   std::vector<WallPoints> wall_points_;
+  // Per body, this step: the rotation from its reference shape of each body of a round
+  // particle with wall entries (measure_body_rotations; rotated_bodies_ lists them).
+  std::vector<contact::matrix3> body_rotation_;
+  std::vector<std::uint8_t> body_rotated_;
+  std::vector<index_t> rotated_bodies_;
   std::vector<real> wall_entry_stiffness_;
   std::vector<std::array<real, 6>> wall_entry_reaction_;
   std::vector<std::array<real, 6>> wall_reactions_;

@@ -23,7 +23,10 @@
 // curvature radius 1/kappa between 2 h and 50 h: a disc, a sphere, an ellipse) is round:
 // walls see each of its surface points through its osculating sphere, centre o_i = s_i - n_i /
 // kappa_i (at length d_i - 1/kappa_i along the normal), instead of its contact sphere, so that
-// a rolling disc meets the wall on its circle rather than on the polygon of its points.
+// a rolling disc meets the wall on its circle rather than on the polygon of its points. That
+// normal is the reference normal turned with the point's body (contact/body_rotation.hpp), not
+// A_i / |A_i|: the anchors' vibration would move o_i by 1/kappa_i times their tilt, ten times
+// the spacing's worth, with no force to account for it (ContactModel::osculating_normal).
 #pragma once
 
 #include <array>
