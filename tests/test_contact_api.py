@@ -207,3 +207,26 @@ def test_particles_outside_their_container_or_overlapping_are_refused() -> None:
     touching.add_body(gr.Disc((0, 0), 1e-3), SOFT, 0.25e-3)
     touching.add_body(gr.Disc((2.25e-3, 0), 1e-3), SOFT, 0.25e-3)
     touching.run(1)
+
+
+@pytest.mark.parametrize(("pair_law", "accepted"), [("surface", True), ("granulate", False)])
+def test_grains_pressed_into_each_other_as_at_rest_start_under_the_surface_law(
+    pair_law: str, accepted: bool
+) -> None:
+    """Under the surface law grains meet at their surfaces, so nodes of grains at rest may lie
+    closer than half a mesh size (a settled pile carried into a new simulation was refused):
+    two hexagons pressed 0.3 h into each other face to face start, and 0.6 h is refused. The
+    node spheres keep nodes apart and refuse both (their nodes lie 0.36 h apart at 0.3 h)."""
+    apothem = 1e-3 * np.cos(np.pi / 6)
+    for overlap, refused in ((0.3, not accepted), (0.6, True)):
+        sim = gr.Simulation(2)
+        sim.contact = gr.Contact(pair_law=pair_law)
+        sim.add_body(gr.RegularPolygon((0, 0), 1e-3, 6), SOFT, 0.2e-3, name="a")
+        sim.add_body(
+            gr.RegularPolygon((0, 2 * apothem - overlap * 0.2e-3), 1e-3, 6), SOFT, 0.2e-3, name="b"
+        )
+        if refused:
+            with pytest.raises(gr.InputError, match="a and b overlap at the start"):
+                sim.run(1)
+        else:
+            sim.run(1)

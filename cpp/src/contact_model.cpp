@@ -316,10 +316,10 @@ std::array<index_t, 2> ContactModel::first_wall_penetration(const Model& model, 
   return {model.node_count(), 0};
 }
 
-std::array<index_t, 2> ContactModel::first_overlap(const Model& model, const State& state,
-                                                   real fraction) const {
+std::array<index_t, 2> ContactModel::first_overlap(const Model& model, const State& state, real fraction) {
   const index_t n = model.node_count();
   if (!any_law_ || n == 0) return {n, n};
+  if (!centres_.found()) centres_.find(model, state, centring_depths(model), surface_particles_);
   real finest = std::numeric_limits<real>::infinity();
   for (const Particle& p : model.particles()) finest = std::min(finest, p.mesh_size);
   const real radius = fraction * finest;
@@ -328,16 +328,82 @@ std::array<index_t, 2> ContactModel::first_overlap(const Model& model, const Sta
   for (index_t i = 0; i < n; ++i) {
     index_t hit = n;
     grid.for_each_within(state.positions, i, radius, dimension_, [&](index_t j, real r2) {
-      if (hit != n || owner[j] == owner[i]) return;
-      const index_t a = model.node_material()[i], b = model.node_material()[j];
-      if (!law_set_[a * material_count_ + b]) return;
+      if (hit != n || owner[j] == owner[i] || !interact(model, i, j) || between_surfaces(model, i, j)) return;
       const real limit =
           fraction * std::min(model.particles()[owner[i]].mesh_size, model.particles()[owner[j]].mesh_size);
       if (r2 < limit * limit) hit = j;
     });
     if (hit != n) return {i, hit};
   }
+  return first_surface_overlap(model, state, fraction);
+}
+
+bool ContactModel::interact(const Model& model, index_t i, index_t j) const {
+  return law_set_[model.node_material()[i] * material_count_ + model.node_material()[j]] != 0;
+}
+
+bool ContactModel::between_surfaces(const Model& model, index_t i, index_t j) const {
+  // Under the surface law a node that carries a surface point meets the other particle at its
+  // surface, where at rest it may lie arbitrarily close to the other's nodes (a mesh's boundary
+  // vertices, a lattice's corner nodes): first_surface_overlap judges those.
+  const auto& owner = model.node_particle();
+  return surface_particles_[owner[i]] && surface_particles_[owner[j]] &&
+         (on_surface(model, i) || on_surface(model, j));
+}
+
+std::array<index_t, 2> ContactModel::first_surface_overlap(const Model& model, const State& state,
+                                                           real fraction) const {
+  // Surface point s_i of one particle and the nearest surface point s_j of another (within 4
+  // mesh sizes): they overlap where s_i lies deeper than fraction h inside j's osculating
+  // sphere and s_j deeper than that inside the sphere of the point of i's particle nearest to
+  // it (one side alone misleads at a corner, whose sphere is one face's plane).
+  const index_t n = model.node_count();
+  const auto& owner = model.node_particle();
+  std::vector<index_t> nodes;
+  std::vector<real> points(3 * static_cast<std::size_t>(n), 0.0);
+  real coarsest = 0;
+  for (index_t i = 0; i < n; ++i) {
+    if (!surface_particles_[owner[i]] || !on_surface(model, i)) continue;
+    nodes.push_back(i);
+    const vec3 s = centres_.at_surface(model, state, i);
+    for (int c = 0; c < 3; ++c) points[3 * i + c] = s[c];
+    coarsest = std::max(coarsest, model.particles()[owner[i]].mesh_size);
+  }
+  if (nodes.empty()) return {n, n};
+  const real reach = 4 * coarsest;
+  const CellGrid grid = CellGrid::build(points, nodes, reach);
+  auto nearest = [&](index_t i, auto&& wanted) {
+    index_t best = n;
+    real best_r2 = reach * reach;
+    grid.for_each_within(points, i, reach, dimension_, [&](index_t j, real r2) {
+      if (wanted(j) && (r2 < best_r2 || (r2 == best_r2 && j < best))) best = j, best_r2 = r2;
+    });
+    return best;
+  };
+  for (const index_t i : nodes) {
+    const index_t j = nearest(i, [&](index_t k) { return owner[k] != owner[i] && interact(model, i, k); });
+    if (j == n) continue;
+    const real limit =
+        fraction * std::min(model.particles()[owner[i]].mesh_size, model.particles()[owner[j]].mesh_size);
+    if (!(depth_inside(model, state, i, j) > limit)) continue;
+    const index_t k = nearest(j, [&](index_t m) { return owner[m] == owner[i]; });
+    if (k != n && depth_inside(model, state, j, k) > limit) return {i, j};
+  }
   return {n, n};
+}
+
+real ContactModel::depth_inside(const Model& model, const State& state, index_t probe, index_t node) const {
+  const SurfaceCentres::Seen seen = centres_.seen(model, node);
+  const vec3 a = SurfaceCentres::anchored_vector(seen, state.positions, node);
+  const real size = std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+  contact::SurfacePoint point;
+  for (int c = 0; c < 3; ++c) {
+    point.normal[c] = a[c] / size;
+    point.position[c] = state.positions[3 * node + c] + seen.surface_length * point.normal[c];
+  }
+  point.curvature = seen.anchor->curvature / seen.mesh_size;
+  const vec3 p = centres_.at_surface(model, state, probe);
+  return -contact::point_terms(point, p, 1e3 * seen.mesh_size).distance;
 }
 
 }  // namespace granulate

@@ -192,8 +192,8 @@ class Interactions:
         if i < model.node_count:
             a, b = bodies[owner[i]], bodies[owner[j]]
             raise InputError(
-                f"{a.name} and {b.name} overlap at the start (nodes {i} and {j} are closer than "
-                "half a mesh size); move them apart, or generate the assembly with "
+                f"{a.name} and {b.name} overlap at the start (at nodes {i} and {j}, by more "
+                "than half a mesh size); move them apart, or generate the assembly with "
                 "granulate.pack, which never overlaps"
             )
 

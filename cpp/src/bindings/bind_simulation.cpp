@@ -45,7 +45,7 @@ void bind_run_setup(nb::class_<Simulation>& cls) {
            })
       .def(
           "first_overlap",
-          [](const Simulation& self, real fraction) {
+          [](Simulation& self, real fraction) {
             return self.contact().first_overlap(self.model(), self.state(), fraction);
           },
           "fraction"_a)

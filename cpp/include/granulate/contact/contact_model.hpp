@@ -150,8 +150,11 @@ class ContactModel {
   /// (a particle placed outside its container, or inside an obstacle); {node count, 0} if none.
   std::array<index_t, 2> first_wall_penetration(const Model& model, const State& state) const;
   /// The first pair of nodes of different particles (with a contact law between them) closer
-  /// than `fraction` times the finer mesh size: overlapping particles; {n, n} if none.
-  std::array<index_t, 2> first_overlap(const Model& model, const State& state, real fraction) const;
+  /// than `fraction` times the finer mesh size: overlapping particles; {n, n} if none. Under
+  /// the surface law, where touching grains' nodes may meet, a node carrying a surface point
+  /// overlaps only where its point lies deeper than that inside the other's surface
+  /// (first_surface_overlap).
+  std::array<index_t, 2> first_overlap(const Model& model, const State& state, real fraction);
 
   ContactCheckpoint checkpoint() const;
   /// Restores a checkpoint taken with the same model, laws and walls; `state` is the restored
@@ -449,6 +452,17 @@ class ContactModel {
   /// turns its osculating sphere about y_i: (o - y_i) x F of the springs F, plus the turn of
   /// their weights and of the contact sphere's rest.
   vec3 osculating_couple(const Model& model, const State& state, index_t i, index_t e) const;
+  /// Whether nodes i and j have a contact law between them.
+  bool interact(const Model& model, index_t i, index_t j) const;
+  /// Whether first_overlap leaves nodes i and j to first_surface_overlap: both particles are
+  /// under the surface law and one of the nodes carries a surface point.
+  bool between_surfaces(const Model& model, index_t i, index_t j) const;
+  /// The first surface point lying deeper than `fraction` h inside another particle's surface,
+  /// and that particle's nearest surface point lying as deep inside the first's.
+  std::array<index_t, 2> first_surface_overlap(const Model& model, const State& state, real fraction) const;
+  /// How deep surface node probe's surface point lies inside surface node node's osculating
+  /// sphere [m] (negative outside).
+  real depth_inside(const Model& model, const State& state, index_t probe, index_t node) const;
   /// Contact radius of node i in a contact of law `law` with node j (its share of the pair's Rc).
   real node_radius(const contact::Law& law, const Model& model, index_t i, index_t j,
                    real contact_radius) const;
