@@ -10,8 +10,8 @@
 //
 // In 2D (the x-y plane) R turns by theta = atan2(B_yx - B_xy, B_xx + B_yy). In 3D, Newton's
 // iteration X <- (g X + X^-T / g) / 2, g = (|X^-1|_F / |X|_F)^(1/2), from X = B converges
-// quadratically to R while det B > 0. A body whose B is singular or reflecting (a fragment of
-// one or two nodes, a sheet of nodes in 3D) has no rotation.
+// quadratically to R while det B > 0. A body whose B vanishes (one node) has no rotation, nor
+// in 3D one whose B is singular or reflecting (two nodes, a sheet of nodes).
 #pragma once
 
 #include <algorithm>
