@@ -219,7 +219,10 @@ def test_restitution_of_grains_of_different_sizes_meshed_alike(dimension: int, f
         speeds = (0.01, 0.05, 1.0) if dimension == 2 else (0.05, 1.0)  # 3D 0.01 m/s: 150 s each
         impacts = [(v, SOFT, 0.5e-3, 1.0) for v in speeds]
         impacts += [(10.0, STIFF, 0.5e-3, 1.0 if dimension == 2 else 10.0)]
-        if dimension == 2:  # radius ratio 10: measured 0.573 / 0.963 at 0.05 and 1 m/s
+        # Radius ratio 10: measured 0.573 / 0.963 at 0.05 and 1 m/s. The 0.963 owes to the
+        # coarse 2 mm disc: meshed at R/h = 20 / 40 it returns 0.922 / 0.927 for 1.0 at 1 m/s
+        # (the surface law 0.913 / 0.911), its elastic waves taking 14-17 % of the energy.
+        if dimension == 2:
             impacts += [(0.05, SOFT, 0.2e-3, 1.0), (1.0, SOFT, 0.2e-3, 1.0)]
         cases = [(*impact, e) for impact in impacts for e in (0.6, 0.9, 1.0)]
     elif dimension == 2:  # the slow impact damped, the fast one elastic
