@@ -267,6 +267,7 @@ void ContactModel::finish_lists(const Model& model) {
   carry_over_collisions(old_slots, old_particle_slots);
   group_contact_nodes(model);
   find_groups(model);
+  find_rotated_bodies(model);
   pair_stiffness_.assign(pair_partner_.size(), 0);
   wall_entry_stiffness_.assign(wall_entry_.size(), 0);
   wall_points_.assign(wall_entry_.size(), {});
@@ -278,6 +279,29 @@ void ContactModel::finish_lists(const Model& model) {
   fit(slots_);
   fit(slot_stiffness_);
   fit(wall_entry_);
+}
+
+void ContactModel::find_rotated_bodies(const Model& model) {
+  // The bodies of round particles that have wall entries, whose osculating spheres' normals
+  // turn with them (measure_wall_points): they change only with the lists and the bodies.
+  rotated_bodies_.clear();
+  body_rotation_slot_.clear();
+  if (any_surface_) {
+    body_rotation_slot_.assign(body_mass_.size(), no_rotation);
+    for (index_t i = 0; i < model.node_count(); ++i) {
+      const index_t b = node_body_[i];
+      if (wall_offsets_[i] == wall_offsets_[i + 1] || body_rotation_slot_[b] != no_rotation) continue;
+      if (centres_.seen(model, i).osculating_radius > 0) {
+        body_rotation_slot_[b] = static_cast<index_t>(rotated_bodies_.size());
+        rotated_bodies_.push_back(b);
+      }
+    }
+  }
+  body_rotation_.resize(rotated_bodies_.size());
+  body_rotated_.assign(rotated_bodies_.size(), 0);
+  for (auto* v : {&rotated_bodies_, &body_rotation_slot_}) fit(*v);
+  fit(body_rotation_);
+  fit(body_rotated_);
 }
 
 void ContactModel::find_slots(const Model& model) {

@@ -96,15 +96,6 @@ vec surface_normal(const Model& model, const State& state, index_t i) {
   return {sum[0] / norm, sum[1] / norm, sum[2] / norm};
 }
 
-/// The contact point with the largest spring of a node-wall entry's points (the friction point).
-std::size_t deepest_point(const WallContact* points, std::size_t count) {
-  std::size_t best = 0;
-  for (std::size_t k = 1; k < count; ++k) {
-    if (points[k].distance < points[best].distance) best = k;
-  }
-  return best;
-}
-
 }  // namespace
 
 vec3 ContactModel::contact_position(const Model& model, const State& state, index_t i) const {
@@ -172,15 +163,12 @@ ContactModel::WallGeometry ContactModel::wall_geometry(const Model& model, index
   // Friction acts at the deepest point of the deepest sphere: p = c - (r - overlap / 2) m, m from
   // the wall towards the node.
   const WallPoints& points = wall_points_[e];
-  std::size_t deepest = deepest_point(points.points.data(), points.count);
-  if (points.osculating > 0) {
-    auto overlap = [&](std::size_t k) {
-      return spheres.radius[sphere_of(points, k)] - points.points[k].distance;
-    };
-    deepest = 0;
-    for (std::size_t k = 1; k < points.count; ++k)
-      if (overlap(k) > overlap(deepest)) deepest = k;
-  }
+  auto overlap = [&](std::size_t k) {
+    return spheres.radius[sphere_of(points, k)] - points.points[k].distance;
+  };
+  std::size_t deepest = 0;
+  for (std::size_t k = 1; k < points.count; ++k)
+    if (overlap(k) > overlap(deepest)) deepest = k;
   const int sphere = sphere_of(points, deepest);
   const real radius = spheres.radius[sphere];
   const real lever = radius - 0.5 * (radius - points.points[deepest].distance);
@@ -301,20 +289,7 @@ contact::matrix3 body_moment(const Model& model, const State& state, const index
 }  // namespace
 
 void ContactModel::measure_body_rotations(const Model& model, const State& state) {
-  // The rotation of every body of a round particle that has wall entries: its osculating
-  // spheres' normals turn with it (measure_wall_points).
-  const index_t n = model.node_count();
-  body_rotated_.assign(body_mass_.size(), 0);
-  body_rotation_.resize(body_mass_.size());
-  rotated_bodies_.clear();
-  for (index_t i = 0; i < n; ++i) {
-    const index_t b = node_body_[i];
-    if (wall_offsets_[i] == wall_offsets_[i + 1] || body_rotated_[b] != 0) continue;
-    if (centres_.seen(model, i).osculating_radius > 0) {
-      body_rotated_[b] = 1;
-      rotated_bodies_.push_back(b);
-    }
-  }
+  // The rotation of each body find_rotated_bodies listed, this step.
   const std::int64_t count = static_cast<std::int64_t>(rotated_bodies_.size());
 #pragma omp parallel for schedule(dynamic, 16)
   for (std::int64_t k = 0; k < count; ++k) {
@@ -323,8 +298,8 @@ void ContactModel::measure_body_rotations(const Model& model, const State& state
         contact::best_rotation(body_moment(model, state, body_nodes_.data() + body_node_offsets_[b],
                                            body_node_offsets_[b + 1] - body_node_offsets_[b]),
                                dimension_);
-    body_rotated_[b] = rotation ? 1 : 0;
-    if (rotation) body_rotation_[b] = *rotation;
+    body_rotated_[k] = rotation ? 1 : 0;
+    if (rotation) body_rotation_[k] = *rotation;
   }
 }
 
@@ -334,19 +309,22 @@ void ContactModel::measure_surface_points(const Model& model, const State& state
   const std::int64_t count = static_cast<std::int64_t>(surface_nodes_.size());
 #pragma omp parallel for schedule(static)
   for (std::int64_t k = 0; k < count; ++k) {
-    const index_t j = surface_nodes_[k];
-    const SurfaceCentres::Seen seen = centres_.seen(model, j);
-    contact::SurfacePoint& point = surface_points_[k];
-    const vec3 a = SurfaceCentres::anchored_vector(seen, state.positions, j);
-    const real size = std::sqrt(dot(a, a));
-    const real* y = state.positions.data();
-    for (int c = 0; c < 3; ++c) {
-      point.normal[c] = a[c] / size;
-      point.position[c] = y[3 * j + c] + seen.surface_length * point.normal[c];
-    }
-    point.curvature = seen.anchor->curvature / seen.mesh_size;
-    surface_sizes_[k] = size;
+    surface_points_[k] = surface_point_now(model, state, surface_nodes_[k], surface_sizes_[k]);
   }
+}
+
+contact::SurfacePoint ContactModel::surface_point_now(const Model& model, const State& state, index_t j,
+                                                      real& size) const {
+  const SurfaceCentres::Seen seen = centres_.seen(model, j);
+  const vec3 a = SurfaceCentres::anchored_vector(seen, state.positions, j);
+  size = std::sqrt(dot(a, a));
+  contact::SurfacePoint point;
+  for (int c = 0; c < 3; ++c) {
+    point.normal[c] = a[c] / size;
+    point.position[c] = state.positions[3 * j + c] + seen.surface_length * point.normal[c];
+  }
+  point.curvature = seen.anchor->curvature / seen.mesh_size;
+  return point;
 }
 
 void ContactModel::measure_contacts(const Model& model, const State& state) {
@@ -464,13 +442,13 @@ vec3 ContactModel::osculating_normal(const Model& model, const State& state, con
                                      index_t i) const {
   // R n_0, the reference normal turned with the body, where the body has a rotation; the
   // anchored normal A / |A| otherwise.
-  const index_t b = node_body_[i];
-  const bool turned = body_rotated_[b] != 0;
+  const index_t slot = body_rotation_slot_[node_body_[i]];
+  const bool turned = slot != no_rotation && body_rotated_[slot] != 0;
   const vec3 a =
       SurfaceCentres::anchored_vector(seen, turned ? model.reference_positions() : state.positions, i);
   const real size = std::sqrt(dot(a, a));
   const vec3 n{a[0] / size, a[1] / size, a[2] / size};
-  return turned ? contact::rotate(body_rotation_[b], n) : n;
+  return turned ? contact::rotate(body_rotation_[slot], n) : n;
 }
 
 real ContactModel::measure_probes(const Model& model, const State& state, index_t i, ProbeScratch& scratch) {

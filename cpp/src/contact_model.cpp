@@ -289,13 +289,13 @@ std::size_t ContactModel::memory_bytes() const {
          bytes(wall_entry_stiffness_) + bytes(wall_entry_reaction_) + bytes(springs_) + bytes(free_springs_) +
          bytes(pair_spring_) + bytes(wall_spring_) + bytes(contact_nodes_) + bytes(body_contact_offsets_) +
          bytes(body_touch_) + bytes(touching_bodies_) + bytes(slot_touch_) + bytes(body_motion_) +
-         bytes(body_rotation_) + bytes(body_rotated_) + bytes(rotated_bodies_) + bytes(body_load_) +
-         bytes(slot_force_) + bytes(slot_normal_) + bytes(slot_point_) + bytes(slot_load_) +
-         bytes(damping_tables_) + bytes(wall_damping_tables_) + bytes(slot_surface_normal_) +
-         bytes(touching_nodes_) + bytes(touching_normals_) + centres_.memory_bytes() + bytes(anchor_forces_) +
-         bytes(entry_group_) + bytes(entry_target_) + bytes(taking_part_) + bytes(surface_nodes_) +
-         bytes(surface_slot_) + bytes(surface_points_) + bytes(surface_sizes_) + bytes(groups_) +
-         bytes(group_offsets_) + bytes(probes_);
+         bytes(body_rotation_) + bytes(body_rotated_) + bytes(rotated_bodies_) + bytes(body_rotation_slot_) +
+         bytes(body_load_) + bytes(slot_force_) + bytes(slot_normal_) + bytes(slot_point_) +
+         bytes(slot_load_) + bytes(damping_tables_) + bytes(wall_damping_tables_) +
+         bytes(slot_surface_normal_) + bytes(touching_nodes_) + bytes(touching_normals_) +
+         centres_.memory_bytes() + bytes(anchor_forces_) + bytes(entry_group_) + bytes(entry_target_) +
+         bytes(taking_part_) + bytes(surface_nodes_) + bytes(surface_slot_) + bytes(surface_points_) +
+         bytes(surface_sizes_) + bytes(groups_) + bytes(group_offsets_) + bytes(probes_);
 }
 
 std::array<index_t, 2> ContactModel::first_wall_penetration(const Model& model, const State& state) const {
@@ -393,17 +393,12 @@ std::array<index_t, 2> ContactModel::first_surface_overlap(const Model& model, c
 }
 
 real ContactModel::depth_inside(const Model& model, const State& state, index_t probe, index_t node) const {
-  const SurfaceCentres::Seen seen = centres_.seen(model, node);
-  const vec3 a = SurfaceCentres::anchored_vector(seen, state.positions, node);
-  const real size = std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
-  contact::SurfacePoint point;
-  for (int c = 0; c < 3; ++c) {
-    point.normal[c] = a[c] / size;
-    point.position[c] = state.positions[3 * node + c] + seen.surface_length * point.normal[c];
-  }
-  point.curvature = seen.anchor->curvature / seen.mesh_size;
-  const vec3 p = centres_.at_surface(model, state, probe);
-  return -contact::point_terms(point, p, 1e3 * seen.mesh_size).distance;
+  real size = 0;
+  const contact::SurfacePoint point = surface_point_now(model, state, node, size);
+  const vec3 p = surface_point_now(model, state, probe, size).position;
+  // Support far beyond any probe: the sphere's distance, whatever the weight.
+  return -contact::point_terms(point, p, 1e3 * model.particles()[model.node_particle()[node]].mesh_size)
+              .distance;
 }
 
 }  // namespace granulate

@@ -434,7 +434,9 @@ class ContactModel {
   /// round particle and a wall of planes, boxes or circles, from its osculating sphere.
   void measure_wall_points(const Model& model, const State& state, index_t i, index_t e, const vec3& centre,
                            std::vector<WallContact>& found);
-  /// The rotation R of every body of a round particle with wall entries (body_rotation.hpp).
+  /// The bodies of round particles with wall entries (rotated_bodies_), at every list change.
+  void find_rotated_bodies(const Model& model);
+  /// The rotation R of each of those bodies (body_rotation.hpp), per step.
   void measure_body_rotations(const Model& model, const State& state);
   /// The unit normal n of a round particle's node i that places its osculating sphere: R n_0,
   /// its reference normal turned with its body, or A_i / |A_i| if the body has no rotation.
@@ -460,6 +462,10 @@ class ContactModel {
   /// The first surface point lying deeper than `fraction` h inside another particle's surface,
   /// and that particle's nearest surface point lying as deep inside the first's.
   std::array<index_t, 2> first_surface_overlap(const Model& model, const State& state, real fraction) const;
+  /// Node j's surface point at the state's positions (normal A / |A|, position y + d n,
+  /// curvature), and |A| into `size`.
+  contact::SurfacePoint surface_point_now(const Model& model, const State& state, index_t j,
+                                          real& size) const;
   /// How deep surface node probe's surface point lies inside surface node node's osculating
   /// sphere [m] (negative outside).
   real depth_inside(const Model& model, const State& state, index_t probe, index_t node) const;
@@ -577,11 +583,13 @@ class ContactModel {
   /// Which sphere of WallSpheres point k of an entry belongs to.
   static int sphere_of(const WallPoints& points, std::size_t k) { return k < points.osculating ? 1 : 0; }
   std::vector<WallPoints> wall_points_;
-  // Per body, this step: the rotation from its reference shape of each body of a round
-  // particle with wall entries (measure_body_rotations; rotated_bodies_ lists them).
+  // The bodies of round particles with wall entries (listed with the lists), and per listed
+  // body its rotation from its reference shape this step and whether it has one
+  // (measure_body_rotations); per body its place in that list, or no_rotation (surface law only).
+  static constexpr index_t no_rotation = ~index_t{0};
+  std::vector<index_t> rotated_bodies_, body_rotation_slot_;
   std::vector<contact::matrix3> body_rotation_;
   std::vector<std::uint8_t> body_rotated_;
-  std::vector<index_t> rotated_bodies_;
   std::vector<real> wall_entry_stiffness_;
   std::vector<std::array<real, 6>> wall_entry_reaction_;
   std::vector<std::array<real, 6>> wall_reactions_;
