@@ -418,6 +418,7 @@ void ContactModel::find_groups(const Model& model) {
     std::vector<index_t>().swap(entry_target_);
     surface_nodes_.clear();
     probes_.clear();
+    group_probe_.clear();
     return;
   }
   entry_group_.assign(pair_partner_.size(), no_group);
@@ -458,7 +459,8 @@ void ContactModel::find_groups(const Model& model) {
       if (node_body_[j] != node_body_[i]) entry_target_[e] = target_group(i, j);
     }
   }
-  probes_.assign(groups_.size(), {});
+  probes_.clear();
+  group_probe_.assign(groups_.size(), no_probe);
 }
 
 index_t ContactModel::target_group(index_t i, index_t j) const {

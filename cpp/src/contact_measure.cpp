@@ -334,6 +334,7 @@ void ContactModel::measure_contacts(const Model& model, const State& state) {
   const auto& volume = model.volumes();
   const std::int64_t n = model.node_count();
   touching_nodes_.clear();
+  std::vector<ProbeState> touching_probes;  // the surface probes that touch, from every thread
 #pragma omp parallel
   {
     std::vector<WallContact> found;  // scratch of this thread
@@ -377,10 +378,12 @@ void ContactModel::measure_contacts(const Model& model, const State& state) {
 #pragma omp critical
     {
       touching_nodes_.insert(touching_nodes_.end(), touching_nodes.begin(), touching_nodes.end());
+      touching_probes.insert(touching_probes.end(), probe_scratch.touching.begin(), probe_scratch.touching.end());
       statistics_.deepest_overlap = std::max(statistics_.deepest_overlap, deepest);
     }
   }
   std::sort(touching_nodes_.begin(), touching_nodes_.end());  // the same for any thread count
+  if (any_surface_) keep_touching_probes(touching_probes);
 }
 
 void ContactModel::measure_wall_points(const Model& model, const State& state, index_t i, index_t e,
@@ -466,6 +469,8 @@ real ContactModel::measure_probes(const Model& model, const State& state, index_
   scratch.weights.assign(last - first, 0.0);
   // The distance of each group's nearest point in reach (-1: none yet).
   scratch.nearest.assign(group_end - group_begin, -1);
+  scratch.states.resize(group_end - group_begin);
+  auto state_of = [&](index_t g) -> ProbeState& { return scratch.states[g - group_begin]; };
   for (index_t e = first; e < last; ++e) {  // the points in reach, and each group's nearest
     const index_t g = entry_group_[e];
     if (g == no_group) continue;
@@ -478,10 +483,11 @@ real ContactModel::measure_probes(const Model& model, const State& state, index_
     scratch.points[e - first] = &point;
     real& best = scratch.nearest[g - group_begin];
     if (best < 0) {  // the group's first point in reach: set the probe up
-      ProbeState& probe = probes_[g];
+      ProbeState& probe = state_of(g);
       probe = ProbeState{};
       const contact::PairLaw& law = slot_law(pair_slot_[e]);
       const contact::Law& own = laws_[model.node_material()[i] * material_count_ + model.node_material()[j]];
+      probe.group = g;
       probe.point = p;
       probe.support = support;
       probe.radius = surface ? 0.0 : node_radius(own, model, i, j, law.contact_radius);
@@ -490,13 +496,13 @@ real ContactModel::measure_probes(const Model& model, const State& state, index_
     }
     if (best < 0 || distance < best) {
       best = distance;
-      probes_[g].facing = point.normal;
+      state_of(g).facing = point.normal;
     }
   }
   for (index_t e = first; e < last; ++e) {
     const contact::SurfacePoint* point = scratch.points[e - first];
     if (point == nullptr) continue;
-    ProbeState& probe = probes_[entry_group_[e]];
+    ProbeState& probe = state_of(entry_group_[e]);
     if (!contact::faces(*point, probe.facing)) continue;
     const contact::PointTerms t = contact::point_terms(*point, p, probe.support);
     scratch.weights[e - first] = t.weight;
@@ -504,28 +510,37 @@ real ContactModel::measure_probes(const Model& model, const State& state, index_
   }
   real deepest = 0;
   for (index_t g = group_begin; g < group_end; ++g) {
-    ProbeState& probe = probes_[g];
-    probe.push = probe.taper = 0;
+    ProbeState& probe = state_of(g);
+    probe.push = 0;
     if (scratch.nearest[g - group_begin] < 0 || !probe.sums.reached()) continue;
     const real overlap = probe.radius - probe.sums.gap();
     if (!(overlap > 0)) continue;
     probe.gradient = probe.sums.gradient();
     probe.push = probe.stiffness * overlap * contact::surface_taper(probe.sums.weight);
     probe.taper = 0.5 * probe.stiffness * overlap * overlap * contact::surface_taper_slope(probe.sums.weight);
-    probe.friction = probe.foot = {0, 0, 0};
+    if (!(probe.push > 0)) continue;  // tapered to nothing past the edge of its points
+    scratch.touching.push_back(probe);
     // The overlap that carries force (a probe tapered past the edge of its points does not).
     deepest = std::max(deepest, probe.push / (probe.stiffness * probe.contact_radius));
   }
   for (index_t e = first; e < last; ++e) {
     const index_t g = entry_group_[e];
     if (g == no_group) continue;
-    const ProbeState& probe = probes_[g];
+    const ProbeState& probe = state_of(g);
     pair_stiffness_[e] =
-        probe.push == 0
-            ? 0.0f
-            : static_cast<float>(probe.stiffness * scratch.weights[e - first] / probe.sums.weight);
+        probe.push > 0 ? static_cast<float>(probe.stiffness * scratch.weights[e - first] / probe.sums.weight)
+                       : 0.0f;
   }
   return deepest;
+}
+
+void ContactModel::keep_touching_probes(std::vector<ProbeState>& measured) {
+  std::sort(measured.begin(), measured.end(),
+            [](const ProbeState& a, const ProbeState& b) { return a.group < b.group; });
+  probes_.swap(measured);
+  measured.clear();
+  group_probe_.assign(groups_.size(), no_probe);
+  for (std::size_t k = 0; k < probes_.size(); ++k) group_probe_[probes_[k].group] = static_cast<index_t>(k);
 }
 
 real ContactModel::surface_share(const ProbeState& probe, const contact::SurfacePoint& point) const {
@@ -546,7 +561,7 @@ void ContactModel::sum_slot_stiffness() {
     touching += pair_stiffness_[e] > 0 && !probe ? 1 : 0;
   }
   touching /= 2;
-  for (const ProbeState& probe : probes_) touching += probe.push > 0 ? 1 : 0;
+  touching += probes_.size();
   for (std::size_t e = 0; e < wall_entry_stiffness_.size(); ++e) {
     slot_stiffness_[wall_slot_[e]] += wall_entry_stiffness_[e];
     wall_touching += wall_entry_stiffness_[e] > 0 ? 1 : 0;
@@ -654,15 +669,13 @@ void ContactModel::sum_slot_springs(const Model& model, const State& state) {
 void ContactModel::sum_probe_springs() {
   // The surface probes' pushes, in group order: the force k delta |G| along the surface's normal
   // (from the slot's first body to its second), at the probe point.
-  for (std::size_t g = 0; g < groups_.size(); ++g) {
-    const ProbeState& probe = probes_[g];
-    if (probe.push == 0) continue;
-    const std::size_t slot = groups_[g].slot;
-    const index_t touch = slot_touch_[slot];
+  for (const ProbeState& probe : probes_) {
+    const ProbeGroup& group = groups_[probe.group];
+    const index_t touch = slot_touch_[group.slot];
     const real size = std::sqrt(dot(probe.gradient, probe.gradient));
     const real force = probe.push * size;
     // G points out of the target body; the slot's normal from its first body to its second.
-    const real sign = groups_[g].body == slots_[slot][0] ? 1.0 : -1.0;
+    const real sign = group.body == slots_[group.slot][0] ? 1.0 : -1.0;
     slot_force_[touch] += force;
     for (int k = 0; k < 3; ++k) {
       const real along = sign * probe.gradient[k] / size;
@@ -695,10 +708,8 @@ real ContactModel::spring_energy(const Model& model, const State& state) const {
     }
   }
   // The surface probes, from their last evaluation: k delta^2 tau / 2 = P^2 / (2 k tau).
-  for (const ProbeState& probe : probes_) {
-    if (probe.push > 0)
-      energy += 0.5 * probe.push * probe.push / (probe.stiffness * contact::surface_taper(probe.sums.weight));
-  }
+  for (const ProbeState& probe : probes_)
+    energy += 0.5 * probe.push * probe.push / (probe.stiffness * contact::surface_taper(probe.sums.weight));
   return energy;
 }
 

@@ -28,8 +28,9 @@ void ContactModel::probe_friction(const Model& model, const State& state, index_
   const index_t first = pair_offsets_[i], last = pair_offsets_[i + 1];
   shares.resize(last - first);  // w_k / S of each entry, set for a group's entries before use
   for (index_t g = group_begin; g < group_end; ++g) {
-    ProbeState& probe = probes_[g];
-    if (probe.push == 0) continue;
+    ProbeState* touching = touching_probe(g);
+    if (touching == nullptr) continue;
+    ProbeState& probe = *touching;
     const contact::Law& law = laws_[material * material_count_ + body_material_[groups_[g].body]];
     if (law.friction == 0 && !law.peridem_friction) continue;
     // The slip of p against the target's surface there, each side moving with its nodes and
@@ -83,12 +84,11 @@ void ContactModel::probe_friction(const Model& model, const State& state, index_
   }
 }
 
-void ContactModel::target_forces(const contact::SurfacePoint& point, real size, index_t group, vec3& on_point,
-                                 vec3& on_normal, vec3& on_friction) const {
+void ContactModel::target_forces(const contact::SurfacePoint& point, real size, const ProbeState& probe,
+                                 vec3& on_point, vec3& on_normal, vec3& on_friction) const {
   // The exact reaction of a target's surface point and normal to the probe's energy (see
   // contact/surface_law.hpp), and its share w / S of the friction force, opposite (on the
   // node; probe_couples adds the couple).
-  const ProbeState& probe = probes_[group];
   on_point = on_normal = on_friction = {0, 0, 0};
   if (!contact::faces(point, probe.facing)) return;
   const contact::PointTerms t = contact::point_terms(point, probe.point, probe.support);
@@ -147,11 +147,11 @@ ContactModel::NodeContactForces ContactModel::gather_node_forces(const Model& mo
   }
   const auto [group_begin, group_end] = groups_of(i);
   for (index_t g = group_begin; g < group_end; ++g) {
-    const ProbeState& probe = probes_[g];
-    if (probe.push == 0) continue;  // apart (its other fields may be an earlier step's)
+    const ProbeState* probe = touching_probe(g);
+    if (probe == nullptr) continue;
     for (int c = 0; c < 3; ++c) {
-      at_surface[c] += probe.push * probe.gradient[c] - probe.taper * probe.sums.spread[c];
-      at_node[c] += probe.friction[c];
+      at_surface[c] += probe->push * probe->gradient[c] - probe->taper * probe->sums.spread[c];
+      at_node[c] += probe->friction[c];
     }
   }
   if (!anchored || surface_slot_.empty() || surface_slot_[i] == no_group) {
@@ -161,9 +161,10 @@ ContactModel::NodeContactForces ContactModel::gather_node_forces(const Model& mo
   const real size = surface_sizes_[surface_slot_[i]];
   for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
     const index_t g = entry_target_[e];
-    if (g == no_group || probes_[g].push == 0) continue;
+    const ProbeState* probe = g == no_group ? nullptr : touching_probe(g);
+    if (probe == nullptr) continue;
     vec on_point, on_normal, on_friction;
-    target_forces(own, size, g, on_point, on_normal, on_friction);
+    target_forces(own, size, *probe, on_point, on_normal, on_friction);
     for (int c = 0; c < 3; ++c) {
       at_surface[c] += on_point[c];
       on_vector[c] += on_normal[c];
@@ -208,17 +209,17 @@ void ContactModel::probe_couples(const State& state) {
   // (at their mean y = foot): the probe's body takes (p - y_i) x F_t, the target's
   // (y - p) x F_t, so both act at p and their moments cancel.
   const real* x = state.positions.data();
-  for (std::size_t g = 0; g < groups_.size(); ++g) {
-    const ProbeState& probe = probes_[g];
-    if (probe.push == 0 || probe.friction == vec3{0, 0, 0}) continue;
-    const index_t i = groups_[g].probe;
+  for (const ProbeState& probe : probes_) {
+    if (probe.friction == vec3{0, 0, 0}) continue;
+    const ProbeGroup& group = groups_[probe.group];
+    const index_t i = group.probe;
     const vec own =
         cross({probe.point[0] - x[3 * i], probe.point[1] - x[3 * i + 1], probe.point[2] - x[3 * i + 2]},
               probe.friction);
     const vec target = cross(
         {probe.foot[0] - probe.point[0], probe.foot[1] - probe.point[1], probe.foot[2] - probe.point[2]},
         probe.friction);
-    const index_t probe_touch = body_touch_[node_body_[i]], target_touch = body_touch_[groups_[g].body];
+    const index_t probe_touch = body_touch_[node_body_[i]], target_touch = body_touch_[group.body];
     for (int c = 0; c < 3; ++c) {
       body_load_[probe_touch][3 + c] += own[c];
       body_load_[target_touch][3 + c] += target[c];
@@ -318,11 +319,11 @@ ContactNetwork ContactModel::network(const Model& model, const State& state) con
       for (int c = 0; c < 3; ++c) on_first[slot_touch_[wall_slot_[e]]][c] -= wall_entry_reaction_[e][c];
     }
   }
-  for (std::size_t g = 0; g < groups_.size(); ++g) {
-    const ProbeState& probe = probes_[g];
-    const std::size_t slot = groups_[g].slot;
-    if (probe.push == 0 || slot_touch_[slot] == not_touching) continue;
-    const real sign = node_body_[groups_[g].probe] == slots_[slot][0] ? 1.0 : -1.0;
+  for (const ProbeState& probe : probes_) {
+    const ProbeGroup& group = groups_[probe.group];
+    const std::size_t slot = group.slot;
+    if (slot_touch_[slot] == not_touching) continue;
+    const real sign = node_body_[group.probe] == slots_[slot][0] ? 1.0 : -1.0;
     for (int c = 0; c < 3; ++c)
       on_first[slot_touch_[slot]][c] +=
           sign * (probe.push * probe.gradient[c] - probe.taper * probe.sums.spread[c] + probe.friction[c]);

@@ -272,15 +272,16 @@ class ContactModel {
     index_t body = 0;   ///< the body whose surface it probes
     index_t slot = 0;   ///< the slot of the two bodies
   };
-  /// Per step: the sums over a group's surface points, and what the group's contact is.
+  /// Per step: the sums over a touching group's surface points, and what its contact is.
   struct ProbeState {
+    index_t group = 0;  ///< the group it measures
     contact::SurfaceGap sums;
     vec3 point{0, 0, 0};      ///< the probe point p (a surface point, or the node)
     real radius = 0;          ///< its contact radius r (0 for a surface point)
     real support = 0;         ///< the target's support radius a
     real stiffness = 0;       ///< k of the probe
     real contact_radius = 0;  ///< Rc of the pair's law (the scale of the deepest overlap)
-    real push = 0;            ///< P = k delta tau (0: apart)
+    real push = 0;            ///< P = k delta tau (> 0: only touching groups are kept)
     real taper = 0;           ///< Q = k delta^2 tau'(S) / 2 (0 on a surface)
     vec3 gradient{0, 0, 0};   ///< G, the surface's normal direction at p (out of the target)
     vec3 friction{0, 0, 0};   ///< the friction force on the probe
@@ -298,7 +299,20 @@ class ContactModel {
     if (group_offsets_.empty()) return {0, 0};
     return {group_offsets_[i], group_offsets_[i + 1]};
   }
+  // This step's touching groups, in group order, and each group's index among them (or
+  // no_probe): the groups apart, most of them, keep no state.
+  static constexpr index_t no_probe = ~index_t{0};
   std::vector<ProbeState> probes_;
+  std::vector<index_t> group_probe_;
+  /// Group g's state this step, or null where it does not touch.
+  const ProbeState* touching_probe(index_t g) const {
+    return group_probe_[g] == no_probe ? nullptr : &probes_[group_probe_[g]];
+  }
+  ProbeState* touching_probe(index_t g) {
+    return group_probe_[g] == no_probe ? nullptr : &probes_[group_probe_[g]];
+  }
+  /// probes_ and group_probe_ from the touching groups each thread measured (any order).
+  void keep_touching_probes(std::vector<ProbeState>& measured);
   /// The probe k of a group of node i against body b: beta kn V_i^2, beta = h_b^2 / (h_i^2 + h_b^2)
   /// (the finer surface probes the coarser; equal meshes share the contact equally).
   real probe_stiffness(const Model& model, index_t i, index_t target, const contact::PairLaw& law) const;
@@ -312,10 +326,13 @@ class ContactModel {
   void find_groups(const Model& model);
   /// The group of the probe j whose target body holds node i (the entry (j, i)), or no_group.
   index_t target_group(index_t i, index_t j) const;
-  /// Pass A for node i's groups: the sums, the gap, the push, and its probe entries' springs.
+  /// Pass A for node i's groups: the sums, the gap, the push, and its probe entries' springs;
+  /// the touching groups' states go to scratch.touching.
   struct ProbeScratch {  // per thread: per entry of the node, and per group
     std::vector<const contact::SurfacePoint*> points;
     std::vector<real> weights, nearest;
+    std::vector<ProbeState> states;    // the node's groups
+    std::vector<ProbeState> touching;  // every node's touching groups, kept for the step
   };
   real measure_probes(const Model& model, const State& state, index_t i, ProbeScratch& scratch);
   /// w_k / S of a target point in a group's sums (0 if it does not face the probe).
@@ -328,9 +345,9 @@ class ContactModel {
   /// v(s_k)), weighted by w_k / S; and the foot f = sum_k (w_k / S) y_k (`shares`: scratch,
   /// per entry of the node).
   void probe_friction(const Model& model, const State& state, index_t i, real dt, std::vector<real>& shares);
-  /// The force on a target's surface point (`point`, with |A| = `size`) from a probing group,
+  /// The force on a target's surface point (`point`, with |A| = `size`) from a touching probe,
   /// and the force on its anchored vector A.
-  void target_forces(const contact::SurfacePoint& point, real size, index_t group, vec3& on_point,
+  void target_forces(const contact::SurfacePoint& point, real size, const ProbeState& probe, vec3& on_point,
                      vec3& on_normal, vec3& on_friction) const;
 
   /// Nodes with list entries, grouped by body (each group in node order), and the per-step
