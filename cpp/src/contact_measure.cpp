@@ -378,7 +378,8 @@ void ContactModel::measure_contacts(const Model& model, const State& state) {
 #pragma omp critical
     {
       touching_nodes_.insert(touching_nodes_.end(), touching_nodes.begin(), touching_nodes.end());
-      touching_probes.insert(touching_probes.end(), probe_scratch.touching.begin(), probe_scratch.touching.end());
+      touching_probes.insert(touching_probes.end(), probe_scratch.touching.begin(),
+                             probe_scratch.touching.end());
       statistics_.deepest_overlap = std::max(statistics_.deepest_overlap, deepest);
     }
   }
