@@ -198,8 +198,9 @@ class Interactions:
             )
 
     def warn_deep_contact(self, core: _core.Simulation) -> None:
-        """Warn once when node pairs of two bodies came within half their contact distance
-        into each other: the contact layer is too soft for the impact or the load, and nodes
+        """Warn once when two bodies pressed into each other by more than half their contact
+        radius (node spheres: a node pair's overlap; surface law: a probe's depth under the
+        other's surface): the contact layer is too soft for the impact or the load, and nodes
         may pass through each other (an impact's overlap falls as 1 / sqrt(stiffness_factor),
         a steady load's as 1 / stiffness_factor)."""
         deepest = core.contact_statistics.deepest_overlap
@@ -207,9 +208,9 @@ class Interactions:
             return
         self._deep_contact_warned = True
         warnings.warn(
-            f"contact: node pairs overlapped by {deepest:.0%} of their contact radius (by step "
-            f"{core.step}); the contact layer is too soft for these impacts or loads and nodes "
-            "may pass through each other. Raise Contact(stiffness_factor=...): an impact's "
+            f"contact: bodies pressed {deepest:.0%} of their contact radius into each other (by "
+            f"step {core.step}); the contact layer is too soft for these impacts or loads and "
+            "nodes may pass through each other. Raise Contact(stiffness_factor=...): an impact's "
             "overlap falls as 1/sqrt of it (10 keeps a 10 m/s impact of soft grains to a fifth), "
             "a steady load's as 1/its value; a stiffer contact shortens the time step",
             GranulateWarning,

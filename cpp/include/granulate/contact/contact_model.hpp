@@ -38,9 +38,9 @@ struct ContactStatistics {
   std::uint64_t list_entries = 0;   ///< node-pair entries in the current lists (both directions)
   std::uint64_t node_contacts = 0;  ///< node pairs in contact at the last evaluation (once each)
   std::uint64_t wall_contacts = 0;  ///< node-wall contacts at the last evaluation
-  /// Deepest node-pair overlap so far, over the pair's Rc (not checkpointed; PeriDEM's node-pair
-  /// law not counted): near 1, nodes are about to pass through each other (the contact layer
-  /// is too soft for the impacts).
+  /// Deepest overlap so far, over the pair's Rc: a node pair's, or a surface probe's depth under
+  /// the other body's surface (not checkpointed; PeriDEM's node-pair law not counted): near 1,
+  /// nodes are about to pass through each other (the contact layer is too soft for the impacts).
   real deepest_overlap = 0;
 };
 
