@@ -161,7 +161,7 @@ void ContactModel::label_bodies(const Model& model, const State& state, std::uin
   body_particle_.assign(count, 0);
   body_node_offsets_.assign(static_cast<std::size_t>(count) + 1, 0);
   for (index_t i = 0; i < n; ++i) {
-    body_mass_[node_body_[i]] += model.node_density()[i] * model.volumes()[i];
+    body_mass_[node_body_[i]] += model.density(i) * model.volumes()[i];
     if (node_kinematic_.empty() || !node_kinematic_[i]) body_kinematic_[node_body_[i]] = 0;
     body_material_[node_body_[i]] = model.node_material()[i];
     body_particle_[node_body_[i]] = model.node_particle()[i];

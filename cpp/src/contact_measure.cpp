@@ -40,7 +40,7 @@ BodyMotion measure_body(const Model& model, const State& state, const index_t* n
   std::array<real, 6> second{0, 0, 0, 0, 0, 0};  // sum m r r^T: xx, yy, zz, xy, xz, yz
   for (index_t slot = 0; slot < count; ++slot) {
     const index_t i = nodes[slot];
-    const real m = model.node_density()[i] * model.volumes()[i];
+    const real m = model.density(i) * model.volumes()[i];
     const vec r{x[3 * i] - origin[0], x[3 * i + 1] - origin[1], x[3 * i + 2] - origin[2]};
     const vec p{m * v[3 * i], m * v[3 * i + 1], m * v[3 * i + 2]};
     mass += m;
@@ -271,7 +271,7 @@ contact::matrix3 body_moment(const Model& model, const State& state, const index
   contact::matrix3 moment{};
   for (index_t slot = 0; slot < count; ++slot) {
     const index_t i = nodes[slot];
-    const real m = model.node_density()[i] * model.volumes()[i];
+    const real m = model.density(i) * model.volumes()[i];
     const vec a{y[3 * i] - y[3 * first], y[3 * i + 1] - y[3 * first + 1], y[3 * i + 2] - y[3 * first + 2]};
     const vec b{X[3 * i] - X[3 * first], X[3 * i + 1] - X[3 * first + 1], X[3 * i + 2] - X[3 * first + 2]};
     mass += m;

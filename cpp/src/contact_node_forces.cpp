@@ -245,8 +245,7 @@ vec3 ContactModel::pair_force(const Model& model, const State& state, index_t i,
     // the pair's approach speed in one step (c dt / m_ij <= 1/2): where few node pairs carry K,
     // the body's mass M over a node's would make the explicit dashpot unstable.
     const real K = slot_stiffness_[pair_slot_[e]];
-    const real mi = model.node_density()[i] * model.volumes()[i],
-               mj = model.node_density()[j] * model.volumes()[j];
+    const real mi = model.density(i) * model.volumes()[i], mj = model.density(j) * model.volumes()[j];
     const real stable = dt > 0 ? 0.5 * mi * mj / ((mi + mj) * dt) : 0.0;
     const real c =
         std::min(2.0 * law.damping_ratio * k * std::sqrt(slot_reduced_mass(pair_slot_[e]) / K), stable);

@@ -249,7 +249,6 @@ void ContactModel::body_loads(const Model& model, State& state) {
   // the body gets rho_i (F / M + alpha x (x_i - c)), alpha = I^-1 tau. They add up to F and tau.
   const auto& x = state.positions;
   auto& f = state.forces;
-  const real* const density = model.node_density().data();
   const std::int64_t count = static_cast<std::int64_t>(touching_bodies_.size());
 #pragma omp parallel for schedule(dynamic, 16)
   for (std::int64_t touch = 0; touch < count; ++touch) {
@@ -268,7 +267,7 @@ void ContactModel::body_loads(const Model& model, State& state) {
       const index_t i = body_nodes_[k];
       const vec spin = cross(turn, {x[3 * i] - motion.centre[0], x[3 * i + 1] - motion.centre[1],
                                     x[3 * i + 2] - motion.centre[2]});
-      for (int c = 0; c < 3; ++c) f[3 * i + c] += density[i] * (acceleration[c] + spin[c]);
+      for (int c = 0; c < 3; ++c) f[3 * i + c] += model.density(i) * (acceleration[c] + spin[c]);
     }
   }
 }

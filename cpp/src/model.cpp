@@ -164,7 +164,6 @@ index_t Model::add_particle(index_t shape_index, index_t material, std::span<con
   for (real v : shape.volumes) volumes_.push_back(volume_scale * v);
   node_particle_.insert(node_particle_.end(), n, id);
   node_material_.insert(node_material_.end(), n, material);
-  node_density_.insert(node_density_.end(), n, materials_[material].params.density);
   return id;
 }
 
@@ -202,7 +201,6 @@ void Model::finalize() {
   volumes_.shrink_to_fit();
   node_particle_.shrink_to_fit();
   node_material_.shrink_to_fit();
-  node_density_.shrink_to_fit();
   finalized_ = true;
 }
 
@@ -489,7 +487,7 @@ real Model::stable_time_step() const {
             (pmb_stiffness_[i] + pmb_stiffness_[bonds.neighbor(b)]) * bonds.weight(b) / bonds.length(b);
       }
     }
-    if (stiffness > 0) dt = std::min(dt, std::sqrt(2.0 * node_density_[i] / stiffness));
+    if (stiffness > 0) dt = std::min(dt, std::sqrt(2.0 * density(i) / stiffness));
   }
   return dt;
 }

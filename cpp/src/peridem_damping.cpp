@@ -55,7 +55,6 @@ void PeridemDamping::add_forces(const Model& model, State& state) const {
   const auto& v = state.velocities;
   auto& f = state.forces;
   const int dimension = model.dimension();
-  const auto& density = model.node_density();
   const std::size_t count = particles_.size();
 
   const real reach = 2 * max_radius_ + 1.01 * max_contact_radius_;
@@ -72,7 +71,7 @@ void PeridemDamping::add_forces(const Model& model, State& state) const {
       const Particle& particle = model.particles()[pp];
       const index_t c = me.center;
       const real area = std::numbers::pi * me.radius * me.radius;
-      const real mass = density[c] * area;
+      const real mass = model.density(c) * area;
       real force[3] = {0, 0, 0};
       auto damp = [&](index_t k, real beta) {  // dashpot along the centre-to-k direction
         real n[3] = {x[3 * k] - x[3 * c], x[3 * k + 1] - x[3 * c + 1], x[3 * k + 2] - x[3 * c + 2]};
@@ -95,7 +94,8 @@ void PeridemDamping::add_forces(const Model& model, State& state) const {
                 pairs_[particle.material * material_count_ + model.particles()[q].material];
             if (pair.betan == 0 || !(std::sqrt(r2) < me.radius + other.radius + 1.01 * pair.contact_radius))
               return;
-            const real other_mass = density[other_center] * std::numbers::pi * other.radius * other.radius;
+            const real other_mass =
+                model.density(other_center) * std::numbers::pi * other.radius * other.radius;
             const real reduced = 2 * mass * other_mass / (mass + other_mass);  // harmonic mean
             damp(other_center, pair.betan * std::sqrt(pair.kappa * pair.contact_radius * reduced));
           });

@@ -155,7 +155,6 @@ void Simulation::update_kinematic_nodes() {
 
 void Simulation::run(std::uint64_t steps) {
   const Model& m = *model_;
-  const auto& density = m.node_density();
   const auto& particles = m.particles();
   const auto& node_particle = m.node_particle();
   const std::int64_t n3 = 3 * static_cast<std::int64_t>(m.node_count());
@@ -170,9 +169,12 @@ void Simulation::run(std::uint64_t steps) {
   for (std::uint64_t s = 0; s < steps; ++s) {
     auto start = clock_type::now();
 #pragma omp parallel for schedule(static)
-    for (std::int64_t k = 0; k < n3; ++k) {
-      v[k] += 0.5 * dt * f[k] / density[k / 3];
-      x[k] += dt * v[k];
+    for (std::int64_t i = 0; i < n3 / 3; ++i) {
+      const real density = m.density(static_cast<index_t>(i));
+      for (std::int64_t k = 3 * i; k < 3 * i + 3; ++k) {
+        v[k] += 0.5 * dt * f[k] / density;
+        x[k] += dt * v[k];
+      }
     }
     state_.time += dt;
     phase_times_.integration += seconds_since(start);
@@ -193,8 +195,9 @@ void Simulation::run(std::uint64_t steps) {
 #pragma omp parallel for schedule(static) reduction(min : first_unstable)
     for (std::int64_t i = 0; i < n3 / 3; ++i) {
       real speed2 = 0;
+      const real density = m.density(static_cast<index_t>(i));
       for (std::int64_t k = 3 * i; k < 3 * i + 3; ++k) {
-        v[k] += 0.5 * dt * f[k] / density[i];
+        v[k] += 0.5 * dt * f[k] / density;
         speed2 += v[k] * v[k];
       }
       const real limit = particles[node_particle[i]].mesh_size / dt;
@@ -216,8 +219,8 @@ std::array<std::size_t, 2> Simulation::memory_bytes() const {
   std::size_t other = state_.bonds.offset_bytes() + bytes(state_.positions) + bytes(state_.velocities) +
                       bytes(state_.forces) + bytes(state_.dilatation) + bytes(pressure_) +
                       bytes(m.reference_positions()) + bytes(m.volumes()) + bytes(m.node_particle()) +
-                      bytes(m.node_material()) + bytes(m.node_density()) + bytes(m.bond_offsets()) +
-                      bytes(m.lps_coefficients()) + bytes(m.pmb_stiffness()) + contact_.memory_bytes();
+                      bytes(m.node_material()) + bytes(m.bond_offsets()) + bytes(m.lps_coefficients()) +
+                      bytes(m.pmb_stiffness()) + contact_.memory_bytes();
   for (const BondFamilies& f : m.families()) other += bytes(f.offsets) + bytes(f.forward);
   other += m.bond_schedule().memory_bytes();
   for (const Shape& s : m.shapes()) other += s.anchors.memory_bytes();  // nodes and volumes released
@@ -273,10 +276,9 @@ void Simulation::check_stability() const {
 real Simulation::kinetic_energy() const {
   const auto& v = state_.velocities;
   const auto& volume = model_->volumes();
-  const auto& density = model_->node_density();
   real sum = 0;
   for (index_t i = 0; i < model_->node_count(); ++i) {
-    sum += 0.5 * density[i] * volume[i] *
+    sum += 0.5 * model_->density(i) * volume[i] *
            (v[3 * i] * v[3 * i] + v[3 * i + 1] * v[3 * i + 1] + v[3 * i + 2] * v[3 * i + 2]);
   }
   return sum;

@@ -224,7 +224,6 @@ void Simulation::start_node_forces() {
   const auto& materials = m.materials();
   const auto& node_material = m.node_material();
   const auto& lps_coefficients = m.lps_coefficients();
-  const auto& density = m.node_density();
   auto& f = state_.forces;
   auto& theta = state_.dilatation;
   const std::int64_t n = m.node_count();
@@ -239,9 +238,10 @@ void Simulation::start_node_forces() {
       theta[i] = 0;
     }
     const real* vi = &state_.velocities[3 * i];
-    f[3 * i] = density[i] * (g[0] - viscous_damping_ * vi[0]);
-    f[3 * i + 1] = density[i] * (g[1] - viscous_damping_ * vi[1]);
-    f[3 * i + 2] = density[i] * (g[2] - viscous_damping_ * vi[2]);
+    const real density = materials[node_material[i]].params.density;
+    f[3 * i] = density * (g[0] - viscous_damping_ * vi[0]);
+    f[3 * i + 1] = density * (g[1] - viscous_damping_ * vi[1]);
+    f[3 * i + 2] = density * (g[2] - viscous_damping_ * vi[2]);
   }
 }
 

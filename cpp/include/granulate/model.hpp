@@ -154,7 +154,8 @@ class Model {
   const std::vector<real>& volumes() const { return volumes_; }
   const std::vector<index_t>& node_particle() const { return node_particle_; }
   const std::vector<index_t>& node_material() const { return node_material_; }
-  const std::vector<real>& node_density() const { return node_density_; }
+  /// Node i's mass density rho [kg/m^3], its material's (kept per material, not per node).
+  real density(index_t i) const { return materials_[node_material_[i]].params.density; }
   const std::vector<Shape>& shapes() const { return shapes_; }
   /// The anchors of node i if it lies on its shape's surface (see surface_anchors.hpp), else
   /// null; their nodes are local to the particle (add its first node). Valid after finalize().
@@ -218,7 +219,6 @@ class Model {
   std::vector<real> volumes_;
   std::vector<index_t> node_particle_;
   std::vector<index_t> node_material_;
-  std::vector<real> node_density_;
   std::vector<BondFamilies> families_;
   std::vector<std::size_t> bond_offsets_;
   BondSchedule bond_schedule_;

@@ -75,11 +75,14 @@ void bind_contents(nb::class_<Model>& model) {
                      return view(const_cast<real*>(self.volumes().data()), self.node_count(), 0,
                                  nb::find(self));
                    })
-      .def_prop_ro("node_density",
-                   [](Model& self) {
-                     return view(const_cast<real*>(self.node_density().data()), self.node_count(), 0,
-                                 nb::find(self));
-                   })
+      .def_prop_ro(
+          "node_density",
+          [](const Model& self) {  // a copy: densities are kept per material
+            std::vector<real> density(self.node_count());
+            for (index_t i = 0; i < self.node_count(); ++i) density[i] = self.density(i);
+            return copy_out(density);
+          },
+          nb::rv_policy::move, "each node's mass density [kg/m^3] (a new array)")
       .def_prop_ro("node_particle",
                    [](Model& self) {
                      return view(const_cast<index_t*>(self.node_particle().data()), self.node_count(), 0,
