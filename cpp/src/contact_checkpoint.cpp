@@ -121,8 +121,9 @@ void ContactModel::restore_collisions(const ContactCheckpoint& saved) {
 void ContactModel::restore(const Model& model, const State& state, const ContactCheckpoint& saved) {
   check_checkpoint(model, saved);
   skin_ = saved.skin;
-  bodies_labelled_ = false;  // the restored bonds may differ from the current ones
-  centres_.forget();         // and so may the detached surface nodes
+  bodies_labelled_ = false;        // the restored bonds may differ from the current ones
+  relabelled_first_node_.clear();  // the restored slots number the restored bodies
+  centres_.forget();               // and so may the detached surface nodes
   newly_broken_.clear();
   slots_ = saved.slots;
   particle_slot_count_ = saved.particle_slot_count;

@@ -139,6 +139,11 @@ void ContactModel::update_after_breaks(const Model& model, const State& state, s
 
 void ContactModel::label_bodies(const Model& model, const State& state, std::uint64_t broken_bonds) {
   if (bodies_labelled_ && broken_bonds == broken_at_labelling_) return;
+  if (bodies_labelled_) {  // the slots were found with the present numbering
+    relabelled_first_node_.resize(body_node_offsets_.size() - 1);
+    for (std::size_t b = 0; b + 1 < body_node_offsets_.size(); ++b)
+      relabelled_first_node_[b] = body_nodes_[body_node_offsets_[b]];
+  }
   bodies_labelled_ = true;
   broken_at_labelling_ = broken_bonds;
   const index_t n = model.node_count();
@@ -304,20 +309,42 @@ void ContactModel::find_rotated_bodies(const Model& model) {
   fit(body_rotated_);
 }
 
+ContactModel::HeldSlots ContactModel::held_slots() const {
+  // Called before slots_ is replaced: its slots, their collisions, and (after a relabelling)
+  // the smallest node of each of the bodies they name.
+  HeldSlots held;
+  auto now = [&](index_t body) {
+    return relabelled_first_node_.empty() ? body : node_body_[relabelled_first_node_[body]];
+  };
+  for (std::size_t slot = 0; slot < slots_.size(); ++slot) {
+    if (!(collisions_.approach(slot) > 0)) continue;
+    const index_t p = now(slots_[slot][0]);
+    if (slot >= particle_slot_count_) {
+      held.walls.push_back({p, slots_[slot][1]});
+      continue;
+    }
+    const index_t q = now(slots_[slot][1]);
+    if (p != q) held.particles.push_back({std::min(p, q), std::max(p, q)});
+  }
+  return held;
+}
+
 void ContactModel::find_slots(const Model& model) {
   // One slot per pair of bodies that appear in the lists, in sorted order, then one per pair of
-  // a body and a wall.
+  // a body and a wall; and the slots of collisions still open (held_slots).
   const index_t n = model.node_count();
   const auto& node_body = node_body_;
   // Bucketed by the first body (a counting sort), so the sorts are per body and small, and an
   // entry finds its slot among its first body's few slots (fragments make many entries).
   const index_t bodies = static_cast<index_t>(body_mass_.size());
+  const HeldSlots held = held_slots();
   std::vector<index_t> bucket(static_cast<std::size_t>(bodies) + 1, 0);
   for (index_t i = 0; i < n; ++i) {
     for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
       ++bucket[std::min(node_body[i], node_body[pair_partner_[e]]) + 1];
     }
   }
+  for (const auto& [a, b] : held.particles) ++bucket[a + 1];
   for (index_t a = 0; a < bodies; ++a) bucket[a + 1] += bucket[a];
   std::vector<index_t> second(bucket.back()), filled(bucket.begin(), bucket.end() - 1);
   for (index_t i = 0; i < n; ++i) {
@@ -328,6 +355,7 @@ void ContactModel::find_slots(const Model& model) {
       second[filled[a]++] = b;
     }
   }
+  for (const auto& [a, b] : held.particles) second[filled[a]++] = b;
   slots_.clear();
   std::vector<index_t> body_slots(static_cast<std::size_t>(bodies) + 1, 0);  // slots of first body a
   for (index_t a = 0; a < bodies; ++a) {
@@ -352,7 +380,7 @@ void ContactModel::find_slots(const Model& model) {
           slots_.begin());
     }
   }
-  std::vector<std::array<index_t, 2>> wall_keys;
+  std::vector<std::array<index_t, 2>> wall_keys = held.walls;
   for (index_t i = 0; i < n; ++i) {
     for (index_t e = wall_offsets_[i]; e < wall_offsets_[i + 1]; ++e)
       wall_keys.push_back({node_body[i], wall_entry_[e][0]});
@@ -393,16 +421,32 @@ void ContactModel::carry_over_collisions(const std::vector<std::array<index_t, 2
   slot_stiffness_.assign(slots_.size(), 0);
   // The collisions carry over by slot. Old and new slots are sorted within their two parts
   // (particle pairs, walls): merge walks.
+  // Slots are keyed by their bodies' smallest nodes (the numbering's order, so both stay
+  // sorted); the second of a wall slot is the wall.
+  const bool relabelled = !relabelled_first_node_.empty();
+  auto key = [&](const std::array<index_t, 2>& slot, bool wall, const std::vector<index_t>& first) {
+    if (!relabelled) return slot;
+    return std::array<index_t, 2>{first[slot[0]], wall ? slot[1] : first[slot[1]]};
+  };
+  std::vector<index_t> first_node;
+  if (relabelled) {
+    first_node.resize(body_node_offsets_.size() - 1);
+    for (std::size_t b = 0; b < first_node.size(); ++b) first_node[b] = body_nodes_[body_node_offsets_[b]];
+  }
   std::vector<index_t> old_of_new(slots_.size(), contact::CollisionStore::none);
-  auto carry_over = [&](std::size_t slot, std::size_t slot_end, std::size_t old, std::size_t old_end) {
+  auto carry_over = [&](std::size_t slot, std::size_t slot_end, std::size_t old, std::size_t old_end,
+                        bool wall) {
     for (; slot < slot_end && old < old_end; ++slot) {
-      while (old < old_end && old_slots[old] < slots_[slot]) ++old;
-      if (old < old_end && old_slots[old] == slots_[slot]) old_of_new[slot] = static_cast<index_t>(old);
+      const std::array<index_t, 2> now = key(slots_[slot], wall, first_node);
+      while (old < old_end && key(old_slots[old], wall, relabelled_first_node_) < now) ++old;
+      if (old < old_end && key(old_slots[old], wall, relabelled_first_node_) == now)
+        old_of_new[slot] = static_cast<index_t>(old);
     }
   };
-  carry_over(0, particle_slots, 0, old_particle_slots);
-  carry_over(particle_slots, slots_.size(), old_particle_slots, old_slots.size());
+  carry_over(0, particle_slots, 0, old_particle_slots, false);
+  carry_over(particle_slots, slots_.size(), old_particle_slots, old_slots.size(), true);
   collisions_.renumber(old_of_new);
+  std::vector<index_t>().swap(relabelled_first_node_);
 }
 
 void ContactModel::find_groups(const Model& model) {

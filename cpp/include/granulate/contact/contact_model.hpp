@@ -195,11 +195,21 @@ class ContactModel {
   /// slots_ (pairs of bodies in the lists, sorted, then pairs of a body and a wall, sorted) and
   /// each entry's slot (pair_slot_, wall_slot_).
   void find_slots(const Model& model);
+  /// The pairs of bodies (in the new numbering) whose collision is still open in a gap
+  /// (approach > 0): their slots stay though no entry names them, so that a collision ends
+  /// when the bodies are back where they touched and not when a search drops their entries
+  /// (which depends on the Verlet skin: a fragment would collide afresh, with another dashpot).
+  struct HeldSlots {
+    std::vector<std::array<index_t, 2>> particles, walls;
+  };
+  HeldSlots held_slots() const;
   /// Each slot's law (slot_law_index_ into resolved_laws_): one per pair of particles, or of a
   /// particle and a wall, however many fragments the particles broke into.
   void resolve_slot_laws();
   /// The collisions in progress carried from `old_slots` (their first `old_particle_slots`
-  /// between particles) to the same pairs' new slots; the slots' stiffness reset.
+  /// between particles) to the same pairs' new slots; the slots' stiffness reset. A body is
+  /// known by its smallest node across a relabelling (fragments are numbered in that order, so
+  /// a new fragment renumbers the bodies after it); a fragment that splits off starts afresh.
   void carry_over_collisions(const std::vector<std::array<index_t, 2>>& old_slots,
                              std::size_t old_particle_slots);
   /// The lists and their friction springs as they were before a rebuild.
@@ -515,6 +525,9 @@ class ContactModel {
   std::vector<index_t> body_node_offsets_, body_nodes_;  // CSR: nodes of each body
   bool bodies_labelled_ = false;
   std::uint64_t broken_at_labelling_ = 0;
+  // Each body's smallest node under the labelling the slots were found with, kept from a
+  // relabelling to the next carry_over_collisions (empty: the body numbers did not change).
+  std::vector<index_t> relabelled_first_node_;
   int dimension_ = 3;
 
   // Lists (rebuilt): node pairs and node-wall-surface candidates, CSR by node.
