@@ -133,7 +133,7 @@ def test_rotated_spheres_of_different_sizes_collide_head_on(full: bool) -> None:
 
 # A triangle's tip, one vertex on the other grain's face, sinks half a contact radius deep
 # under the default kn (warned): a point load on one node.
-@pytest.mark.filterwarnings("ignore:contact. node pairs overlapped")
+@pytest.mark.filterwarnings("ignore:contact. bodies pressed")
 @pytest.mark.validation
 @pytest.mark.parametrize("mesh", ["mesh_tri_small_0.msh", "mesh_drum2d_small_0.msh"])
 def test_elastic_collisions_of_meshed_grains_with_corners_keep_their_energy(mesh: str) -> None:
