@@ -103,6 +103,7 @@ def crushed_discs(law: str, skin: float | None) -> tuple[np.ndarray, np.ndarray,
     return np.array(sim.positions), np.array(sim.velocities), sim
 
 
+@pytest.mark.filterwarnings("ignore:contact. bodies pressed")  # 40 m/s on the default spring
 @pytest.mark.parametrize("law", ["granulate", "surface"])
 def test_results_do_not_depend_on_the_verlet_skin(law: str) -> None:
     """The skin decides only when the lists are searched again, never a force: with a skin of
