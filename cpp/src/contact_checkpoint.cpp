@@ -47,6 +47,7 @@ ContactCheckpoint ContactModel::checkpoint() const {
     c.slot_work.push_back(collision.work);
     c.slot_work.push_back(collision.exponent);
     c.slot_work.push_back(collision.phase);
+    c.slot_slide.insert(c.slot_slide.end(), collision.slide.begin(), collision.slide.end());
     if (any_rolling_)
       c.slot_rolling.insert(c.slot_rolling.end(), collision.rolling.begin(), collision.rolling.end());
   }
@@ -68,6 +69,7 @@ void ContactModel::check_checkpoint(const Model& model, const ContactCheckpoint&
   if (saved.slot_approach.size() != slots || saved.slot_normal.size() != 3 * slots ||
       saved.slot_work.size() != 3 * slots || saved.particle_slot_count > slots ||
       (!saved.slot_rolling.empty() && saved.slot_rolling.size() != 3 * slots) ||
+      (!saved.slot_slide.empty() && saved.slot_slide.size() != 3 * slots) ||
       (saved.built && saved.positions_at_build.size() != 3 * static_cast<std::size_t>(n)) ||
       saved.wall_reactions.size() != walls_.size()) {
     throw InputError("the checkpoint's contact data do not match this model (nodes or walls differ)");
@@ -83,9 +85,9 @@ void ContactModel::check_checkpoint(const Model& model, const ContactCheckpoint&
   }
   const bool finite = all_finite(saved.positions_at_build) && all_finite(saved.slot_approach) &&
                       all_finite(saved.slot_normal) && all_finite(saved.slot_work) &&
-                      all_finite(saved.slot_rolling) && all_finite(saved.springs) &&
-                      std::isfinite(saved.skin) && std::isfinite(saved.time_at_build) &&
-                      std::isfinite(saved.last_time);
+                      all_finite(saved.slot_rolling) && all_finite(saved.slot_slide) &&
+                      all_finite(saved.springs) && std::isfinite(saved.skin) &&
+                      std::isfinite(saved.time_at_build) && std::isfinite(saved.last_time);
   if (!finite) throw InputError("the checkpoint's contact data hold non-finite values");
   if (!saved.pair_offsets.empty() && !valid_lists(saved.pair_offsets, saved.pair_partners, n))
     throw InputError("the checkpoint's contact lists are out of range (partners past the node count)");
@@ -110,6 +112,9 @@ void ContactModel::restore_collisions(const ContactCheckpoint& saved) {
     c.work = saved.slot_work[3 * slot];
     c.exponent = static_cast<float>(saved.slot_work[3 * slot + 1]);
     c.phase = static_cast<float>(saved.slot_work[3 * slot + 2]);
+    if (!saved.slot_slide.empty()) {
+      for (int k = 0; k < 3; ++k) c.slide[k] = static_cast<float>(saved.slot_slide[3 * slot + k]);
+    }
     for (int k = 0; k < 3; ++k) c.normal[k] = saved.slot_normal[3 * slot + k];
     if (!saved.slot_rolling.empty()) {
       for (int k = 0; k < 3; ++k) c.rolling[k] = saved.slot_rolling[3 * slot + k];

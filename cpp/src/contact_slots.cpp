@@ -29,9 +29,10 @@ void ContactModel::slot_dashpots(const State& state, real dt) {
     }
     const index_t touch = slot_touch_[slot];
     // A collision lasts until the bodies are back where they first touched (approach x = 0),
-    // not while springs are in contact: the surface nodes of deformable bodies chatter (touch,
-    // part, touch again) within one collision when the contact is stiffer than the material,
-    // and a dashpot restarted at each touch would damp the collision many times over.
+    // or have slid apart in a gap (slid_apart), not while springs are in contact: the surface
+    // nodes of deformable bodies chatter (touch, part, touch again) within one collision when
+    // the contact is stiffer than the material, and a dashpot restarted at each touch would damp
+    // the collision many times over.
     const bool in_contact = slot_in_contact(slot);
     if (!in_contact && !(collisions_.approach(slot) > 0)) {  // apart: the collision is over
       collisions_.close(slot);
@@ -55,8 +56,10 @@ void ContactModel::slot_dashpots(const State& state, real dt) {
     collision.approach += approach * dt;
     if (!in_contact) {  // a gap within the collision: no spring, no dashpot
       collision.approach = std::max(0.0, collision.approach);
+      if (slid_apart(slot, collision, relative, dt)) collisions_.close(slot);
       continue;
     }
+    collision.slide = {0, 0, 0};
     const real zeta = damping_ratio(slot, collision, approach * dt);
     const real K = slot_stiffness_[slot];
     const real secant = collision.approach > 0 ? std::min(K, slot_force_[touch] / collision.approach) : K;
@@ -224,6 +227,23 @@ void ContactModel::slot_redirects() {
     add_body_load(q, point, turn);
     add_body_load(p, point, {-turn[0], -turn[1], -turn[2]});
   }
+}
+
+bool ContactModel::slid_apart(std::size_t slot, contact::Collision& collision, const vec3& relative,
+                              real dt) const {
+  // x is measured along the collision's last normal, so bodies that slide apart sideways in a
+  // gap keep x > 0: their collision would never end, and the next touch, elsewhere, would take
+  // its dashpot from a stale x (F / x too soft). Their sideways travel since the last touch ends
+  // it past the contact radius; a distance to the other body would need the lists beyond that
+  // radius, which the skin sets.
+  const vec& n = collision.normal;
+  const real along = dot(relative, n);
+  real travel = 0;
+  for (int k = 0; k < 3; ++k) {
+    collision.slide[k] = static_cast<float>(collision.slide[k] + (relative[k] - along * n[k]) * dt);
+    travel += static_cast<real>(collision.slide[k]) * collision.slide[k];
+  }
+  return std::sqrt(travel) > slot_law(slot).contact_radius;
 }
 
 real ContactModel::damping_ratio(std::size_t slot, contact::Collision& collision, real advance) {

@@ -56,6 +56,7 @@ nb::dict checkpoint_dict(const Simulation& self) {
   d["contact_slot_normal"] = copy_out(c.slot_normal);
   d["contact_slot_work"] = copy_out(c.slot_work);
   d["contact_slot_rolling"] = copy_out(c.slot_rolling);
+  d["contact_slot_slide"] = copy_out(c.slot_slide);
   d["contact_last_time"] = c.last_time;
   d["contact_has_last_time"] = c.has_last_time;
   d["contact_statistics"] = copy_out(
@@ -98,6 +99,8 @@ void restore_dict(Simulation& self, const nb::dict& d) {
   c.slot_work = entry<real>(d, "contact_slot_work");
   // Written since rolling resistance exists; a checkpoint without it had none.
   if (d.contains("contact_slot_rolling")) c.slot_rolling = entry<real>(d, "contact_slot_rolling");
+  // Written since sideways travel ends collisions; a checkpoint without it had none.
+  if (d.contains("contact_slot_slide")) c.slot_slide = entry<real>(d, "contact_slot_slide");
   c.last_time = scalar<real>(d, "contact_last_time");
   c.has_last_time = scalar<bool>(d, "contact_has_last_time");
   const auto statistics = entry<std::uint64_t>(d, "contact_statistics");

@@ -12,8 +12,8 @@
 namespace granulate::contact {
 
 /// What a collision of two bodies (or a body and a wall) remembers, from the step they first
-/// touch until they are back where they touched (ContactModel::slot_dashpots), through the gaps
-/// of chattering surface nodes in between.
+/// touch until they are back where they touched or slid apart (ContactModel::slot_dashpots),
+/// through the gaps of chattering surface nodes in between.
 struct Collision {
   real approach = 0;                     ///< x: how far the bodies approached since they touched [m]
   real work = 0;                         ///< W = sum F dx: the contact springs' work over x [J]
@@ -24,6 +24,10 @@ struct Collision {
   /// durations t_c = pi sqrt(m / K_s) (half the period of the secant spring K_s = F / x on the
   /// reduced mass m: an impact ends near tau = 1)
   float phase = 0;
+  /// The bodies' sideways travel at the contact since they last touched [m] (zero while in
+  /// contact): a gap in which they slid apart by more than the contact radius ends the
+  /// collision (ContactModel::slot_dashpots).
+  std::array<float, 3> slide{0, 0, 0};
 
   bool operator==(const Collision&) const = default;
 };

@@ -60,6 +60,9 @@ struct ContactCheckpoint {
   std::vector<real> slot_work;    ///< 3 per slot: the springs' work, force-law exponent, phase
   /// 3 per slot: the rolling rotation of each pair of bodies (empty without rolling resistance).
   std::vector<real> slot_rolling;
+  /// 3 per slot: the sideways travel since the bodies last touched (empty in checkpoints
+  /// written before it: none).
+  std::vector<real> slot_slide;
   std::vector<index_t> pair_offsets, pair_partners;  ///< the lists (updated after bond breaks)
   /// Friction springs: the pool (3 per spring) and each list entry's spring (none: 2^32 - 1).
   std::vector<real> springs;
@@ -434,6 +437,9 @@ class ContactModel {
   /// Damping ratio of a slot in contact that gives the requested restitution for the force law
   /// of its collision, after adding the springs' work over `advance` (the approach this step).
   real damping_ratio(std::size_t slot, contact::Collision& collision, real advance);
+  /// Adds a gap step's sideways travel (`relative`: the bodies' relative velocity at the
+  /// contact) to the collision's; whether it now exceeds the contact radius, which ends it.
+  bool slid_apart(std::size_t slot, contact::Collision& collision, const vec3& relative, real dt) const;
   /// Force on node i of its list entry e (updates the entry's friction spring).
   vec3 pair_force(const Model& model, const State& state, index_t i, index_t e, real dt);
   /// PeriDEM's friction on node i of entry e: mu |push| against the tangential relative velocity.
