@@ -139,11 +139,7 @@ void ContactModel::update_after_breaks(const Model& model, const State& state, s
 
 void ContactModel::label_bodies(const Model& model, const State& state, std::uint64_t broken_bonds) {
   if (bodies_labelled_ && broken_bonds == broken_at_labelling_) return;
-  if (bodies_labelled_) {  // the slots were found with the present numbering
-    relabelled_first_node_.resize(body_node_offsets_.size() - 1);
-    for (std::size_t b = 0; b + 1 < body_node_offsets_.size(); ++b)
-      relabelled_first_node_[b] = body_nodes_[body_node_offsets_[b]];
-  }
+  if (bodies_labelled_) relabelled_first_node_ = body_first_nodes();  // the slots' numbering
   bodies_labelled_ = true;
   broken_at_labelling_ = broken_bonds;
   const index_t n = model.node_count();
@@ -176,6 +172,12 @@ void ContactModel::label_bodies(const Model& model, const State& state, std::uin
   body_nodes_.resize(n);
   std::vector<index_t> fill(body_node_offsets_.begin(), body_node_offsets_.end() - 1);
   for (index_t i = 0; i < n; ++i) body_nodes_[fill[node_body_[i]]++] = i;
+}
+
+std::vector<index_t> ContactModel::body_first_nodes() const {
+  std::vector<index_t> first(body_node_offsets_.size() - 1);
+  for (std::size_t b = 0; b < first.size(); ++b) first[b] = body_nodes_[body_node_offsets_[b]];
+  return first;
 }
 
 void ContactModel::carry_over_springs(const KeptLists& kept, index_t n) {
@@ -428,11 +430,7 @@ void ContactModel::carry_over_collisions(const std::vector<std::array<index_t, 2
     if (!relabelled) return slot;
     return std::array<index_t, 2>{first[slot[0]], wall ? slot[1] : first[slot[1]]};
   };
-  std::vector<index_t> first_node;
-  if (relabelled) {
-    first_node.resize(body_node_offsets_.size() - 1);
-    for (std::size_t b = 0; b < first_node.size(); ++b) first_node[b] = body_nodes_[body_node_offsets_[b]];
-  }
+  const std::vector<index_t> first_node = relabelled ? body_first_nodes() : std::vector<index_t>{};
   std::vector<index_t> old_of_new(slots_.size(), contact::CollisionStore::none);
   auto carry_over = [&](std::size_t slot, std::size_t slot_end, std::size_t old, std::size_t old_end,
                         bool wall) {

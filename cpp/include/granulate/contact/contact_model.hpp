@@ -534,6 +534,8 @@ class ContactModel {
   // Each body's smallest node under the labelling the slots were found with, kept from a
   // relabelling to the next carry_over_collisions (empty: the body numbers did not change).
   std::vector<index_t> relabelled_first_node_;
+  /// Each body's smallest node (bodies list their nodes in node order).
+  std::vector<index_t> body_first_nodes() const;
   int dimension_ = 3;
 
   // Lists (rebuilt): node pairs and node-wall-surface candidates, CSR by node.
