@@ -33,7 +33,7 @@ bool valid_lists(const std::vector<index_t>& offsets, const std::vector<index_t>
 ContactCheckpoint ContactModel::checkpoint() const {
   ContactCheckpoint c;
   c.built = built_;
-  c.positions_at_build = positions_at_build_;
+  c.positions_at_build.assign(positions_at_build_.begin(), positions_at_build_.end());
   c.time_at_build = time_at_build_;
   c.broken_at_build = broken_at_build_;
   c.skin = skin_;
@@ -139,7 +139,7 @@ void ContactModel::restore(const Model& model, const State& state, const Contact
     // and rebuild() carries each pair's collision history over from the restored slots.
     State at_build = state;
     at_build.time = saved.time_at_build;
-    positions_at_build_ = saved.positions_at_build;
+    positions_at_build_.assign(saved.positions_at_build.begin(), saved.positions_at_build.end());
     centres_.find(model, state, centring_depths(model),
                   surface_particles_);  // which nodes carry surface points
     // Lists updated after bond breaks are not those of a search: take the saved ones (a

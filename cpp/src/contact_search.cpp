@@ -43,7 +43,7 @@ void ContactModel::rebuild(const Model& model, const State& state, std::uint64_t
 
 ContactModel::NearParticles ContactModel::near_particles(const Model& model, const State& state,
                                                          std::uint64_t broken_bonds, real reach) const {
-  const std::vector<real>& x = positions_at_build_;
+  const std::vector<float>& x = positions_at_build_;
   const auto& particles = model.particles();
   const std::size_t particle_count = particles.size();
   // Broad phase: bounding spheres of particles; a particle takes part when another particle's
@@ -99,7 +99,7 @@ ContactModel::NearParticles ContactModel::near_particles(const Model& model, con
 
 void ContactModel::search_node_pairs(const Model& model, const State& state,
                                      const std::vector<std::uint8_t>& near_particle, real reach) {
-  const std::vector<real>& x = positions_at_build_;
+  const std::vector<float>& x = positions_at_build_;
   const index_t n = model.node_count();
   const auto& particles = model.particles();
   const auto& node_particle = model.node_particle();
@@ -162,7 +162,7 @@ void ContactModel::search_node_pairs(const Model& model, const State& state,
 
 void ContactModel::search_node_walls(const Model& model, const State& state,
                                      const std::vector<std::uint8_t>& near_wall) {
-  const std::vector<real>& x = positions_at_build_;
+  const std::vector<float>& x = positions_at_build_;
   const index_t n = model.node_count();
   const auto& particles = model.particles();
   const auto& node_particle = model.node_particle();
@@ -195,7 +195,8 @@ void ContactModel::search_node_walls(const Model& model, const State& state,
         const real support = contact::surface_support_factor * particles[node_particle[i]].mesh_size;
         limit = std::max(limit, support * support / (2 * r) + skin_);
       }
-      const auto p = walls_[w].to_reference(&x[3 * i], state.time);
+      const real at[3] = {x[3 * i], x[3 * i + 1], x[3 * i + 2]};
+      const auto p = walls_[w].to_reference(at, state.time);
       for (std::size_t s = 0; s < walls_[w].surfaces.size(); ++s) {
         local.clear();
         walls_[w].contacts(s, p, limit, dimension_, local);

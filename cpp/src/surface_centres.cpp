@@ -18,15 +18,18 @@ void SurfaceCentres::find(const Model& model, const State& state, std::vector<re
   for (index_t p = 0; p < round_.size(); ++p)
     round_[p] = surface_[p] && depth_[p] > 0 && round_shape[model.particles()[p].shape];
   // Which nodes are seen at anchors (1 byte each: most nodes have none, and contact asks for
-  // every node every step); under the surface law, which look them up many times per step, a
-  // pointer per node as well.
+  // every node every step); under the surface law, which looks them up many times per step,
+  // each anchored node's place in its shape's anchors as well (4 bytes, where a pointer is 8).
   anchored_.assign(any_ ? model.node_count() : 0, 0);
   const bool cached = any_ && std::any_of(surface_.begin(), surface_.end(), [](std::uint8_t f) { return f; });
-  anchors_.assign(cached ? model.node_count() : 0, nullptr);
+  anchor_slot_.assign(cached ? model.node_count() : 0, SurfaceAnchors::none);
   for (index_t i = 0; i < anchored_.size(); ++i) {
     const SurfaceAnchor* a = lookup(model, i);
     anchored_[i] = a != nullptr;
-    if (cached) anchors_[i] = a;
+    if (cached && a != nullptr) {
+      const Particle& particle = model.particles()[model.node_particle()[i]];
+      anchor_slot_[i] = static_cast<index_t>(a - model.shapes()[particle.shape].anchors.anchors.data());
+    }
   }
   if (!any_ || state.bonds.broken(model.bond_offsets(), 0, model.node_count()) == 0) return;
   for (index_t i = 0; i < model.node_count(); ++i) {
@@ -50,7 +53,7 @@ bool SurfaceCentres::is_round(const Shape& shape) {
 
 void SurfaceCentres::detach(index_t i) {
   anchored_[i] = 0;
-  if (!anchors_.empty()) anchors_[i] = nullptr;
+  if (!anchor_slot_.empty()) anchor_slot_[i] = SurfaceAnchors::none;
 }
 
 const SurfaceAnchor* SurfaceCentres::lookup(const Model& model, index_t i) const {
@@ -72,13 +75,13 @@ void SurfaceCentres::detach_anchored(const Model& model, std::span<const std::ar
   }
 }
 
-void SurfaceCentres::fill_positions(const Model& model, const State& state, std::vector<real>& x) const {
+void SurfaceCentres::fill_positions(const Model& model, const State& state, std::vector<float>& x) const {
   x.resize(state.positions.size());
   const std::int64_t n = model.node_count();
 #pragma omp parallel for schedule(static)
   for (std::int64_t i = 0; i < n; ++i) {
     const vec3 c = at_list(model, state, static_cast<index_t>(i));
-    for (int k = 0; k < 3; ++k) x[3 * i + k] = c[k];
+    for (int k = 0; k < 3; ++k) x[3 * i + k] = static_cast<float>(c[k]);
   }
 }
 

@@ -13,24 +13,27 @@ namespace granulate {
 
 class CellGrid {
  public:
-  /// Grid over nodes first .. first+count-1 of x (n x 3), cells of at least cell_size. The cell
-  /// count is capped at ~64 per node (sparse sets get larger cells; searches stay correct).
-  static CellGrid build(const std::vector<real>& x, index_t first, index_t count, real cell_size) {
+  /// Grid over nodes first .. first+count-1 of x (n x 3, double or float), cells of at least
+  /// cell_size. The cell count is capped at ~64 per node (sparse sets get larger cells; searches
+  /// stay correct). Distances are computed in double precision from the stored values.
+  template <class T>
+  static CellGrid build(const std::vector<T>& x, index_t first, index_t count, real cell_size) {
     return build(x, count, cell_size, [first](index_t a) { return first + a; });
   }
 
   /// Grid over an explicit list of nodes.
-  static CellGrid build(const std::vector<real>& x, const std::vector<index_t>& nodes, real cell_size) {
+  template <class T>
+  static CellGrid build(const std::vector<T>& x, const std::vector<index_t>& nodes, real cell_size) {
     return build(x, static_cast<index_t>(nodes.size()), cell_size, [&nodes](index_t a) { return nodes[a]; });
   }
 
   /// Calls visit(j, r^2) for every grid node j != i with |x_j - x_i| <= radius (x_i may be
   /// any point of the x array, inside the grid or not). Cells are visited in a fixed order.
-  template <class Visit>
-  void for_each_within(const std::vector<real>& x, index_t i, real radius, int dimension,
-                       Visit&& visit) const {
+  template <class T, class Visit>
+  void for_each_within(const std::vector<T>& x, index_t i, real radius, int dimension, Visit&& visit) const {
     if (cell_nodes_.empty()) return;
-    const real* xi = &x[3 * static_cast<std::size_t>(i)];
+    const std::size_t at = 3 * static_cast<std::size_t>(i);
+    const std::array<real, 3> xi{x[at], x[at + 1], x[at + 2]};
     const real limit = radius * radius * (1.0 + 1e-10);
     std::array<std::int64_t, 3> lo{}, hi{};
     for (int k = 0; k < 3; ++k) {
@@ -46,9 +49,9 @@ class CellGrid {
           for (index_t k = cell_start_[cell]; k < cell_start_[cell + 1]; ++k) {
             const index_t j = cell_nodes_[k];
             if (j == i) continue;
-            const real* xj = &x[3 * static_cast<std::size_t>(j)];
-            const real r2 = (xj[0] - xi[0]) * (xj[0] - xi[0]) + (xj[1] - xi[1]) * (xj[1] - xi[1]) +
-                            (xj[2] - xi[2]) * (xj[2] - xi[2]);
+            const std::size_t jt = 3 * static_cast<std::size_t>(j);
+            const real dx = real(x[jt]) - xi[0], dy = real(x[jt + 1]) - xi[1], dz = real(x[jt + 2]) - xi[2];
+            const real r2 = dx * dx + dy * dy + dz * dz;
             if (r2 <= limit) visit(j, r2);
           }
         }
@@ -64,8 +67,8 @@ class CellGrid {
     return static_cast<std::int64_t>(c);
   }
 
-  template <class NodeOf>
-  static CellGrid build(const std::vector<real>& x, index_t count, real cell_size, NodeOf node_of) {
+  template <class T, class NodeOf>
+  static CellGrid build(const std::vector<T>& x, index_t count, real cell_size, NodeOf node_of) {
     CellGrid grid;
     if (count == 0) return grid;
     std::array<real, 3> lo{}, hi{};
@@ -74,8 +77,8 @@ class CellGrid {
     for (index_t a = 0; a < count; ++a) {
       const std::size_t i = node_of(a);
       for (int k = 0; k < 3; ++k) {
-        lo[k] = std::min(lo[k], x[3 * i + k]);
-        hi[k] = std::max(hi[k], x[3 * i + k]);
+        lo[k] = std::min(lo[k], real(x[3 * i + k]));
+        hi[k] = std::max(hi[k], real(x[3 * i + k]));
       }
     }
     for (;;) {
@@ -93,7 +96,7 @@ class CellGrid {
     grid.cell_start_.assign(static_cast<std::size_t>(cells) + 1, 0);
     std::vector<std::int64_t> node_cell(count);
     for (index_t a = 0; a < count; ++a) {
-      const real* p = &x[3 * static_cast<std::size_t>(node_of(a))];
+      const T* p = &x[3 * static_cast<std::size_t>(node_of(a))];
       node_cell[a] = (grid.clamped(p[2], 2) * grid.dims_[1] + grid.clamped(p[1], 1)) * grid.dims_[0] +
                      grid.clamped(p[0], 0);
       ++grid.cell_start_[node_cell[a] + 1];

@@ -540,7 +540,10 @@ class ContactModel {
 
   // Lists (rebuilt): node pairs and node-wall-surface candidates, CSR by node.
   bool built_ = false;
-  std::vector<real> positions_at_build_;
+  // Every node's list position at the search (n x 3), in single precision: the search and the
+  // rebuild test (largest_displacement) both measure from these stored values, so nodes that
+  // have moved less than half the skin from them still find every partner within reach.
+  std::vector<float> positions_at_build_;
   real time_at_build_ = 0;
   std::uint64_t broken_at_build_ = 0;
   std::vector<std::array<index_t, 2>> newly_broken_;  // bonds broken since the last list change

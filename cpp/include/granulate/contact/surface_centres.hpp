@@ -65,7 +65,9 @@ class SurfaceCentres {
   /// it is attached), else null.
   const SurfaceAnchor* anchor(const Model& model, index_t i) const {
     if (!moved(i)) return nullptr;
-    return anchors_.empty() ? lookup(model, i) : anchors_[i];
+    if (anchor_slot_.empty()) return lookup(model, i);
+    const Particle& particle = model.particles()[model.node_particle()[i]];
+    return &model.shapes()[particle.shape].anchors.anchors[anchor_slot_[i]];
   }
 
   /// What one look-up of node i's anchors gives: the anchors (null: the node is seen at
@@ -110,10 +112,10 @@ class SurfaceCentres {
     return surface_[model.node_particle()[i]] ? at_surface(model, state, i) : at_centre(model, state, i);
   }
   /// Every node's list position (at_list), into x (n x 3).
-  void fill_positions(const Model& model, const State& state, std::vector<real>& x) const;
+  void fill_positions(const Model& model, const State& state, std::vector<float>& x) const;
 
   std::size_t memory_bytes() const {
-    return depth_.capacity() * sizeof(real) + anchors_.capacity() * sizeof(const SurfaceAnchor*) +
+    return depth_.capacity() * sizeof(real) + anchor_slot_.capacity() * sizeof(index_t) +
            anchored_.capacity() + surface_.capacity() + round_.capacity();
   }
 
@@ -133,11 +135,12 @@ class SurfaceCentres {
 
   bool found_ = false;
   bool any_ = false;
-  std::vector<real> depth_;                    // per particle
-  std::vector<std::uint8_t> surface_;          // per particle: under the surface law
-  std::vector<std::uint8_t> round_;            // per particle: round (see above)
-  std::vector<std::uint8_t> anchored_;         // per node: seen at its anchors (0 once detached)
-  std::vector<const SurfaceAnchor*> anchors_;  // per node under the surface law: lookup(), kept
+  std::vector<real> depth_;             // per particle
+  std::vector<std::uint8_t> surface_;   // per particle: under the surface law
+  std::vector<std::uint8_t> round_;     // per particle: round (see above)
+  std::vector<std::uint8_t> anchored_;  // per node: seen at its anchors (0 once detached)
+  // Per node under the surface law: lookup()'s anchor, as its place in the shape's anchors.
+  std::vector<index_t> anchor_slot_;
 };
 
 inline real SurfaceCentres::linear_scale(const Seen& s, real length) {
@@ -154,8 +157,8 @@ inline SurfaceCentres::Seen SurfaceCentres::seen(const Model& model, index_t i) 
   if (!moved(i)) return s;
   const index_t p = model.node_particle()[i];
   const Particle& particle = model.particles()[p];
-  s.anchor =
-      anchors_.empty() ? model.shapes()[particle.shape].anchors.of(i - particle.first_node) : anchors_[i];
+  const SurfaceAnchors& anchors = model.shapes()[particle.shape].anchors;
+  s.anchor = anchor_slot_.empty() ? anchors.of(i - particle.first_node) : &anchors.anchors[anchor_slot_[i]];
   s.first = particle.first_node;
   s.mesh_size = particle.mesh_size;
   s.along_normal = surface_[p] != 0;
