@@ -99,6 +99,8 @@ def test_interactions_refuse_a_wall_name_twice_and_resolve_laws() -> None:
     assert interactions.add_wall(floor, None, 2) == "wall0"
     with pytest.raises(gr.InputError, match="exists already"):
         interactions.add_wall(floor, "wall0", 2)
+    assert interactions.uses_surface_law()  # the default law
+    interactions.set_default(gr.Contact(pair_law="granulate"))
     assert not interactions.uses_surface_law()
     interactions.set_pair(ROCK, ROCK, gr.Contact(pair_law="surface"))
     assert interactions.uses_surface_law()

@@ -57,6 +57,13 @@ def main(argv: list[str] | None = None) -> dict[str, float]:
         default=0.0,
         help="distance of the drum's axis from its centre [m]",
     )
+    parser.add_argument(
+        "--pair-law",
+        choices=("surface", "granulate"),
+        default="surface",
+        help="contact law: surface (the default) or granulate (the node spheres, which made the "
+        "committed figures)",
+    )
     args = parser.parse_args(argv)
 
     # (1) Materials (SI units): the large grains need twice the energy to crack.
@@ -83,7 +90,7 @@ def main(argv: list[str] | None = None) -> dict[str, float]:
     print(packing.summary())
 
     sim = gr.Simulation(dimension=2, gravity=(0, -9.81))
-    sim.contact = gr.Contact(restitution=0.5, friction=0.5)
+    sim.contact = gr.Contact(restitution=0.5, friction=0.5, pair_law=args.pair_law)
     sim.add_packing(packing)
 
     # (4) The drum: container and lifters turning together.

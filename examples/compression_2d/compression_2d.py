@@ -47,10 +47,11 @@ GAP = 0.05e-3  # the top wall starts this far above the highest node [m]
 @dataclass(frozen=True)
 class Options:
     """peridem: PeriDEM's 2D peridynamics (3D LPS constants, bonds breaking in compression);
-    stiffness_factor: of the contact spring."""
+    stiffness_factor: of the contact spring; pair_law: Contact(pair_law=...)."""
 
     peridem: bool = False
     stiffness_factor: float = 1.0
+    pair_law: str = "surface"
 
 
 def material(options: Options = Options()) -> gr.Material:
@@ -88,7 +89,10 @@ def simulation(grains: gr.Packing, width: float, options: Options = Options()) -
     plane = "peridem" if options.peridem else "strain"
     sim = gr.Simulation(dimension=2, gravity=(0, -10), plane=plane)
     sim.contact = gr.Contact(
-        restitution=0.95, friction=0.0, stiffness_factor=options.stiffness_factor
+        restitution=0.95,
+        friction=0.0,
+        stiffness_factor=options.stiffness_factor,
+        pair_law=options.pair_law,
     )
     sim.add_packing(grains)
     sides = (gr.Plane((0, 0), (0, 1)), gr.Plane((0, 0), (1, 0)), gr.Plane((width, 0), (-1, 0)))
@@ -165,12 +169,19 @@ def main(argv: list[str] | None = None) -> dict[str, float]:
     parser.add_argument(
         "--stiffness-factor", type=float, default=1.0, help="of the contact spring (default 1)"
     )
+    parser.add_argument(
+        "--pair-law",
+        choices=("surface", "granulate"),
+        default="surface",
+        help="contact law: surface (the default) or granulate (the node spheres, which made the "
+        "committed figures)",
+    )
     args = parser.parse_args(argv)
     count, travel, until = (40, 0.2e-3, 5e-3) if args.smoke else (args.grains, args.travel, 1.0)
     width = WIDTH * min(1.0, math.sqrt(count / 502))  # the paper's proportions
     out = Path(args.out)
 
-    options = Options(args.peridem_constants, args.stiffness_factor)
+    options = Options(args.peridem_constants, args.stiffness_factor, args.pair_law)
     grains = packing(count, width, args.seed, options)
     print(grains.summary())
     settled, bodies = settle(grains, width, until, out / "settle", args.overwrite, options)

@@ -51,8 +51,9 @@ class ContactSpec(Spec):
         "coulomb", description="'peridem': PeriDEM's friction (speeds sliding up), comparisons only"
     )
     pair_law: Literal["granulate", "surface", "peridem"] = Field(
-        "granulate",
+        "surface",
         description="'surface': surface nodes probe the other particle's smooth surface; "
+        "'granulate': every node a sphere (cheaper, node-scale bumps); "
         "'peridem': PeriDEM's node-pair law (one Rc from the finer mesh, springs kn V_i V_j), "
         "comparisons only",
     )
