@@ -209,6 +209,43 @@ def test_particles_outside_their_container_or_overlapping_are_refused() -> None:
     touching.run(1)
 
 
+def test_the_start_checks_judge_the_positions_a_run_starts_from() -> None:
+    """start_from (a restart from another run's frame): two discs whose reference positions
+    overlap, one of them also through the floor, start once moved apart and above it (PeriDEM's
+    run2 decks move a wall down onto grains that settled since the reference, and were refused),
+    and moved positions that overlap are refused."""
+
+    def discs() -> gr.Simulation:
+        sim = gr.Simulation(2)
+        sim.add_body(gr.Disc((0, 0.5e-3), 1e-3), SOFT, 0.25e-3, name="a")
+        sim.add_body(gr.Disc((1.5e-3, 1.2e-3), 1e-3), SOFT, 0.25e-3, name="b")
+        sim.add_wall(gr.Plane((0, 0), (0, 1)), name="floor")
+        return sim
+
+    with pytest.raises(gr.InputError, match="a starts on the wrong side of wall 'floor'"):
+        discs().run(1)
+    up = np.array([0, 1e-3, 0])
+    sim = discs()
+    moved = sim.reference_positions + up  # both up 1 mm, b 1.5 mm to the right
+    moved[sim.bodies[1].first_node :, 0] += 1.5e-3
+    velocities = np.zeros_like(moved)
+    velocities[:, 1] = -0.1
+    sim.start_from(moved, velocities)
+    sim.run(1)
+    lowest = sim.reference_positions[:, 1].min() + 1e-3  # one step of 0.1 m/s later
+    assert sim.positions[:, 1].min() == pytest.approx(lowest, abs=1e-7)
+    assert sim.velocities[:, 1].max() < -0.09
+    # built by the run: too late to move the start
+    with pytest.raises(gr.InputError, match="cannot set the start positions after"):
+        sim.start_from(moved, velocities)
+    overlapping = discs()
+    overlapping.start_from(overlapping.reference_positions + up, np.zeros_like(moved))
+    with pytest.raises(gr.InputError, match="a and b overlap at the start"):
+        overlapping.run(1)
+    with pytest.raises(gr.InputError, match="positions must be 104 x 3"):
+        discs().start_from(np.zeros((3, 3)), np.zeros((3, 3)))
+
+
 @pytest.mark.parametrize(("pair_law", "accepted"), [("surface", True), ("granulate", False)])
 def test_grains_pressed_into_each_other_as_at_rest_start_under_the_surface_law(
     pair_law: str, accepted: bool

@@ -111,6 +111,7 @@ class Simulation(SimulationSetup, SimulationResults):
         self._reference: NDArray[np.float64] | None = None
         self._record = RunRecord()
         self._precracks: list[tuple[NDArray[np.float64], NDArray[np.float64], Shape | None]] = []
+        self._start: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None  # start_from
         self._tuner: threads.ThreadTuner | None = None
         self._core_materials: list[Material] = []
         self._setup_digest: str | None = None
@@ -165,12 +166,17 @@ class Simulation(SimulationSetup, SimulationResults):
         core = _core.Simulation(model)
         self._interactions.apply(core, core_materials)
         self._core_materials = core_materials
+        if self._start is not None:
+            core.positions[:] = self._start[0]
         self._interactions.check_start(model, core, self.dimension)
         self._set_time_step(core)
         core.set_body_acceleration(tuple(self._gravity))
         core.viscous_damping = self._viscous_damping
         self._loading.apply(core)
         self._assembly.set_initial_velocities(model, core)
+        if self._start is not None:
+            core.velocities[:] = self._start[1]
+            self._start = None
         self._model = model
         self._core = core
         self._analysis = Analysis(core, model, len(self.bodies))

@@ -46,6 +46,7 @@ class SimulationSetup:
     _gravity: NDArray[np.float64]
     _viscous_damping: float
     _output: Outputs | None
+    _start: tuple[NDArray[np.float64], NDArray[np.float64]] | None
     _build: Callable[[], _core.Simulation]
 
     @property
@@ -192,6 +193,26 @@ class SimulationSetup:
         if self._model is not None:
             return read_only(self._model.reference_positions)
         return self._assembly.reference_positions()
+
+    def start_from(self, positions: ArrayLike, velocities: ArrayLike) -> None:
+        """Start from these node positions x [m] and velocities v [m/s] ((n, 3) each, in node
+        order) instead of the reference positions at rest, as a restart from another run's
+        frame does. The start checks (a node on the wrong side of a wall, particles
+        overlapping) judge these positions; the bonds start intact (but for precracks) and
+        loaded nodes keep their prescribed motion. Call it before the first run."""
+        self._require_building("set the start positions")
+        shape = (self._assembly.node_count, 3)
+        x = np.array(positions, dtype=np.float64)
+        v = np.array(velocities, dtype=np.float64)
+        for name, value in (("positions", x), ("velocities", v)):
+            if value.shape != shape:
+                raise InputError(
+                    f"start_from: {name} must be {shape[0]} x 3 (one row per node), got "
+                    f"{' x '.join(map(str, value.shape))}"
+                )
+            if not np.all(np.isfinite(value)):
+                raise InputError(f"start_from: {name} must be finite")
+        self._start = (x, v)
 
     def select(
         self,

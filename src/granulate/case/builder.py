@@ -411,8 +411,9 @@ def _restart(sim: Simulation, path: Path, step: int) -> None:
             f"restart file {path} holds {len(displacement)} nodes, the case has "
             f"{sim.node_count}: it belongs to another set-up"
         )
-    sim.positions[:] = sim.model.reference_positions + displacement
-    sim.velocities[:] = velocity
+    # Before the core is built, so that its start checks judge the frame's positions (a
+    # restart may move a wall close to grains that have settled since the reference).
+    sim.start_from(sim.reference_positions + displacement, velocity)
     sim.core.step = step
     sim.core.time = step * sim.dt
 
