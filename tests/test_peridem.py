@@ -135,17 +135,14 @@ def test_restitution_with_peridems_stiff_contact(
 ) -> None:
     """PeriDEM's contact (Kn = 1.6e24, some 2,000 times granulate's default for these discs) is
     much stiffer than the material: the surface nodes chatter (about 10 touches in one
-    collision). The dashpot treats them as one collision and gives the e asked for within 0.05:
-    measured 0.537 / 0.784 / 0.913 with the lower disc held at the deck's dt (0.489 / 0.782 /
-    0.938 before the surface nodes' spheres were centred a contact radius deep, f2366c2). Two
-    free discs (--full) at dt / 8, below granulate's stable estimate, give 0.555 / 0.763 / 0.932
-    (at dt / 4, 1.1 times the estimate: 0.557 / 0.770 / 0.933): 0.5 fails. The free discs' nodes
-    touch 13 times, in 412 of the 533 steps from the first touch to the last (held: 5 times, 124
-    of 134), and the dashpot acts only while they touch. Scaling it by 1 / sqrt(f), f the share
-    of the collision's steps in contact (the damping of the time-averaged spring), gave 0.471 /
-    0.741 / 0.925: the gaps are not the whole cause. At the deck's dt, 4.4 times granulate's
-    stable estimate, free discs gain energy even without damping, e = 9.6, as they do in
-    PeriDEM."""
+    collision). The dashpot treats them as one collision and gives the e asked for within 0.05,
+    under the default surface law: 0.489 / 0.816 / 0.944 with the lower disc held at the deck's
+    dt, and two free discs (--full) at dt / 8, below granulate's stable estimate, 0.531 / 0.810
+    / 0.948. On the node spheres (pair_law granulate) the held discs gave 0.537 / 0.784 / 0.913
+    and the free ones 0.555 / 0.763 / 0.932, so 0.5 failed there: their nodes touched 13 times,
+    in 412 of the 533 steps from the first touch to the last, and the dashpot acts only while
+    they touch. At the deck's dt, 4.4 times granulate's stable estimate, free discs gain energy
+    even without damping, e = 9.6 on the node spheres, as they do in PeriDEM."""
     assert abs(restitution(tmp_path, epsilon, held=True) - epsilon) < 0.05
     if full:
         free = restitution(tmp_path / "free", epsilon, held=False, dt_divisor=8)
