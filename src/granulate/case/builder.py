@@ -165,7 +165,9 @@ class Case:
             sim.add_wall(_wall(w, case), name=w.name)
         for load in spec.loading:
             _load(sim, load, case, named)
-        if spec.restart is not None and not resume:
+        if spec.restart is not None:
+            # On --resume too: the start checks judge the restart's positions, not the
+            # reference ones (the checkpoint then replaces the whole state).
             _restart(sim, case.path(spec.restart.file), spec.restart.step)
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
