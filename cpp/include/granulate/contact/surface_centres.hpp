@@ -65,9 +65,7 @@ class SurfaceCentres {
   /// it is attached), else null.
   const SurfaceAnchor* anchor(const Model& model, index_t i) const {
     if (!moved(i)) return nullptr;
-    if (anchor_slot_.empty()) return lookup(model, i);
-    const Particle& particle = model.particles()[model.node_particle()[i]];
-    return &model.shapes()[particle.shape].anchors.anchors[anchor_slot_[i]];
+    return kept_anchor(model, model.particles()[model.node_particle()[i]], i);
   }
 
   /// What one look-up of node i's anchors gives: the anchors (null: the node is seen at
@@ -132,6 +130,12 @@ class SurfaceCentres {
   /// Node i's anchors from the shape (none for an outer-layer node of a particle not under the
   /// surface law).
   const SurfaceAnchor* lookup(const Model& model, index_t i) const;
+  /// The anchors of node i of `particle`, which is seen at them (moved): from anchor_slot_ under
+  /// the surface law, else from its shape.
+  const SurfaceAnchor* kept_anchor(const Model& model, const Particle& particle, index_t i) const {
+    const SurfaceAnchors& anchors = model.shapes()[particle.shape].anchors;
+    return anchor_slot_.empty() ? anchors.of(i - particle.first_node) : &anchors.anchors[anchor_slot_[i]];
+  }
 
   bool found_ = false;
   bool any_ = false;
@@ -157,8 +161,7 @@ inline SurfaceCentres::Seen SurfaceCentres::seen(const Model& model, index_t i) 
   if (!moved(i)) return s;
   const index_t p = model.node_particle()[i];
   const Particle& particle = model.particles()[p];
-  const SurfaceAnchors& anchors = model.shapes()[particle.shape].anchors;
-  s.anchor = anchor_slot_.empty() ? anchors.of(i - particle.first_node) : &anchors.anchors[anchor_slot_[i]];
+  s.anchor = kept_anchor(model, particle, i);
   s.first = particle.first_node;
   s.mesh_size = particle.mesh_size;
   s.along_normal = surface_[p] != 0;
