@@ -21,7 +21,7 @@ from granulate import peridem
 from granulate.case import load_case
 from granulate.cli import main
 from granulate.errors import InputError
-from granulate.io.vtu import read_vtu_point_data
+from granulate.io.vtu import read_vtu_point_data, write_vtu
 from peridem_decks import (
     DECKS,
     broken_deck,
@@ -293,8 +293,6 @@ def test_restart_from_peridems_output(tmp_path: Path) -> None:
 
 
 def test_vtu_reader_reads_what_the_writer_writes(tmp_path: Path) -> None:
-    from granulate.io.vtu import write_vtu
-
     rng = np.random.default_rng(4)
     points = rng.uniform(size=(70_000, 3))  # several zlib blocks
     fields = {
@@ -335,6 +333,36 @@ def test_resume_across_an_impact_on_a_held_disc_is_bitwise(tmp_path: Path) -> No
     assert (whole / "history.csv").read_bytes() == (split / "history.csv").read_bytes()
     rows = history(whole)
     assert max(abs(r["p0_fy"]) for r in rows if r["step"] > 10_000) > 0  # impact after resume
+
+
+def test_resuming_a_restarted_deck_starts_from_the_restart_positions(tmp_path: Path) -> None:
+    """A deck whose reference grains overlap (the top disc of twop_circ 1.2 mm into the lower
+    one) is refused, and runs when it restarts from a frame that lifts them apart; resumed from
+    its checkpoint it runs on (--resume judged the reference positions and refused it:
+    n500_circ_hex's stage 2) and writes the same history as an uninterrupted run."""
+    with pytest.warns(gr.GranulateWarning, match="exceeds the stable"):  # PeriDEM's own dt
+        apart = load_case(DECKS / "twop_circ" / "input_0.yaml").build(outputs=False)
+    top = apart.bodies[1].nodes
+    deck = broken_deck(tmp_path, "twop_circ", lambda text: text)
+    locations = deck.parent / "particle_locations_0.csv"
+    locations.write_text(locations.read_text().replace("0.003600", "0.001800"))
+    with pytest.raises(InputError, match="p0 and p1 overlap at the start"):
+        load_case(deck).build(outputs=False)
+    displacement = np.zeros((apart.node_count, 3))
+    displacement[top, 1] = 1.8e-3  # back to twop_circ's positions, centres 2.6 mm apart
+    velocity = np.zeros((apart.node_count, 3))
+    velocity[top, 1] = -0.1
+    write_vtu(
+        deck.parent / "lifted.vtu",
+        apart.reference_positions,
+        {"Displacement": displacement, "Velocity": velocity},
+    )
+    deck.write_text(deck.read_text() + "Restart:\n  File: lifted.vtu\n  Step: 0\n")
+    whole = run_deck("twop_circ", tmp_path / "whole", 10_000, deck=deck)
+    split = run_deck("twop_circ", tmp_path / "split", 5_000, deck=deck)
+    run_deck("twop_circ", split, 5_000, "--resume", deck=deck)
+    assert (whole / "history.csv").read_bytes() == (split / "history.csv").read_bytes()
+    assert history(whole)[-1]["step"] == 10_000
 
 
 def test_a_deck_writes_its_output_in_the_working_directory(
