@@ -117,14 +117,22 @@ const contact::SurfacePoint& ContactModel::surface_point(index_t j) const {
 real ContactModel::probe_stiffness(const Model& model, index_t i, index_t target,
                                    const contact::PairLaw& law) const {
   // Per unit area the contact is as stiff as the sphere law's node pairs of the finer mesh,
-  // kn min(V_i, V_t)^2 per (finer h)^(d-1); a probe carries its own node's share of the surface,
-  // h_i^(d-1), and its side's share of the contact.
+  // kn min(V_i, V_t)^2 per (finer h)^(d-1) (V: stiffness_volume); a probe carries its own node's
+  // share of the surface, h_i^(d-1), and its side's share of the contact.
   const real hi = particle_side_[model.node_particle()[i]].mesh_size;
   const real ht = particle_side_[model.node_particle()[target]].mesh_size;
   const real share = ht * ht / (hi * hi + ht * ht);
   const real area =
       dimension_ == 2 ? hi / std::min(hi, ht) : (hi * hi) / (std::min(hi, ht) * std::min(hi, ht));
-  return share * area * contact::pair_stiffness(law, model.volumes()[i], model.volumes()[target]);
+  return share * area *
+         contact::pair_stiffness(law, stiffness_volume(model, i), stiffness_volume(model, target));
+}
+
+real ContactModel::stiffness_volume(const Model& model, index_t i) const {
+  const index_t p = model.node_particle()[i];
+  if (!surface_particles_[p]) return model.volumes()[i];
+  const real h = particle_side_[p].mesh_size;
+  return std::sqrt(model.volumes()[i] * (dimension_ == 2 ? h * h : h * h * h));  // sqrt(V_i h^d)
 }
 
 real ContactModel::node_radius(const contact::Law& law, const Model& model, index_t i, index_t j,
@@ -139,7 +147,8 @@ real ContactModel::entry_stiffness(const Model& model, index_t i, index_t e) con
 }
 
 real ContactModel::wall_spring_stiffness(const Model& model, index_t i, index_t e) const {
-  return contact::pair_stiffness(slot_law(wall_slot_[e]), model.volumes()[i], model.volumes()[i]);
+  const real volume = stiffness_volume(model, i);
+  return contact::pair_stiffness(slot_law(wall_slot_[e]), volume, volume);
 }
 
 ContactModel::PairGeometry ContactModel::pair_geometry(const Model& model, const State& state, index_t i,

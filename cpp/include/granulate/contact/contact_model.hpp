@@ -326,8 +326,9 @@ class ContactModel {
   }
   /// probes_ and group_probe_ from the touching groups each thread measured (any order).
   void keep_touching_probes(std::vector<ProbeState>& measured);
-  /// The probe k of a group of node i against body b: beta kn V_i^2, beta = h_b^2 / (h_i^2 + h_b^2)
-  /// (the finer surface probes the coarser; equal meshes share the contact equally).
+  /// The probe k of a group of node i against body b: beta kn min(V_i, V_b)^2 (h_i/h_min)^(d-1),
+  /// V the stiffness_volume of i and of b's node, beta = h_b^2 / (h_i^2 + h_b^2) (the finer
+  /// surface probes the coarser; equal meshes share the contact equally).
   real probe_stiffness(const Model& model, index_t i, index_t target, const contact::PairLaw& law) const;
   /// Node j's surface point as the surface law sees it (this step's, from measure_surface_points).
   const contact::SurfacePoint& surface_point(index_t j) const;
@@ -430,8 +431,16 @@ class ContactModel {
   /// Spring stiffness k of node i's list entry e in double precision (pair_stiffness_ keeps it
   /// in single precision, as the in-contact flag and for the sums of pass B).
   real entry_stiffness(const Model& model, index_t i, index_t e) const;
-  /// Spring stiffness of each contact point of node i's wall entry e: kn V_i^2.
+  /// Spring stiffness of each contact point of node i's wall entry e: kn V_i^2 (V_i its
+  /// stiffness_volume).
   real wall_spring_stiffness(const Model& model, index_t i, index_t e) const;
+  /// The volume node i stands for in a contact spring [m^d]: sqrt(V_i h^d) under the surface
+  /// law, so that a spring kn min(V_i, V_j)^2 is kn V_i h^d between equal particles, in
+  /// proportion to the node's mass (every node rings on its contact at a lattice's frequency,
+  /// so the time step that suits a lattice suits any mesh), where kn V_i^2 made a mesh's
+  /// boundary vertices, which hold 0.3-0.5 h^d, 4-5 times softer per area than a lattice's
+  /// surface; its own V_i under the node spheres and PeriDEM's law.
+  real stiffness_volume(const Model& model, index_t i) const;
   /// The collisions of a checkpoint's slots (slots_ restored).
   void restore_collisions(const ContactCheckpoint& saved);
   /// Damping ratio of a slot in contact that gives the requested restitution for the force law
