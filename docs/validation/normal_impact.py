@@ -25,14 +25,13 @@ import granulate as gr
 
 E, NU, RADIUS, DENSITY = 3e7, 0.25, 1e-3, 1200.0
 E_STAR = E / (1 - NU**2)
-CONTACT_OPTIONS: dict[str, str] = {}  # --pair-law
 
 
 def simulate(nodes_across_radius: int, speed: float, stiffness_factor: float = 100.0) -> dict:
     """The plane's force against time during one impact, and the rebound speed."""
     h = RADIUS / nodes_across_radius
     sim = gr.Simulation(3)
-    sim.contact = gr.Contact(restitution=1.0, stiffness_factor=stiffness_factor, **CONTACT_OPTIONS)
+    sim.contact = gr.Contact(restitution=1.0, stiffness_factor=stiffness_factor)
     grain = gr.Material(density=DENSITY, youngs_modulus=E, poisson_ratio=NU, fracture=False)
     sim.add_body(
         gr.Sphere((0, RADIUS + 0.3 * h, 0), RADIUS),
@@ -68,7 +67,7 @@ def simulate_pair(nodes_across_radius: int, speed: float, stiffness_factor: floa
     against time (one sphere's momentum change per step), and the restitution."""
     h = RADIUS / nodes_across_radius
     sim = gr.Simulation(3)
-    sim.contact = gr.Contact(restitution=1.0, stiffness_factor=stiffness_factor, **CONTACT_OPTIONS)
+    sim.contact = gr.Contact(restitution=1.0, stiffness_factor=stiffness_factor)
     grain = gr.Material(density=DENSITY, youngs_modulus=E, poisson_ratio=NU, fracture=False)
     bodies = [
         sim.add_body(
@@ -191,15 +190,7 @@ def figure(pair: bool, speeds: list[float]) -> None:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--smoke", action="store_true")
-    parser.add_argument(
-        "--pair-law",
-        choices=("surface", "granulate"),
-        help="Contact(pair_law=...): surface (the default) or granulate (the node spheres, "
-        "which made the committed figure)",
-    )
     args = parser.parse_args()
-    if args.pair_law is not None:
-        CONTACT_OPTIONS["pair_law"] = args.pair_law
     speeds = [5.0] if args.smoke else [2.0, 5.0, 10.0]
     figure(False, speeds)
     figure(True, speeds)

@@ -47,7 +47,7 @@ import hertz_mindlin  # beside this script
 SOFT = gr.Material(density=1200, bulk_modulus=2.16e7, shear_modulus=1.296e7, fracture=False)
 RADIUS, SPEED, MU, RESTITUTION = 1e-3, 0.5, 0.3, 0.8
 #: Contact options besides e and mu (--tangential-stiffness-ratio), and the figure names' suffix.
-CONTACT_OPTIONS: dict[str, float | str] = {}
+CONTACT_OPTIONS: dict[str, float] = {}
 
 
 def run_through_impact(sim: gr.Simulation, against_wall: bool = True) -> None:
@@ -350,15 +350,7 @@ def main() -> None:
         help="Contact(tangential_stiffness_ratio=...) (default: granulate's 2/7); Mindlin's is "
         "2 (1 - nu) / (2 - nu), 0.857 for these grains; the figure's name gets _kt<ratio>",
     )
-    parser.add_argument(
-        "--pair-law",
-        choices=("surface", "granulate"),
-        help="Contact(pair_law=...): surface (the default) or granulate (the node spheres, "
-        "which made the committed figure)",
-    )
     args = parser.parse_args()
-    if args.pair_law is not None:
-        CONTACT_OPTIONS["pair_law"] = args.pair_law
     if args.tangential_stiffness_ratio is not None:
         CONTACT_OPTIONS["tangential_stiffness_ratio"] = args.tangential_stiffness_ratio
     figures = {4: angle_figure, 5: tangential_figure, 6: spin_figure}

@@ -29,7 +29,8 @@ it 1000 times denser as well).
 
 Run: python docs/validation/pair_impact.py [--dimension 2|3] [--test 7|8] [--smoke]; writes
 docs/validation/pair_impact_test<7|8>_<d>d.png and prints the table. --friction MU (the table
-only) and --nodes N (nodes per radius) vary the set-up.
+only) and --nodes N (nodes per radius) vary the set-up; --pair-law granulate runs the node
+spheres instead of the surface law (the figure's name ends in _granulate).
 """
 
 from __future__ import annotations
@@ -80,7 +81,7 @@ def pair_impact(
     spins: tuple[float, float],
     nodes_across_radius: int,
     friction: float = MU,
-    pair_law: str = "granulate",
+    pair_law: str = "surface",
 ) -> dict:
     """Bodies of `radii` spinning at omega R = `spins` meet at SPEED: their masses, friction,
     velocities and spins (omega R) before and after, and the normal restitution."""
@@ -142,7 +143,7 @@ def table(
     rates: list[float],
     npr: int,
     friction: float,
-    pair_law: str = "granulate",
+    pair_law: str = "surface",
 ) -> list[dict]:
     """Run test 7 or 8 at omega R = rates x v_n and print the rebound against the theory."""
     radii = (RADIUS, RADIUS if test == 7 else LARGE * RADIUS)
@@ -168,7 +169,7 @@ def figure(
     rows: list[dict],
     rates: list[float],
     npr: int,
-    pair_law: str = "granulate",
+    pair_law: str = "surface",
 ) -> None:
     """Rebound of body 1 against omega R / v_n for test 7 or 8, with the theory."""
     import matplotlib
@@ -206,8 +207,8 @@ def figure(
         if test == 7
         else f"a spinning {shape} and one {LARGE:g} times larger at rest"
     )
-    suffix = "" if pair_law == "granulate" else f"_{pair_law}"
-    law = "" if pair_law == "granulate" else f", pair_law {pair_law}"
+    suffix = "" if pair_law == "surface" else f"_{pair_law}"
+    law = "" if pair_law == "surface" else f", pair_law {pair_law}"
     name = f"pair_impact_test{test}_{dimension}d{suffix}.png"
     resolution = f"R/h = {npr} each{law}"
     save_test_figure(fig, test, f"Head-on impact of {what}", "v_n", resolution, name)
@@ -221,9 +222,10 @@ def main() -> None:
     parser.add_argument("--friction", type=float, help="another mu than 0.3: the table only")
     parser.add_argument(
         "--pair-law",
-        default="granulate",
-        choices=("granulate", "surface"),
-        help="the contact's pair law (surface: the figure's name ends in _surface)",
+        default="surface",
+        choices=("surface", "granulate"),
+        help="the contact's pair law: surface (the default) or granulate (the node spheres; the "
+        "figure's name ends in _granulate)",
     )
     parser.add_argument("--smoke", action="store_true")
     args = parser.parse_args()

@@ -26,7 +26,6 @@ import granulate as gr
 SOFT = gr.Material(density=1200, bulk_modulus=2.16e7, shear_modulus=1.296e7, fracture=False)
 RADIUS = 1e-3
 NODES_ACROSS_RADIUS = {2: 10, 3: 6}
-CONTACT_OPTIONS: dict[str, str] = {}  # --pair-law
 
 
 def rebound(dimension: int, restitution: float, speed: float) -> float:
@@ -34,7 +33,7 @@ def rebound(dimension: int, restitution: float, speed: float) -> float:
     impact speed, 50 steps after the last node left the plane."""
     h = RADIUS / NODES_ACROSS_RADIUS[dimension]
     sim = gr.Simulation(dimension)
-    sim.contact = gr.Contact(restitution=restitution, **CONTACT_OPTIONS)
+    sim.contact = gr.Contact(restitution=restitution)
     centre = (0.0, RADIUS + 0.6 * h, 0.0)[:dimension]
     shape = gr.Disc(centre, RADIUS) if dimension == 2 else gr.Sphere(centre, RADIUS)
     velocity = (0.0, -speed, 0.0)[:dimension]
@@ -48,15 +47,7 @@ def rebound(dimension: int, restitution: float, speed: float) -> float:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--smoke", action="store_true")
-    parser.add_argument(
-        "--pair-law",
-        choices=("surface", "granulate"),
-        help="Contact(pair_law=...): surface (the default) or granulate (the node spheres, "
-        "which made the committed figure)",
-    )
     args = parser.parse_args()
-    if args.pair_law is not None:
-        CONTACT_OPTIONS["pair_law"] = args.pair_law
     requested = [0.1, 0.5, 0.9] if args.smoke else [round(0.1 * k, 1) for k in range(1, 11)]
     speeds = [0.05, 0.5, 5.0]
     import matplotlib

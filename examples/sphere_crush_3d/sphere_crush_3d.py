@@ -38,13 +38,6 @@ def main(argv: list[str] | None = None) -> dict[str, float]:
     parser.add_argument(
         "--nodes-per-radius", type=float, default=12, help="R/h of the sphere (smoke: 3)"
     )
-    parser.add_argument(
-        "--pair-law",
-        choices=("surface", "granulate"),
-        default="surface",
-        help="contact law: surface (the default) or granulate (the node spheres, which made the "
-        "committed figures)",
-    )
     args = parser.parse_args(argv)
 
     # (1) Material (SI units).
@@ -52,9 +45,7 @@ def main(argv: list[str] | None = None) -> dict[str, float]:
     # (2) The sphere on the floor.
     h = RADIUS / (3 if args.smoke else args.nodes_per_radius)
     sim = gr.Simulation(3)
-    sim.contact = gr.Contact(
-        restitution=0.5, friction=0.5, stiffness_factor=100, pair_law=args.pair_law
-    )
+    sim.contact = gr.Contact(restitution=0.5, friction=0.5, stiffness_factor=100)
     sim.add_body(gr.Sphere((0, RADIUS, 0), RADIUS), stone, h, discretization="conforming")
     sim.add_wall(gr.Plane((0, 0, 0), (0, 1, 0)), name="floor")
     # (3) The top plate, half a mesh size above the sphere's surface (its contact layer).
