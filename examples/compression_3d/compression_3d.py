@@ -36,13 +36,6 @@ def main(argv: list[str] | None = None) -> dict[str, float]:
     parser.add_argument("--out", default="out/compression_3d", help="output directory")
     parser.add_argument("--overwrite", action="store_true", help="replace an earlier run in --out")
     parser.add_argument("--travel", type=float, default=3.5e-3, help="plate travel [m]")
-    parser.add_argument(
-        "--pair-law",
-        choices=("surface", "granulate"),
-        default="surface",
-        help="contact law: surface (the default) or granulate (the node spheres, which made the "
-        "committed figures)",
-    )
     args = parser.parse_args(argv)
 
     # (1), (2) Material and grain.
@@ -64,9 +57,7 @@ def main(argv: list[str] | None = None) -> dict[str, float]:
     print(packing.summary())
 
     sim = gr.Simulation(dimension=3)
-    sim.contact = gr.Contact(
-        restitution=0.5, friction=0.3, stiffness_factor=100, pair_law=args.pair_law
-    )
+    sim.contact = gr.Contact(restitution=0.5, friction=0.3, stiffness_factor=100)
     sim.add_packing(packing)
     # (4) The box and the plate.
     walls = (
