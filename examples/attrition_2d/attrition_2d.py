@@ -61,8 +61,8 @@ def main(argv: list[str] | None = None) -> dict[str, float]:
         "--pair-law",
         choices=("surface", "granulate"),
         default="surface",
-        help="contact law: surface (the default) or granulate (the node spheres, which made the "
-        "committed figures)",
+        help="contact law: surface (the default) or granulate (the node spheres, which made "
+        "attrition_six_turns.png)",
     )
     args = parser.parse_args(argv)
 
