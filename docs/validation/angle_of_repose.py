@@ -20,8 +20,8 @@ flow and stop together), so these angles are lower than the angles of repose of 
 of the same grains.
 
 Run: python docs/validation/angle_of_repose.py; prints the table (two packings per case) and
-writes docs/validation/angle_of_repose.png (about 6 minutes on 2 cores). --smoke: the small column,
-table only.
+writes docs/validation/angle_of_repose.png (11 minutes on one thread of a shared 2-core
+machine). --smoke: the small column, table only.
 """
 
 from __future__ import annotations
@@ -38,7 +38,6 @@ GRAIN = gr.Material(density=2000, youngs_modulus=1e7, poisson_ratio=0.25, fractu
 RADIUS = 1e-3  # the reference disc; the grains are scaled from it
 NODES_ACROSS_RADIUS = 3
 GRAVITY = 100.0
-CONTACT_OPTIONS: dict[str, str] = {}  # --pair-law
 
 
 @dataclass(frozen=True)
@@ -72,9 +71,7 @@ def collapse(
     column = gr.Rectangle((0, 0), (width, 3 * width))
     packing = gr.pack(column, [grain], _column_count(width), method="lattice", seed=seed)
     sim = gr.Simulation(2, gravity=(0, -GRAVITY), viscous_damping=5.0)
-    sim.contact = gr.Contact(
-        restitution=0.3, friction=friction, rolling_friction=rolling_friction, **CONTACT_OPTIONS
-    )
+    sim.contact = gr.Contact(restitution=0.3, friction=friction, rolling_friction=rolling_friction)
     sim.add_packing(packing)
     sim.add_wall(rough_floor(10 * width), name="floor")
     sim.add_wall(gr.Plane((0, 0), (1, 0)), name="wall")
@@ -135,15 +132,7 @@ def main() -> None:
     parser.add_argument(
         "--smoke", action="store_true", help="the 8 mm column (28 grains); prints, draws nothing"
     )
-    parser.add_argument(
-        "--pair-law",
-        choices=("surface", "granulate"),
-        help="Contact(pair_law=...): surface (the default) or granulate (the node spheres, "
-        "which made the committed figure)",
-    )
     args = parser.parse_args()
-    if args.pair_law is not None:
-        CONTACT_OPTIONS["pair_law"] = args.pair_law
     width = 8e-3 if args.smoke else 16e-3
     import matplotlib
 

@@ -30,21 +30,20 @@ def settled_angle(
 @pytest.mark.validation
 def test_the_heap_of_a_collapsed_column_is_steeper_with_friction(full: bool) -> None:
     """--full: a 16 mm x 48 mm column (121 grains) after 0.14 s, the angles averaged over two
-    packings: measured 5.5, 8.4 and 8.9 degrees for mu = 0, 0.2 and 0.5, and 20.3 with mu = 0.5 and
-    rolling resistance mu_r = 0.3 (seed 1: 5.3, 7.9, 9.2, 20.4; seed 2: 5.6, 8.8, 8.6, 20.3; before
-    aedd09a: 4.8, 7.5, 8.9, 17.3). Round grains roll rather than slide, so above mu = 0.2 friction
-    adds little and rolling resistance much: asserted, mu = 0.2 at least 1.5 degrees over mu = 0,
-    mu = 0.5 at least 3 over mu = 0 and not below mu = 0.2 by more than a degree, and mu_r = 0.3 at
-    least 5 over mu = 0.5 alone. One heap is a noisy measure: changing the damping ratios by 1e-6
-    (a04e262) moved seed 1's angles from 5.2 / 7.4 / 10.6 / 18.5 to 4.8 / 7.6 / 10.0 / 18.9, and
-    fading the turned collision force out of lasting contacts (8606011) moved the means from 5.0 /
-    8.1 / 9.3 / 18.5 to 4.8 / 7.5 / 8.9 / 17.3. The smoke test collapses an 8 mm x 24 mm column (28
-    grains) for 0.1 s, packings 1 and 2, mu = 0 and 0.5: 3.6 / 4.4 and 9.7 / 6.7 degrees (kinetic
-    energy at most 2.4e-4 of the weight times the width), means asserted at least 2 degrees apart.
-    One packing is not enough: over packings 1-6 the gaps are 6.1, 2.3, 1.6, 5.2, 8.0 and 3.3 (mu =
-    0: 3.3-5.4 degrees, mu = 0.5: 6.7-11.3; measured after collisions in gaps kept their slots and
-    end when the bodies slide apart, aedd09a), so a single heap can fall under the margin; the mean
-    of two is 3.4-5.7 (before 8606011 it was 3.6-5.0)."""
+    packings: measured under the surface law 3.6, 6.6 and 8.7 degrees for mu = 0, 0.2 and 0.5,
+    and 17.0 with mu = 0.5 and rolling resistance mu_r = 0.3 (seed 1: 3.4, 6.3, 8.3, 19.1; seed
+    2: 3.9, 6.9, 9.2, 14.9); on the node spheres 5.5, 8.4, 8.9 and 20.3, their staircase of node
+    spheres holding the grains a little steeper. Round grains roll rather than slide, so above
+    mu = 0.2 friction adds little and rolling resistance much: asserted, mu = 0.2 at least 1.5
+    degrees over mu = 0, mu = 0.5 at least 3 over mu = 0 and not below mu = 0.2 by more than a
+    degree, and mu_r = 0.3 at least 5 over mu = 0.5 alone. One heap is a noisy measure: on the
+    node spheres, changing the damping ratios by 1e-6 (a04e262) moved seed 1's angles from 5.2 /
+    7.4 / 10.6 / 18.5 to 4.8 / 7.6 / 10.0 / 18.9. The smoke test collapses an 8 mm x 24 mm
+    column (28 grains) for 0.1 s, packings 1 and 2, mu = 0 and 0.5: 3.1 / 4.1 and 8.0 / 9.9
+    degrees under the surface law (3.6 / 4.4 and 9.7 / 6.7 on the node spheres), means asserted
+    at least 2 degrees apart. One packing is not enough: on the node spheres, over packings 1-6,
+    the gaps were 6.1, 2.3, 1.6, 5.2, 8.0 and 3.3, so a single heap can fall under the margin;
+    the mean of two was 3.4-5.7."""
     if full:
         angles = [
             np.mean(
