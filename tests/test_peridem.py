@@ -194,17 +194,22 @@ def test_compression_deck_settles_like_peridem(tmp_path: Path) -> None:
     PeriDEM's contact spheres sit on the mesh's surface nodes and reach Rc = 0.95 h (0.16 mm)
     beyond each grain; granulate's reach the surfaces themselves. So the settled pile (grain
     radius 1 mm, one to three layers) is lower than PeriDEM's by up to Rc per contact below a
-    grain, three contacts at most: the mean grain centroid height at the last frame is
-    0.02-0.5 mm below PeriDEM's (measured 0.268 mm; 26 um above it while granulate's spheres
-    also stood proud of the mesh's surface). The walls' reactions are those of the grains
-    (PeriDEM's summed force on its walls is their weight alone: it does not report the grains'
-    push, the "one-way walls" of the notes)."""
+    grain, three contacts at most: the mean grain centroid height over frames 4-10 (steps 8,000
+    to 20,000) is 0.05-0.5 mm below PeriDEM's (measured 0.209 mm; 0.197 before the surface
+    law's fade and smooth facing; 26 um above it while granulate's spheres also stood proud of
+    the mesh's surface). The grains bounce without damping, so one frame's mean is chaotic:
+    the last frame's alone ranged from 0.015 to 0.19 mm between builds that differ only in
+    rare contact configurations, and frames 4-10 of one run from 0.057 to 0.355 mm. The walls'
+    reactions are those of the grains (PeriDEM's summed force on its walls is their weight
+    alone: it does not report the grains' push, the "one-way walls" of the notes)."""
     out = run_deck("compression_small_set", tmp_path / "out", None)
     ref = reference("compression_small_set")
-    last = ref[ref[:, 0] == 10]
-    ours = centroids(frame(out, 10), 17)
     grains = slice(0, 15)
-    assert 2e-5 < last[grains, 7].mean() - ours[grains, 1].mean() < 5e-4
+    below = [
+        ref[ref[:, 0] == k][grains, 7].mean() - centroids(frame(out, k), 17)[grains, 1].mean()
+        for k in range(4, 11)
+    ]
+    assert 5e-5 < np.mean(below) < 5e-4
     rows = history(out)
     assert rows[-1]["broken_bonds"] == 0
     assert rows[-1]["p16_uy"] == pytest.approx(-3e-3, rel=1e-9)

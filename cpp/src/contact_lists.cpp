@@ -490,9 +490,11 @@ void ContactModel::find_groups(const Model& model) {
   }
   surface_points_.resize(surface_nodes_.size());
   surface_sizes_.resize(surface_nodes_.size());
+  surface_stretches_.resize(surface_nodes_.size());
   fit(surface_nodes_);
   fit(surface_points_);
   fit(surface_sizes_);
+  fit(surface_stretches_);
   fit(groups_);
   // Each entry (i, j) of a node i with a surface point: the group of j that probes i's body.
   entry_target_.assign(pair_partner_.size(), no_group);

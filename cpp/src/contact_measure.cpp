@@ -117,15 +117,16 @@ const contact::SurfacePoint& ContactModel::surface_point(index_t j) const {
 real ContactModel::probe_stiffness(const Model& model, index_t i, index_t target,
                                    const contact::PairLaw& law) const {
   // Per unit area the contact is as stiff as the sphere law's node pairs of the finer mesh,
-  // kn min(V_i, V_t)^2 per (finer h)^(d-1) (V: stiffness_volume); a probe carries its own node's
-  // share of the surface, h_i^(d-1), and its side's share of the contact.
+  // kn min(V_i, h_t^d)^2 per (finer h)^(d-1) (V_i: stiffness_volume; h_t^d: the target body's
+  // nominal node volume); a probe carries its own node's share of the surface, h_i^(d-1), and
+  // its side's share of the contact.
   const real hi = particle_side_[model.node_particle()[i]].mesh_size;
   const real ht = particle_side_[model.node_particle()[target]].mesh_size;
   const real share = ht * ht / (hi * hi + ht * ht);
   const real area =
       dimension_ == 2 ? hi / std::min(hi, ht) : (hi * hi) / (std::min(hi, ht) * std::min(hi, ht));
-  return share * area *
-         contact::pair_stiffness(law, stiffness_volume(model, i), stiffness_volume(model, target));
+  const real nominal = dimension_ == 2 ? ht * ht : ht * ht * ht;
+  return share * area * contact::pair_stiffness(law, stiffness_volume(model, i), nominal);
 }
 
 real ContactModel::stiffness_volume(const Model& model, index_t i) const {
@@ -318,7 +319,11 @@ void ContactModel::measure_surface_points(const Model& model, const State& state
   const std::int64_t count = static_cast<std::int64_t>(surface_nodes_.size());
 #pragma omp parallel for schedule(static)
   for (std::int64_t k = 0; k < count; ++k) {
-    surface_points_[k] = surface_point_now(model, state, surface_nodes_[k], surface_sizes_[k]);
+    const index_t j = surface_nodes_[k];
+    surface_points_[k] = surface_point_now(model, state, j, surface_sizes_[k]);
+    const SurfaceCentres::Seen seen = centres_.seen(model, j);  // |A_0| = (h/2) |o| (surface_anchors.hpp)
+    surface_stretches_[k] =
+        static_cast<float>(surface_sizes_[k] / (0.5 * seen.mesh_size * seen.anchor->reach));
   }
 }
 
@@ -474,6 +479,12 @@ real ContactModel::measure_probes(const Model& model, const State& state, index_
   if (group_begin == group_end) return 0;
   const bool surface = on_surface(model, i);
   const vec3 p = centres_.at_surface(model, state, i);
+  // The fade of the probe's own point (1 for a node without one): phi, and d phi / d|A|.
+  const index_t own_slot = surface ? surface_slot_[i] : no_group;
+  const real stretch = own_slot == no_group ? 1.0 : surface_stretches_[own_slot];
+  const real own_fade = contact::surface_fade(stretch);
+  const real own_fade_slope =
+      own_slot == no_group ? 0.0 : contact::surface_fade_slope(stretch) * stretch / surface_sizes_[own_slot];
   const index_t first = pair_offsets_[i], last = pair_offsets_[i + 1];
   scratch.points.assign(last - first, nullptr);  // the points in reach (null: none)
   scratch.weights.assign(last - first, 0.0);
@@ -489,7 +500,7 @@ real ContactModel::measure_probes(const Model& model, const State& state, index_
     const contact::SurfacePoint& point = surface_point(j);
     const vec d{p[0] - point.position[0], p[1] - point.position[1], p[2] - point.position[2]};
     const real distance = std::sqrt(dot(d, d));
-    if (!(distance < support)) continue;
+    if (!(distance < support) || surface_fade_of(j) == 0) continue;
     scratch.points[e - first] = &point;
     real& best = scratch.nearest[g - group_begin];
     if (best < 0) {  // the group's first point in reach: set the probe up
@@ -501,20 +512,27 @@ real ContactModel::measure_probes(const Model& model, const State& state, index_
       probe.point = p;
       probe.support = support;
       probe.radius = surface ? 0.0 : node_radius(own, model, i, j, law.contact_radius);
-      probe.stiffness = probe_stiffness(model, i, j, law);
+      probe.stiffness = own_fade * probe_stiffness(model, i, j, law);
       probe.contact_radius = law.contact_radius;
+      if (own_slot != no_group) {
+        const vec3& n = surface_points_[own_slot].normal;
+        probe.facing = {-n[0], -n[1], -n[2]};
+        probe.smooth_facing = true;
+      }
     }
     if (best < 0 || distance < best) {
       best = distance;
-      state_of(g).facing = point.normal;
+      if (!state_of(g).smooth_facing) state_of(g).facing = point.normal;
     }
   }
   for (index_t e = first; e < last; ++e) {
     const contact::SurfacePoint* point = scratch.points[e - first];
     if (point == nullptr) continue;
     ProbeState& probe = state_of(entry_group_[e]);
-    if (!contact::faces(*point, probe.facing)) continue;
-    const contact::PointTerms t = contact::point_terms(*point, p, probe.support);
+    const real share = contact::facing_share(*point, probe.facing, probe.smooth_facing);
+    if (share == 0) continue;
+    const contact::PointTerms t = contact::faded(contact::point_terms(*point, p, probe.support),
+                                                 share * surface_fade_of(pair_partner_[e]));
     scratch.weights[e - first] = t.weight;
     probe.sums.add(t);
   }
@@ -529,6 +547,9 @@ real ContactModel::measure_probes(const Model& model, const State& state, index_
     probe.push = probe.stiffness * overlap * contact::surface_taper(probe.sums.weight);
     probe.taper = 0.5 * probe.stiffness * overlap * overlap * contact::surface_taper_slope(probe.sums.weight);
     if (!(probe.push > 0)) continue;  // tapered to nothing past the edge of its points
+    // E = phi k0 delta^2 tau / 2: its derivative through the fade, along the own normal on A.
+    probe.fade_force = own_fade_slope == 0 ? 0.0 : 0.5 * probe.push * overlap * own_fade_slope / own_fade;
+    if (probe.smooth_facing) probe.facing_force = facing_force(i, g, probe, first, last);
     scratch.touching.push_back(probe);
     // The overlap that carries force (a probe tapered past the edge of its points does not).
     deepest = std::max(deepest, probe.push / (probe.stiffness * probe.contact_radius));
@@ -553,11 +574,41 @@ void ContactModel::keep_touching_probes(std::vector<ProbeState>& measured) {
   for (std::size_t k = 0; k < probes_.size(); ++k) group_probe_[probes_[k].group] = static_cast<index_t>(k);
 }
 
-real ContactModel::surface_share(const ProbeState& probe, const contact::SurfacePoint& point) const {
-  if (!contact::faces(point, probe.facing)) return 0;
+vec3 ContactModel::facing_force(index_t i, index_t g, const ProbeState& probe, index_t first,
+                                index_t last) const {
+  // The force on the probe's own A through its facing -n_p, n_p = A / |A|: each point's share
+  // psi(n_k . (-n_p)) moves with n_p, dE/d(omega_k) = -P (d_k - g) / S + Q (omega_k = phi_k
+  // psi_k w_k), so the force on n_p is sum_k (P (d_k - g) / S - Q) phi_k w_k psi'_k (-n_k),
+  // and on A its tangential part over |A| (surface_centres.hpp).
+  const real gap = probe.sums.gap(), weight = probe.sums.weight;
+  vec3 on_normal{0, 0, 0};
+  for (index_t e = first; e < last; ++e) {
+    if (entry_group_[e] != g) continue;
+    const index_t j = pair_partner_[e];
+    const contact::SurfacePoint& point = surface_point(j);
+    const real slope = contact::facing_share_slope(point, probe.facing, true);
+    if (slope == 0) continue;
+    const contact::PointTerms raw = contact::point_terms(point, probe.point, probe.support);
+    if (raw.weight == 0) continue;
+    const real coefficient =
+        (probe.push * (raw.distance - gap) / weight - probe.taper) * surface_fade_of(j) * raw.weight * slope;
+    for (int c = 0; c < 3; ++c) on_normal[c] -= coefficient * point.normal[c];
+  }
+  const contact::SurfacePoint& own = surface_point(i);
+  const real size = surface_sizes_[surface_slot_[i]];
+  const real along = dot(on_normal, own.normal);
+  return {(on_normal[0] - along * own.normal[0]) / size, (on_normal[1] - along * own.normal[1]) / size,
+          (on_normal[2] - along * own.normal[2]) / size};
+}
+
+real ContactModel::surface_share(const ProbeState& probe, index_t j) const {
+  const contact::SurfacePoint& point = surface_point(j);
+  const real share = contact::facing_share(point, probe.facing, probe.smooth_facing);
+  if (share == 0) return 0;
   const vec d{probe.point[0] - point.position[0], probe.point[1] - point.position[1],
               probe.point[2] - point.position[2]};
-  return contact::surface_weight(std::sqrt(dot(d, d)) / probe.support) / probe.sums.weight;
+  return share * surface_fade_of(j) * contact::surface_weight(std::sqrt(dot(d, d)) / probe.support) /
+         probe.sums.weight;
 }
 
 void ContactModel::sum_slot_stiffness() {

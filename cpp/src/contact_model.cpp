@@ -295,8 +295,8 @@ std::size_t ContactModel::memory_bytes() const {
          bytes(slot_surface_normal_) + bytes(touching_nodes_) + bytes(touching_normals_) +
          centres_.memory_bytes() + bytes(anchor_forces_) + bytes(entry_group_) + bytes(entry_target_) +
          bytes(taking_part_) + bytes(surface_nodes_) + bytes(surface_slot_) + bytes(surface_points_) +
-         bytes(surface_sizes_) + bytes(groups_) + bytes(group_offsets_) + bytes(probes_) +
-         bytes(group_probe_);
+         bytes(surface_sizes_) + bytes(surface_stretches_) + bytes(groups_) + bytes(group_offsets_) +
+         bytes(probes_) + bytes(group_probe_);
 }
 
 std::array<index_t, 2> ContactModel::first_wall_penetration(const Model& model, const State& state) const {

@@ -46,7 +46,7 @@ void ContactModel::probe_friction(const Model& model, const State& state, index_
       if (entry_group_[e] != g) continue;
       const index_t j = pair_partner_[e];
       const contact::SurfacePoint& point = surface_point(j);
-      const real fraction = shares[e - first] = surface_share(probe, point);
+      const real fraction = shares[e - first] = surface_share(probe, j);
       if (fraction == 0) continue;
       const vec turn = cross(spin_target, {point.position[0] - y[3 * j], point.position[1] - y[3 * j + 1],
                                            point.position[2] - y[3 * j + 2]});
@@ -84,22 +84,35 @@ void ContactModel::probe_friction(const Model& model, const State& state, index_
   }
 }
 
-void ContactModel::target_forces(const contact::SurfacePoint& point, real size, const ProbeState& probe,
-                                 vec3& on_point, vec3& on_normal, vec3& on_friction) const {
+void ContactModel::target_forces(const contact::SurfacePoint& point, real size, real stretch,
+                                 const ProbeState& probe, vec3& on_point, vec3& on_normal,
+                                 vec3& on_friction) const {
   // The exact reaction of a target's surface point and normal to the probe's energy (see
-  // contact/surface_law.hpp), and its share w / S of the friction force, opposite (on the
-  // node; probe_couples adds the couple).
+  // contact/surface_law.hpp), and its share phi w / S of the friction force, opposite (on the
+  // node; probe_couples adds the couple). Its weight phi w moves with |A| through the fade:
+  // dE/d(phi w) = -P (d - g) / S + Q, times w phi' / |A_0| along n on A.
   on_point = on_normal = on_friction = {0, 0, 0};
-  if (!contact::faces(point, probe.facing)) return;
-  const contact::PointTerms t = contact::point_terms(point, probe.point, probe.support);
-  if (t.weight == 0) return;
+  // Its share psi moves with n_k too: (P (d - g) / S - Q) phi w psi' facing on n_k.
+  const real fade = contact::surface_fade(stretch);
+  const real facing = contact::facing_share(point, probe.facing, probe.smooth_facing);
+  if (fade == 0 || facing == 0) return;
+  const contact::PointTerms raw = contact::point_terms(point, probe.point, probe.support);
+  if (raw.weight == 0) return;
+  const contact::PointTerms t = contact::faded(raw, fade * facing);
   const real gap = probe.sums.gap(), weight = probe.sums.weight;
   const vec3 share = contact::point_share(t, gap, weight);
   const real fraction = t.weight / weight;
+  const real pull = probe.push * (t.distance - gap) / weight - probe.taper;  // -dE/d(omega)
+  const real fade_slope = contact::surface_fade_slope(stretch);
+  const real radial = fade_slope == 0 ? 0.0 : pull * raw.weight * facing * fade_slope * stretch / size;
+  const real turn =
+      pull * raw.weight * fade * contact::facing_share_slope(point, probe.facing, probe.smooth_facing);
+  const real along = turn * contact::facing_cosine(point, probe.facing);  // its normal part
   for (int c = 0; c < 3; ++c) {
     on_point[c] = -probe.push * share[c] + probe.taper * t.weight_gradient[c];
     on_friction[c] = -fraction * probe.friction[c];
-    on_normal[c] = probe.push * fraction * t.normal_sensitivity[c] / size;
+    on_normal[c] = probe.push * fraction * t.normal_sensitivity[c] / size + radial * point.normal[c] +
+                   (turn * probe.facing[c] - along * point.normal[c]) / size;
   }
 }
 
@@ -153,18 +166,24 @@ ContactModel::NodeContactForces ContactModel::gather_node_forces(const Model& mo
       at_surface[c] += probe->push * probe->gradient[c] - probe->taper * probe->sums.spread[c];
       at_node[c] += probe->friction[c];
     }
+    if (probe->fade_force != 0) {  // only on a node with a surface point, whose fade is below 1
+      const vec3& n = surface_point(i).normal;
+      for (int c = 0; c < 3; ++c) on_vector[c] -= probe->fade_force * n[c];
+    }
+    for (int c = 0; c < 3; ++c) on_vector[c] += probe->facing_force[c];
   }
   if (!anchored || surface_slot_.empty() || surface_slot_[i] == no_group) {
     return forces;
   }
   const contact::SurfacePoint& own = surface_point(i);
   const real size = surface_sizes_[surface_slot_[i]];
+  const real stretch = surface_stretches_[surface_slot_[i]];
   for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
     const index_t g = entry_target_[e];
     const ProbeState* probe = g == no_group ? nullptr : touching_probe(g);
     if (probe == nullptr) continue;
     vec on_point, on_normal, on_friction;
-    target_forces(own, size, *probe, on_point, on_normal, on_friction);
+    target_forces(own, size, stretch, *probe, on_point, on_normal, on_friction);
     for (int c = 0; c < 3; ++c) {
       at_surface[c] += on_point[c];
       on_vector[c] += on_normal[c];

@@ -289,17 +289,20 @@ class ContactModel {
   struct ProbeState {
     index_t group = 0;  ///< the group it measures
     contact::SurfaceGap sums;
-    vec3 point{0, 0, 0};      ///< the probe point p (a surface point, or the node)
-    real radius = 0;          ///< its contact radius r (0 for a surface point)
-    real support = 0;         ///< the target's support radius a
-    real stiffness = 0;       ///< k of the probe
-    real contact_radius = 0;  ///< Rc of the pair's law (the scale of the deepest overlap)
-    real push = 0;            ///< P = k delta tau (> 0: only touching groups are kept)
-    real taper = 0;           ///< Q = k delta^2 tau'(S) / 2 (0 on a surface)
-    vec3 gradient{0, 0, 0};   ///< G, the surface's normal direction at p (out of the target)
-    vec3 friction{0, 0, 0};   ///< the friction force on the probe
-    vec3 foot{0, 0, 0};       ///< sum_k (w_k / S) y_k: where the target's nodes take the friction force
-    vec3 facing{0, 0, 0};     ///< the normal of the nearest point: the points counted face along it
+    vec3 point{0, 0, 0};         ///< the probe point p (a surface point, or the node)
+    real radius = 0;             ///< its contact radius r (0 for a surface point)
+    real support = 0;            ///< the target's support radius a
+    real stiffness = 0;          ///< k of the probe
+    real contact_radius = 0;     ///< Rc of the pair's law (the scale of the deepest overlap)
+    real push = 0;               ///< P = k delta tau (> 0: only touching groups are kept)
+    real taper = 0;              ///< Q = k delta^2 tau'(S) / 2 (0 on a surface)
+    real fade_force = 0;         ///< dE/d|A| of the probe's own point through its fade (0 unless it fades)
+    vec3 gradient{0, 0, 0};      ///< G, the surface's normal direction at p (out of the target)
+    vec3 friction{0, 0, 0};      ///< the friction force on the probe
+    vec3 foot{0, 0, 0};          ///< sum_k (w_k / S) y_k: where the target's nodes take the friction force
+    vec3 facing{0, 0, 0};        ///< the points counted face along it (surface_law.hpp: facing_start)
+    bool smooth_facing = false;  ///< facing is -n_p, the probe's own normal (shares psi smooth)
+    vec3 facing_force{0, 0, 0};  ///< the force on the probe's own A through the shares psi
   };
   std::vector<index_t> entry_group_;  // per pair entry: the group it belongs to as a probe entry
   /// Whether list entry e belongs to a surface probe (none without the surface law).
@@ -326,9 +329,10 @@ class ContactModel {
   }
   /// probes_ and group_probe_ from the touching groups each thread measured (any order).
   void keep_touching_probes(std::vector<ProbeState>& measured);
-  /// The probe k of a group of node i against body b: beta kn min(V_i, V_b)^2 (h_i/h_min)^(d-1),
-  /// V the stiffness_volume of i and of b's node, beta = h_b^2 / (h_i^2 + h_b^2) (the finer
-  /// surface probes the coarser; equal meshes share the contact equally).
+  /// The probe k of a group of node i against body b: beta kn min(V_i, h_b^d)^2 (h_i/h_min)^(d-1),
+  /// V_i the stiffness_volume of i, h_b^d the nominal volume of b's nodes (the same for all of
+  /// b's points, so k does not jump when the point `target` leaves reach), beta = h_b^2 / (h_i^2
+  /// + h_b^2) (the finer surface probes the coarser; equal meshes share the contact equally).
   real probe_stiffness(const Model& model, index_t i, index_t target, const contact::PairLaw& law) const;
   /// Node j's surface point as the surface law sees it (this step's, from measure_surface_points).
   const contact::SurfacePoint& surface_point(index_t j) const;
@@ -336,6 +340,11 @@ class ContactModel {
   std::vector<index_t> surface_nodes_, surface_slot_;  // nodes with entries and surface points; per node
   std::vector<contact::SurfacePoint> surface_points_;  // per step, per surface node
   std::vector<real> surface_sizes_;                    // |A| of each, per step
+  std::vector<float> surface_stretches_;               // |A| / |A_0| of each, per step
+  /// The fade phi of node j's surface point this step (contact/surface_law.hpp).
+  real surface_fade_of(index_t j) const {
+    return contact::surface_fade(surface_stretches_[surface_slot_[j]]);
+  }
   /// Groups from the lists and the bodies (after every list change).
   void find_groups(const Model& model);
   /// The group of the probe j whose target body holds node i (the entry (j, i)), or no_group.
@@ -349,8 +358,10 @@ class ContactModel {
     std::vector<ProbeState> touching;  // every node's touching groups, kept for the step
   };
   real measure_probes(const Model& model, const State& state, index_t i, ProbeScratch& scratch);
-  /// w_k / S of a target point in a group's sums (0 if it does not face the probe).
-  real surface_share(const ProbeState& probe, const contact::SurfacePoint& point) const;
+  /// The force on the own A of node i's touching probe of group g through its smooth facing.
+  vec3 facing_force(index_t i, index_t g, const ProbeState& probe, index_t first, index_t last) const;
+  /// phi_k w_k / S of node j's surface point in a group's sums (0 if it does not face the probe).
+  real surface_share(const ProbeState& probe, index_t j) const;
   /// Friction of every touching group (updates its entries' springs), per probing node in
   /// parallel, after pass B.
   void probe_frictions(const Model& model, const State& state, real dt);
@@ -359,10 +370,10 @@ class ContactModel {
   /// v(s_k)), weighted by w_k / S; and the foot f = sum_k (w_k / S) y_k (`shares`: scratch,
   /// per entry of the node).
   void probe_friction(const Model& model, const State& state, index_t i, real dt, std::vector<real>& shares);
-  /// The force on a target's surface point (`point`, with |A| = `size`) from a touching probe,
-  /// and the force on its anchored vector A.
-  void target_forces(const contact::SurfacePoint& point, real size, const ProbeState& probe, vec3& on_point,
-                     vec3& on_normal, vec3& on_friction) const;
+  /// The force on a target's surface point (`point`, with |A| = `size` and |A| / |A_0| =
+  /// `stretch`) from a touching probe, and the force on its anchored vector A.
+  void target_forces(const contact::SurfacePoint& point, real size, real stretch, const ProbeState& probe,
+                     vec3& on_point, vec3& on_normal, vec3& on_friction) const;
 
   /// Nodes with list entries, grouped by body (each group in node order), and the per-step
   /// scratch of bodies and slots.
