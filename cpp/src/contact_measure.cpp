@@ -332,10 +332,13 @@ contact::SurfacePoint ContactModel::surface_point_now(const Model& model, const 
   const SurfaceCentres::Seen seen = centres_.seen(model, j);
   const vec3 a = SurfaceCentres::anchored_vector(seen, state.positions, j);
   size = std::sqrt(dot(a, a));
+  // Where SurfaceCentres::point puts it: the offset fades where the neighbourhood folds.
+  const real offset =
+      seen.surface_length * contact::surface_fade(size / (0.5 * seen.mesh_size * seen.anchor->reach));
   contact::SurfacePoint point;
   for (int c = 0; c < 3; ++c) {
     point.normal[c] = a[c] / size;
-    point.position[c] = state.positions[3 * j + c] + seen.surface_length * point.normal[c];
+    point.position[c] = state.positions[3 * j + c] + offset * point.normal[c];
   }
   point.curvature = seen.anchor->curvature / seen.mesh_size;
   return point;

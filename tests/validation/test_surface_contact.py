@@ -277,7 +277,7 @@ def test_a_lattice_disc_rolls_on_a_turning_drum() -> None:
     assert spin > 10.0, spin
 
 
-def _still_drum_of_soft_grains(tmp_path: Path) -> Path:
+def _still_drum_of_soft_grains(tmp_path: Path, steps: int) -> Path:
     """PeriDEM's attrition deck with its drum held still, no gravity, and the twelve grains
     (K = 5 kPa, wave speed 2.9 m/s) thrown at 2 m/s in seeded directions at a tenth of the
     deck's time step: an isolated elastic system (e = 1, no friction) whose grains crush
@@ -294,7 +294,7 @@ def _still_drum_of_soft_grains(tmp_path: Path) -> Path:
     text = text.replace("rate: -125.6637", "rate: 0.0").replace(
         "gravity: [0.0, -10.0]", "gravity: [0.0, 0.0]"
     )
-    text = re.sub(r"time: \{dt: [^}]*\}", "time: {dt: 2.5e-07, steps: 2500}", text)
+    text = re.sub(r"time: \{dt: [^}]*\}", f"time: {{dt: 2.5e-07, steps: {steps}}}", text)
     directions = np.random.default_rng(1).uniform(0, 2 * np.pi, 12)
     for k, a in enumerate(directions):
         text = re.sub(
@@ -310,18 +310,23 @@ def _still_drum_of_soft_grains(tmp_path: Path) -> Path:
 
 
 @pytest.mark.validation
-def test_soft_grains_crushed_on_thin_protrusions_keep_their_energy(tmp_path: Path) -> None:
+def test_soft_grains_crushed_on_thin_protrusions_keep_their_energy(
+    tmp_path: Path, full: bool
+) -> None:
     """Grains flattened against thin protrusions fold their surface: a surface point's
     anchored vector A shrank to 0.007 of its reference at step 1,904, and a probe's nearest
     point changed at a corner, taking points out of its sums at once. Before the fade of folded
     points and the smooth facing (contact/surface_law.hpp) the total energy jumped by 1.4 % at
-    step 1,724 and by 3.4 % by step 1,900 (and twelvefold by step 80,000); now it stays within
-    1e-4 up to step 6,000. Asserted: within 1e-3 over 2,500 steps."""
+    step 1,724 and grew twelvefold by step 80,000; with them, but the contact centres of node
+    pairs still swinging with a folded normal (contact/surface_centres.hpp), it passed 1e-4 at
+    step 6,200 (2.1e-4 by 8,000) and grew 3.8-fold by 80,000. Now it stays within 6.2e-5 to
+    step 8,000 and 2.5e-4 to 80,000. Asserted: 1e-4 over 8,000 steps; 1e-3 over 80,000 with
+    --full."""
     from granulate.cli import main
 
-    case = _still_drum_of_soft_grains(tmp_path)
+    case = _still_drum_of_soft_grains(tmp_path, 80_000 if full else 8_000)
     assert main(["run", str(case), "--out", str(tmp_path / "out"), "--quiet"]) == 0
     history = np.genfromtxt(tmp_path / "out" / "history.csv", delimiter=",", names=True)
     total = history["total_energy"]
     assert history["node_contacts"].max() > 0  # the grains do meet the drum
-    assert np.abs(total / total[0] - 1).max() < 1e-3
+    assert np.abs(total / total[0] - 1).max() < (1e-3 if full else 1e-4)

@@ -10,6 +10,9 @@
 //   the contact centre   c_i = y_i + (d_i - rho |o_i|) n_i  (rho |o_i| below s_i, so that the
 //                        sphere of radius rho reaches every face at a mesh corner; walls, and
 //                        node pairs within one body, see the node's sphere there).
+// Under the surface law the offset fades where the neighbourhood folds (contact/surface_law.hpp,
+// surface_fade of |A_i| / |A_0|): q = y_i + l phi n_i, so a folded node's points slide back to
+// the node instead of swinging with a normal that means nothing. With phi = 1:
 // A point q = y_i + l n_i moves at v_i + l (1 - n n^T) A_i(v) / |A_i|. A force F on q goes F
 // to the node and, as the force (l / |A_i|) (1 - n n^T) F on A_i, -W of that to the node and
 // w_k to anchor k (W = sum w_k): F at q in momentum, moment and work. A force along the normal
@@ -35,6 +38,7 @@
 #include <span>
 #include <vector>
 
+#include "granulate/contact/surface_law.hpp"
 #include "granulate/model.hpp"
 #include "granulate/state.hpp"
 #include "granulate/surface_anchors.hpp"
@@ -124,6 +128,8 @@ class SurfaceCentres {
   /// The factor f of the linear form y_i + f A_i outside the surface law: length / ((h/2) |o_i|).
   static real linear_scale(const Seen& s, real length);
   static real length_of(const vec3& a);
+  /// |A_0| = (h/2) |o|, the anchored vector's length in the reference (surface_anchors.hpp).
+  static real reference_length(const Seen& s);
   void detach(index_t i);
   /// Whether every surface point of the shape has a curvature radius within the round bounds.
   static bool is_round(const Shape& shape);
@@ -184,13 +190,19 @@ inline SurfaceCentres::vec3 SurfaceCentres::anchored_vector(const Seen& s, const
   return sum;
 }
 
+inline real SurfaceCentres::reference_length(const Seen& s) {
+  return 0.5 * s.mesh_size * s.anchor->reach;
+}
+
 inline SurfaceCentres::vec3 SurfaceCentres::point(const State& state, const Seen& s, index_t i,
                                                   real length) const {
   const real* y = state.positions.data();
   vec3 q{y[3 * i], y[3 * i + 1], y[3 * i + 2]};
   if (length == 0 || s.anchor == nullptr) return q;
   const vec3 a = anchored_vector(s, state.positions, i);
-  const real scale = s.along_normal ? length / length_of(a) : linear_scale(s, length);
+  const real size = length_of(a);
+  const real scale = s.along_normal ? length * contact::surface_fade(size / reference_length(s)) / size
+                                    : linear_scale(s, length);
   for (int d = 0; d < 3; ++d) q[d] += scale * a[d];
   return q;
 }
@@ -211,12 +223,18 @@ inline SurfaceCentres::vec3 SurfaceCentres::lever(const State& state, const Seen
     const real scale = linear_scale(s, length);
     return {scale * force[0], scale * force[1], scale * force[2]};
   }
+  // q = y + length phi(|A| / |A_0|) A / |A|: the tangential lever length phi / |A|, and the
+  // fade's radial one length phi' / |A_0| (0 unless the neighbourhood has folded).
   const vec3 a = anchored_vector(s, state.positions, i);
   const real size2 = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
   const real size = std::sqrt(size2);
   const real along = (a[0] * force[0] + a[1] * force[1] + a[2] * force[2]) / size2;
-  return {length * (force[0] - along * a[0]) / size, length * (force[1] - along * a[1]) / size,
-          length * (force[2] - along * a[2]) / size};
+  const real stretch = size / reference_length(s);
+  const real fade = contact::surface_fade(stretch);
+  const real radial = length * contact::surface_fade_slope(stretch) / reference_length(s) * along * size;
+  return {length * fade * (force[0] - along * a[0]) / size + radial * a[0] / size,
+          length * fade * (force[1] - along * a[1]) / size + radial * a[1] / size,
+          length * fade * (force[2] - along * a[2]) / size + radial * a[2] / size};
 }
 
 }  // namespace granulate
