@@ -334,7 +334,7 @@ contact::SurfacePoint ContactModel::surface_point_now(const Model& model, const 
   size = std::sqrt(dot(a, a));
   // Where SurfaceCentres::point puts it: the offset fades where the neighbourhood folds.
   const real offset =
-      seen.surface_length * contact::surface_fade(size / (0.5 * seen.mesh_size * seen.anchor->reach));
+      seen.surface_length * contact::surface_fade(size / SurfaceCentres::reference_length(seen));
   contact::SurfacePoint point;
   for (int c = 0; c < 3; ++c) {
     point.normal[c] = a[c] / size;

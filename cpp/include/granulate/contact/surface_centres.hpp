@@ -93,6 +93,8 @@ class SurfaceCentres {
   vec3 lever(const State& state, const Seen& s, index_t i, real length, const vec3& force) const;
   /// A_i = sum_k w_k (f_k - f_i) of an anchored node for a nodal field f (zero without anchors).
   static vec3 anchored_vector(const Seen& s, const std::vector<real>& field, index_t i);
+  /// |A_0| = (h/2) |o|, the anchored vector's length in the reference (surface_anchors.hpp).
+  static real reference_length(const Seen& s);
 
   /// Node i's contact centre, and how fast it moves.
   vec3 at_centre(const Model& model, const State& state, index_t i) const {
@@ -128,8 +130,6 @@ class SurfaceCentres {
   /// The factor f of the linear form y_i + f A_i outside the surface law: length / ((h/2) |o_i|).
   static real linear_scale(const Seen& s, real length);
   static real length_of(const vec3& a);
-  /// |A_0| = (h/2) |o|, the anchored vector's length in the reference (surface_anchors.hpp).
-  static real reference_length(const Seen& s);
   void detach(index_t i);
   /// Whether every surface point of the shape has a curvature radius within the round bounds.
   static bool is_round(const Shape& shape);
