@@ -320,21 +320,17 @@ void ContactModel::measure_surface_points(const Model& model, const State& state
 #pragma omp parallel for schedule(static)
   for (std::int64_t k = 0; k < count; ++k) {
     const index_t j = surface_nodes_[k];
-    surface_points_[k] = surface_point_now(model, state, j, surface_sizes_[k]);
-    const SurfaceCentres::Seen seen = centres_.seen(model, j);  // |A_0| = (h/2) |o| (surface_anchors.hpp)
-    surface_stretches_[k] =
-        static_cast<float>(surface_sizes_[k] / (0.5 * seen.mesh_size * seen.anchor->reach));
+    const SurfaceCentres::Seen seen = centres_.seen(model, j);
+    surface_points_[k] = surface_point_now(seen, state, j, surface_sizes_[k]);
+    surface_stretches_[k] = static_cast<float>(SurfaceCentres::stretch(seen, surface_sizes_[k]));
   }
 }
 
-contact::SurfacePoint ContactModel::surface_point_now(const Model& model, const State& state, index_t j,
-                                                      real& size) const {
-  const SurfaceCentres::Seen seen = centres_.seen(model, j);
+contact::SurfacePoint ContactModel::surface_point_now(const SurfaceCentres::Seen& seen, const State& state,
+                                                      index_t j, real& size) {
   const vec3 a = SurfaceCentres::anchored_vector(seen, state.positions, j);
   size = std::sqrt(dot(a, a));
-  // Where SurfaceCentres::point puts it: the offset fades where the neighbourhood folds.
-  const real offset =
-      seen.surface_length * contact::surface_fade(size / SurfaceCentres::reference_length(seen));
+  const real offset = SurfaceCentres::faded_length(seen, seen.surface_length, size);  // as point() has it
   contact::SurfacePoint point;
   for (int c = 0; c < 3; ++c) {
     point.normal[c] = a[c] / size;

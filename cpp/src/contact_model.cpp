@@ -395,8 +395,8 @@ std::array<index_t, 2> ContactModel::first_surface_overlap(const Model& model, c
 
 real ContactModel::depth_inside(const Model& model, const State& state, index_t probe, index_t node) const {
   real size = 0;
-  const contact::SurfacePoint point = surface_point_now(model, state, node, size);
-  const vec3 p = surface_point_now(model, state, probe, size).position;
+  const contact::SurfacePoint point = surface_point_now(centres_.seen(model, node), state, node, size);
+  const vec3 p = surface_point_now(centres_.seen(model, probe), state, probe, size).position;
   // Support far beyond any probe: the sphere's distance, whatever the weight.
   return -contact::point_terms(point, p, 1e3 * model.particles()[model.node_particle()[node]].mesh_size)
               .distance;

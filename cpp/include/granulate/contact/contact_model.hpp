@@ -515,10 +515,10 @@ class ContactModel {
   /// The first surface point lying deeper than `fraction` h inside another particle's surface,
   /// and that particle's nearest surface point lying as deep inside the first's.
   std::array<index_t, 2> first_surface_overlap(const Model& model, const State& state, real fraction) const;
-  /// Node j's surface point at the state's positions (normal A / |A|, position y + d n,
-  /// curvature), and |A| into `size`.
-  contact::SurfacePoint surface_point_now(const Model& model, const State& state, index_t j,
-                                          real& size) const;
+  /// Node j's surface point at the state's positions (normal A / |A|, position y + d phi n,
+  /// curvature), and |A| into `size`; `seen` is j's (SurfaceCentres::seen).
+  static contact::SurfacePoint surface_point_now(const SurfaceCentres::Seen& seen, const State& state,
+                                                 index_t j, real& size);
   /// How deep surface node probe's surface point lies inside surface node node's osculating
   /// sphere [m] (negative outside).
   real depth_inside(const Model& model, const State& state, index_t probe, index_t node) const;

@@ -93,8 +93,12 @@ class SurfaceCentres {
   vec3 lever(const State& state, const Seen& s, index_t i, real length, const vec3& force) const;
   /// A_i = sum_k w_k (f_k - f_i) of an anchored node for a nodal field f (zero without anchors).
   static vec3 anchored_vector(const Seen& s, const std::vector<real>& field, index_t i);
-  /// |A_0| = (h/2) |o|, the anchored vector's length in the reference (surface_anchors.hpp).
-  static real reference_length(const Seen& s);
+  /// rho = |A_i| / |A_0|, |A_0| = (h/2) |o_i| the anchored vector's length in the reference
+  /// (surface_anchors.hpp): 1 while the neighbourhood keeps its shape, towards 0 as it folds.
+  static real stretch(const Seen& s, real size);
+  /// How far out along n_i a surface-law point `length` out at rest lies when |A_i| = size:
+  /// length phi(rho) (contact/surface_law.hpp, surface_fade).
+  static real faded_length(const Seen& s, real length, real size);
 
   /// Node i's contact centre, and how fast it moves.
   vec3 at_centre(const Model& model, const State& state, index_t i) const {
@@ -129,6 +133,8 @@ class SurfaceCentres {
  private:
   /// The factor f of the linear form y_i + f A_i outside the surface law: length / ((h/2) |o_i|).
   static real linear_scale(const Seen& s, real length);
+  /// |A_0| = (h/2) |o_i|, the anchored vector's length in the reference (surface_anchors.hpp).
+  static real reference_length(const Seen& s) { return 0.5 * s.mesh_size * s.anchor->reach; }
   static real length_of(const vec3& a);
   void detach(index_t i);
   /// Whether every surface point of the shape has a curvature radius within the round bounds.
@@ -154,7 +160,7 @@ class SurfaceCentres {
 };
 
 inline real SurfaceCentres::linear_scale(const Seen& s, real length) {
-  return length / (0.5 * s.mesh_size * s.anchor->reach);
+  return length / reference_length(s);
 }
 
 inline real SurfaceCentres::length_of(const vec3& a) {
@@ -190,8 +196,12 @@ inline SurfaceCentres::vec3 SurfaceCentres::anchored_vector(const Seen& s, const
   return sum;
 }
 
-inline real SurfaceCentres::reference_length(const Seen& s) {
-  return 0.5 * s.mesh_size * s.anchor->reach;
+inline real SurfaceCentres::stretch(const Seen& s, real size) {
+  return size / reference_length(s);
+}
+
+inline real SurfaceCentres::faded_length(const Seen& s, real length, real size) {
+  return length * contact::surface_fade(stretch(s, size));
 }
 
 inline SurfaceCentres::vec3 SurfaceCentres::point(const State& state, const Seen& s, index_t i,
@@ -201,8 +211,7 @@ inline SurfaceCentres::vec3 SurfaceCentres::point(const State& state, const Seen
   if (length == 0 || s.anchor == nullptr) return q;
   const vec3 a = anchored_vector(s, state.positions, i);
   const real size = length_of(a);
-  const real scale = s.along_normal ? length * contact::surface_fade(size / reference_length(s)) / size
-                                    : linear_scale(s, length);
+  const real scale = s.along_normal ? faded_length(s, length, size) / size : linear_scale(s, length);
   for (int d = 0; d < 3; ++d) q[d] += scale * a[d];
   return q;
 }
@@ -223,18 +232,19 @@ inline SurfaceCentres::vec3 SurfaceCentres::lever(const State& state, const Seen
     const real scale = linear_scale(s, length);
     return {scale * force[0], scale * force[1], scale * force[2]};
   }
-  // q = y + length phi(|A| / |A_0|) A / |A|: the tangential lever length phi / |A|, and the
-  // fade's radial one length phi' / |A_0| (0 unless the neighbourhood has folded).
+  // q = y + length phi(rho) n, rho = |A| / |A_0|: the tangential lever length phi / |A|, and
+  // the fade's radial one length phi' / |A_0| = length phi' rho / |A| (0 unless folded).
   const vec3 a = anchored_vector(s, state.positions, i);
-  const real size2 = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
-  const real size = std::sqrt(size2);
-  const real along = (a[0] * force[0] + a[1] * force[1] + a[2] * force[2]) / size2;
-  const real stretch = size / reference_length(s);
-  const real fade = contact::surface_fade(stretch);
-  const real radial = length * contact::surface_fade_slope(stretch) / reference_length(s) * along * size;
-  return {length * fade * (force[0] - along * a[0]) / size + radial * a[0] / size,
-          length * fade * (force[1] - along * a[1]) / size + radial * a[1] / size,
-          length * fade * (force[2] - along * a[2]) / size + radial * a[2] / size};
+  const real size = length_of(a);
+  const vec3 n{a[0] / size, a[1] / size, a[2] / size};
+  const real normal_part = n[0] * force[0] + n[1] * force[1] + n[2] * force[2];
+  const real rho = stretch(s, size);
+  const real tangential = length * contact::surface_fade(rho) / size;
+  const real radial = length * contact::surface_fade_slope(rho) * rho / size;
+  vec3 on_a;
+  for (int d = 0; d < 3; ++d)
+    on_a[d] = tangential * (force[d] - normal_part * n[d]) + radial * normal_part * n[d];
+  return on_a;
 }
 
 }  // namespace granulate
