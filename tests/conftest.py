@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 from collections.abc import Iterator
 
 import pytest
@@ -14,6 +15,35 @@ def pytest_addoption(parser: pytest.Parser) -> None:
         default=False,
         help="run validation cases at full resolution (slow); default is the smoke size",
     )
+
+
+def pytest_configure(config: pytest.Config) -> None:
+    if os.environ.get("PYTEST_XDIST_WORKER"):
+        # The suite runs on one worker per CPU (-n auto, pyproject.toml): each worker's runs get
+        # one thread, as the adaptive policy would pick next to a busy sibling, without its
+        # trials. Tests of the thread count still set their own.
+        from granulate import threads
+
+        threads.set_num_threads(1)
+    config.addinivalue_line(
+        "markers",
+        "full_only: a variant that only --full runs; the default suite runs a smoke version of"
+        " the same claim (another parameter or a smaller size), to stay within its time budget",
+    )
+
+
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    """Without --full, the variants marked full_only are deselected (counted as such in
+    pytest's summary line). The validation tests, the longest, are queued first, so that the
+    workers end on short tests and finish together (the order of the rest is kept)."""
+    kept, dropped = [], []
+    for item in items:
+        full_only = item.get_closest_marker("full_only") is not None
+        (dropped if full_only and not config.getoption("--full") else kept).append(item)
+    if dropped:
+        config.hook.pytest_deselected(items=dropped)
+    kept.sort(key=lambda item: item.get_closest_marker("validation") is None)
+    items[:] = kept
 
 
 @pytest.fixture

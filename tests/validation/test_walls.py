@@ -123,22 +123,24 @@ def test_a_grain_in_a_turning_drum_rolls_as_a_rigid_one_does(dimension: int, ful
     """Friction spins a grain at the bottom of a turning drum up until it rolls on the drum's
     surface; it then swings about the bottom like a pendulum, up to the rigid-rolling peak
     (rigid_rolling_peak: 1.574 degrees for the disc, 1.304 for the sphere, 58-62 ms in).
-    The deformable grain's flattened contact resists rolling a little, less as h falls:
-    measured peak / rigid 1.53 (disc and sphere at R/h = 4), 1.15 (disc, R/h = 8; sphere,
-    R/h = 6), 1.038 (disc, R/h = 12), 1.036 (disc, R/h = 16), 1.098 (sphere, R/h = 8).
-    Asserted: within 20 % at R/h = 8 (disc) and 6 (sphere), within 6 % and 12 % at 12 and 8
-    (--full); and without friction the grain stays within 0.5 degrees of the bottom. On the
-    node spheres of pair_law "granulate" the staircase of the grain's outer nodes catches on
-    the drum: both grains (R/h = 4) are dragged up 11.5 degrees in 0.1 s (7.3 and 8.8 times
-    the peak)."""
-    coarse, fine = (8, 12) if dimension == 2 else (6, 8)
+    The deformable grain's flattened contact resists rolling a little, less as h falls.
+    Measured peak / rigid at af1eaf8: 1.027 (disc, R/h = 8), 1.024 (sphere, R/h = 4); at
+    30b26df, before the surface points' fades, 1.53 (disc and sphere at R/h = 4), 1.15 (disc,
+    R/h = 8; sphere, R/h = 6), 1.038 (disc, R/h = 12), 1.036 (disc, R/h = 16), 1.098 (sphere,
+    R/h = 8). Asserted: within 20 % at R/h = 8 (disc) and 4 (sphere; 17 s, against 72 s at
+    R/h = 6), within 6 % and 12 % at 12 and 8 (--full); and without friction the grain stays
+    within 0.5 degrees of the bottom (the sphere under --full). On the node spheres of pair_law
+    "granulate" the staircase of the grain's outer nodes catches on the drum: both grains
+    (R/h = 4) are dragged up 11.5 degrees in 0.1 s (7.3 and 8.8 times the peak)."""
+    coarse, fine = (8, 12) if dimension == 2 else (4, 8)
     peak = drum_angles(dimension, 0.8, fine if full else coarse, until=0.07).max()
     theory = rigid_rolling_peak(dimension, 2.0, 10e-3, 1e-3)
     tolerance = (0.06 if dimension == 2 else 0.12) if full else 0.20
     assert peak / theory == pytest.approx(1.0, abs=tolerance), f"peak {peak:.3f} degrees"
-    frictionless = drum_angles(dimension, 0.0, 4, until=0.02)
-    moved = np.abs(frictionless).max()
-    assert moved < 0.5, f"frictionless grain moved {moved:.2f} degrees"
+    if dimension == 2 or full:
+        frictionless = drum_angles(dimension, 0.0, 4, until=0.02)
+        moved = np.abs(frictionless).max()
+        assert moved < 0.5, f"frictionless grain moved {moved:.2f} degrees"
 
 
 @pytest.mark.validation
