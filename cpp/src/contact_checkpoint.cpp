@@ -56,6 +56,7 @@ ContactCheckpoint ContactModel::checkpoint() const {
   for (const vec3& spring : springs_) c.springs.insert(c.springs.end(), spring.begin(), spring.end());
   c.pair_springs = pair_spring_;
   c.wall_springs = wall_spring_;
+  c.opened_rest = opened_rest_;
   c.last_time = last_time_;
   c.has_last_time = has_last_time_;
   c.statistics = statistics_;
@@ -71,7 +72,8 @@ void ContactModel::check_checkpoint(const Model& model, const ContactCheckpoint&
       (!saved.slot_rolling.empty() && saved.slot_rolling.size() != 3 * slots) ||
       (!saved.slot_slide.empty() && saved.slot_slide.size() != 3 * slots) ||
       (saved.built && saved.positions_at_build.size() != 3 * static_cast<std::size_t>(n)) ||
-      saved.wall_reactions.size() != walls_.size()) {
+      saved.wall_reactions.size() != walls_.size() ||
+      (!saved.opened_rest.empty() && saved.opened_rest.size() != static_cast<std::size_t>(n))) {
     throw InputError("the checkpoint's contact data do not match this model (nodes or walls differ)");
   }
   // Bodies are numbered below the node count; a wall slot's second entry is a wall. Slots are
@@ -83,11 +85,11 @@ void ContactModel::check_checkpoint(const Model& model, const ContactCheckpoint&
     if (slot[0] >= n || slot[1] >= (wall ? walls_.size() : n) || !sorted)
       throw InputError("the checkpoint's contact slots are out of range or out of order");
   }
-  const bool finite = all_finite(saved.positions_at_build) && all_finite(saved.slot_approach) &&
-                      all_finite(saved.slot_normal) && all_finite(saved.slot_work) &&
-                      all_finite(saved.slot_rolling) && all_finite(saved.slot_slide) &&
-                      all_finite(saved.springs) && std::isfinite(saved.skin) &&
-                      std::isfinite(saved.time_at_build) && std::isfinite(saved.last_time);
+  const bool finite =
+      all_finite(saved.positions_at_build) && all_finite(saved.slot_approach) &&
+      all_finite(saved.slot_normal) && all_finite(saved.slot_work) && all_finite(saved.slot_rolling) &&
+      all_finite(saved.slot_slide) && all_finite(saved.springs) && all_finite(saved.opened_rest) &&
+      std::isfinite(saved.skin) && std::isfinite(saved.time_at_build) && std::isfinite(saved.last_time);
   if (!finite) throw InputError("the checkpoint's contact data hold non-finite values");
   if (!saved.pair_offsets.empty() && !valid_lists(saved.pair_offsets, saved.pair_partners, n))
     throw InputError("the checkpoint's contact lists are out of range (partners past the node count)");
@@ -170,6 +172,7 @@ void ContactModel::restore(const Model& model, const State& state, const Contact
     wall_spring_ = saved.wall_springs;
     compact_springs();
   }
+  opened_rest_ = saved.opened_rest;
   last_time_ = saved.last_time;
   has_last_time_ = saved.has_last_time;
   statistics_ = saved.statistics;

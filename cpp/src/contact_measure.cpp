@@ -347,6 +347,7 @@ void ContactModel::measure_contacts(const Model& model, const State& state) {
   const auto& volume = model.volumes();
   const std::int64_t n = model.node_count();
   touching_nodes_.clear();
+  if (any_surface_ && opened_rest_.size() != static_cast<std::size_t>(n)) opened_rest_.assign(n, -1);
   std::vector<ProbeState> touching_probes;  // the surface probes that touch, from every thread
 #pragma omp parallel
   {
@@ -535,12 +536,22 @@ real ContactModel::measure_probes(const Model& model, const State& state, index_
     scratch.weights[e - first] = t.weight;
     probe.sums.add(t);
   }
+  real rest = 0;  // the overlap the probe counts from (0 for a surface point)
+  if (!surface) {
+    real raw = 0;
+    for (index_t g = group_begin; g < group_end; ++g) {
+      const ProbeState& probe = state_of(g);
+      if (scratch.nearest[g - group_begin] < 0 || !probe.sums.reached()) continue;
+      raw = std::max(raw, probe.radius - probe.sums.gap());
+    }
+    rest = settle_opened_rest(i, raw);
+  }
   real deepest = 0;
   for (index_t g = group_begin; g < group_end; ++g) {
     ProbeState& probe = state_of(g);
     probe.push = 0;
     if (scratch.nearest[g - group_begin] < 0 || !probe.sums.reached()) continue;
-    const real overlap = probe.radius - probe.sums.gap();
+    const real overlap = probe.radius - probe.sums.gap() - rest;
     if (!(overlap > 0)) continue;
     probe.gradient = probe.sums.gradient();
     probe.push = probe.stiffness * overlap * contact::surface_taper(probe.sums.weight);
@@ -562,6 +573,12 @@ real ContactModel::measure_probes(const Model& model, const State& state, index_
                        : 0.0f;
   }
   return deepest;
+}
+
+real ContactModel::settle_opened_rest(index_t i, real deepest) {
+  real& rest = opened_rest_[i];
+  rest = rest < 0 ? deepest : std::min(rest, deepest);
+  return rest;
 }
 
 void ContactModel::keep_touching_probes(std::vector<ProbeState>& measured) {

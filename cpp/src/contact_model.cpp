@@ -52,6 +52,7 @@ void ContactModel::configure(const Model& model) {
   find_surface_particles();
   built_ = false;
   centres_.forget();
+  opened_rest_.clear();
 }
 
 bool ContactModel::centres_particle(const Model& model, index_t p) const {
@@ -169,6 +170,7 @@ void ContactModel::set_law(index_t a, index_t b, const contact::Law& law) {
   find_surface_particles();
   built_ = false;
   centres_.forget();
+  opened_rest_.clear();
 }
 
 index_t ContactModel::add_wall(Wall wall, int dimension) {
@@ -294,9 +296,9 @@ std::size_t ContactModel::memory_bytes() const {
          bytes(slot_load_) + bytes(damping_tables_) + bytes(wall_damping_tables_) +
          bytes(slot_surface_normal_) + bytes(touching_nodes_) + bytes(touching_normals_) +
          centres_.memory_bytes() + bytes(anchor_forces_) + bytes(entry_group_) + bytes(entry_target_) +
-         bytes(taking_part_) + bytes(surface_nodes_) + bytes(surface_slot_) + bytes(surface_points_) +
-         bytes(surface_sizes_) + bytes(surface_stretches_) + bytes(groups_) + bytes(group_offsets_) +
-         bytes(probes_) + bytes(group_probe_);
+         bytes(taking_part_) + bytes(opened_rest_) + bytes(surface_nodes_) + bytes(surface_slot_) +
+         bytes(surface_points_) + bytes(surface_sizes_) + bytes(surface_stretches_) + bytes(groups_) +
+         bytes(group_offsets_) + bytes(probes_) + bytes(group_probe_);
 }
 
 std::array<index_t, 2> ContactModel::first_wall_penetration(const Model& model, const State& state) const {

@@ -67,6 +67,7 @@ nb::dict checkpoint_dict(const Simulation& self) {
   d["contact_springs"] = copy_out(c.springs);
   d["contact_pair_springs"] = copy_out(c.pair_springs);
   d["contact_wall_springs"] = copy_out(c.wall_springs);
+  d["contact_opened_rest"] = copy_out(c.opened_rest);
   std::vector<real> reactions;
   for (const auto& r : c.wall_reactions) reactions.insert(reactions.end(), r.begin(), r.end());
   d["contact_wall_reactions"] = copy_out(reactions);
@@ -111,6 +112,7 @@ void restore_dict(Simulation& self, const nb::dict& d) {
   c.springs = entry<real>(d, "contact_springs");
   c.pair_springs = entry<index_t>(d, "contact_pair_springs");
   c.wall_springs = entry<index_t>(d, "contact_wall_springs");
+  c.opened_rest = entry<real>(d, "contact_opened_rest");
   const auto reactions = entry<real>(d, "contact_wall_reactions");
   if (reactions.size() % 6) throw InputError("the checkpoint's wall reactions are malformed");
   for (std::size_t k = 0; k < reactions.size(); k += 6) {

@@ -67,6 +67,9 @@ struct ContactCheckpoint {
   /// Friction springs: the pool (3 per spring) and each list entry's spring (none: 2^32 - 1).
   std::vector<real> springs;
   std::vector<index_t> pair_springs, wall_springs;
+  /// Per node: the overlap its probe opened with (ContactModel::opened_rest_; empty before the
+  /// first force evaluation).
+  std::vector<real> opened_rest;
   real last_time = 0;
   bool has_last_time = false;
   ContactStatistics statistics;
@@ -358,6 +361,15 @@ class ContactModel {
     std::vector<ProbeState> touching;  // every node's touching groups, kept for the step
   };
   real measure_probes(const Model& model, const State& state, index_t i, ProbeScratch& scratch);
+  /// The rest overlap of node i's contact-sphere probe this step (below), from the deepest
+  /// overlap `deepest` (>= 0) of its groups: set to it on the first measure, then never above it.
+  real settle_opened_rest(index_t i, real deepest);
+  /// Per node, the overlap its contact-sphere probe (a node without a surface point: on a crack
+  /// face, or detached) counts from, or -1 before its first measure. A crack can open a node
+  /// already inside the contact layer of a body pressed against its grain; counting its overlap
+  /// from there, a rest that only falls with the overlap (so it changes only where the probe
+  /// pushes nothing), gives it no push out of nothing: a bond break no longer adds energy.
+  std::vector<real> opened_rest_;
   /// The force on the own A of node i's touching probe of group g through its smooth facing.
   vec3 facing_force(index_t i, index_t g, const ProbeState& probe, index_t first, index_t last) const;
   /// phi_k w_k / S of node j's surface point in a group's sums (0 if it does not face the probe).
