@@ -47,11 +47,15 @@ GAP = 0.05e-3  # the top wall starts this far above the highest node [m]
 @dataclass(frozen=True)
 class Options:
     """peridem: PeriDEM's 2D peridynamics (3D LPS constants, bonds breaking in compression);
-    stiffness_factor: of the contact spring; pair_law: Contact(pair_law=...)."""
+    stiffness_factor: of the contact spring; pair_law: Contact(pair_law=...); restitution:
+    Contact(restitution=...); history_every: steps between history rows of the compression
+    (None: the frames' interval)."""
 
     peridem: bool = False
     stiffness_factor: float = 1.0
     pair_law: str = "surface"
+    restitution: float = 0.95
+    history_every: int | None = None
 
 
 def material(options: Options = Options()) -> gr.Material:
@@ -89,7 +93,7 @@ def simulation(grains: gr.Packing, width: float, options: Options = Options()) -
     plane = "peridem" if options.peridem else "strain"
     sim = gr.Simulation(dimension=2, gravity=(0, -10), plane=plane)
     sim.contact = gr.Contact(
-        restitution=0.95,
+        restitution=options.restitution,
         friction=0.0,
         stiffness_factor=options.stiffness_factor,
         pair_law=options.pair_law,
@@ -143,7 +147,9 @@ def compress(
     )
     sim.add_wall(plate, name="top")
     steps = math.ceil(travel / speed / sim.dt)
-    sim.output(out, every=max(1, steps // 40), overwrite=overwrite)
+    sim.output(
+        out, every=max(1, steps // 40), history_every=options.history_every, overwrite=overwrite
+    )
     sim.run(steps)
     return sim
 
