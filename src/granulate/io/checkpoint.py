@@ -79,8 +79,8 @@ def load(path: str | Path) -> tuple[dict[str, Any], dict[str, Any]]:
             f"format {FORMAT} (format 1 predates the contact model with friction springs and "
             "per-node contact radii, format 2 the damping fitted to each collision's force law, "
             "format 3 contact against the particles' smooth surfaces, format 4 the turned "
-            "collision forces fading out in lasting contacts, format 5 the rest overlaps of nodes that "
-            "cracks open; their trajectories differ); run "
+            "collision forces fading out in lasting contacts, format 5 the rest overlaps of "
+            "nodes that cracks open; their trajectories differ); run "
             "without --resume to start over"
         )
     checksum = header.get("checksum")
