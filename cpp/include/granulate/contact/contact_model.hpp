@@ -365,7 +365,9 @@ class ContactModel {
   /// overlap `deepest` (>= 0) of its groups: set to it on the first measure, then never above it.
   real settle_opened_rest(index_t i, real deepest);
   /// Per node, the overlap its contact-sphere probe (a node without a surface point: on a crack
-  /// face, or detached) counts from, or -1 before its first measure. A crack can open a node
+  /// face, detached, or of a particle without surface points) counts from, or -1 before its
+  /// first measure (a particle set down inside another's contact layer gets no push out of it
+  /// either; one that comes into reach gets 0). A crack can open a node
   /// already inside the contact layer of a body pressed against its grain; counting its overlap
   /// from there, a rest that only falls with the overlap (so it changes only where the probe
   /// pushes nothing), gives it no push out of nothing: a bond break no longer adds energy.
