@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 
 #include "contact_vectors.hpp"
 #include "granulate/contact/contact_model.hpp"
@@ -536,22 +537,24 @@ real ContactModel::measure_probes(const Model& model, const State& state, index_
     scratch.weights[e - first] = t.weight;
     probe.sums.add(t);
   }
+  // A group's overlap before the rest (-inf: no point of it in reach).
+  auto raw_overlap = [&](index_t g) {
+    const ProbeState& probe = state_of(g);
+    if (scratch.nearest[g - group_begin] < 0 || !probe.sums.reached())
+      return -std::numeric_limits<real>::infinity();
+    return probe.radius - probe.sums.gap();
+  };
   real rest = 0;  // the overlap the probe counts from (0 for a surface point)
   if (!surface) {
     real raw = 0;
-    for (index_t g = group_begin; g < group_end; ++g) {
-      const ProbeState& probe = state_of(g);
-      if (scratch.nearest[g - group_begin] < 0 || !probe.sums.reached()) continue;
-      raw = std::max(raw, probe.radius - probe.sums.gap());
-    }
+    for (index_t g = group_begin; g < group_end; ++g) raw = std::max(raw, raw_overlap(g));
     rest = settle_opened_rest(i, raw);
   }
   real deepest = 0;
   for (index_t g = group_begin; g < group_end; ++g) {
     ProbeState& probe = state_of(g);
     probe.push = 0;
-    if (scratch.nearest[g - group_begin] < 0 || !probe.sums.reached()) continue;
-    const real overlap = probe.radius - probe.sums.gap() - rest;
+    const real overlap = raw_overlap(g) - rest;
     if (!(overlap > 0)) continue;
     probe.gradient = probe.sums.gradient();
     probe.push = probe.stiffness * overlap * contact::surface_taper(probe.sums.weight);

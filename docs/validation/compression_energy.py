@@ -29,14 +29,14 @@ GRAINS = 120
 
 def settled_pile(folder: Path, options: compression_2d.Options, model: str | None, gc: float):
     """The example's grains, placed where the last frame of `folder`/settle has them."""
-    if model is not None:  # another bond model, for the test of where energy comes from
-        compression_2d.material = lambda _: gr.Material(
-            density=1200,
-            bulk_modulus=2.16e7,
-            shear_modulus=1.296e7,
-            fracture_energy=gc,
-            horizon=0.6e-3,
-            model=model,
+    if model is not None:  # the example's material with another bond model and Gc
+        example_material = compression_2d.material
+        compression_2d.material = lambda options: gr.Material(
+            **{
+                **example_material(options).model_dump(exclude_unset=True),
+                "model": model,
+                "fracture_energy": gc,
+            }
         )
     width = compression_2d.WIDTH * min(1.0, math.sqrt(GRAINS / 502))
     grains = compression_2d.packing(GRAINS, width, seed=1, options=options)

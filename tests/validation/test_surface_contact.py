@@ -344,9 +344,11 @@ def energy_across_a_cut(speed: float, behind: tuple[float, float]) -> tuple[floa
     left = sim.add_body(
         gr.Disc((-radius - 0.05e-3, 0), radius), SOFT, h, discretization="conforming"
     )
-    sim.add_body(gr.Disc((radius + 0.05e-3, 0), radius), SOFT, h, discretization="conforming")
+    right = sim.add_body(
+        gr.Disc((radius + 0.05e-3, 0), radius), SOFT, h, discretization="conforming"
+    )
     sim.velocities[left.nodes, 0] = speed
-    sim.velocities[sim.node_count // 2 :, 0] = -speed
+    sim.velocities[right.nodes, 0] = -speed
 
     def energies() -> tuple[float, float]:
         contact = sim.core.contact_energy()

@@ -367,10 +367,10 @@ class ContactModel {
   /// Per node, the overlap its contact-sphere probe (a node without a surface point: on a crack
   /// face, detached, or of a particle without surface points) counts from, or -1 before its
   /// first measure (a particle set down inside another's contact layer gets no push out of it
-  /// either; one that comes into reach gets 0). A crack can open a node
-  /// already inside the contact layer of a body pressed against its grain; counting its overlap
-  /// from there, a rest that only falls with the overlap (so it changes only where the probe
-  /// pushes nothing), gives it no push out of nothing: a bond break no longer adds energy.
+  /// either; one that comes into reach gets 0). A crack can open a node already inside the
+  /// contact layer of a body pressed against its grain; counting its overlap from there, a rest
+  /// that only falls with the overlap (so it changes only where the probe pushes nothing), gives
+  /// it no push out of nothing: opening a node adds no energy.
   std::vector<real> opened_rest_;
   /// The force on the own A of node i's touching probe of group g through its smooth facing.
   vec3 facing_force(index_t i, index_t g, const ProbeState& probe, index_t first, index_t last) const;
