@@ -107,16 +107,18 @@ def crushed_discs(law: str, skin: float | None) -> tuple[np.ndarray, np.ndarray,
 @pytest.mark.parametrize("law", ["granulate", "surface"])
 def test_results_do_not_depend_on_the_verlet_skin(law: str) -> None:
     """The skin decides only when the lists are searched again, never a force: with a skin of
-    0.02 h (a search every step) shattering discs move bit for bit as with the default (a
-    search every 3 to 8 steps). Two faults broke this: a new fragment renumbered the bodies
-    after it and their collisions went to other pairs, and a collision open in a gap ended when
-    a search dropped its bodies' entries (both measured here before the fix: 2e-5 to 7e-5 m
-    apart after 300 steps)."""
+    0.02 h (a search every step) shattering discs move bit for bit as with the default (106
+    searches in 300 steps under the surface law). Faults that broke this: a new fragment
+    renumbered the bodies after it and their collisions went to other pairs, and a collision
+    open in a gap ended when a search dropped its bodies' entries (both measured here before
+    the fix: 2e-5 to 7e-5 m apart after 300 steps); a crack node's rest taken when it first had
+    list entries, which the skin decides, and the update after breaks leaving out a broken pair
+    whose reach grew when a later break parted its nodes (0.24 m/s apart at step 201)."""
     x, v, default = crushed_discs(law, None)
     x_small, v_small, small = crushed_discs(law, 2e-6)
     assert default.broken_bonds() > 5000  # the discs shattered
     assert small.core.contact_statistics.rebuilds == 301  # searched at every step
-    assert default.core.contact_statistics.rebuilds < 100
+    assert default.core.contact_statistics.rebuilds < 150
     assert np.array_equal(x, x_small) and np.array_equal(v, v_small)
 
 

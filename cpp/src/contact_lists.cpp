@@ -68,7 +68,27 @@ bool ContactModel::surface_entry(const Model& model, index_t i, std::size_t e) c
          (on_surface(model, i) || on_surface(model, j));
 }
 
+void ContactModel::bonds_broke(const Model& model, const State& state,
+                               std::span<const std::array<index_t, 2>> pairs) {
+  if (!active()) return;
+  newly_broken_.insert(newly_broken_.end(), pairs.begin(), pairs.end());
+  if (!centres_.any()) return;
+  std::vector<index_t> surface_nodes;  // the pairs' nodes that carry a surface point
+  for (const auto& [i, j] : pairs) {
+    for (const index_t k : {i, j}) {
+      if (on_surface(model, k)) surface_nodes.push_back(k);
+    }
+  }
+  centres_.detach_anchored(model, state, pairs);
+  for (const index_t k : surface_nodes) {
+    if (on_surface(model, k)) continue;  // new anchors
+    if (!opened_rest_.empty()) opened_rest_[k] = -1;
+    detached_since_build_ = true;
+  }
+}
+
 bool ContactModel::breaks_open_new_nodes(const Model& model) const {
+  if (detached_since_build_) return true;
   if (taking_part_.empty()) return false;  // every node takes part already
   for (const auto& [i, j] : newly_broken_) {
     for (const index_t k : {i, j}) {
@@ -84,8 +104,9 @@ void ContactModel::update_after_breaks(const Model& model, const State& state, s
   // that could come within its Rc before the next rebuild: a node moves at most skin/2 from
   // where the lists were built before that, so a pair now at d stays beyond d - skin - 2 w (w:
   // the largest displacement since the build so far). A pair left out now stays out of reach
-  // until the next rebuild (w only grows), so only the bonds broken since the last update are
-  // candidates. Then the bodies are labelled again.
+  // until the next rebuild (w only grows; the reach taken is the larger of its reaches within
+  // one body and between two), so only the bonds broken since the last update are candidates.
+  // The bodies are labelled first.
   label_bodies(model, state, broken_bonds);
   const index_t n = model.node_count();
   const auto& node_material = model.node_material();
@@ -94,7 +115,9 @@ void ContactModel::update_after_breaks(const Model& model, const State& state, s
   for (const auto& [i, j] : newly_broken_) {
     const index_t m = node_material[i];  // a bond joins two nodes of one particle
     if (!law_set_[m * material_count_ + m]) continue;
-    const real limit = pair_reach(model, i, j, node_body_[i] == node_body_[j]) + extra;
+    // The reach the pair has as two bodies, if larger: were they one body now, a later break
+    // could part them before the next rebuild, and the pair would not be a candidate then.
+    const real limit = std::max(pair_reach(model, i, j, true), pair_reach(model, i, j, false)) + extra;
     const vec3 xi = centres_.at_list(model, state, i);
     const vec3 xj = centres_.at_list(model, state, j);
     const real dx = xj[0] - xi[0], dy = xj[1] - xi[1], dz = xj[2] - xi[2];

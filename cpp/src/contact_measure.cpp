@@ -163,7 +163,7 @@ ContactModel::PairGeometry ContactModel::pair_geometry(const Model& model, const
   const real distance = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
   PairGeometry g;
   g.normal = {d[0] / distance, d[1] / distance, d[2] / distance};
-  g.overlap = contact_radius - distance;
+  g.overlap = contact_radius - distance - pair_rest(i, j, slot_law(pair_slot_[e]));
   g.lever_i = node_radius(law, model, i, j, contact_radius) - 0.5 * g.overlap;
   g.lever_j = node_radius(law, model, j, i, contact_radius) - 0.5 * g.overlap;
   return g;
@@ -350,16 +350,23 @@ void ContactModel::measure_contacts(const Model& model, const State& state) {
   touching_nodes_.clear();
   if (any_surface_ && opened_rest_.size() != static_cast<std::size_t>(n)) opened_rest_.assign(n, -1);
   std::vector<ProbeState> touching_probes;  // the surface probes that touch, from every thread
+  std::vector<index_t> rested_nodes;        // the nodes whose overlaps count from a rest
 #pragma omp parallel
   {
     std::vector<WallContact> found;  // scratch of this thread
     ProbeScratch probe_scratch;
-    std::vector<index_t> touching_nodes;
+    std::vector<index_t> touching_nodes, rested;
     real deepest = 0;  // overlap / Rc
 #pragma omp for schedule(static) nowait
     for (std::int64_t ii = 0; ii < n; ++ii) {
       const index_t i = static_cast<index_t>(ii);
-      if (pair_offsets_[i] == pair_offsets_[i + 1] && wall_offsets_[i] == wall_offsets_[i + 1]) continue;
+      if (pair_offsets_[i] == pair_offsets_[i + 1] && wall_offsets_[i] == wall_offsets_[i + 1]) {
+        // Nothing in reach: the rest of a node that takes part falls to 0, as it would were the
+        // node listed (the skin, which decides which nodes are, must change no force). A node
+        // inside an intact surface keeps -1 until a crack opens it.
+        if (!opened_rest_.empty() && (taking_part_.empty() || taking_part_[i])) opened_rest_[i] = 0;
+        continue;
+      }
       vec3 xi{0, 0, 0};
       bool have_xi = false;  // the contact centre, where a sphere pair or a wall needs it
       auto centre = [&]() -> const vec3& {
@@ -367,6 +374,7 @@ void ContactModel::measure_contacts(const Model& model, const State& state) {
         return xi;
       };
       bool touching = false;
+      real pair_overlap = 0;  // the deepest of its sphere pairs under the surface law
       for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
         const index_t j = pair_partner_[e];
         const contact::PairLaw& law = slot_law(pair_slot_[e]);
@@ -384,15 +392,18 @@ void ContactModel::measure_contacts(const Model& model, const State& state) {
         touching = touching || (pair_stiffness_[e] > 0 && !law.node_pair && node_body_[i] != node_body_[j]);
         if (pair_stiffness_[e] > 0 && !law.node_pair)
           deepest = std::max(deepest, 1 - distance / law.contact_radius);
+        if (law.surface) pair_overlap = std::max(pair_overlap, law.contact_radius - distance);
       }
       if (touching) touching_nodes.push_back(i);
-      deepest = std::max(deepest, measure_probes(model, state, i, probe_scratch));
+      deepest = std::max(deepest, measure_probes(model, state, i, probe_scratch, pair_overlap));
+      if (!opened_rest_.empty() && opened_rest_[i] > 0) rested.push_back(i);
       for (index_t e = wall_offsets_[i]; e < wall_offsets_[i + 1]; ++e)
         measure_wall_points(model, state, i, e, centre(), found);
     }
 #pragma omp critical
     {
       touching_nodes_.insert(touching_nodes_.end(), touching_nodes.begin(), touching_nodes.end());
+      rested_nodes.insert(rested_nodes.end(), rested.begin(), rested.end());
       touching_probes.insert(touching_probes.end(), probe_scratch.touching.begin(),
                              probe_scratch.touching.end());
       statistics_.deepest_overlap = std::max(statistics_.deepest_overlap, deepest);
@@ -400,6 +411,7 @@ void ContactModel::measure_contacts(const Model& model, const State& state) {
   }
   std::sort(touching_nodes_.begin(), touching_nodes_.end());  // the same for any thread count
   if (any_surface_) keep_touching_probes(touching_probes);
+  release_rested_pairs(model, state, rested_nodes);
 }
 
 void ContactModel::measure_wall_points(const Model& model, const State& state, index_t i, index_t e,
@@ -470,14 +482,18 @@ vec3 ContactModel::osculating_normal(const Model& model, const State& state, con
   return turned ? contact::rotate(body_rotation_[slot], n) : n;
 }
 
-real ContactModel::measure_probes(const Model& model, const State& state, index_t i, ProbeScratch& scratch) {
+real ContactModel::measure_probes(const Model& model, const State& state, index_t i, ProbeScratch& scratch,
+                                  real pair_overlap) {
   // Node i's probes of other bodies' surfaces (contact/surface_law.hpp): each group's points
   // in reach that face the probe, their sums, then the gap, its gradient and the push, then
   // each probe entry's share of the probe's stiffness (its in-contact flag). Returns the
   // deepest overlap over Rc. A group with no point in reach is apart (push 0) and costs one
   // distance per entry.
   const auto [group_begin, group_end] = groups_of(i);
-  if (group_begin == group_end) return 0;
+  if (group_begin == group_end) {
+    if (!opened_rest_.empty() && !on_surface(model, i)) settle_opened_rest(i, pair_overlap);
+    return 0;
+  }
   const bool surface = on_surface(model, i);
   const vec3 p = centres_.at_surface(model, state, i);
   // The fade of the probe's own point (1 for a node without one): phi, and d phi / d|A|.
@@ -546,7 +562,7 @@ real ContactModel::measure_probes(const Model& model, const State& state, index_
   };
   real rest = 0;  // the overlap the probe counts from (0 for a surface point)
   if (!surface) {
-    real raw = 0;
+    real raw = pair_overlap;
     for (index_t g = group_begin; g < group_end; ++g) raw = std::max(raw, raw_overlap(g));
     rest = settle_opened_rest(i, raw);
   }
@@ -699,6 +715,25 @@ void ContactModel::measure_surface_normals(const Model& model, const State& stat
 #pragma omp parallel for schedule(static)
   for (std::int64_t k = 0; k < count; ++k)
     touching_normals_[k] = surface_normal(model, state, touching_nodes_[k]);
+}
+
+void ContactModel::release_rested_pairs(const Model& model, const State& state,
+                                        const std::vector<index_t>& rested) {
+  // The sphere pairs of a node with a rest touch only past it (pair_geometry); both entries of
+  // a pair are cleared, so the pair stays symmetric. After the parallel pass, when every rest of
+  // the step is settled: the same for any thread count.
+  for (const index_t i : rested) {
+    for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
+      if (pair_stiffness_[e] == 0 || surface_entry(model, i, e) ||
+          pair_geometry(model, state, i, e).overlap > 0)
+        continue;
+      pair_stiffness_[e] = 0;
+      const index_t j = pair_partner_[e];
+      const index_t* listed = pair_partner_.data();
+      const index_t* other = std::lower_bound(listed + pair_offsets_[j], listed + pair_offsets_[j + 1], i);
+      pair_stiffness_[other - listed] = 0;
+    }
+  }
 }
 
 void ContactModel::sum_slot_springs(const Model& model, const State& state) {

@@ -27,6 +27,7 @@ void ContactModel::rebuild(const Model& model, const State& state, std::uint64_t
                        std::move(wall_offsets_), std::move(wall_entry_),   std::move(wall_spring_)};
   const real reach = largest_pair_reach(model) + skin_;
   newly_broken_.clear();  // the search finds every unbonded pair
+  detached_since_build_ = false;
   label_bodies(model, state, broken_bonds);
   const NearParticles near = near_particles(model, state, broken_bonds, reach);
   search_node_pairs(model, state, near.particle, reach);

@@ -356,7 +356,7 @@ void Simulation::break_bonds(const std::vector<std::array<index_t, 2>>& pairs) {
       BondStates::clear(state_.bonds.node(backward[0]), backward[1]);
       broken_bond_copies_ += 2;
       const std::array<index_t, 2> pair{i, j};
-      contact_.bonds_broke(*model_, {&pair, 1});
+      contact_.bonds_broke(*model_, state_, {&pair, 1});
     }
   }
   forces_current_ = false;

@@ -214,7 +214,7 @@ std::uint64_t Simulation::sum_dilatation_and_break_bonds() {
     const NodeBonds bonds = m.node_bonds(j);
     BondStates::clear(intact.node(j), bonds.find(i));
   }
-  contact_.bonds_broke(m, broken);
+  contact_.bonds_broke(m, state_, broken);
   return 2 * broken.size();
 }
 

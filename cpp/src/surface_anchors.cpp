@@ -46,7 +46,7 @@ std::vector<index_t> nearest(const CellGrid& grid, const std::vector<real>& x, i
 /// The d candidates whose bond directions from a span best: the largest |det| of the unit
 /// vectors (1 when orthogonal; in 2D with (0, 0, 1) as third column), the first such in
 /// nearest-first order; empty if none exceeds 0.2.
-std::vector<index_t> best_span(const std::vector<real>& x, index_t a, const std::vector<index_t>& candidates,
+std::vector<index_t> best_span(std::span<const real> x, index_t a, std::span<const index_t> candidates,
                                int dimension) {
   std::vector<vec> unit;
   for (const index_t j : candidates) {
@@ -126,6 +126,24 @@ real surface_curvature(std::span<const real> points, std::span<const real> norma
   return spread > 0 ? bend / spread : 0.0;
 }
 
+bool span_anchors(std::span<const real> x, index_t a, std::span<const index_t> candidates,
+                  const std::array<real, 3>& target, int dimension, index_t first, SurfaceAnchor& anchor) {
+  const std::vector<index_t> chosen = best_span(x, a, candidates, dimension);
+  if (chosen.empty()) return false;
+  std::array<vec, 3> columns{};
+  for (std::size_t k = 0; k < chosen.size(); ++k) {
+    for (int c = 0; c < 3; ++c) columns[k][c] = x[3 * chosen[k] + c] - x[3 * a + c];
+  }
+  const std::array<real, 3> w = solve(columns, target, dimension);
+  anchor.nodes = {SurfaceAnchor::no_anchor, SurfaceAnchor::no_anchor, SurfaceAnchor::no_anchor};
+  anchor.weights = {0, 0, 0};
+  for (std::size_t k = 0; k < chosen.size(); ++k) {
+    anchor.nodes[k] = chosen[k] - first;
+    anchor.weights[k] = static_cast<float>(w[k]);
+  }
+  return true;
+}
+
 SurfaceAnchors build_surface_anchors(std::span<const real> positions, std::span<const real> offsets,
                                      std::span<const real> depths, real mesh_size, int dimension) {
   const index_t n = static_cast<index_t>(positions.size() / 3);
@@ -138,20 +156,10 @@ SurfaceAnchors build_surface_anchors(std::span<const real> positions, std::span<
   for (index_t a = 0; a < n; ++a) {
     const vec o{offsets[3 * a], offsets[3 * a + 1], offsets[3 * a + 2]};
     if (o[0] == 0 && o[1] == 0 && o[2] == 0) continue;
-    const std::vector<index_t> chosen =
-        best_span(x, a, nearest(grid, x, a, radius, dimension, candidates), dimension);
-    if (chosen.empty()) continue;
-    std::array<vec, 3> columns{};
-    for (std::size_t k = 0; k < chosen.size(); ++k) {
-      for (int c = 0; c < 3; ++c) columns[k][c] = x[3 * chosen[k] + c] - x[3 * a + c];
-    }
     const vec target{0.5 * mesh_size * o[0], 0.5 * mesh_size * o[1], 0.5 * mesh_size * o[2]};
-    const std::array<real, 3> w = solve(columns, target, dimension);
     SurfaceAnchor anchor;
-    for (std::size_t k = 0; k < chosen.size(); ++k) {
-      anchor.nodes[k] = chosen[k];
-      anchor.weights[k] = static_cast<float>(w[k]);
-    }
+    if (!span_anchors(x, a, nearest(grid, x, a, radius, dimension, candidates), target, dimension, 0, anchor))
+      continue;
     const real reach = std::sqrt(o[0] * o[0] + o[1] * o[1] + o[2] * o[2]);
     anchor.reach = static_cast<float>(reach);
     if (!depths.empty()) anchor.depth = static_cast<float>(depths[a] / mesh_size);

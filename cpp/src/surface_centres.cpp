@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <utility>
+#include <vector>
 
 namespace granulate {
 
@@ -31,17 +33,63 @@ void SurfaceCentres::find(const Model& model, const State& state, std::vector<re
       anchor_slot_[i] = static_cast<index_t>(a - model.shapes()[particle.shape].anchors.anchors.data());
     }
   }
+  spare_.clear();
   if (!any_ || state.bonds.broken(model.bond_offsets(), 0, model.node_count()) == 0) return;
   for (index_t i = 0; i < model.node_count(); ++i) {
     const SurfaceAnchor* a = anchor(model, i);
-    if (a == nullptr) continue;
-    const index_t first = model.particles()[model.node_particle()[i]].first_node;
-    const NodeBonds bonds = model.node_bonds(i);
-    for (const index_t k : a->nodes) {
-      const index_t b = k == SurfaceAnchor::no_anchor ? bonds.count : bonds.find(first + k);
-      if (b != bonds.count && !state.bonds.intact(i, b)) detach(i);  // the bond broke
-    }
+    if (a != nullptr && anchor_bond_broken(model, state, i, *a)) reanchor(model, state, i);
   }
+}
+
+bool SurfaceCentres::anchor_bond_broken(const Model& model, const State& state, index_t i,
+                                        const SurfaceAnchor& a) {
+  const index_t first = model.particles()[model.node_particle()[i]].first_node;
+  const NodeBonds bonds = model.node_bonds(i);
+  for (const index_t k : a.nodes) {
+    const index_t b = k == SurfaceAnchor::no_anchor ? bonds.count : bonds.find(first + k);
+    if (b != bonds.count && !state.bonds.intact(i, b)) return true;
+  }
+  return false;
+}
+
+void SurfaceCentres::reanchor(const Model& model, const State& state, index_t i) {
+  // The same anchored vector in the reference, A_0 = sum_k w_k (X_k - X_i) of the shape's
+  // anchors, from the intact bonds within 1.75 h, nearest first (ties by index), as
+  // build_surface_anchors chose among all the neighbours. A function of the bond states only,
+  // so a restore finds the same anchors.
+  const index_t p = model.node_particle()[i];
+  const SurfaceAnchor* primary = lookup(model, i);
+  if (anchor_slot_.empty() || !surface_[p] || primary == nullptr) {  // outside the surface law
+    detach(i);
+    return;
+  }
+  const Particle& particle = model.particles()[p];
+  const std::vector<real>& x = model.reference_positions();
+  Seen reference;
+  reference.anchor = primary;
+  reference.first = particle.first_node;
+  const vec3 target = anchored_vector(reference, x, i);
+  const real radius = 1.75 * particle.mesh_size;
+  const NodeBonds bonds = model.node_bonds(i);
+  std::vector<std::pair<real, index_t>> near;
+  for (index_t b = 0; b < bonds.count; ++b) {
+    if (!state.bonds.intact(i, b)) continue;
+    const index_t j = bonds.neighbor(b);
+    real r2 = 0;
+    for (int c = 0; c < 3; ++c) r2 += (x[3 * j + c] - x[3 * i + c]) * (x[3 * j + c] - x[3 * i + c]);
+    if (r2 <= radius * radius) near.push_back({r2, j});
+  }
+  std::sort(near.begin(), near.end());
+  const std::size_t most = model.dimension() == 2 ? 12 : 18;  // as build_surface_anchors
+  std::vector<index_t> candidates;
+  for (std::size_t k = 0; k < near.size() && k < most; ++k) candidates.push_back(near[k].second);
+  SurfaceAnchor anchor = *primary;
+  if (!span_anchors(x, i, candidates, target, model.dimension(), particle.first_node, anchor)) {
+    detach(i);
+    return;
+  }
+  anchor_slot_[i] = spare_bit | static_cast<index_t>(spare_.size());
+  spare_.push_back(anchor);
 }
 
 bool SurfaceCentres::is_round(const Shape& shape) {
@@ -63,14 +111,17 @@ const SurfaceAnchor* SurfaceCentres::lookup(const Model& model, index_t i) const
   return a != nullptr && (a->depth == 0 || surface_[p]) ? a : nullptr;
 }
 
-void SurfaceCentres::detach_anchored(const Model& model, std::span<const std::array<index_t, 2>> pairs) {
+void SurfaceCentres::detach_anchored(const Model& model, const State& state,
+                                     std::span<const std::array<index_t, 2>> pairs) {
+  // The new anchors depend on the bond states alone, so the order of `pairs` (the threads')
+  // changes nothing but the places in spare_.
   if (!found_ || !any_) return;
   for (const auto& [i, j] : pairs) {
     for (const auto& [node, other] : {std::array<index_t, 2>{i, j}, std::array<index_t, 2>{j, i}}) {
       const SurfaceAnchor* a = anchor(model, node);
       if (a == nullptr) continue;
       const index_t local = other - model.particles()[model.node_particle()[node]].first_node;
-      if (std::find(a->nodes.begin(), a->nodes.end(), local) != a->nodes.end()) detach(node);
+      if (std::find(a->nodes.begin(), a->nodes.end(), local) != a->nodes.end()) reanchor(model, state, node);
     }
   }
 }

@@ -74,3 +74,41 @@ TEST_CASE("surface anchors follow any affine motion of the neighbourhood") {
   CHECK_CLOSE(moved[0], F[0] * 0.5 * h + F[1] * 0.5 * h, 1e-7);
   CHECK_CLOSE(moved[1], F[2] * 0.5 * h + F[3] * 0.5 * h, 1e-7);
 }
+
+TEST_CASE("anchors taken again without a broken bond give the same anchored vector in any affine motion") {
+  // The face node (0, 2h) anchored anew from its neighbours but the one its first anchors
+  // use first (as after that bond broke): the same offset at rest and after y = F x + t.
+  const real h = 0.1;
+  const Grid g = square_grid(h);
+  const SurfaceAnchors anchors = build_surface_anchors(g.positions, g.offsets, {}, h, 2);
+  const index_t a = 2;
+  const SurfaceAnchor& first = *anchors.of(a);
+  const std::array<real, 3> minus_a = offset(first, g.positions, a);
+  const std::array<real, 3> target{-minus_a[0], -minus_a[1], -minus_a[2]};
+  std::vector<index_t> candidates;
+  for (const index_t j : {1, 3, 7, 6, 8}) {  // within 1.75 h, nearest first
+    if (j != first.nodes[0]) candidates.push_back(j);
+  }
+  SurfaceAnchor again;
+  CHECK(span_anchors(g.positions, a, candidates, target, 2, 0, again));
+  CHECK(again.nodes[0] != first.nodes[0] && again.nodes[1] != first.nodes[0]);
+  const auto rest = offset(again, g.positions, a);
+  CHECK_CLOSE(rest[0], minus_a[0], 1e-7);
+  CHECK_CLOSE(rest[1], minus_a[1], 1e-7);
+  const real c = std::cos(0.3), s = std::sin(0.3);
+  const std::array<real, 4> F{1.1 * c, -0.9 * s, 1.1 * s, 0.9 * c};
+  std::vector<real> y(g.positions.size());
+  for (std::size_t k = 0; k < y.size() / 3; ++k) {
+    const real x0 = g.positions[3 * k], x1 = g.positions[3 * k + 1];
+    y[3 * k] = F[0] * x0 + F[1] * x1 + 2.0;
+    y[3 * k + 1] = F[2] * x0 + F[3] * x1 - 1.0;
+  }
+  const auto moved = offset(again, y, a), before = offset(first, y, a);
+  CHECK_CLOSE(moved[0], before[0], 1e-7);
+  CHECK_CLOSE(moved[1], before[1], 1e-7);
+  // Candidates on one line span nothing: no anchors, and `again` keeps what it had.
+  const std::vector<index_t> line{1, 3};
+  SurfaceAnchor none = again;
+  CHECK(!span_anchors(g.positions, a, line, target, 2, 0, none));
+  CHECK(none.nodes == again.nodes);
+}

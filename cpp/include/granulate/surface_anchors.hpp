@@ -58,6 +58,14 @@ struct SurfaceAnchors {
 SurfaceAnchors build_surface_anchors(std::span<const real> positions, std::span<const real> offsets,
                                      std::span<const real> depths, real mesh_size, int dimension);
 
+/// The anchors of node a for the anchored vector `target` = sum_k w_k (x_k - x_a) [m], from
+/// `candidates` (nodes of x, n x 3, nearest first): the pair (triple in 3D) whose bond directions
+/// span best, as build_surface_anchors chooses them, and the weights that give `target`; the
+/// anchors' indices are stored less `first`. Only the nodes and weights of `anchor` are set;
+/// false (anchor unchanged) if no candidates span the plane (space).
+bool span_anchors(std::span<const real> x, index_t a, std::span<const index_t> candidates,
+                  const std::array<real, 3>& target, int dimension, index_t first, SurfaceAnchor& anchor);
+
 /// Mean curvature kappa at surface point a from nearby surface points b with unit normals:
 ///   kappa = sum_b w_ab (n_b - n_a) . (s_b - s_a) / sum_b w_ab |s_b - s_a|^2,
 /// w_ab = W(|s_b - s_a| / radius) (Wendland C2), over the b with n_a . n_b > cos 30 degrees (an

@@ -3,6 +3,7 @@
 // contact_law.hpp, damping aggregated per pair of bodies, wall reactions.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <span>
@@ -134,11 +135,10 @@ class ContactModel {
   /// Bonds (i, j) that broke since the last evaluation: the candidates the next list update
   /// inserts (a pair broken earlier and not inserted then cannot reach its Rc before the next
   /// rebuild; see update_after_breaks).
-  void bonds_broke(const Model& model, std::span<const std::array<index_t, 2>> pairs) {
-    if (!active()) return;
-    newly_broken_.insert(newly_broken_.end(), pairs.begin(), pairs.end());
-    centres_.detach_anchored(model, pairs);
-  }
+  /// Surface nodes whose anchor bond broke take new anchors, or lose their surface point; those
+  /// that lose it count their overlaps from a rest measured anew (opened_rest_) and make the next
+  /// contact phase search the lists, since their reach grows.
+  void bonds_broke(const Model& model, const State& state, std::span<const std::array<index_t, 2>> pairs);
 
   /// Per wall: force (x, y, z) and torque about its centre (x, y, z) exerted by the particles
   /// [N, N m; per unit thickness in 2D], from the last evaluation.
@@ -257,8 +257,10 @@ class ContactModel {
   /// the surface law, else the surface points and the nodes on crack faces (with a broken
   /// bond): the nodes inside an intact surface never touch another body.
   bool takes_part(const Model& model, const State& state, index_t i) const;
-  /// Whether the bonds broken since the last list change open nodes that took no part.
+  /// Whether the bonds broken since the last list change open nodes that took no part, or took
+  /// a surface point from a node.
   bool breaks_open_new_nodes(const Model& model) const;
+  bool detached_since_build_ = false;      // a surface node lost its point since the last search
   std::vector<std::uint8_t> taking_part_;  // per node, at the last search
   /// Whether node i carries a point of its body's surface (surface_centres.hpp).
   bool on_surface(const Model& model, index_t i) const { return centres_.anchor(model, i) != nullptr; }
@@ -360,18 +362,34 @@ class ContactModel {
     std::vector<ProbeState> states;    // the node's groups
     std::vector<ProbeState> touching;  // every node's touching groups, kept for the step
   };
-  real measure_probes(const Model& model, const State& state, index_t i, ProbeScratch& scratch);
-  /// The rest overlap of node i's contact-sphere probe this step (below), from the deepest
-  /// overlap `deepest` (>= 0) of its groups: set to it on the first measure, then never above it.
+  /// `pair_overlap` (>= 0): the deepest overlap of node i's sphere pairs under the surface law,
+  /// which its rest covers too.
+  real measure_probes(const Model& model, const State& state, index_t i, ProbeScratch& scratch,
+                      real pair_overlap);
+  /// The rest overlap of node i's contact-sphere probe and sphere pairs this step (below), from
+  /// the deepest overlap `deepest` (>= 0) of its groups and pairs: set to it on the first
+  /// measure, then never above it.
   real settle_opened_rest(index_t i, real deepest);
-  /// Per node, the overlap its contact-sphere probe (a node without a surface point: on a crack
-  /// face, detached, or of a particle without surface points) counts from, or -1 before its
-  /// first measure (a particle set down inside another's contact layer gets no push out of it
-  /// either; one that comes into reach gets 0). A crack can open a node already inside the
-  /// contact layer of a body pressed against its grain; counting its overlap from there, a rest
-  /// that only falls with the overlap (so it changes only where the probe pushes nothing), gives
-  /// it no push out of nothing: opening a node adds no energy.
+  /// Per node, the overlap its contact-sphere probe and its sphere pairs under the surface law
+  /// (a node without a surface point: on a crack face, detached, or of a particle without
+  /// surface points) count from, or -1 before its first measure (a particle set down inside
+  /// another's contact layer gets no push out of it either; one that comes into reach gets 0).
+  /// A crack can open a node already inside the contact layer of a body pressed against its
+  /// grain, or inside the sphere of a node of that body which has no surface point either (a
+  /// crack face of its own), or of the node across the bond that broke; counting its overlaps
+  /// from there, a rest that only falls with them (so it changes only where it pushes nothing),
+  /// gives it no push out of nothing: opening a node adds no energy. A sphere pair counts from
+  /// the larger rest of its two nodes (pair_rest).
   std::vector<real> opened_rest_;
+  /// The rest a sphere pair of nodes i and j under `law` counts its overlap from: the larger of
+  /// their rests under the surface law (0 for a node without one), else 0.
+  real pair_rest(index_t i, index_t j, const contact::PairLaw& law) const {
+    if (!law.surface || opened_rest_.empty()) return 0;
+    return std::max({real{0}, opened_rest_[i], opened_rest_[j]});
+  }
+  /// Clears the in-contact flags of the sphere pairs of the `rested` nodes (those with a rest
+  /// above 0) that do not reach past their rest.
+  void release_rested_pairs(const Model& model, const State& state, const std::vector<index_t>& rested);
   /// The force on the own A of node i's touching probe of group g through its smooth facing.
   vec3 facing_force(index_t i, index_t g, const ProbeState& probe, index_t first, index_t last) const;
   /// phi_k w_k / S of node j's surface point in a group's sums (0 if it does not face the probe).

@@ -19,8 +19,13 @@
 // stays on the node; only its tangential part reaches the anchors. Particles outside the
 // surface law keep the linear form q = y_i + (l / ((h/2) |o_i|)) A_i (the same point at rest;
 // it stretches with the neighbourhood), which needs no square root per node and step. A node
-// whose bond to one of its anchors breaks is detached: it is seen at itself from then on, and
-// carries no surface point.
+// whose bond to one of its anchors breaks takes new anchors under the surface law: the pair
+// (triple) of its neighbours within 1.75 h, still bonded to it, that spans best, weighted to
+// give the same A_i in the reference (so the same A_i, normal and points under any affine
+// motion of the neighbourhood: the point stays where it was, up to the neighbourhood's
+// non-affine strain), the choice a function of the bond states alone. Where none spans, and
+// outside the surface law, the node is detached: seen at itself from then on, with no surface
+// point.
 //
 // A particle under the surface law whose surface is curved everywhere (every surface point's
 // curvature radius 1/kappa between 2 h and 50 h: a disc, a sphere, an ellipse) is round:
@@ -60,8 +65,9 @@ class SurfaceCentres {
   void forget() { found_ = false; }
   bool any() const { return any_; }
 
-  /// Detaches the nodes whose bond to one of their anchors is among `pairs` (bonds that broke).
-  void detach_anchored(const Model& model, std::span<const std::array<index_t, 2>> pairs);
+  /// The nodes whose bond to one of their anchors is among `pairs` (bonds that broke, already
+  /// broken in `state`) take new anchors, or are detached (see above).
+  void detach_anchored(const Model& model, const State& state, std::span<const std::array<index_t, 2>> pairs);
 
   /// Whether node i is seen away from itself (it has anchors): a cheap test for the hot loops.
   bool moved(index_t i) const { return any_ && anchored_[i]; }
@@ -124,7 +130,8 @@ class SurfaceCentres {
 
   std::size_t memory_bytes() const {
     return depth_.capacity() * sizeof(real) + anchor_slot_.capacity() * sizeof(index_t) +
-           anchored_.capacity() + surface_.capacity() + round_.capacity();
+           anchored_.capacity() + surface_.capacity() + round_.capacity() +
+           spare_.capacity() * sizeof(SurfaceAnchor);
   }
 
   /// The bounds of a round particle's curvature radii, over its h (see above).
@@ -137,6 +144,10 @@ class SurfaceCentres {
   static real reference_length(const Seen& s) { return 0.5 * s.mesh_size * s.anchor->reach; }
   static real length_of(const vec3& a);
   void detach(index_t i);
+  /// Node i's anchors from the bonds it still has (see above), or detached if none span.
+  void reanchor(const Model& model, const State& state, index_t i);
+  /// Whether one of the bonds of node i to the anchors `a` has broken.
+  static bool anchor_bond_broken(const Model& model, const State& state, index_t i, const SurfaceAnchor& a);
   /// Whether every surface point of the shape has a curvature radius within the round bounds.
   static bool is_round(const Shape& shape);
   /// Node i's anchors from the shape (none for an outer-layer node of a particle not under the
@@ -146,8 +157,12 @@ class SurfaceCentres {
   /// the surface law, else from its shape.
   const SurfaceAnchor* kept_anchor(const Model& model, const Particle& particle, index_t i) const {
     const SurfaceAnchors& anchors = model.shapes()[particle.shape].anchors;
-    return anchor_slot_.empty() ? anchors.of(i - particle.first_node) : &anchors.anchors[anchor_slot_[i]];
+    if (anchor_slot_.empty()) return anchors.of(i - particle.first_node);
+    const index_t slot = anchor_slot_[i];
+    return (slot & spare_bit) ? &spare_[slot & ~spare_bit] : &anchors.anchors[slot];
   }
+  /// Marks an anchor_slot_ that is a place in spare_, not in the shape's anchors.
+  static constexpr index_t spare_bit = index_t{1} << 31;
 
   bool found_ = false;
   bool any_ = false;
@@ -155,8 +170,10 @@ class SurfaceCentres {
   std::vector<std::uint8_t> surface_;   // per particle: under the surface law
   std::vector<std::uint8_t> round_;     // per particle: round (see above)
   std::vector<std::uint8_t> anchored_;  // per node: seen at its anchors (0 once detached)
-  // Per node under the surface law: lookup()'s anchor, as its place in the shape's anchors.
+  // Per node under the surface law: its anchors, as a place in the shape's anchors (lookup()'s),
+  // or with spare_bit, in spare_.
   std::vector<index_t> anchor_slot_;
+  std::vector<SurfaceAnchor> spare_;  // the anchors taken after bonds broke (reanchor)
 };
 
 inline real SurfaceCentres::linear_scale(const Seen& s, real length) {
