@@ -54,9 +54,10 @@ bool SurfaceCentres::anchor_bond_broken(const Model& model, const State& state, 
 
 void SurfaceCentres::reanchor(const Model& model, const State& state, index_t i) {
   // The same anchored vector in the reference, A_0 = sum_k w_k (X_k - X_i) of the shape's
-  // anchors, from the intact bonds within 1.75 h, nearest first (ties by index), as
-  // build_surface_anchors chose among all the neighbours. A function of the bond states only,
-  // so a restore finds the same anchors.
+  // anchors, from all the intact bonds within 1.75 h, nearest first (ties by index). A function
+  // of the bond states only, so a restore finds the same anchors: bonds only break, and the
+  // first best span of a set is the first best of any subset that holds it, so anchors taken
+  // earlier are those this would take now while their bonds hold.
   const index_t p = model.node_particle()[i];
   const SurfaceAnchor* primary = lookup(model, i);
   if (anchor_slot_.empty() || !surface_[p] || primary == nullptr) {  // outside the surface law
@@ -80,12 +81,15 @@ void SurfaceCentres::reanchor(const Model& model, const State& state, index_t i)
     if (r2 <= radius * radius) near.push_back({r2, j});
   }
   std::sort(near.begin(), near.end());
-  const std::size_t most = model.dimension() == 2 ? 12 : 18;  // as build_surface_anchors
   std::vector<index_t> candidates;
-  for (std::size_t k = 0; k < near.size() && k < most; ++k) candidates.push_back(near[k].second);
+  for (const auto& entry : near) candidates.push_back(entry.second);
   SurfaceAnchor anchor = *primary;
   if (!span_anchors(x, i, candidates, target, model.dimension(), particle.first_node, anchor)) {
     detach(i);
+    return;
+  }
+  if (anchor_slot_[i] & spare_bit) {  // taken again: its earlier spare anchors are no one's
+    spare_[anchor_slot_[i] & ~spare_bit] = anchor;
     return;
   }
   anchor_slot_[i] = spare_bit | static_cast<index_t>(spare_.size());

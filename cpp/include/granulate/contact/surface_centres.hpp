@@ -20,7 +20,8 @@
 // surface law keep the linear form q = y_i + (l / ((h/2) |o_i|)) A_i (the same point at rest;
 // it stretches with the neighbourhood), which needs no square root per node and step. A node
 // whose bond to one of its anchors breaks takes new anchors under the surface law: the pair
-// (triple) of its neighbours within 1.75 h, still bonded to it, that spans best, weighted to
+// (triple) of its neighbours within 1.75 h, still bonded to it (all of them, nearest first),
+// that spans best, weighted to
 // give the same A_i in the reference (so the same A_i, normal and points under any affine
 // motion of the neighbourhood: the point stays where it was, up to the neighbourhood's
 // non-affine strain), the choice a function of the bond states alone. Where none spans, and
