@@ -730,8 +730,9 @@ void ContactModel::release_rested_pairs(const Model& model, const State& state,
       pair_stiffness_[e] = 0;
       const index_t j = pair_partner_[e];
       const index_t* listed = pair_partner_.data();
-      const index_t* other = std::lower_bound(listed + pair_offsets_[j], listed + pair_offsets_[j + 1], i);
-      pair_stiffness_[other - listed] = 0;
+      const index_t* end = listed + pair_offsets_[j + 1];
+      const index_t* other = std::lower_bound(listed + pair_offsets_[j], end, i);
+      if (other != end && *other == i) pair_stiffness_[other - listed] = 0;
     }
   }
 }
