@@ -7,7 +7,8 @@ first bond breaks, and a break may only release energy.
 
 Run: python examples/compression_2d/compression_2d.py --out out/compression (settles the pile,
 17 minutes here), then python docs/validation/compression_energy.py out/compression
-[--restitution 1] [--travel 3.4e-3] [--model pmb --fracture-energy 2] (under a minute).
+[--restitution 1] [--friction 0] [--travel 3.4e-3] [--model pmb --fracture-energy 2] (under a
+minute).
 """
 
 from __future__ import annotations
@@ -59,13 +60,16 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("folder", type=Path, help="the example's --out folder")
     parser.add_argument("--restitution", type=float, default=1.0)
+    parser.add_argument("--friction", type=float, default=0.0, help="while compressed")
     parser.add_argument("--speed", type=float, default=0.6, help="[m/s]")
     parser.add_argument("--travel", type=float, default=3.4e-3, help="[m]")
     parser.add_argument("--model", choices=("lps", "pmb"), default=None)
     parser.add_argument("--fracture-energy", type=float, default=50.0, help="with --model [J/m^2]")
     parser.add_argument("--out", type=Path, default=Path("out/compression_energy"))
     args = parser.parse_args()
-    options = compression_2d.Options(restitution=args.restitution, history_every=5)
+    options = compression_2d.Options(
+        restitution=args.restitution, history_every=5, friction=args.friction
+    )
     grains, width, settled, bodies = settled_pile(
         args.folder, options, args.model, args.fracture_energy
     )

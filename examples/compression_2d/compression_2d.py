@@ -11,6 +11,7 @@ stress ``top_stress`` [Pa] (its force over the container's width) against its tr
     python examples/compression_2d/compression_2d.py --grains 502 --speed 0.06  # the paper's
     python examples/compression_2d/compression_2d.py --peridem-constants  # PeriDEM's 2D LPS
     python examples/compression_2d/compression_2d.py --stiffness-factor 10  # a stiffer contact
+    python examples/compression_2d/compression_2d.py --friction 0.5  # frictional compression
 
 Steps: (1) the material (LPS, linear influence, horizon 0.6 mm); (2) two grains, discs with
 conforming (ring) nodes and hexagons on a lattice, both of mesh size 0.2 mm at radius 1 mm;
@@ -23,6 +24,9 @@ above the highest node, moved down; the wall stress against its travel is the lo
 constants and critical stretch in 2D (``Simulation(plane="peridem")``) and bonds that also
 break in compression (``Material(break_in_compression=True)``), as the paper's runs did;
 ``--stiffness-factor`` multiplies the contact spring (``Contact(stiffness_factor=...)``).
+``--friction`` gives the grains friction in stage 2 (they settle frictionless, as the paper's):
+frictionless grains under the surface law slide past each other when a force chain gives way,
+and the pile keeps a third of the wall's work as motion (docs/validation/README.md).
 Stage 2 starts from the settled positions as PeriDEM's run2 restarts from its output_400
 (the settling's contact history is not carried over: at rest, without friction, there is
 none that matters).
@@ -31,6 +35,7 @@ none that matters).
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -49,13 +54,15 @@ class Options:
     """peridem: PeriDEM's 2D peridynamics (3D LPS constants, bonds breaking in compression);
     stiffness_factor: of the contact spring; pair_law: Contact(pair_law=...); restitution:
     Contact(restitution=...); history_every: steps between history rows of the compression
-    (None: the frames' interval)."""
+    (None: the frames' interval); friction: Contact(friction=...) of the compression (the
+    settling is frictionless)."""
 
     peridem: bool = False
     stiffness_factor: float = 1.0
     pair_law: str = "surface"
     restitution: float = 0.95
     history_every: int | None = None
+    friction: float = 0.0
 
 
 def material(options: Options = Options()) -> gr.Material:
@@ -139,6 +146,7 @@ def compress(
     """Stage 2: the settled grains under a top wall placed GAP above them, moved down at `speed`
     until it has travelled `travel`; its stress is recorded over the container's width."""
     sim = simulation(settled.placements_now(bodies, grains), width, options)  # where they rest
+    sim.contact = dataclasses.replace(sim.contact, friction=options.friction)
     top = float(settled.positions[:, 1].max()) + GAP
     plate = gr.Wall(
         (gr.Plane((0, top), (0, -1)),),
@@ -182,12 +190,17 @@ def main(argv: list[str] | None = None) -> dict[str, float]:
         help="contact law: surface (the default) or granulate (the node spheres, which made the "
         "committed figures)",
     )
+    parser.add_argument(
+        "--friction", type=float, default=0.0, help="grains' friction while compressed (default 0)"
+    )
     args = parser.parse_args(argv)
     count, travel, until = (40, 0.2e-3, 5e-3) if args.smoke else (args.grains, args.travel, 1.0)
     width = WIDTH * min(1.0, math.sqrt(count / 502))  # the paper's proportions
     out = Path(args.out)
 
-    options = Options(args.peridem_constants, args.stiffness_factor, args.pair_law)
+    options = Options(
+        args.peridem_constants, args.stiffness_factor, args.pair_law, friction=args.friction
+    )
     grains = packing(count, width, args.seed, options)
     print(grains.summary())
     settled, bodies = settle(grains, width, until, out / "settle", args.overwrite, options)
