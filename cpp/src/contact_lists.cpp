@@ -73,10 +73,10 @@ void ContactModel::bonds_broke(const Model& model, const State& state,
   if (!active()) return;
   newly_broken_.insert(newly_broken_.end(), pairs.begin(), pairs.end());
   if (!centres_.any()) return;
-  std::vector<index_t> surface_nodes;  // the pairs' nodes that carry a surface point
+  std::vector<index_t> surface_nodes;  // the pairs' nodes that carry a point under the surface law
   for (const auto& [i, j] : pairs) {
     for (const index_t k : {i, j}) {
-      if (on_surface(model, k)) surface_nodes.push_back(k);
+      if (surface_particle(model.node_particle()[k]) && on_surface(model, k)) surface_nodes.push_back(k);
     }
   }
   centres_.detach_anchored(model, state, pairs);

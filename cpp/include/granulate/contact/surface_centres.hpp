@@ -21,12 +21,11 @@
 // it stretches with the neighbourhood), which needs no square root per node and step. A node
 // whose bond to one of its anchors breaks takes new anchors under the surface law: the pair
 // (triple) of its neighbours within 1.75 h, still bonded to it (all of them, nearest first),
-// that spans best, weighted to
-// give the same A_i in the reference (so the same A_i, normal and points under any affine
-// motion of the neighbourhood: the point stays where it was, up to the neighbourhood's
-// non-affine strain), the choice a function of the bond states alone. Where none spans, and
-// outside the surface law, the node is detached: seen at itself from then on, with no surface
-// point.
+// that spans best, weighted to give the same A_i in the reference (so the same A_i, normal and
+// points under any affine motion of the neighbourhood: the point stays where it was, up to the
+// neighbourhood's non-affine strain), the choice a function of the bond states alone. Where
+// none spans, and outside the surface law, the node is detached: seen at itself from then on,
+// with no surface point.
 //
 // A particle under the surface law whose surface is curved everywhere (every surface point's
 // curvature radius 1/kappa between 2 h and 50 h: a disc, a sphere, an ellipse) is round:
