@@ -350,7 +350,7 @@ void ContactModel::measure_contacts(const Model& model, const State& state) {
   touching_nodes_.clear();
   if (any_surface_ && opened_rest_.size() != static_cast<std::size_t>(n)) opened_rest_.assign(n, -1);
   std::vector<ProbeState> touching_probes;  // the surface probes that touch, from every thread
-  std::vector<index_t> rested_nodes;        // the nodes whose overlaps count from a rest
+  std::vector<index_t> rested_nodes;        // the nodes with sphere pairs under the surface law
 #pragma omp parallel
   {
     std::vector<WallContact> found;  // scratch of this thread
@@ -374,7 +374,8 @@ void ContactModel::measure_contacts(const Model& model, const State& state) {
         return xi;
       };
       bool touching = false;
-      real pair_overlap = 0;  // the deepest of its sphere pairs under the surface law
+      real pair_overlap = 0;    // the deepest of its sphere pairs under the surface law
+      bool rest_pairs = false;  // whether one of them touches before their rests
       for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
         const index_t j = pair_partner_[e];
         const contact::PairLaw& law = slot_law(pair_slot_[e]);
@@ -390,13 +391,14 @@ void ContactModel::measure_contacts(const Model& model, const State& state) {
                                  ? static_cast<float>(contact::pair_stiffness(law, volume[i], volume[j]))
                                  : 0.0f;
         touching = touching || (pair_stiffness_[e] > 0 && !law.node_pair && node_body_[i] != node_body_[j]);
-        if (pair_stiffness_[e] > 0 && !law.node_pair)
+        if (pair_stiffness_[e] > 0 && !law.node_pair && !law.surface)
           deepest = std::max(deepest, 1 - distance / law.contact_radius);
         if (law.surface) pair_overlap = std::max(pair_overlap, law.contact_radius - distance);
+        if (law.surface && pair_stiffness_[e] > 0) rest_pairs = true;
       }
       if (touching) touching_nodes.push_back(i);
       deepest = std::max(deepest, measure_probes(model, state, i, probe_scratch, pair_overlap));
-      if (!opened_rest_.empty() && opened_rest_[i] > 0) rested.push_back(i);
+      if (rest_pairs) rested.push_back(i);
       for (index_t e = wall_offsets_[i]; e < wall_offsets_[i + 1]; ++e)
         measure_wall_points(model, state, i, e, centre(), found);
     }
@@ -719,14 +721,19 @@ void ContactModel::measure_surface_normals(const Model& model, const State& stat
 
 void ContactModel::release_rested_pairs(const Model& model, const State& state,
                                         const std::vector<index_t>& rested) {
-  // The sphere pairs of a node with a rest touch only past it (pair_geometry); both entries of
-  // a pair are cleared, so the pair stays symmetric. After the parallel pass, when every rest of
-  // the step is settled: the same for any thread count.
+  // The sphere pairs under the surface law touch only past the larger rest of their nodes
+  // (pair_geometry); both entries of a pair that does not are cleared, so the pair stays
+  // symmetric, and those that do count in the deepest overlap. After the parallel pass, when
+  // every rest of the step is settled: the same for any thread count.
   for (const index_t i : rested) {
     for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
-      if (pair_stiffness_[e] == 0 || surface_entry(model, i, e) ||
-          pair_geometry(model, state, i, e).overlap > 0)
+      if (pair_stiffness_[e] == 0 || surface_entry(model, i, e) || !slot_law(pair_slot_[e]).surface) continue;
+      const real overlap = pair_geometry(model, state, i, e).overlap;
+      if (overlap > 0) {
+        statistics_.deepest_overlap =
+            std::max(statistics_.deepest_overlap, overlap / slot_law(pair_slot_[e]).contact_radius);
         continue;
+      }
       pair_stiffness_[e] = 0;
       const index_t j = pair_partner_[e];
       const index_t* listed = pair_partner_.data();
