@@ -41,6 +41,23 @@ std::array<real, 3> offset(const SurfaceAnchor& anchor, const std::vector<real>&
   return c;
 }
 
+/// The grid moved by y = F x + t, F a rotation by 0.3 rad times a stretch (row-major, 2 x 2).
+struct Moved {
+  std::array<real, 4> F;
+  std::vector<real> y;
+};
+
+Moved stretched_and_turned(const Grid& g) {
+  const real c = std::cos(0.3), s = std::sin(0.3);
+  Moved m{{1.1 * c, -0.9 * s, 1.1 * s, 0.9 * c}, std::vector<real>(g.positions.size())};
+  for (std::size_t a = 0; a < m.y.size() / 3; ++a) {
+    const real x0 = g.positions[3 * a], x1 = g.positions[3 * a + 1];
+    m.y[3 * a] = m.F[0] * x0 + m.F[1] * x1 + 2.0;
+    m.y[3 * a + 1] = m.F[2] * x0 + m.F[3] * x1 - 1.0;
+  }
+  return m;
+}
+
 }  // namespace
 
 TEST_CASE("surface anchors put a face node's centre h/2 inside, a corner's h/2 from both faces") {
@@ -61,15 +78,8 @@ TEST_CASE("surface anchors follow any affine motion of the neighbourhood") {
   const real h = 0.1;
   const Grid g = square_grid(h);
   const SurfaceAnchors anchors = build_surface_anchors(g.positions, g.offsets, {}, h, 2);
-  // y = F x + t with F a rotation by 0.3 rad times a stretch: the offset is F (h/2, h/2).
-  const real c = std::cos(0.3), s = std::sin(0.3);
-  const std::array<real, 4> F{1.1 * c, -0.9 * s, 1.1 * s, 0.9 * c};
-  std::vector<real> y(g.positions.size());
-  for (std::size_t a = 0; a < y.size() / 3; ++a) {
-    const real x0 = g.positions[3 * a], x1 = g.positions[3 * a + 1];
-    y[3 * a] = F[0] * x0 + F[1] * x1 + 2.0;
-    y[3 * a + 1] = F[2] * x0 + F[3] * x1 - 1.0;
-  }
+  // y = F x + t: the offset is F (h/2, h/2).
+  const auto [F, y] = stretched_and_turned(g);
   const auto moved = offset(*anchors.of(0), y, 0);
   CHECK_CLOSE(moved[0], F[0] * 0.5 * h + F[1] * 0.5 * h, 1e-7);
   CHECK_CLOSE(moved[1], F[2] * 0.5 * h + F[3] * 0.5 * h, 1e-7);
@@ -95,14 +105,7 @@ TEST_CASE("anchors taken again without a broken bond give the same anchored vect
   const auto rest = offset(again, g.positions, a);
   CHECK_CLOSE(rest[0], minus_a[0], 1e-7);
   CHECK_CLOSE(rest[1], minus_a[1], 1e-7);
-  const real c = std::cos(0.3), s = std::sin(0.3);
-  const std::array<real, 4> F{1.1 * c, -0.9 * s, 1.1 * s, 0.9 * c};
-  std::vector<real> y(g.positions.size());
-  for (std::size_t k = 0; k < y.size() / 3; ++k) {
-    const real x0 = g.positions[3 * k], x1 = g.positions[3 * k + 1];
-    y[3 * k] = F[0] * x0 + F[1] * x1 + 2.0;
-    y[3 * k + 1] = F[2] * x0 + F[3] * x1 - 1.0;
-  }
+  const std::vector<real> y = stretched_and_turned(g).y;
   const auto moved = offset(again, y, a), before = offset(first, y, a);
   CHECK_CLOSE(moved[0], before[0], 1e-7);
   CHECK_CLOSE(moved[1], before[1], 1e-7);
