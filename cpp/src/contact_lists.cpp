@@ -72,16 +72,8 @@ void ContactModel::bonds_broke(const Model& model, const State& state,
                                std::span<const std::array<index_t, 2>> pairs) {
   if (!active()) return;
   newly_broken_.insert(newly_broken_.end(), pairs.begin(), pairs.end());
-  if (!centres_.any()) return;
-  std::vector<index_t> surface_nodes;  // the pairs' nodes that carry a point under the surface law
-  for (const auto& [i, j] : pairs) {
-    for (const index_t k : {i, j}) {
-      if (surface_particle(model.node_particle()[k]) && on_surface(model, k)) surface_nodes.push_back(k);
-    }
-  }
-  centres_.detach_anchored(model, state, pairs);
-  for (const index_t k : surface_nodes) {
-    if (on_surface(model, k)) continue;  // new anchors
+  for (const index_t k : centres_.detach_anchored(model, state, pairs)) {
+    if (!surface_particle(model.node_particle()[k])) continue;  // the node spheres' reach is kept
     if (!opened_rest_.empty()) opened_rest_[k] = -1;
     detached_since_build_ = true;
   }

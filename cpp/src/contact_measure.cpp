@@ -350,12 +350,12 @@ void ContactModel::measure_contacts(const Model& model, const State& state) {
   touching_nodes_.clear();
   if (any_surface_ && opened_rest_.size() != static_cast<std::size_t>(n)) opened_rest_.assign(n, -1);
   std::vector<ProbeState> touching_probes;  // the surface probes that touch, from every thread
-  std::vector<index_t> rested_nodes;        // the nodes with sphere pairs under the surface law
+  std::vector<index_t> sphere_pair_nodes;   // the nodes touching in sphere pairs under the surface law
 #pragma omp parallel
   {
     std::vector<WallContact> found;  // scratch of this thread
     ProbeScratch probe_scratch;
-    std::vector<index_t> touching_nodes, rested;
+    std::vector<index_t> touching_nodes, sphere_pairs;
     real deepest = 0;  // overlap / Rc
 #pragma omp for schedule(static) nowait
     for (std::int64_t ii = 0; ii < n; ++ii) {
@@ -364,7 +364,8 @@ void ContactModel::measure_contacts(const Model& model, const State& state) {
         // Nothing in reach: the rest of a node that takes part falls to 0, as it would were the
         // node listed (the skin, which decides which nodes are, must change no force). A node
         // inside an intact surface keeps -1 until a crack opens it.
-        if (!opened_rest_.empty() && (taking_part_.empty() || taking_part_[i])) opened_rest_[i] = 0;
+        if (!opened_rest_.empty() && opened_rest_[i] != 0 && (taking_part_.empty() || taking_part_[i]))
+          opened_rest_[i] = 0;
         continue;
       }
       vec3 xi{0, 0, 0};
@@ -374,8 +375,8 @@ void ContactModel::measure_contacts(const Model& model, const State& state) {
         return xi;
       };
       bool touching = false;
-      real pair_overlap = 0;    // the deepest of its sphere pairs under the surface law
-      bool rest_pairs = false;  // whether one of them touches before their rests
+      real pair_overlap = 0;     // the deepest of its sphere pairs under the surface law
+      bool sphere_pair = false;  // whether one of them touches, before their rests
       for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
         const index_t j = pair_partner_[e];
         const contact::PairLaw& law = slot_law(pair_slot_[e]);
@@ -394,18 +395,18 @@ void ContactModel::measure_contacts(const Model& model, const State& state) {
         if (pair_stiffness_[e] > 0 && !law.node_pair && !law.surface)
           deepest = std::max(deepest, 1 - distance / law.contact_radius);
         if (law.surface) pair_overlap = std::max(pair_overlap, law.contact_radius - distance);
-        if (law.surface && pair_stiffness_[e] > 0) rest_pairs = true;
+        if (law.surface && pair_stiffness_[e] > 0) sphere_pair = true;
       }
       if (touching) touching_nodes.push_back(i);
       deepest = std::max(deepest, measure_probes(model, state, i, probe_scratch, pair_overlap));
-      if (rest_pairs) rested.push_back(i);
+      if (sphere_pair) sphere_pairs.push_back(i);
       for (index_t e = wall_offsets_[i]; e < wall_offsets_[i + 1]; ++e)
         measure_wall_points(model, state, i, e, centre(), found);
     }
 #pragma omp critical
     {
       touching_nodes_.insert(touching_nodes_.end(), touching_nodes.begin(), touching_nodes.end());
-      rested_nodes.insert(rested_nodes.end(), rested.begin(), rested.end());
+      sphere_pair_nodes.insert(sphere_pair_nodes.end(), sphere_pairs.begin(), sphere_pairs.end());
       touching_probes.insert(touching_probes.end(), probe_scratch.touching.begin(),
                              probe_scratch.touching.end());
       statistics_.deepest_overlap = std::max(statistics_.deepest_overlap, deepest);
@@ -413,7 +414,7 @@ void ContactModel::measure_contacts(const Model& model, const State& state) {
   }
   std::sort(touching_nodes_.begin(), touching_nodes_.end());  // the same for any thread count
   if (any_surface_) keep_touching_probes(touching_probes);
-  release_rested_pairs(model, state, rested_nodes);
+  release_rested_pairs(model, state, sphere_pair_nodes);
 }
 
 void ContactModel::measure_wall_points(const Model& model, const State& state, index_t i, index_t e,
@@ -720,26 +721,22 @@ void ContactModel::measure_surface_normals(const Model& model, const State& stat
 }
 
 void ContactModel::release_rested_pairs(const Model& model, const State& state,
-                                        const std::vector<index_t>& rested) {
+                                        const std::vector<index_t>& nodes) {
   // The sphere pairs under the surface law touch only past the larger rest of their nodes
-  // (pair_geometry); both entries of a pair that does not are cleared, so the pair stays
-  // symmetric, and those that do count in the deepest overlap. After the parallel pass, when
+  // (pair_geometry); the entries of those that do not are cleared, and those that do count in
+  // the deepest overlap. Each pair is listed both ways with the same distance and rest, so the
+  // partner, which is in `nodes` too, clears its entry alike. After the parallel pass, when
   // every rest of the step is settled: the same for any thread count.
-  for (const index_t i : rested) {
+  for (const index_t i : nodes) {
     for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
       if (pair_stiffness_[e] == 0 || surface_entry(model, i, e) || !slot_law(pair_slot_[e]).surface) continue;
       const real overlap = pair_geometry(model, state, i, e).overlap;
       if (overlap > 0) {
         statistics_.deepest_overlap =
             std::max(statistics_.deepest_overlap, overlap / slot_law(pair_slot_[e]).contact_radius);
-        continue;
+      } else {
+        pair_stiffness_[e] = 0;
       }
-      pair_stiffness_[e] = 0;
-      const index_t j = pair_partner_[e];
-      const index_t* listed = pair_partner_.data();
-      const index_t* end = listed + pair_offsets_[j + 1];
-      const index_t* other = std::lower_bound(listed + pair_offsets_[j], end, i);
-      if (other != end && *other == i) pair_stiffness_[other - listed] = 0;
     }
   }
 }

@@ -52,7 +52,7 @@ bool SurfaceCentres::anchor_bond_broken(const Model& model, const State& state, 
   return false;
 }
 
-void SurfaceCentres::reanchor(const Model& model, const State& state, index_t i) {
+bool SurfaceCentres::reanchor(const Model& model, const State& state, index_t i) {
   // The same anchored vector in the reference, A_0 = sum_k w_k (X_k - X_i) of the shape's
   // anchors, from all the intact bonds within 1.75 h, nearest first (ties by index). A function
   // of the bond states only, so a restore finds the same anchors: bonds only break, and the
@@ -62,7 +62,7 @@ void SurfaceCentres::reanchor(const Model& model, const State& state, index_t i)
   const SurfaceAnchor* primary = lookup(model, i);
   if (anchor_slot_.empty() || !surface_[p] || primary == nullptr) {  // outside the surface law
     detach(i);
-    return;
+    return false;
   }
   const Particle& particle = model.particles()[p];
   const std::vector<real>& x = model.reference_positions();
@@ -86,14 +86,15 @@ void SurfaceCentres::reanchor(const Model& model, const State& state, index_t i)
   SurfaceAnchor anchor = *primary;
   if (!span_anchors(x, i, candidates, target, model.dimension(), particle.first_node, anchor)) {
     detach(i);
-    return;
+    return false;
   }
   if (anchor_slot_[i] & spare_bit) {  // taken again: its earlier spare anchors are no one's
     spare_[anchor_slot_[i] & ~spare_bit] = anchor;
-    return;
+  } else {
+    anchor_slot_[i] = spare_bit | static_cast<index_t>(spare_.size());
+    spare_.push_back(anchor);
   }
-  anchor_slot_[i] = spare_bit | static_cast<index_t>(spare_.size());
-  spare_.push_back(anchor);
+  return true;
 }
 
 bool SurfaceCentres::is_round(const Shape& shape) {
@@ -115,19 +116,23 @@ const SurfaceAnchor* SurfaceCentres::lookup(const Model& model, index_t i) const
   return a != nullptr && (a->depth == 0 || surface_[p]) ? a : nullptr;
 }
 
-void SurfaceCentres::detach_anchored(const Model& model, const State& state,
-                                     std::span<const std::array<index_t, 2>> pairs) {
+std::vector<index_t> SurfaceCentres::detach_anchored(const Model& model, const State& state,
+                                                     std::span<const std::array<index_t, 2>> pairs) {
   // The new anchors depend on the bond states alone, so the order of `pairs` (the threads')
   // changes nothing but the places in spare_.
-  if (!found_ || !any_) return;
+  std::vector<index_t> detached;
+  if (!found_ || !any_) return detached;
   for (const auto& [i, j] : pairs) {
     for (const auto& [node, other] : {std::array<index_t, 2>{i, j}, std::array<index_t, 2>{j, i}}) {
       const SurfaceAnchor* a = anchor(model, node);
       if (a == nullptr) continue;
       const index_t local = other - model.particles()[model.node_particle()[node]].first_node;
-      if (std::find(a->nodes.begin(), a->nodes.end(), local) != a->nodes.end()) reanchor(model, state, node);
+      if (std::find(a->nodes.begin(), a->nodes.end(), local) != a->nodes.end() &&
+          !reanchor(model, state, node))
+        detached.push_back(node);
     }
   }
+  return detached;
 }
 
 void SurfaceCentres::fill_positions(const Model& model, const State& state, std::vector<float>& x) const {

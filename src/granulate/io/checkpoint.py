@@ -24,8 +24,9 @@ from granulate.errors import InputError
 from granulate.io.atomic import atomic_write
 
 # 2: per-contact friction springs and per-node contact radii; 3: each collision's force-law
-# exponent (the damping that gives the requested restitution); 6: the rest overlaps of nodes
-# opened by cracks
+# exponent (the damping that gives the requested restitution); 4: contact against the
+# particles' smooth surfaces; 5: the turned collision forces fading out in lasting contacts;
+# 6: the rest overlaps of nodes opened by cracks
 FORMAT = 6
 HEADER = "__header__"
 

@@ -387,10 +387,10 @@ class ContactModel {
     if (!law.surface || opened_rest_.empty()) return 0;
     return std::max({real{0}, opened_rest_[i], opened_rest_[j]});
   }
-  /// Clears the in-contact flags of the sphere pairs under the surface law of the `rested` nodes
-  /// (those with such pairs in reach) that do not reach past their rest; the others count in the
-  /// deepest overlap.
-  void release_rested_pairs(const Model& model, const State& state, const std::vector<index_t>& rested);
+  /// Clears the in-contact flags of the sphere pairs under the surface law of `nodes` (those
+  /// with such a pair within its contact radius) that do not reach past their rest; the others
+  /// count in the deepest overlap.
+  void release_rested_pairs(const Model& model, const State& state, const std::vector<index_t>& nodes);
   /// The force on the own A of node i's touching probe of group g through its smooth facing.
   vec3 facing_force(index_t i, index_t g, const ProbeState& probe, index_t first, index_t last) const;
   /// phi_k w_k / S of node j's surface point in a group's sums (0 if it does not face the probe).

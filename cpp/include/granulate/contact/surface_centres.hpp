@@ -66,8 +66,9 @@ class SurfaceCentres {
   bool any() const { return any_; }
 
   /// The nodes whose bond to one of their anchors is among `pairs` (bonds that broke, already
-  /// broken in `state`) take new anchors, or are detached (see above).
-  void detach_anchored(const Model& model, const State& state, std::span<const std::array<index_t, 2>> pairs);
+  /// broken in `state`) take new anchors, or are detached (see above); returns those detached.
+  std::vector<index_t> detach_anchored(const Model& model, const State& state,
+                                       std::span<const std::array<index_t, 2>> pairs);
 
   /// Whether node i is seen away from itself (it has anchors): a cheap test for the hot loops.
   bool moved(index_t i) const { return any_ && anchored_[i]; }
@@ -144,8 +145,9 @@ class SurfaceCentres {
   static real reference_length(const Seen& s) { return 0.5 * s.mesh_size * s.anchor->reach; }
   static real length_of(const vec3& a);
   void detach(index_t i);
-  /// Node i's anchors from the bonds it still has (see above), or detached if none span.
-  void reanchor(const Model& model, const State& state, index_t i);
+  /// Node i's anchors from the bonds it still has (see above), or detached if none span (or
+  /// outside the surface law): returns whether it keeps anchors.
+  bool reanchor(const Model& model, const State& state, index_t i);
   /// Whether one of the bonds of node i to the anchors `a` has broken.
   static bool anchor_bond_broken(const Model& model, const State& state, index_t i, const SurfaceAnchor& a);
   /// Whether every surface point of the shape has a curvature radius within the round bounds.
