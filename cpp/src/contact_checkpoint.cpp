@@ -137,15 +137,17 @@ void ContactModel::restore(const Model& model, const State& state, const Contact
   restore_collisions(saved);
   built_ = false;
   if (saved.built) {
-    // Rebuild the lists from the positions and time they were built at: the same lists,
-    // and rebuild() carries each pair's collision history over from the restored slots.
+    // Rebuild the lists from the positions each node was last listed at and the walls at the
+    // search's time: the same wall entries (a node's depend only on those), and rebuild()
+    // carries each pair's collision history over from the restored slots.
     State at_build = state;
     at_build.time = saved.time_at_build;
     positions_at_build_.assign(saved.positions_at_build.begin(), saved.positions_at_build.end());
     centres_.find(model, state, centring_depths(model),
                   surface_particles_);  // which nodes carry surface points
-    // Lists updated after bond breaks are not those of a search: take the saved ones (a
-    // checkpoint without them predates these updates, and a search gives them again).
+    // Pair lists updated in place are not those of a search (broken pairs are inserted from
+    // the current positions): take the saved ones (a checkpoint without them predates these
+    // updates, and a search gives them again).
     const bool saved_lists = saved.pair_offsets.size() == static_cast<std::size_t>(model.node_count()) + 1 &&
                              saved.pair_offsets.back() == saved.pair_partners.size();
     rebuild(model, at_build, saved.broken_at_build, !saved_lists);

@@ -2,6 +2,7 @@
 // springs carried over, slots, groups (the searches themselves: contact_search.cpp).
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <limits>
 #include <map>
 
@@ -41,15 +42,51 @@ real ContactModel::largest_displacement(const Model& model, const State& state) 
   return std::sqrt(worst);
 }
 
-bool ContactModel::needs_rebuild(const Model& model, const State& state, real& moved) const {
+std::vector<index_t> ContactModel::nodes_moved_past(const Model& model, const State& state,
+                                                    real limit) const {
+  std::vector<index_t> moved;
+  for (index_t i = 0; i < model.node_count(); ++i) {
+    const vec3 x = centres_.at_list(model, state, i);
+    real d2 = 0;
+    for (int k = 0; k < 3; ++k) {
+      const real d = x[k] - positions_at_build_[3 * i + k];
+      d2 += d * d;
+    }
+    if (d2 > limit * limit) moved.push_back(i);
+  }
+  return moved;
+}
+
+bool ContactModel::needs_search(const Model& model, const State& state, bool broke, real& moved,
+                                std::vector<index_t>& relist) const {
   moved = 0;
+  relist.clear();
   if (!built_) return true;
   const real half_skin = 0.5 * skin_;
   for (const Wall& wall : walls_) {
     if (wall.motion_bound(time_at_build_, state.time) > half_skin) return true;
   }
   moved = largest_displacement(model, state);
-  return moved > half_skin;
+  if (moved > half_skin) {
+    if (!all_near_ || !relisting_) return true;  // a moved node may reach a particle not searched
+    // The nodes that moved a quarter of the skin come along: their turn would come soon, and
+    // every list change costs a pass over all entries (finish_lists).
+    relist = nodes_moved_past(model, state, 0.25 * skin_);
+  }
+  if (broke) {
+    // A node a crack opened, or that lost its surface point (its list position and reach
+    // change), has not moved half the skin (or it is relisted already): it can reach only the
+    // particles near its own.
+    std::vector<index_t> changed = opened_nodes(model);
+    changed.insert(changed.end(), detached_nodes_.begin(), detached_nodes_.end());
+    for (const index_t k : changed) {
+      if (!near_particle_[model.node_particle()[k]] || !relisting_) return true;
+      relist.push_back(k);
+    }
+    std::sort(relist.begin(), relist.end());
+    relist.erase(std::unique(relist.begin(), relist.end()), relist.end());
+  }
+  return relist.size() * relist_share > static_cast<std::size_t>(model.node_count());
 }
 
 bool ContactModel::takes_part(const Model& model, const State& state, index_t i) const {
@@ -75,79 +112,134 @@ void ContactModel::bonds_broke(const Model& model, const State& state,
   for (const index_t k : centres_.detach_anchored(model, state, pairs)) {
     if (!surface_particle(model.node_particle()[k])) continue;  // the node spheres' reach is kept
     if (!opened_rest_.empty()) opened_rest_[k] = -1;
-    detached_since_build_ = true;
+    detached_nodes_.push_back(k);
   }
 }
 
-bool ContactModel::breaks_open_new_nodes(const Model& model) const {
-  if (detached_since_build_) return true;
-  if (taking_part_.empty()) return false;  // every node takes part already
+std::vector<index_t> ContactModel::opened_nodes(const Model& model) const {
+  std::vector<index_t> opened;
+  if (taking_part_.empty()) return opened;  // every node takes part already
   for (const auto& [i, j] : newly_broken_) {
     for (const index_t k : {i, j}) {
-      if (!taking_part_[k] && surface_particle(model.node_particle()[k])) return true;
+      if (!taking_part_[k] && surface_particle(model.node_particle()[k])) opened.push_back(k);
     }
   }
-  return false;
+  std::sort(opened.begin(), opened.end());
+  opened.erase(std::unique(opened.begin(), opened.end()), opened.end());
+  return opened;
 }
 
-void ContactModel::update_after_breaks(const Model& model, const State& state, std::uint64_t broken_bonds,
-                                       real moved) {
-  // Bonds broke, nothing moved far: no grid search. The lists gain every newly unbonded pair
-  // that could come within its Rc before the next rebuild: a node moves at most skin/2 from
-  // where the lists were built before that, so a pair now at d stays beyond d - skin - 2 w (w:
-  // the largest displacement since the build so far). A pair left out now stays out of reach
-  // until the next rebuild (w only grows; the reach taken is the larger of its reaches within
-  // one body and between two), so only the bonds broken since the last update are candidates.
-  // The bodies are labelled first.
-  label_bodies(model, state, broken_bonds);
-  const index_t n = model.node_count();
+std::vector<std::array<index_t, 2>> ContactModel::broken_pairs(const Model& model, const State& state,
+                                                               real moved) {
+  // A node moves at most skin/2 from where it was listed before it is listed again, so a pair
+  // now at d stays beyond d - skin - 2 w (w: the largest displacement since listed so far). A
+  // pair left out now stays out of reach until then (w only grows; the reach taken is the larger
+  // of its reaches within one body and between two: were they one body now, a later break could
+  // part them), so only the bonds broken since the last update are candidates.
   const auto& node_material = model.node_material();
   const real extra = skin_ + 2 * moved;
-  std::vector<std::array<index_t, 2>> added;  // (node, partner), both ways
+  std::vector<std::array<index_t, 2>> added;
   for (const auto& [i, j] : newly_broken_) {
     const index_t m = node_material[i];  // a bond joins two nodes of one particle
     if (!law_set_[m * material_count_ + m]) continue;
-    // The reach the pair has as two bodies, if larger: were they one body now, a later break
-    // could part them before the next rebuild, and the pair would not be a candidate then.
     const real limit = std::max(pair_reach(model, i, j, true), pair_reach(model, i, j, false)) + extra;
     const vec3 xi = centres_.at_list(model, state, i);
     const vec3 xj = centres_.at_list(model, state, j);
     const real dx = xj[0] - xi[0], dy = xj[1] - xi[1], dz = xj[2] - xi[2];
     if (dx * dx + dy * dy + dz * dz > limit * limit) continue;
-    const index_t* listed = pair_partner_.data();
-    if (std::binary_search(listed + pair_offsets_[i], listed + pair_offsets_[i + 1], j)) continue;
     added.push_back({i, j});
     added.push_back({j, i});
   }
   newly_broken_.clear();
-  if (!added.empty()) {
-    std::sort(added.begin(), added.end());
-    added.erase(std::unique(added.begin(), added.end()), added.end());
-    std::vector<index_t> offsets(static_cast<std::size_t>(n) + 1, 0);
-    for (const auto& [i, j] : added) ++offsets[i + 1];
-    for (index_t i = 0; i < n; ++i) offsets[i + 1] += offsets[i] + (pair_offsets_[i + 1] - pair_offsets_[i]);
-    // Merge the (sorted) new partners in; listed entries keep their friction springs.
-    std::vector<index_t> partners(offsets[n]), springs(offsets[n], no_spring);
+  return added;
+}
+
+std::vector<std::array<index_t, 2>> ContactModel::relisted_pairs(const Model& model, const State& state,
+                                                                 const std::vector<index_t>& relist) {
+  // Each relisted node's partners are those a search would list: a grid over every node that
+  // takes part, at its list position (as listed), within each pair's reach plus the skin.
+  const auto& node_particle = model.node_particle();
+  for (const index_t k : relist) {
+    if (!taking_part_.empty() && surface_particle(node_particle[k]) && takes_part(model, state, k))
+      taking_part_[k] = 1;
+  }
+  auto part = [&](index_t i) {
+    const index_t p = node_particle[i];
+    return near_particle_[p] && (taking_part_.empty() || !surface_particle(p) || taking_part_[i]);
+  };
+  std::vector<index_t> searched;
+  for (index_t i = 0; i < model.node_count(); ++i) {
+    if (part(i)) searched.push_back(i);
+  }
+  const real reach = largest_pair_reach(model) + skin_;
+  const CellGrid grid = CellGrid::build(positions_at_build_, searched, reach);
+  std::vector<std::array<index_t, 2>> pairs;
+  for (const index_t k : relist) {
+    if (!part(k)) continue;
+    grid.for_each_within(positions_at_build_, k, reach, dimension_, [&](index_t j, real r2) {
+      if (!lists_pair(model, state, k, j, r2, true)) return;
+      pairs.push_back({k, j});
+      pairs.push_back({j, k});
+    });
+  }
+  return pairs;
+}
+
+void ContactModel::update_lists(const Model& model, const State& state, std::uint64_t broken_bonds,
+                                real moved, const std::vector<index_t>& relist) {
+  label_bodies(model, state, broken_bonds);
+  const index_t n = model.node_count();
+  std::vector<std::array<index_t, 2>> added = broken_pairs(model, state, moved);
+  std::vector<std::uint8_t> relisted(relist.empty() ? 0 : n, 0);
+  for (const index_t k : relist) {
+    relisted[k] = 1;
+    const vec3 x = centres_.at_list(model, state, k);
+    for (int c = 0; c < 3; ++c) positions_at_build_[3 * k + c] = static_cast<float>(x[c]);
+  }
+  if (!relist.empty()) {
+    const auto pairs = relisted_pairs(model, state, relist);
+    added.insert(added.end(), pairs.begin(), pairs.end());
+  }
+  std::sort(added.begin(), added.end());
+  added.erase(std::unique(added.begin(), added.end()), added.end());
+  if (added.empty() && relist.empty()) {
+    finish_lists(model);  // the bodies may have changed
+  } else {
+    const KeptLists kept{std::move(pair_offsets_), std::move(pair_partner_), std::move(pair_spring_),
+                         std::move(wall_offsets_), std::move(wall_entry_),   std::move(wall_spring_)};
+    auto is_relisted = [&](index_t i) { return !relisted.empty() && relisted[i]; };
+    // Per node: the kept partners (none for a relisted node, no relisted one otherwise) and the
+    // added ones, merged in order.
+    pair_offsets_.assign(static_cast<std::size_t>(n) + 1, 0);
+    pair_partner_.clear();
+    wall_offsets_.assign(static_cast<std::size_t>(n) + 1, 0);
+    wall_entry_.clear();
+    std::vector<index_t> old, fresh;
     auto next = added.begin();
     for (index_t i = 0; i < n; ++i) {
-      index_t old = pair_offsets_[i], out = offsets[i];
-      auto copy_old = [&] {
-        springs[out] = pair_spring_[old];
-        partners[out++] = pair_partner_[old++];
-      };
-      while (next != added.end() && (*next)[0] == i) {
-        while (old < pair_offsets_[i + 1] && pair_partner_[old] < (*next)[1]) copy_old();
-        partners[out++] = (*next)[1];
-        ++next;
+      old.clear();
+      fresh.clear();
+      if (!is_relisted(i)) {
+        for (index_t e = kept.pair_offsets[i]; e < kept.pair_offsets[i + 1]; ++e) {
+          if (!is_relisted(kept.pair_partner[e])) old.push_back(kept.pair_partner[e]);
+        }
       }
-      while (old < pair_offsets_[i + 1]) copy_old();
+      for (; next != added.end() && (*next)[0] == i; ++next) fresh.push_back((*next)[1]);
+      std::set_union(old.begin(), old.end(), fresh.begin(), fresh.end(), std::back_inserter(pair_partner_));
+      pair_offsets_[i + 1] = static_cast<index_t>(pair_partner_.size());
+      if (is_relisted(i)) {
+        list_node_walls(model, time_at_build_, i, wall_entry_);
+      } else {
+        wall_entry_.insert(wall_entry_.end(), kept.wall_entry.begin() + kept.wall_offsets[i],
+                           kept.wall_entry.begin() + kept.wall_offsets[i + 1]);
+      }
+      wall_offsets_[i + 1] = static_cast<index_t>(wall_entry_.size());
     }
-    pair_offsets_ = std::move(offsets);
-    pair_partner_ = std::move(partners);
-    pair_spring_ = std::move(springs);
+    carry_over_springs(kept, n);
+    finish_lists(model);
   }
-  finish_lists(model);
   broken_at_build_ = broken_bonds;
+  detached_nodes_.clear();
   ++statistics_.list_updates;
   statistics_.list_entries = pair_partner_.size();
 }

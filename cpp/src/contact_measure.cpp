@@ -236,15 +236,14 @@ void ContactModel::add_forces(const Model& model, State& state, std::uint64_t br
   if (!active()) return;
   const auto search_start = std::chrono::steady_clock::now();
   if (!centres_.found()) centres_.find(model, state, centring_depths(model), surface_particles_);
-  real moved = 0;  // largest node displacement since the build
-  // A crack that opens nodes which took no part in contact needs a search: they may face
-  // another body now.
-  if (needs_rebuild(model, state, moved) ||
-      (broken_bonds != broken_at_build_ && breaks_open_new_nodes(model))) {
+  real moved = 0;  // largest node displacement since listed
+  const bool broke = broken_bonds != broken_at_build_;
+  std::vector<index_t> relist;
+  if (needs_search(model, state, broke, moved, relist)) {
     centres_.fill_positions(model, state, positions_at_build_);
     rebuild(model, state, broken_bonds);
-  } else if (broken_bonds != broken_at_build_) {
-    update_after_breaks(model, state, broken_bonds, moved);
+  } else if (broke || !relist.empty()) {
+    update_lists(model, state, broken_bonds, moved, relist);
   }
   search_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - search_start).count();
   const real dt = has_last_time_ ? state.time - last_time_ : 0.0;

@@ -27,9 +27,12 @@ void ContactModel::rebuild(const Model& model, const State& state, std::uint64_t
                        std::move(wall_offsets_), std::move(wall_entry_),   std::move(wall_spring_)};
   const real reach = largest_pair_reach(model) + skin_;
   newly_broken_.clear();  // the search finds every unbonded pair
-  detached_since_build_ = false;
+  detached_nodes_.clear();
   label_bodies(model, state, broken_bonds);
   const NearParticles near = near_particles(model, state, broken_bonds, reach);
+  near_particle_ = near.particle;
+  all_near_ =
+      std::all_of(near_particle_.begin(), near_particle_.end(), [](std::uint8_t f) { return f != 0; });
   search_node_pairs(model, state, near.particle, reach);
   search_node_walls(model, state, near.wall);
   carry_over_springs(kept, model.node_count());
@@ -103,8 +106,6 @@ void ContactModel::search_node_pairs(const Model& model, const State& state,
   const std::vector<float>& x = positions_at_build_;
   const index_t n = model.node_count();
   const auto& particles = model.particles();
-  const auto& node_particle = model.node_particle();
-  const auto& node_material = model.node_material();
   const std::size_t particle_count = particles.size();
   // Node pairs: a grid over the nodes that take part (takes_part) of particles near another
   // particle or broken.
@@ -125,13 +126,6 @@ void ContactModel::search_node_pairs(const Model& model, const State& state,
   }
   const CellGrid grid = CellGrid::build(x, searched, reach);
   pair_offsets_.assign(n + 1, 0);
-  auto accept = [&](index_t i, index_t j, real r2) {
-    const index_t mi = node_material[i], mj = node_material[j];
-    if (!law_set_[mi * material_count_ + mj]) return false;
-    const real limit = pair_reach(model, i, j, node_body_[i] == node_body_[j]) + skin_;
-    if (r2 > limit * limit) return false;
-    return node_particle[i] != node_particle[j] || !intact_bond(model, state, i, j);
-  };
   // One search: each thread keeps its nodes' partners, then copies them into place.
   const std::int64_t searched_count = static_cast<std::int64_t>(searched.size());
 #pragma omp parallel
@@ -143,7 +137,7 @@ void ContactModel::search_node_pairs(const Model& model, const State& state,
       const index_t i = searched[a];
       const std::size_t first = found_partners.size();
       grid.for_each_within(x, i, reach, dimension_, [&](index_t j, real r2) {
-        if (accept(i, j, r2)) found_partners.push_back(j);
+        if (lists_pair(model, state, i, j, r2, false)) found_partners.push_back(j);
       });
       std::sort(found_partners.begin() + static_cast<std::ptrdiff_t>(first), found_partners.end());
       pair_offsets_[i + 1] = static_cast<index_t>(found_partners.size() - first);
@@ -161,16 +155,25 @@ void ContactModel::search_node_pairs(const Model& model, const State& state,
   }
 }
 
+bool ContactModel::lists_pair(const Model& model, const State& state, index_t i, index_t j, real r2,
+                              bool either_reach) const {
+  const index_t mi = model.node_material()[i], mj = model.node_material()[j];
+  if (!law_set_[mi * material_count_ + mj]) return false;
+  // Most candidates are bonded neighbours: the bond test first, the reach after.
+  if (model.node_particle()[i] == model.node_particle()[j] && intact_bond(model, state, i, j)) return false;
+  const bool same_body = node_body_[i] == node_body_[j];
+  real reach = pair_reach(model, i, j, same_body);
+  if (same_body && either_reach) reach = std::max(reach, pair_reach(model, i, j, false));
+  const real limit = reach + skin_;
+  return r2 <= limit * limit;
+}
+
 void ContactModel::search_node_walls(const Model& model, const State& state,
                                      const std::vector<std::uint8_t>& near_wall) {
-  const std::vector<float>& x = positions_at_build_;
   const index_t n = model.node_count();
   const auto& particles = model.particles();
-  const auto& node_particle = model.node_particle();
-  const auto& node_material = model.node_material();
   const std::size_t particle_count = particles.size();
-  // Node-wall candidates.
-  wall_offsets_.assign(n + 1, 0);
+  // Node-wall candidates of the nodes of particles near a wall.
   std::vector<std::vector<std::array<index_t, 2>>> per_node(n);
   std::vector<index_t> wall_nodes;
   for (std::size_t p = 0; p < particle_count; ++p) {
@@ -182,35 +185,42 @@ void ContactModel::search_node_walls(const Model& model, const State& state,
   const std::int64_t wall_node_count = static_cast<std::int64_t>(wall_nodes.size());
 #pragma omp parallel for schedule(static)
   for (std::int64_t a = 0; a < wall_node_count; ++a) {
-    const index_t i = wall_nodes[a];
-    std::vector<WallContact> local;
-    for (std::size_t w = 0; w < walls_.size(); ++w) {
-      if (!wall_law_set_[w * material_count_ + node_material[i]]) continue;
-      // x is the list position, list_offset out from the contact centre.
-      const real radius = wall_law(static_cast<index_t>(w), node_particle[i]).contact_radius;
-      real limit = radius + list_offset(model, i, radius) + skin_;
-      // An osculating sphere weighs the points whose chord to the wall is below the support a:
-      // the surface point then lies within a^2 / (2 r) of the wall.
-      const real r = centres_.seen(model, i).osculating_radius;
-      if (r > 0) {
-        const real support = contact::surface_support_factor * particles[node_particle[i]].mesh_size;
-        limit = std::max(limit, support * support / (2 * r) + skin_);
-      }
-      const real at[3] = {x[3 * i], x[3 * i + 1], x[3 * i + 2]};
-      const auto p = walls_[w].to_reference(at, state.time);
-      for (std::size_t s = 0; s < walls_[w].surfaces.size(); ++s) {
-        local.clear();
-        walls_[w].contacts(s, p, limit, dimension_, local);
-        if (!local.empty()) per_node[i].push_back({static_cast<index_t>(w), static_cast<index_t>(s)});
-      }
-    }
+    list_node_walls(model, state.time, wall_nodes[a], per_node[wall_nodes[a]]);
   }
+  wall_offsets_.assign(n + 1, 0);
   for (index_t i = 0; i < n; ++i)
     wall_offsets_[i + 1] = wall_offsets_[i] + static_cast<index_t>(per_node[i].size());
   wall_entry_.clear();
   wall_entry_.reserve(wall_offsets_[n]);
   for (index_t i = 0; i < n; ++i)
     wall_entry_.insert(wall_entry_.end(), per_node[i].begin(), per_node[i].end());
+}
+
+void ContactModel::list_node_walls(const Model& model, real time, index_t i,
+                                   std::vector<std::array<index_t, 2>>& out) const {
+  const std::vector<float>& x = positions_at_build_;
+  const auto& node_particle = model.node_particle();
+  std::vector<WallContact> found;
+  for (std::size_t w = 0; w < walls_.size(); ++w) {
+    if (!wall_law_set_[w * material_count_ + model.node_material()[i]]) continue;
+    // x is the list position, list_offset out from the contact centre.
+    const real radius = wall_law(static_cast<index_t>(w), node_particle[i]).contact_radius;
+    real limit = radius + list_offset(model, i, radius) + skin_;
+    // An osculating sphere weighs the points whose chord to the wall is below the support a:
+    // the surface point then lies within a^2 / (2 r) of the wall.
+    const real r = centres_.seen(model, i).osculating_radius;
+    if (r > 0) {
+      const real support = contact::surface_support_factor * model.particles()[node_particle[i]].mesh_size;
+      limit = std::max(limit, support * support / (2 * r) + skin_);
+    }
+    const real at[3] = {x[3 * i], x[3 * i + 1], x[3 * i + 2]};
+    const auto p = walls_[w].to_reference(at, time);
+    for (std::size_t s = 0; s < walls_[w].surfaces.size(); ++s) {
+      found.clear();
+      walls_[w].contacts(s, p, limit, dimension_, found);
+      if (!found.empty()) out.push_back({static_cast<index_t>(w), static_cast<index_t>(s)});
+    }
+  }
 }
 
 }  // namespace granulate

@@ -112,7 +112,11 @@ void bind_loading(nb::class_<Simulation>& cls) {
             self.contact().set_wall_law(wall, material, law);
           },
           "wall"_a, "material"_a, "law"_a)
-      .def("set_contact_skin", [](Simulation& self, real skin) { self.contact().set_skin(skin); }, "skin"_a);
+      .def(
+          "set_contact_skin", [](Simulation& self, real skin) { self.contact().set_skin(skin); }, "skin"_a)
+      .def(
+          "set_contact_relisting",
+          [](Simulation& self, bool relisting) { self.contact().set_relisting(relisting); }, "relisting"_a);
 }
 
 // Wall reactions, the contact network, energies, damage, fragments, timings.

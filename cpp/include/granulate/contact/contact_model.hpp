@@ -102,9 +102,14 @@ class ContactModel {
   /// Adds a wall; returns its index. Give each wall a law per material with set_wall_law.
   index_t add_wall(Wall wall, int dimension);
   void set_wall_law(index_t wall, index_t material, const contact::Law& law);
-  /// Verlet skin [m]; lists are rebuilt when a node moves more than skin/2 relative to its
-  /// last build, a wall moves more than skin/2, or a bond breaks.
+  /// Verlet skin [m]: a node is listed again when it moves more than skin/2 from where it was
+  /// listed (with the nodes that moved skin/4, in place; a search when a quarter of the nodes
+  /// do, or a wall moves skin/2); bond breaks update the lists in place (needs_search).
   void set_skin(real skin);
+  /// Whether moved nodes and the nodes breaks open are listed again in place (the default);
+  /// without, every such change is a search, as before in-place relisting (for checks: the
+  /// forces are the same either way).
+  void set_relisting(bool relisting) { relisting_ = relisting; }
   /// Nodes whose every component is prescribed (1) or not (0): a body made of such nodes moves
   /// as told, so its partner's dashpot uses the partner's own mass. Takes effect at the next
   /// list build.
@@ -134,7 +139,7 @@ class ContactModel {
   void add_forces(const Model& model, State& state, std::uint64_t broken_bonds);
   /// Bonds (i, j) that broke since the last evaluation: the candidates the next list update
   /// inserts (a pair broken earlier and not inserted then cannot reach its Rc before the next
-  /// rebuild; see update_after_breaks).
+  /// rebuild; see broken_pairs).
   /// Surface nodes whose anchor bond broke take new anchors, or lose their surface point; those
   /// that lose it count their overlaps from a rest measured anew (opened_rest_) and make the next
   /// contact phase search the lists, since their reach grows.
@@ -171,10 +176,19 @@ class ContactModel {
   void check_checkpoint(const Model& model, const ContactCheckpoint& saved) const;
 
  private:
-  real largest_displacement(const Model& model, const State& state) const;  ///< since the build [m]
-  /// Whether the lists must be searched again; `moved`: the largest node displacement since the
-  /// build (0 when not computed).
-  bool needs_rebuild(const Model& model, const State& state, real& moved) const;
+  real largest_displacement(const Model& model, const State& state) const;  ///< since listed [m]
+  /// The nodes whose list position lies more than `limit` from where they were listed (sorted).
+  std::vector<index_t> nodes_moved_past(const Model& model, const State& state, real limit) const;
+  /// Whether the lists must be searched again (true) or can be updated in place (false, with
+  /// the nodes to list again in `relist`: those that moved more than half the skin, with those
+  /// that moved a quarter, and those the breaks opened or took a surface point from). A search
+  /// is needed before the first lists, when a wall moved half the skin, when a relisted node may
+  /// reach a particle the search left out, and when so many nodes moved that a search costs
+  /// less. `moved`: the largest node displacement since listed (0 when not computed).
+  bool needs_search(const Model& model, const State& state, bool broke, real& moved,
+                    std::vector<index_t>& relist) const;
+  /// Lists are updated in place while at most 1/relist_share of the nodes need listing again.
+  static constexpr std::size_t relist_share = 4;
   /// A grid search at positions_at_build_, which the caller fills with every node's contact
   /// position (contact_position); bonds and time from `state`; `finish`: then finish_lists.
   void rebuild(const Model& model, const State& state, std::uint64_t broken_bonds, bool finish = true);
@@ -193,9 +207,28 @@ class ContactModel {
   /// The node-wall lists (wall_offsets_, wall_entry_): the surfaces within a node's contact
   /// radius, its list offset and the skin, for the nodes of particles near a wall.
   void search_node_walls(const Model& model, const State& state, const std::vector<std::uint8_t>& near);
-  /// After bonds broke (and nothing moved half the skin): the pairs of newly_broken_ into the
-  /// lists.
-  void update_after_breaks(const Model& model, const State& state, std::uint64_t broken_bonds, real moved);
+  /// The wall entries (wall, surface) of node i at its list position and the walls at `time`.
+  void list_node_walls(const Model& model, real time, index_t i,
+                       std::vector<std::array<index_t, 2>>& out) const;
+  /// Whether the search lists node pair (i, j) at squared distance r2 of their list positions:
+  /// a law between their materials, not bonded, within the pair's reach plus the skin (the
+  /// larger of its reaches within one body and between two, with `either_reach`).
+  bool lists_pair(const Model& model, const State& state, index_t i, index_t j, real r2,
+                  bool either_reach) const;
+  /// The lists changed in place, without a search: the pairs of newly_broken_ inserted
+  /// (broken_pairs), and each node of `relist` listed again as a search would list it now, at
+  /// its current list position (relisted_pairs; its wall entries too).
+  void update_lists(const Model& model, const State& state, std::uint64_t broken_bonds, real moved,
+                    const std::vector<index_t>& relist);
+  /// The pairs of newly_broken_ that could come within reach before the next search (both
+  /// ways); newly_broken_ is emptied.
+  std::vector<std::array<index_t, 2>> broken_pairs(const Model& model, const State& state, real moved);
+  /// The nodes of newly_broken_ that took no part until now (sorted).
+  std::vector<index_t> opened_nodes(const Model& model) const;
+  /// The relisted nodes' pairs (both ways) from a grid over the list positions of the nodes
+  /// that take part; marks the relisted nodes that take part.
+  std::vector<std::array<index_t, 2>> relisted_pairs(const Model& model, const State& state,
+                                                     const std::vector<index_t>& relist);
   /// Slots, reduced masses, slot laws and scratch, from the lists and the bodies.
   void finish_lists(const Model& model);
   /// slots_ (pairs of bodies in the lists, sorted, then pairs of a body and a wall, sorted) and
@@ -257,11 +290,11 @@ class ContactModel {
   /// the surface law, else the surface points and the nodes on crack faces (with a broken
   /// bond): the nodes inside an intact surface never touch another body.
   bool takes_part(const Model& model, const State& state, index_t i) const;
-  /// Whether the bonds broken since the last list change open nodes that took no part, or took
-  /// a surface point from a node.
-  bool breaks_open_new_nodes(const Model& model) const;
-  bool detached_since_build_ = false;      // a surface node lost its point since the last search
-  std::vector<std::uint8_t> taking_part_;  // per node, at the last search
+  std::vector<index_t> detached_nodes_;      // surface nodes that lost their point since the last list change
+  std::vector<std::uint8_t> taking_part_;    // per node, since the last search or list update
+  std::vector<std::uint8_t> near_particle_;  // per particle, searched at the last search
+  bool relisting_ = true;                    // set_relisting
+  bool all_near_ = false;                    // every particle was searched at the last search
   /// Whether node i carries a point of its body's surface (surface_centres.hpp).
   bool on_surface(const Model& model, index_t i) const { return centres_.anchor(model, i) != nullptr; }
   /// Whether the surface law decides node i's list entry e (i probes j's body's surface, or j
@@ -593,9 +626,10 @@ class ContactModel {
 
   // Lists (rebuilt): node pairs and node-wall-surface candidates, CSR by node.
   bool built_ = false;
-  // Every node's list position at the search (n x 3), in single precision: the search and the
-  // rebuild test (largest_displacement) both measure from these stored values, so nodes that
-  // have moved less than half the skin from them still find every partner within reach.
+  // Every node's list position when it was last listed (n x 3; at the search, or at an update
+  // that listed it again), in single precision: the lists and the rebuild test
+  // (largest_displacement) both measure from these stored values, so nodes that have moved less
+  // than half the skin from them still find every partner within reach.
   std::vector<float> positions_at_build_;
   real time_at_build_ = 0;
   std::uint64_t broken_at_build_ = 0;
