@@ -99,6 +99,11 @@ def test_bad_walls_are_refused() -> None:
         sim.add_wall(gr.PolygonContainer(((0, 0), (1, 1))))
     with pytest.raises(gr.InputError, match="Translation or a Rotation"):
         sim.add_wall(gr.Wall((gr.Plane((0, 0), (0, 1)),), motion="up"))  # type: ignore[arg-type]
+    with pytest.raises(gr.InputError, match=r"must be a surface \(Plane.*or a tuple of them"):
+        gr.Wall("floor")  # type: ignore[arg-type]
+    one = gr.Wall(gr.Plane((0, 1), (0, -1)), motion=gr.Translation((0, -1), gr.Linear(0.1)))
+    assert one.surfaces == (gr.Plane((0, 1), (0, -1)),)  # one surface: a wall of one surface
+    sim.add_wall(one, name="top")
     bad_normal = gr.Simulation(2)
     bad_normal.add_body(gr.Disc((0, 1e-3), 1e-3), SOFT, 0.25e-3)
     bad_normal.add_wall(gr.Plane((0, 0), (0, 0)))

@@ -270,6 +270,18 @@ class Wall:
     center: ArrayLike = (0.0, 0.0, 0.0)
     area: float | None = None
 
+    def __post_init__(self) -> None:
+        # One surface makes a wall of one surface (Wall(Plane(...)) raised a TypeError).
+        surfaces = (self.surfaces,) if isinstance(self.surfaces, Surface) else self.surfaces
+        if not (
+            isinstance(surfaces, tuple | list) and all(isinstance(s, Surface) for s in surfaces)
+        ):
+            raise InputError(
+                "Wall surfaces must be a surface (Plane, BoxContainer, CircleContainer, ...) or "
+                f"a tuple of them, got {self.surfaces!r}"
+            )
+        object.__setattr__(self, "surfaces", tuple(surfaces))
+
     def core(self, name: str, dimension: int) -> _core.Wall:
         try:
             return self._core(name, dimension)
