@@ -142,7 +142,7 @@ class ContactModel {
   /// rebuild; see broken_pairs).
   /// Surface nodes whose anchor bond broke take new anchors, or lose their surface point; those
   /// that lose it count their overlaps from a rest measured anew (opened_rest_) and make the next
-  /// contact phase search the lists, since their reach grows.
+  /// contact phase list them again, since their reach grows.
   void bonds_broke(const Model& model, const State& state, std::span<const std::array<index_t, 2>> pairs);
 
   /// Per wall: force (x, y, z) and torque about its centre (x, y, z) exerted by the particles
