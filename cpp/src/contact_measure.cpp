@@ -744,13 +744,15 @@ void ContactModel::sum_slot_springs(const Model& model, const State& state) {
   // Spring force, spring-weighted normal (from the first body to the second, or from the wall to
   // the particle) and spring-weighted contact point per slot, summed in node order.
   for (const index_t i : contact_nodes_) {
-    const vec3 xi = contact_position(model, state, i);
+    vec3 xi{0, 0, 0};
+    bool have_xi = false;  // the contact centre, once a node pair needs it (not the probes)
     for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
       const index_t j = pair_partner_[e];
       const std::size_t slot = pair_slot_[e];
       if (pair_stiffness_[e] == 0 || probe_entry(e) || node_body_[i] == node_body_[j] ||
           node_body_[i] != slots_[slot][0])
         continue;
+      if (!have_xi) xi = contact_position(model, state, i), have_xi = true;
       const index_t touch = slot_touch_[slot];
       const PairGeometry g = pair_geometry(model, state, i, e);
       const real spring = contact::normal_force(entry_stiffness(model, i, e), g.overlap);
