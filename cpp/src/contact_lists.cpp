@@ -100,7 +100,7 @@ bool ContactModel::takes_part(const Model& model, const State& state, index_t i)
 
 bool ContactModel::surface_entry(const Model& model, index_t i, std::size_t e) const {
   if (!any_surface_) return false;
-  if (entry_group_[e] != no_group) return true;  // i probes j: a surface point of another body
+  if (probe_entry(e)) return true;  // i probes j: a surface point of another body
   const index_t j = pair_partner_[e];
   return on_surface(model, i) && slot_law(pair_slot_[e]).surface && node_body_[i] != node_body_[j];
 }

@@ -162,6 +162,7 @@ ContactModel::PairGeometry ContactModel::pair_geometry(const Model& model, const
   const vec d{xj[0] - xi[0], xj[1] - xi[1], xj[2] - xi[2]};  // as in A
   const real distance = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
   PairGeometry g;
+  g.centre_i = xi;
   g.normal = {d[0] / distance, d[1] / distance, d[2] / distance};
   g.overlap = contact_radius - distance - pair_rest(i, j, slot_law(pair_slot_[e]));
   g.lever_i = node_radius(law, model, i, j, contact_radius) - 0.5 * g.overlap;
@@ -744,15 +745,12 @@ void ContactModel::sum_slot_springs(const Model& model, const State& state) {
   // Spring force, spring-weighted normal (from the first body to the second, or from the wall to
   // the particle) and spring-weighted contact point per slot, summed in node order.
   for (const index_t i : contact_nodes_) {
-    vec3 xi{0, 0, 0};
-    bool have_xi = false;  // the contact centre, once a node pair needs it (not the probes)
     for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
       const index_t j = pair_partner_[e];
       const std::size_t slot = pair_slot_[e];
       if (pair_stiffness_[e] == 0 || probe_entry(e) || node_body_[i] == node_body_[j] ||
           node_body_[i] != slots_[slot][0])
         continue;
-      if (!have_xi) xi = contact_position(model, state, i), have_xi = true;
       const index_t touch = slot_touch_[slot];
       const PairGeometry g = pair_geometry(model, state, i, e);
       const real spring = contact::normal_force(entry_stiffness(model, i, e), g.overlap);
@@ -760,7 +758,7 @@ void ContactModel::sum_slot_springs(const Model& model, const State& state) {
       slot_force_[touch] += spring;
       for (int k = 0; k < 3; ++k) {
         slot_normal_[touch][k] += spring * g.normal[k];
-        slot_point_[touch][k] += spring * (xi[k] + g.lever_i * g.normal[k]);
+        slot_point_[touch][k] += spring * (g.centre_i[k] + g.lever_i * g.normal[k]);
         slot_surface_normal_[touch][k] += spring * surface[k];
       }
     }

@@ -498,9 +498,10 @@ class ContactModel {
   void probe_couples(const State& state);
   void body_loads(const Model& model, State& state);
   void sum_wall_reactions();
-  /// A node pair in contact: normal from i to j, overlap, and the levers of the contact point
-  /// p = x_i + lever_i n = x_j - lever_j n (the middle of the overlap).
+  /// A node pair in contact: i's contact centre x_i, the normal from i to j, the overlap, and the
+  /// levers of the contact point p = x_i + lever_i n = x_j - lever_j n (the middle of the overlap).
   struct PairGeometry {
+    vec3 centre_i{0, 0, 0};
     vec3 normal{0, 0, 0};
     real overlap = 0, lever_i = 0, lever_j = 0;
   };
