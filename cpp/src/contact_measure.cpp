@@ -520,7 +520,7 @@ real ContactModel::measure_probes(const Model& model, const State& state, index_
     const contact::SurfacePoint& point = surface_point(j);
     const vec d{p[0] - point.position[0], p[1] - point.position[1], p[2] - point.position[2]};
     const real distance = std::sqrt(dot(d, d));
-    if (!(distance < support) || surface_fade_of(j) == 0) continue;
+    if (!(distance < contact::reach_end * support) || surface_fade_of(j) == 0) continue;
     scratch.points[e - first] = &point;
     real& best = scratch.nearest[g - group_begin];
     if (best < 0) {  // the group's first point in reach: set the probe up
@@ -645,7 +645,7 @@ real ContactModel::surface_share(const ProbeState& probe, index_t j) const {
   if (share == 0) return 0;
   const vec d{probe.point[0] - point.position[0], probe.point[1] - point.position[1],
               probe.point[2] - point.position[2]};
-  return share * surface_fade_of(j) * contact::surface_weight(std::sqrt(dot(d, d)) / probe.support) /
+  return share * surface_fade_of(j) * contact::point_weight(dot(d, d), dot(d, point.normal), probe.support) /
          probe.sums.weight;
 }
 

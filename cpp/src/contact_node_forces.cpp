@@ -89,8 +89,8 @@ void ContactModel::target_forces(const contact::SurfacePoint& point, real size, 
                                  vec3& on_friction) const {
   // The exact reaction of a target's surface point and normal to the probe's energy (see
   // contact/surface_law.hpp), and its share phi w / S of the friction force, opposite (on the
-  // node; probe_couples adds the couple). Its weight phi w moves with |A| through the fade:
-  // dE/d(phi w) = -P (d - g) / S + Q, times w phi' / |A_0| along n on A.
+  // node; probe_couples adds the couple). Its weight phi w moves with n_k (m_k) and with |A|
+  // through the fade: dE/d(phi w) = -P (d - g) / S + Q, times w phi' / |A_0| along n on A.
   on_point = on_normal = on_friction = {0, 0, 0};
   // Its share psi moves with n_k too: (P (d - g) / S - Q) phi w psi' facing on n_k.
   const real fade = contact::surface_fade(stretch);
@@ -111,8 +111,8 @@ void ContactModel::target_forces(const contact::SurfacePoint& point, real size, 
   for (int c = 0; c < 3; ++c) {
     on_point[c] = -probe.push * share[c] + probe.taper * t.weight_gradient[c];
     on_friction[c] = -fraction * probe.friction[c];
-    on_normal[c] = probe.push * fraction * t.normal_sensitivity[c] / size + radial * point.normal[c] +
-                   (turn * probe.facing[c] - along * point.normal[c]) / size;
+    on_normal[c] = (probe.push * fraction * t.normal_sensitivity[c] + pull * t.weight_normal[c]) / size +
+                   radial * point.normal[c] + (turn * probe.facing[c] - along * point.normal[c]) / size;
   }
 }
 

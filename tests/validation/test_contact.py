@@ -464,12 +464,15 @@ def test_turning_the_collision_force_feeds_no_energy_into_bouncing_grains() -> N
 @pytest.mark.validation
 def test_a_contact_too_soft_for_the_impact_is_reported() -> None:
     """Two soft discs (K = 21.6 MPa, lattice, R/h = 10) meeting at 10 m/s with the default kn:
-    node pairs overlap by their whole contact radius (measured 0.996 Rc; the outermost nodes of
-    one disc pass the other's by 0.64 h), and the run warns once, naming stiffness_factor. With
-    stiffness_factor 10 the deepest overlap is 0.21 Rc and nothing is said."""
+    the surface law's probes are pressed past their contact radius (measured 1.175 Rc; nodes
+    of one disc reach 2.6 h inside the other's surface), and the run warns once, naming
+    stiffness_factor; the discs still bounce apart. While the points' weights fell with depth
+    (contact/surface_law.hpp) the deepest push was 0.856 Rc, but the discs passed through each
+    other (nodes 10.5 h inside) and went on at +0.97 m/s. With stiffness_factor 10 the deepest
+    overlap is 0.27 Rc (0.65 h) and nothing is said."""
     import warnings
 
-    for factor, deepest in ((1.0, (0.5, 1.01)), (10.0, (0.0, 0.5))):
+    for factor, deepest in ((1.0, (0.5, 1.3)), (10.0, (0.0, 0.5))):
         sim = gr.Simulation(2)
         sim.contact = gr.Contact(restitution=0.6, stiffness_factor=factor)
         sim.add_body(gr.Disc((0, 0), 1e-3), SOFT, 1e-4, velocity=(5.0, 0))
@@ -479,6 +482,9 @@ def test_a_contact_too_soft_for_the_impact_is_reported() -> None:
             sim.run(until=6e-4)
         overlap = sim.core.contact_statistics.deepest_overlap
         assert deepest[0] < overlap < deepest[1], (factor, overlap)
+        # bounced back: the left disc moves left (it was -1.98 m/s at factor 1, -3.04 at 10)
+        left = sim.bodies[0].nodes
+        assert np.average(sim.velocities[left, 0], weights=sim.volumes[left]) < -1.0
         said = [w for w in caught if "too soft" in str(w.message)]
         assert len(said) == (1 if factor == 1.0 else 0), (factor, said)
         if said:

@@ -319,9 +319,13 @@ def test_soft_grains_crushed_on_thin_protrusions_keep_their_energy(
     points and the smooth facing (contact/surface_law.hpp) the total energy jumped by 1.4 % at
     step 1,724 and grew twelvefold by step 80,000; with them, but the contact centres of node
     pairs still swinging with a folded normal (contact/surface_centres.hpp), it passed 1e-4 at
-    step 6,200 (2.1e-4 by 8,000) and grew 3.8-fold by 80,000. Now it stays within 6.2e-5 to
-    step 8,000 and 2.5e-4 to 80,000. Asserted: 1e-4 over 8,000 steps; 1e-3 over 80,000 with
-    --full."""
+    step 6,200 (2.1e-4 by 8,000) and grew 3.8-fold by 80,000. With those mended it stayed
+    within 6.2e-5 to step 8,000 and 2.5e-4 to 80,000. Since the points' weights count the
+    probe's place along the surface rather than its depth (contact/surface_law.hpp), probes deep
+    near an edge keep more of their energy and the contact there is stiffer: 2.0e-4 to 8,000 and
+    1.26e-3 to 80,000, an error of the explicit step (4.8e-5 to 8,000 at half the time step),
+    not a jump.
+    Asserted: 3e-4 over 8,000 steps; 2e-3 over 80,000 with --full."""
     from granulate.cli import main
 
     case = _still_drum_of_soft_grains(tmp_path, 80_000 if full else 8_000)
@@ -329,7 +333,7 @@ def test_soft_grains_crushed_on_thin_protrusions_keep_their_energy(
     history = np.genfromtxt(tmp_path / "out" / "history.csv", delimiter=",", names=True)
     total = history["total_energy"]
     assert history["node_contacts"].max() > 0  # the grains do meet the drum
-    assert np.abs(total / total[0] - 1).max() < (1e-3 if full else 1e-4)
+    assert np.abs(total / total[0] - 1).max() < (2e-3 if full else 3e-4)
 
 
 def energy_across_a_cut(
