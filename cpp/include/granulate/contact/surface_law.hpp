@@ -25,8 +25,8 @@
 // below, which peaked 0.71-0.80 h below a face of points h apart (a = 1.5 h) and fell deeper
 // in: a probe pressed that far was pulled in, and hexagon corners pressed together in a pile
 // pulled each other through and broke bonds at a twentieth of the grains' strength. With the
-// tangential weight E grows with depth to 0.87-1.13 h below a face (deeper at a corner), where
-// chi ends the points' reach.
+// tangential weight E grows with depth to 0.87-1.13 h below a face in 3D (deeper at a corner)
+// and to 1.00-1.13 h in 2D, where chi ends the points' reach (cpp/tests/test_surface_law.cpp).
 //
 // A probe of contact radius r (0 for a surface point, which touches when it crosses the
 // surface; rho for a node without one) has the energy E = k delta^2 tau(S) / 2, delta = r - g > 0.
