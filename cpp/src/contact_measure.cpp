@@ -643,9 +643,7 @@ real ContactModel::surface_share(const ProbeState& probe, index_t j) const {
   const contact::SurfacePoint& point = surface_point(j);
   const real share = contact::facing_share(point, probe.facing, probe.smooth_facing);
   if (share == 0) return 0;
-  const vec d{probe.point[0] - point.position[0], probe.point[1] - point.position[1],
-              probe.point[2] - point.position[2]};
-  return share * surface_fade_of(j) * contact::point_weight(dot(d, d), dot(d, point.normal), probe.support) /
+  return share * surface_fade_of(j) * contact::point_terms(point, probe.point, probe.support).weight /
          probe.sums.weight;
 }
 

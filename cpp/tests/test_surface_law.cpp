@@ -102,6 +102,49 @@ void add_face(std::vector<SurfacePoint>& points, const vec3& n, const vec3& alon
     }
 }
 
+/// 2D: points h apart on the line y = 0 (normal +y), or on a circle of radius R about the
+/// origin (radial normals, curvature 1/R).
+std::vector<SurfacePoint> line_points(real h) {
+  std::vector<SurfacePoint> points;
+  for (int m = -20; m <= 20; ++m) {
+    SurfacePoint point;
+    point.position = {m * h, 0, 0};
+    point.normal = {0, 1, 0};
+    points.push_back(point);
+  }
+  return points;
+}
+
+std::vector<SurfacePoint> circle_points(real radius, real h) {
+  std::vector<SurfacePoint> points;
+  const int count = static_cast<int>(std::round(2 * std::numbers::pi * radius / h));
+  for (int m = 0; m < count; ++m) {
+    const real angle = 2 * std::numbers::pi * m / count;
+    SurfacePoint point;
+    point.normal = {std::sin(angle), std::cos(angle), 0};
+    point.position = {radius * point.normal[0], radius * point.normal[1], 0};
+    point.curvature = 1 / radius;
+    points.push_back(point);
+  }
+  return points;
+}
+
+/// A surface point (r = 0, k = 1) walked in along path(depth), depth = 0.01 h, 0.02 h, ... up to
+/// `deepest`: the first depth at which its energy E fell, or -1 if it never did; `last` is E at
+/// the last depth walked.
+template <class Path>
+real first_fall(const std::vector<SurfacePoint>& points, real support, real deepest, const Path& path,
+                real& last) {
+  last = 0;
+  for (int step = 1; 0.01 * step <= deepest + 1e-12; ++step) {
+    const real depth = 0.01 * step;
+    const real now = energy(points, path(depth), support, 0.0, 1.0);
+    if (now < last) return depth;
+    last = now;
+  }
+  return -1;
+}
+
 TEST_CASE("a surface point's energy grows with its depth below a face or a hexagon's corner") {
   // E = k delta^2 tau(S) / 2 of a surface point (r = 0) pushed straight in, at places along a
   // flat face and round a 120 degree corner: it must not fall with depth down to 0.8 h, never
@@ -109,28 +152,21 @@ TEST_CASE("a surface point's energy grows with its depth below a face or a hexag
   // corner). With isotropic weights W(|v| / a) it peaked 0.71-0.80 h below the face, and
   // hexagons in a pile pulled each other through (docs/validation/README.md, "The compression
   // runs under the surface law").
-  const real h = 1.0, support = contact::surface_support_factor * h, k = 1.0;
+  const real h = 1.0, support = contact::surface_support_factor * h;
   const real c30 = std::sqrt(real(3)) / 2;
   std::vector<SurfacePoint> points;
   add_face(points, {0, 0, 1}, {1, 0, 0}, 0, 10, h);             // the top face, x from 0 to 10 h
   add_face(points, {-c30, 0, 0.5}, {-0.5, 0, -c30}, 1, 10, h);  // the side face below the corner
   for (const real x : {-0.25, 0.0, 0.3, 0.5, 1.0, 3.0, 3.5})
     for (const real y : {0.0, 0.25, 0.5}) {
-      real before = 0;
-      for (int step = 1; step <= 80; ++step) {
-        const real depth = 0.01 * step * h;
-        const real now = energy(points, {x, y, -depth}, support, 0.0, k);
-        if (now < before) {
-          granulate_test::fail(__FILE__, __LINE__,
-                               "E fell at x = " + granulate_test::show(x) +
-                                   " h, y = " + granulate_test::show(y) + " h, " +
-                                   granulate_test::show(depth) + " h deep: " + granulate_test::show(now) +
-                                   " after " + granulate_test::show(before));
-          break;
-        }
-        before = now;
-      }
-      if (x >= 0) CHECK(before > 0);
+      real last = 0;
+      const real fell =
+          first_fall(points, support, 0.8, [&](real depth) { return vec3{x, y, -depth}; }, last);
+      if (fell >= 0)
+        granulate_test::fail(__FILE__, __LINE__,
+                             "E fell at x = " + granulate_test::show(x) + " h, y = " +
+                                 granulate_test::show(y) + " h, " + granulate_test::show(fell) + " h deep");
+      if (x >= 0) CHECK(last > 0);
     }
 }
 
@@ -138,45 +174,22 @@ TEST_CASE("in 2D, a surface point's energy grows with its depth below a line or 
   // Points h apart on a line and on circles of radius 4.5 h to 10 h (a grain of the compression
   // pile is 5 h): E must not fall with depth down to 0.95 h (it peaks at 1.00-1.13 h; with
   // isotropic weights it peaked at 0.74-0.78 h).
-  const real h = 1.0, support = contact::surface_support_factor * h, k = 1.0;
+  const real h = 1.0, support = contact::surface_support_factor * h;
   for (const real radius : {0.0, 4.5, 5.0, 10.0}) {
-    std::vector<SurfacePoint> points;
-    if (radius == 0) {
-      for (int m = -20; m <= 20; ++m) {
-        SurfacePoint point;
-        point.position = {m * h, 0, 0};
-        point.normal = {0, 1, 0};
-        points.push_back(point);
-      }
-    } else {
-      const int count = static_cast<int>(std::round(2 * std::numbers::pi * radius / h));
-      for (int m = 0; m < count; ++m) {
-        const real angle = 2 * std::numbers::pi * m / count;
-        SurfacePoint point;
-        point.normal = {std::sin(angle), std::cos(angle), 0};
-        point.position = {radius * point.normal[0], radius * point.normal[1], 0};
-        point.curvature = 1 / radius;
-        points.push_back(point);
-      }
-    }
+    const std::vector<SurfacePoint> points = radius == 0 ? line_points(h) : circle_points(radius, h);
     for (const real along : {0.0, 0.25, 0.5}) {
-      real before = 0;
-      for (int step = 1; step <= 95; ++step) {
-        const real depth = 0.01 * step * h;
-        const real angle = radius == 0 ? 0.0 : along * h / radius;
-        const vec3 p = radius == 0
-                           ? vec3{along * h, -depth, 0}
-                           : vec3{(radius - depth) * std::sin(angle), (radius - depth) * std::cos(angle), 0};
-        const real now = energy(points, p, support, 0.0, k);
-        if (now < before) {
-          granulate_test::fail(__FILE__, __LINE__,
-                               "E fell at R = " + granulate_test::show(radius) + " h, " +
-                                   granulate_test::show(depth) + " h deep");
-          break;
-        }
-        before = now;
-      }
-      CHECK(before > 0);
+      auto path = [&](real depth) {
+        if (radius == 0) return vec3{along * h, -depth, 0};
+        const real angle = along * h / radius;
+        return vec3{(radius - depth) * std::sin(angle), (radius - depth) * std::cos(angle), 0};
+      };
+      real last = 0;
+      const real fell = first_fall(points, support, 0.95, path, last);
+      if (fell >= 0)
+        granulate_test::fail(__FILE__, __LINE__,
+                             "E fell at R = " + granulate_test::show(radius) + " h, " +
+                                 granulate_test::show(fell) + " h deep");
+      CHECK(last > 0);
     }
   }
 }

@@ -209,14 +209,6 @@ struct PointTerms {
   vec3 gradient{0, 0, 0}, weight_gradient{0, 0, 0}, normal_sensitivity{0, 0, 0}, weight_normal{0, 0, 0};
 };
 
-/// w = W(|t| / a) chi(|v| / a) of a point for a probe v = p - s from it (see above), from |v|^2
-/// and n . v.
-inline real point_weight(real length2, real along, real support) {
-  const real cut = reach_cutoff(std::sqrt(length2) / support);
-  if (cut == 0) return 0;
-  return cut * surface_weight(std::sqrt(std::max(length2 - along * along, real(0))) / support);
-}
-
 /// The terms of point k for a probe at p with support radius a (weight 0 out of reach).
 inline PointTerms point_terms(const SurfacePoint& point, const vec3& p, real support) {
   PointTerms t;
