@@ -47,9 +47,10 @@ class Contact:
         contact_radius: absolute Rc [m] of a node pair (each node's radius Rc / 2);
             overrides the factor.
         normal_stiffness: absolute kn [N/m^7 in 3D, N/m^6 in 2D]; overrides the default.
-        stiffness_factor: multiplies the default kn. A run warns when node pairs overlap by
-            half their contact radius (the layer too soft for the impacts; nodes may pass
-            through each other): raise it then.
+        stiffness_factor: multiplies the default kn. A run warns when bodies press into each
+            other by half their contact radius (the layer too soft for the impacts; nodes may
+            pass through each other), and again past the whole radius (the contact gave way):
+            raise it then.
         tangential_stiffness_ratio: kt / kn of the friction spring of each contact (Cundall &
             Strack), in (0, 1]; default 2/7.
         rolling_friction: coefficient of rolling resistance mu_r >= 0 (default 0: none), for

@@ -58,7 +58,7 @@ class Interactions:
         self.peridem_walls: list[Body | str] = []
         self.walls: list[tuple[str, Wall]] = []
         self.skin: float | None = None
-        self._deep_contact_warned = False
+        self._deep_contact_level = 0  # 1: warned past half of Rc, 2: past Rc
 
     @property
     def wall_names(self) -> list[str]:
@@ -198,24 +198,37 @@ class Interactions:
             )
 
     def warn_deep_contact(self, core: _core.Simulation) -> None:
-        """Warn once when two bodies pressed into each other by more than half their contact
-        radius (node spheres: a node pair's overlap; surface law: a probe's depth under the
-        other's surface): the contact layer is too soft for the impact or the load, and nodes
-        may pass through each other (an impact's overlap falls as 1 / sqrt(stiffness_factor),
-        a steady load's as 1 / stiffness_factor)."""
+        """Warn when two bodies pressed into each other by more than half their contact radius
+        Rc (node spheres: a node pair's overlap; surface law: a probe's depth under the other's
+        surface): the contact layer is too soft for the impact or the load, and nodes may pass
+        through each other (an impact's overlap falls as 1 / sqrt(stiffness_factor), a steady
+        load's as 1 / stiffness_factor); and again, more strongly, past a whole Rc, where the
+        contact gives way: node spheres' centres cross, and the surface law's probes reach the
+        end of its points' reach (about a mesh size deep: 1.0-1.2 Rc at the default contact
+        radius), lose their push and are pulled in. Each warning is given once per run."""
         deepest = core.contact_statistics.deepest_overlap
-        if self._deep_contact_warned or deepest < 0.5:
+        level = 2 if deepest >= 1 else 1 if deepest >= 0.5 else 0
+        if level <= self._deep_contact_level:
             return
-        self._deep_contact_warned = True
-        warnings.warn(
-            f"contact: bodies pressed {deepest:.0%} of their contact radius into each other (by "
-            f"step {core.step}); the contact layer is too soft for these impacts or loads and "
-            "nodes may pass through each other. Raise Contact(stiffness_factor=...): an impact's "
-            "overlap falls as 1/sqrt of it (10 keeps a 10 m/s impact of soft grains to a fifth), "
-            "a steady load's as 1/its value; a stiffer contact shortens the time step",
-            GranulateWarning,
-            stacklevel=4,
+        self._deep_contact_level = level
+        remedy = (
+            "Raise Contact(stiffness_factor=...): an impact's overlap falls as 1/sqrt of it (10 "
+            "keeps a 10 m/s impact of soft grains to a fifth), a steady load's as 1/its value; a "
+            "stiffer contact shortens the time step"
         )
+        pressed = f"bodies pressed {deepest:.0%} of their contact radius into each other"
+        if level == 2:
+            message = (
+                f"contact gave way: {pressed} (by step {core.step}), through the contact layer; "
+                "their nodes pass into each other, where no contact holds them, so broken bonds "
+                "and stresses from then on come from that overlap, not from the loads. "
+            )
+        else:
+            message = (
+                f"contact: {pressed} (by step {core.step}); the contact layer is too soft for "
+                "these impacts or loads and nodes may pass through each other. "
+            )
+        warnings.warn(message + remedy, GranulateWarning, stacklevel=4)
 
     def fingerprint_parts(self, materials: Sequence[Material]) -> list[str]:
         """The walls, laws and PeriDEM damping as text for a checkpoint's fingerprint;
