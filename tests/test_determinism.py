@@ -49,8 +49,8 @@ def test_one_and_two_threads_give_identical_bits(dimension: int) -> None:
 
 
 def tumbling_grains(law: str = "granulate", relisting: bool = True) -> gr.Simulation:
-    """Discs and a triangle thrown into a rotating drum with a lifter at 4 m/s, for 3,000 steps
-    (278-452 bonds break): contact, damping, friction, walls and fracture all at once
+    """Discs and a triangle thrown into a rotating drum with a lifter at 6 m/s, for 3,000 steps
+    (1,034-1,207 bonds break): contact, damping, friction, walls and fracture all at once
     (``law``: the contact's pair_law; ``relisting``: False makes every list change that would
     relist nodes in place a search)."""
     rock = gr.Material(density=2000, youngs_modulus=1e8, poisson_ratio=0.25, fracture_energy=0.5)
@@ -62,7 +62,7 @@ def tumbling_grains(law: str = "granulate", relisting: bool = True) -> gr.Simula
             if k < 3
             else gr.Polygon(((-1e-3, -1e-3), (1.2e-3, -1e-3), (0, 1.3e-3)))
         )
-        sim.add_body(shape, rock, 0.3e-3, velocity=(0.2 * k - 0.3, -4.0))
+        sim.add_body(shape, rock, 0.3e-3, velocity=(0.2 * k - 0.3, -6.0))
     drum = gr.Wall(
         (
             gr.CircleContainer((0, 0), 7e-3),
@@ -113,7 +113,7 @@ def crushed_discs(law: str, skin: float | None) -> tuple[np.ndarray, np.ndarray,
     return np.array(sim.positions), np.array(sim.velocities), sim
 
 
-@pytest.mark.filterwarnings("ignore:contact. bodies pressed")  # 40 m/s on the default spring
+@pytest.mark.filterwarnings("ignore:contact.*bodies pressed")  # 40 m/s on the default spring
 @pytest.mark.parametrize("law", ["granulate", "surface"])
 def test_results_do_not_depend_on_the_verlet_skin(law: str) -> None:
     """The skin decides only when the lists are searched again, never a force: with a skin of
@@ -139,7 +139,9 @@ def test_lists_updated_in_place_give_the_bits_of_searched_lists(law: str) -> Non
     opens or takes a surface point from, are listed again in place: a grid over the list
     positions answers for them alone, the other nodes keep their entries. The tumbling grains
     move bit for bit as with a search at every such change, and search less often (measured:
-    114 searches against 148 on the node spheres, 147 against 171 under the surface law)."""
+    149 searches against 236 on the node spheres, 166 against 310 under the surface law; at 4
+    m/s, as this test was, the damping ratios refitted for a force that never pulls left the
+    node spheres' run with no node listed in place, 142 searches both ways)."""
     in_place = tumbling_grains(law)
     searched = tumbling_grains(law, relisting=False)
     assert in_place.broken_bonds() > 0

@@ -67,7 +67,11 @@ void ContactModel::slot_dashpots(const State& state, real dt) {
     const real duration = std::numbers::pi * std::sqrt(mass / secant);
     if (duration > 0) collision.phase = static_cast<float>(collision.phase + dt / duration);
     if (zeta == 0) continue;
-    const real damping = 2.0 * zeta * std::sqrt(mass * secant) * approach;
+    // As the bodies part, the dashpot pulls no harder than the springs push: the contact force
+    // never holds them together (power_law_damping.hpp fits zeta to that). PeriDEM's law is not
+    // clipped.
+    real damping = 2.0 * zeta * std::sqrt(mass * secant) * approach;
+    if (!slot_law(slot).node_pair) damping = std::max(damping, -slot_force_[touch]);
     for (int k = 0; k < 3; ++k) slot_load_[touch][k] += damping * normal[k];
     if (wall_slot) {  // the wall takes the opposite force, at the contact point
       add_body_load(p, point, {damping * normal[0], damping * normal[1], damping * normal[2]});

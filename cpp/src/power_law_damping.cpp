@@ -9,11 +9,12 @@
 namespace granulate::contact {
 namespace {
 
-// x'' of the scale-free collision (zero outside contact), with x^p = (x^((p - 1) / 2))^2 x.
+// x'' of the scale-free collision (zero outside contact), with x^p = (x^((p - 1) / 2))^2 x; the
+// force, spring and dashpot, never pulls (see power_law_damping.hpp).
 real acceleration(real x, real speed, real zeta, real exponent) {
   if (x <= 0) return 0;
   const real root = std::pow(x, 0.5 * (exponent - 1));
-  return -root * root * x - 2 * zeta * root * speed;
+  return -std::max(0.0, root * root * x + 2 * zeta * root * speed);
 }
 
 // Restitution of the linear spring-dashpot with damping ratio zeta (the inverse of
@@ -53,13 +54,13 @@ real power_law_damping_ratio(real restitution, real exponent, real low, real hig
   if (restitution >= 1) return 0;
   // f(zeta) = e(zeta) - e falls as zeta grows (f(0) = 1 - e). Regula falsi, Illinois variant
   // (the end that stays put twice in a row has its f halved), on a bracket [low, high]: the
-  // given one if f changes sign on it, else [0, 4].
+  // given one if f changes sign on it, else [0, 50] (zeta = 4 still gives e = 0.014 at p = 1).
   auto f = [&](real zeta) {
     return zeta == 0 ? 1 - restitution : power_law_restitution(zeta, exponent) - restitution;
   };
   real f_low = f(low), f_high = f(high);
   if (!(f_low > 0 && f_high <= 0)) {
-    low = 0, high = 4;
+    low = 0, high = 50;
     f_low = f(low), f_high = f(high);
   }
   int kept = 0;  // +1: low moved last, -1: high moved last
@@ -90,7 +91,9 @@ DampingTable::DampingTable(real linear_zeta) {
     return;
   }
   const real restitution = linear_restitution(linear_zeta);
-  zeta_[0] = linear_zeta;
+  // The force that cannot pull takes more damping than the linear formula's (from linear_zeta up).
+  zeta_[0] =
+      linear_zeta == 0 ? 0 : power_law_damping_ratio(restitution, 1.0, linear_zeta, 2 * linear_zeta + 1e-3);
   for (int k = 1; k < size; ++k) {  // zeta grows with p: bracketed from the previous exponent's
     const real previous = zeta_[k - 1];
     zeta_[k] = linear_zeta == 0 ? 0

@@ -20,23 +20,27 @@ TEST_CASE("damping ratio from restitution: e = exp(-pi zeta / sqrt(1 - zeta^2))"
   CHECK(contact::damping_ratio_from_restitution(1.0) == 0.0);
 }
 
-TEST_CASE("power-law collisions: the linear limit, stiffer laws rebound more, the inverse") {
-  // p = 1 is the linear spring-dashpot; for p = 1.5 and 2 the references come from an
-  // independent integration of x'' = -x^p - 2 zeta x^((p-1)/2) x' (RK4, dt = 2e-4, in Python,
-  // printed to 4 digits).
+TEST_CASE("power-law collisions whose force never pulls: stiffer laws rebound more, the inverse") {
+  // The references come from an independent integration of x'' = -max(0, x^p + 2 zeta
+  // x^((p-1)/2) x') (RK4, dt = 2e-4, in Python, printed to 4 digits) with the linear zeta of
+  // e; unclipped, p = 1 gives e itself (and p = 1.5, 2: 0.1413 and 0.1770 for e = 0.1).
   const double e[5] = {0.1, 0.3, 0.5, 0.7, 0.9};
-  const double hertz[5] = {0.1413, 0.3460, 0.5396, 0.7272, 0.9101};
-  const double square[5] = {0.1770, 0.3830, 0.5704, 0.7478, 0.9176};
+  const double linear[5] = {0.2527, 0.3971, 0.5503, 0.7182, 0.9020};
+  const double hertz[5] = {0.2828, 0.4312, 0.5823, 0.7422, 0.9117};
+  const double square[5] = {0.3084, 0.4590, 0.6076, 0.7607, 0.9190};
   for (int k = 0; k < 5; ++k) {
     const double zeta = contact::damping_ratio_from_restitution(e[k]);
-    CHECK_CLOSE(contact::power_law_restitution(zeta, 1.0), e[k], 1e-3);
-    CHECK_CLOSE(contact::power_law_restitution(zeta, 1.5), hertz[k], 1e-3);  // relative
+    CHECK_CLOSE(contact::power_law_restitution(zeta, 1.0), linear[k], 1e-3);  // relative
+    CHECK_CLOSE(contact::power_law_restitution(zeta, 1.5), hertz[k], 1e-3);
     CHECK_CLOSE(contact::power_law_restitution(zeta, 2.0), square[k], 1e-3);
+    const double fitted_linear = contact::power_law_damping_ratio(e[k], 1.0);
     const double fitted = contact::power_law_damping_ratio(e[k], 2.0);
-    CHECK(fitted > zeta);
+    CHECK(fitted_linear > zeta && fitted > fitted_linear);
+    CHECK_CLOSE(contact::power_law_restitution(fitted_linear, 1.0), e[k], 1e-4);
     CHECK_CLOSE(contact::power_law_restitution(fitted, 2.0), e[k], 1e-4);
     const contact::DampingTable table(zeta);
-    CHECK(table.at(1.0) == zeta && table.at(0.5) == zeta);
+    CHECK_CLOSE(table.at(1.0), fitted_linear, 1e-4);
+    CHECK(table.at(0.5) == table.at(1.0));
     CHECK_CLOSE(table.at(2.0), fitted, 1e-4);
   }
   CHECK(contact::power_law_restitution(0.0, 2.0) > 0.999);

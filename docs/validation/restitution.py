@@ -4,11 +4,11 @@ the impact speed against the requested e (the line e_measured = e_requested is t
 
 The grain is a conforming peridynamic disc (R/h = 10) or sphere (R/h = 6), R = 1 mm, K = 21.6 MPa,
 G = 12.96 MPa, 1200 kg/m^3, with the default contact (stiffness_factor 1), dropped at 0.05, 0.5
-and 5 m/s. The contact's damping ratio comes from e by the linear spring-dashpot formula
-zeta = -ln e / sqrt(pi^2 + ln^2 e) (contact_law.hpp), applied on the collision's secant
-stiffness; it is exact for a linear force-approach law. At 5 m/s this soft grain is squashed by
-about a fifth of its radius, its force-approach law stiffens (Hertz-like), and low e come out
-higher than requested.
+and 5 m/s. The contact's damping ratio is fitted to each collision's force-approach law F ~ x^p
+(p measured from the springs' work), for a contact force that never pulls (the dashpot clipped
+at the springs' force as the bodies part; contact/power_law_damping.hpp), and applied on the
+collision's secant stiffness. At 5 m/s this soft grain is squashed by about a fifth of its
+radius and its force-approach law stiffens (Hertz-like), which the fit follows.
 
 Run: python docs/validation/restitution.py [--smoke]; writes docs/validation/restitution.png and
 prints the table.

@@ -464,12 +464,15 @@ def test_turning_the_collision_force_feeds_no_energy_into_bouncing_grains() -> N
 @pytest.mark.validation
 def test_a_contact_too_soft_for_the_impact_is_reported() -> None:
     """Two soft discs (K = 21.6 MPa, lattice, R/h = 10) meeting at 10 m/s with the default kn:
-    the surface law's probes are pressed past their contact radius (measured 1.175 Rc; nodes
+    the surface law's probes are pressed past their contact radius (measured 1.177 Rc; nodes
     of one disc reach 2.6 h inside the other's surface), and the run warns once that the
-    contact gave way, naming stiffness_factor; the discs still bounce apart. While the points'
-    weights fell with depth (contact/surface_law.hpp) the deepest push was 0.856 Rc, but the
-    discs passed through each other (nodes 10.5 h inside) and went on at +0.97 m/s. With
-    stiffness_factor 10 the deepest overlap is 0.27 Rc (0.65 h) and nothing is said."""
+    contact gave way, naming stiffness_factor. What follows is not physics, and it is chaotic:
+    with the damping ratios fitted to a force that never pulls (13 % more damping) the discs
+    lock together, 1.6 h into each other, vibrating; with the unclipped ones they had bounced
+    apart at -1.98 m/s. (While the points' weights fell with depth, contact/surface_law.hpp,
+    the deepest push was 0.856 Rc and the discs passed through each other, nodes 10.5 h inside.)
+    With stiffness_factor 10 the deepest overlap is 0.27 Rc (0.65 h), nothing is said, and the
+    discs part at -2.96 m/s, e = 0.59 for the requested 0.6."""
     import warnings
 
     for factor, deepest in ((1.0, (0.5, 1.3)), (10.0, (0.0, 0.5))):
@@ -482,9 +485,10 @@ def test_a_contact_too_soft_for_the_impact_is_reported() -> None:
             sim.run(until=6e-4)
         overlap = sim.core.contact_statistics.deepest_overlap
         assert deepest[0] < overlap < deepest[1], (factor, overlap)
-        # bounced back: the left disc moves left (it was -1.98 m/s at factor 1, -3.04 at 10)
-        left = sim.bodies[0].nodes
-        assert np.average(sim.velocities[left, 0], weights=sim.volumes[left]) < -1.0
+        if factor == 10.0:  # bounced back with the requested restitution
+            left = sim.bodies[0].nodes
+            speed = np.average(sim.velocities[left, 0], weights=sim.volumes[left])
+            assert speed == pytest.approx(-0.6 * 5.0, abs=0.05 * 5.0)
         said = [str(w.message) for w in caught if "pressed" in str(w.message)]
         assert len(said) == (1 if factor == 1.0 else 0), (factor, said)
         if said:

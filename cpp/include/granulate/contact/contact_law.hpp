@@ -23,14 +23,17 @@
 //             velocities there, rotation included), M their reduced mass (a particle's own mass
 //             against a wall), K_s = F / x the secant stiffness of the collision (total spring
 //             force over the approach x since the bodies touched; at most the sum K of the
-//             springs). A collision lasts until x is back to 0, through the
-//             gaps where chattering surface nodes part for a few steps. zeta gives the
-//             requested coefficient of restitution e for the collision's force law F ~ x^p,
-//             p = F x / W - 1 measured from the springs' work W while the bodies approach
-//             (power_law_damping.hpp); for linear springs (p = 1) it is
-//             zeta = -ln e / sqrt(pi^2 + ln^2 e). Acting on the bodies rather than on the contact
-//             nodes, the dashpot dissipates c (dx/dt)^2 whatever the bodies' deformation, so a
-//             collision of deformable bodies rebounds with e (checked in tests/validation).
+//             springs). As the bodies part, F_d is clipped at -F (the springs' force): the
+//             contact never pulls them together. A collision lasts until x is back to 0,
+//             through the gaps where chattering surface nodes part for a few steps. zeta gives
+//             the requested coefficient of restitution e for the collision's force law F ~ x^p,
+//             p = F x / W - 1 measured from the springs' work W while the bodies approach,
+//             clipped force and all (power_law_damping.hpp; unclipped, linear springs would
+//             have zeta = -ln e / sqrt(pi^2 + ln^2 e)). PeriDEM's node-pair law
+//             (--peridem-compat) keeps that zeta, unclipped. Acting on the bodies rather than
+//             on the contact nodes, the dashpot dissipates c (dx/dt)^2 whatever the bodies'
+//             deformation, so a collision of deformable bodies rebounds with e (checked in
+//             tests/validation).
 //             Fragments of one particle are damped node pair by node pair instead
 //             (c_ij = 2 zeta k_ij sqrt(M / K), force clipped at zero).
 //   friction: Cundall & Strack (1979): a tangential spring kt = ratio x k_ij on the tangential

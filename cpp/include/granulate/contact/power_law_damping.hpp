@@ -4,12 +4,17 @@
 // The body dashpot of ContactModel is 2 zeta sqrt(M K_s) dx/dt with K_s = F / x, the collision's
 // secant stiffness. If the spring force grows as F = k x^p, the collision is scale-free: in
 // units of the impact speed v and of the length (M v^2 / k)^(1 / (p + 1)) it reads
-//     x'' = -x^p - 2 zeta x^((p - 1) / 2) x',   x(0) = 0, x'(0) = 1,
+//     x'' = -max(0, x^p + 2 zeta x^((p - 1) / 2) x'),   x(0) = 0, x'(0) = 1,
 // and the restitution e = -x'(t) when x is back to 0 depends on zeta and p only (Tsuji, Tanaka &
-// Ishida 1992 give the same scale-freedom for Hertz's p = 3/2). For p = 1 (linear springs)
-// zeta = -ln e / sqrt(pi^2 + ln^2 e); the node springs of a curved grain engage over a contact
-// that widens with x, so a grain pressed on a plane or on another grain stiffens: p is about
-// 3/2 in 2D and 2 in 3D, and the linear zeta gives e = 0.14 and 0.18 for a requested 0.1.
+// Ishida 1992 give the same scale-freedom for Hertz's p = 3/2). The max keeps the force from
+// pulling: as the bodies part, the dashpot would otherwise outgrow the spring and hold them
+// together at the end of every collision (LIGGGHTS' limitForce clips the same way). Unclipped,
+// p = 1 (linear springs) has zeta = -ln e / sqrt(pi^2 + ln^2 e), from which the tables below
+// start; that zeta, clipped, gives e = 0.25, 0.55 and 0.90 for 0.1, 0.5 and 0.9, so the tables
+// hold zeta fitted to the clipped collision for every p, 1 included. The node springs of a
+// curved grain engage over a contact that widens with x, so a grain pressed on a plane or on
+// another grain stiffens: p is about 3/2 in 2D and 2 in 3D, and the linear zeta gives e = 0.14
+// and 0.18 for a requested 0.1 (unclipped).
 #pragma once
 
 #include <array>
@@ -23,8 +28,8 @@ real power_law_restitution(real zeta, real exponent);
 
 /// The damping ratio that gives restitution e (0 < e <= 1) for exponent p: the root of
 /// power_law_restitution - e, to 1e-6 in zeta, searched in [low, high] if it lies there (else
-/// in [0, 4]).
-real power_law_damping_ratio(real restitution, real exponent, real low = 0, real high = 4);
+/// in [0, 50]).
+real power_law_damping_ratio(real restitution, real exponent, real low = 0, real high = 50);
 
 /// zeta at one restitution for exponents 1, 1.1, ..., 3, interpolated linearly between them.
 class DampingTable {
