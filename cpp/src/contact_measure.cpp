@@ -409,7 +409,7 @@ void ContactModel::measure_contacts(const Model& model, const State& state) {
       sphere_pair_nodes.insert(sphere_pair_nodes.end(), sphere_pairs.begin(), sphere_pairs.end());
       touching_probes.insert(touching_probes.end(), probe_scratch.touching.begin(),
                              probe_scratch.touching.end());
-      statistics_.deepest_overlap = std::max(statistics_.deepest_overlap, deepest);
+      statistics_.add_overlap(deepest, state.step);
     }
   }
   std::sort(touching_nodes_.begin(), touching_nodes_.end());  // the same for any thread count
@@ -730,8 +730,7 @@ void ContactModel::release_rested_pairs(const Model& model, const State& state,
       if (pair_stiffness_[e] == 0 || surface_entry(model, i, e) || !slot_law(pair_slot_[e]).surface) continue;
       const real overlap = pair_geometry(model, state, i, e).overlap;
       if (overlap > 0) {
-        statistics_.deepest_overlap =
-            std::max(statistics_.deepest_overlap, overlap / slot_law(pair_slot_[e]).contact_radius);
+        statistics_.add_overlap(overlap / slot_law(pair_slot_[e]).contact_radius, state.step);
       } else {
         pair_stiffness_[e] = 0;
       }

@@ -206,7 +206,8 @@ class Interactions:
         contact gives way: node spheres' centres cross, and the surface law's probes reach the
         end of its points' reach (about a mesh size deep: 1.0-1.2 Rc at the default contact
         radius), lose their push and are pulled in. Each warning is given once per run."""
-        deepest = core.contact_statistics.deepest_overlap
+        statistics = core.contact_statistics
+        deepest = statistics.deepest_overlap
         level = 2 if deepest >= 1 else 1 if deepest >= 0.5 else 0
         if level <= self._deep_contact_level:
             return
@@ -219,14 +220,16 @@ class Interactions:
         pressed = f"bodies pressed {deepest:.0%} of their contact radius into each other"
         if level == 2:
             message = (
-                f"contact gave way: {pressed} (by step {core.step}), through the contact layer; "
-                "their nodes pass into each other, where no contact holds them, so broken bonds "
-                "and stresses from then on come from that overlap, not from the loads. "
+                f"contact gave way: {pressed} (past 100% at step {statistics.full_overlap_step}), "
+                "through the contact layer; their nodes pass into each other, where no contact "
+                "holds them, so broken bonds and stresses from then on come from that overlap, not "
+                "from the loads. "
             )
         else:
             message = (
-                f"contact: {pressed} (by step {core.step}); the contact layer is too soft for "
-                "these impacts or loads and nodes may pass through each other. "
+                f"contact: {pressed} (past 50% at step {statistics.half_overlap_step}); the "
+                "contact layer is too soft for these impacts or loads and nodes may pass through "
+                "each other. "
             )
         warnings.warn(message + remedy, GranulateWarning, stacklevel=4)
 

@@ -493,3 +493,6 @@ def test_a_contact_too_soft_for_the_impact_is_reported() -> None:
         assert len(said) == (1 if factor == 1.0 else 0), (factor, said)
         if said:
             assert said[0].startswith("contact gave way") and "stiffness_factor" in said[0]
+            statistics = sim.core.contact_statistics
+            assert 0 < statistics.half_overlap_step < statistics.full_overlap_step < sim.step
+            assert f"past 100% at step {statistics.full_overlap_step})" in said[0]

@@ -23,7 +23,7 @@ void bind_contact(nb::module_& m) {
   m.def("damping_ratio_from_restitution", &contact::damping_ratio_from_restitution, "restitution"_a);
   m.def("power_law_restitution", &contact::power_law_restitution, "damping_ratio"_a, "exponent"_a);
   m.def("power_law_damping_ratio", &contact::power_law_damping_ratio, "restitution"_a, "exponent"_a,
-        "low"_a = 0.0, "high"_a = 4.0);
+        "low"_a = 0.0, "high"_a = 50.0);
 
   nb::class_<ContactStatistics>(m, "ContactStatistics")
       .def_ro("rebuilds", &ContactStatistics::rebuilds)
@@ -31,7 +31,9 @@ void bind_contact(nb::module_& m) {
       .def_ro("list_entries", &ContactStatistics::list_entries)
       .def_ro("node_contacts", &ContactStatistics::node_contacts)
       .def_ro("wall_contacts", &ContactStatistics::wall_contacts)
-      .def_ro("deepest_overlap", &ContactStatistics::deepest_overlap);
+      .def_ro("deepest_overlap", &ContactStatistics::deepest_overlap)
+      .def_ro("half_overlap_step", &ContactStatistics::half_overlap_step)
+      .def_ro("full_overlap_step", &ContactStatistics::full_overlap_step);
 }
 
 }  // namespace granulate::bindings

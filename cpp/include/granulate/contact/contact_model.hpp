@@ -43,6 +43,16 @@ struct ContactStatistics {
   /// the other body's surface (not checkpointed; PeriDEM's node-pair law not counted): near 1,
   /// nodes are about to pass through each other (the contact layer is too soft for the impacts).
   real deepest_overlap = 0;
+  /// The steps at which deepest_overlap first reached 0.5 (the contact layer too soft for the
+  /// loads) and 1 (the contact gave way: nodes pass into the other body), meaningful once it
+  /// has; not checkpointed either.
+  std::uint64_t half_overlap_step = 0, full_overlap_step = 0;
+  /// Takes an overlap (over Rc) measured at `step` into deepest_overlap and the steps above.
+  void add_overlap(real overlap, std::uint64_t step) {
+    if (deepest_overlap < 0.5 && overlap >= 0.5) half_overlap_step = step;
+    if (deepest_overlap < 1 && overlap >= 1) full_overlap_step = step;
+    deepest_overlap = std::max(deepest_overlap, overlap);
+  }
 };
 
 /// What a checkpoint needs of the contact model to continue bit for bit: the state the lists
