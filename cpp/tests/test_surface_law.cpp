@@ -4,6 +4,7 @@
 #include <cmath>
 #include <numbers>
 #include <random>
+#include <utility>
 #include <vector>
 
 #include "check.hpp"
@@ -143,6 +144,23 @@ real first_fall(const std::vector<SurfacePoint>& points, real support, real deep
     last = now;
   }
   return -1;
+}
+
+TEST_CASE("the C1 step: 0 and 1 at its bounds, either way round, and its slope") {
+  for (const auto& [zero_at, one_at] : {std::pair<real, real>{0.25, 0.5}, {0.85, 0.5}, {0.0, 0.2}}) {
+    CHECK(contact::smooth_step(zero_at, zero_at, one_at) == 0);
+    CHECK(contact::smooth_step(one_at, zero_at, one_at) == 1);
+    CHECK(contact::smooth_step(2 * zero_at - one_at, zero_at, one_at) == 0);  // beyond the bounds
+    CHECK(contact::smooth_step(2 * one_at - zero_at, zero_at, one_at) == 1);
+    CHECK_NEAR(contact::smooth_step(0.5 * (zero_at + one_at), zero_at, one_at), 0.5, 1e-15, 0);
+    for (int k = 1; k < 20; ++k) {
+      const real x = zero_at + 0.05 * k * (one_at - zero_at), step = 1e-7;
+      const real slope = (contact::smooth_step(x + step, zero_at, one_at) -
+                          contact::smooth_step(x - step, zero_at, one_at)) /
+                         (2 * step);
+      CHECK_NEAR(contact::smooth_step_slope(x, zero_at, one_at), slope, 1e-6, 1e-9);
+    }
+  }
 }
 
 TEST_CASE("a surface point's energy grows with its depth below a face or a hexagon's corner") {

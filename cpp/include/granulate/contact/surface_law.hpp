@@ -69,6 +69,23 @@ struct SurfacePoint {
 /// small enough that the next layer of nodes in does not reach the surface.
 inline constexpr real surface_support_factor = 1.5;
 
+/// The C1 step s(x) = b^2 (3 - 2 b), b = (x - zero_at) / (one_at - zero_at): 0 up to zero_at,
+/// 1 from one_at (either bound may be the larger), smooth between. The reach, the taper, the
+/// facing shares and the fade below are such steps.
+inline real smooth_step(real x, real zero_at, real one_at) {
+  const real b = (x - zero_at) / (one_at - zero_at);
+  if (!(b > 0)) return 0;
+  if (!(b < 1)) return 1;
+  return b * b * (3 - 2 * b);
+}
+
+/// ds/dx = 6 b (1 - b) / (one_at - zero_at) between the bounds, 0 outside.
+inline real smooth_step_slope(real x, real zero_at, real one_at) {
+  const real b = (x - zero_at) / (one_at - zero_at);
+  if (!(b > 0) || !(b < 1)) return 0;
+  return 6 * b * (1 - b) / (one_at - zero_at);
+}
+
 /// Where a point's weight falls from whole to nothing with the probe's distance from it:
 /// chi(q) = 1 for q = |v| / a <= reach_start, b^2 (3 - 2 b) with b = (reach_end - q) /
 /// (reach_end - reach_start) between, 0 from q = reach_end (see above): the points' reach is
@@ -81,17 +98,12 @@ inline constexpr real reach_start = 0.5, reach_end = 0.85;
 
 /// chi(q) (see reach_start).
 inline real reach_cutoff(real q) {
-  if (!(q > reach_start)) return 1;
-  if (!(q < reach_end)) return 0;
-  const real b = (reach_end - q) / (reach_end - reach_start);
-  return b * b * (3 - 2 * b);
+  return smooth_step(q, reach_end, reach_start);
 }
 
 /// d chi / dq.
 inline real reach_cutoff_slope(real q) {
-  if (!(q > reach_start) || !(q < reach_end)) return 0;
-  const real b = (reach_end - q) / (reach_end - reach_start);
-  return -6 * b * (1 - b) / (reach_end - reach_start);
+  return smooth_step_slope(q, reach_end, reach_start);
 }
 
 /// S_0 of the taper: the weight of one point at 0.54 of the support radius.
@@ -99,16 +111,12 @@ inline constexpr real surface_coverage = 0.2;
 
 /// tau(S) = c^2 (3 - 2 c), c = S / S_0, and 1 for c >= 1 (see above).
 inline real surface_taper(real weight) {
-  if (!(weight < surface_coverage)) return 1;
-  const real c = weight / surface_coverage;
-  return c * c * (3 - 2 * c);
+  return smooth_step(weight, 0, surface_coverage);
 }
 
 /// d tau / dS.
 inline real surface_taper_slope(real weight) {
-  if (!(weight < surface_coverage)) return 0;
-  const real c = weight / surface_coverage;
-  return 6 * c * (1 - c) / surface_coverage;
+  return smooth_step_slope(weight, 0, surface_coverage);
 }
 
 /// The points of a probe's sums are those whose normals face the probe: the faces at a corner
@@ -135,18 +143,12 @@ inline real facing_cosine(const SurfacePoint& point, const vec3& facing) {
 inline real facing_share(const SurfacePoint& point, const vec3& facing, bool smooth) {
   const real c = facing_cosine(point, facing);
   if (!smooth) return c > facing_start ? 1.0 : 0.0;
-  if (!(c < facing_end)) return 1;
-  if (!(c > facing_start)) return 0;
-  const real b = (c - facing_start) / (facing_end - facing_start);
-  return b * b * (3 - 2 * b);
+  return smooth_step(c, facing_start, facing_end);
 }
 
 /// d psi / d c (0 where psi is whole or nothing).
 inline real facing_share_slope(const SurfacePoint& point, const vec3& facing, bool smooth) {
-  const real c = facing_cosine(point, facing);
-  if (!smooth || !(c < facing_end) || !(c > facing_start)) return 0;
-  const real b = (c - facing_start) / (facing_end - facing_start);
-  return 6 * b * (1 - b) / (facing_end - facing_start);
+  return smooth ? smooth_step_slope(facing_cosine(point, facing), facing_start, facing_end) : 0.0;
 }
 
 /// A surface point's fade phi(rho), rho = |A| / |A_0|: its anchored vector against the
@@ -164,17 +166,12 @@ inline constexpr real fade_start = 0.25, fade_end = 0.5;
 
 /// phi(rho) (see fade_start).
 inline real surface_fade(real rho) {
-  if (!(rho < fade_end)) return 1;
-  if (!(rho > fade_start)) return 0;
-  const real c = (rho - fade_start) / (fade_end - fade_start);
-  return c * c * (3 - 2 * c);
+  return smooth_step(rho, fade_start, fade_end);
 }
 
 /// d phi / d rho.
 inline real surface_fade_slope(real rho) {
-  if (!(rho < fade_end) || !(rho > fade_start)) return 0;
-  const real c = (rho - fade_start) / (fade_end - fade_start);
-  return 6 * c * (1 - c) / (fade_end - fade_start);
+  return smooth_step_slope(rho, fade_start, fade_end);
 }
 
 /// Wendland's C2 kernel W(q) = (1 - q)^4 (1 + 4 q), q = distance / support, zero for q >= 1.
