@@ -22,7 +22,8 @@ in the core (contact::resolve), so particles of any size share one law. This kn 
 step near the peridynamic one but makes the contact layer softer than the grains; for Hertzian
 contacts (the grains' elasticity governing) raise stiffness_factor to about 100: a sphere
 squeezed between plates then carries 0.97 of Hertz's force (0.073 with the default; see
-ARCHITECTURE.md, "Choosing kn").
+ARCHITECTURE.md, "Choosing kn"). Under the surface law a confined compression to a wall stress
+sigma wants at least 1000 sigma / K, or its contacts give way (docs/parameters.md).
 """
 
 from __future__ import annotations
