@@ -522,6 +522,7 @@ void ContactModel::resolve_slot_laws() {
     if (added) resolved_laws_.push_back(wall ? wall_law(q, p) : pair_law(p, q));
     slot_law_index_[s] = found->second;
   }
+  resolved_laws_.shrink_to_fit();  // 48 B each, rebuilt at every list build: no growth slack
 }
 
 void ContactModel::carry_over_collisions(const std::vector<std::array<index_t, 2>>& old_slots,
