@@ -15,12 +15,18 @@ examples/compression_2d/compression_curve.png. Several runs draw several curves 
 names them); ``--snapshots NAME ...`` also writes, per run, examples/compression_2d/NAME: the
 nodes coloured by damage at the paper's four instants, wall travels of 0.5, 1.45, 1.95 and
 2.4 mm (the frames nearest them); ``--figure NAME`` writes the curve under another name.
+
+A run may also be the output folder of a PeriDEM deck's compression (n500_circ_hex's stage 2,
+run with --peridem-compat; the deck's README): its loaded wall's history columns (pNNN_stress,
+pNNN_uy) give the curve, the travel counted from the run's first row, where the restart placed
+the wall above the settled pile.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -60,12 +66,11 @@ def main() -> None:
 
     fig, ax = plt.subplots(figsize=(7, 4.2))
     for k, run in enumerate(map(Path, args.runs)):
-        results = gr.Results(run / "compress")
-        history = results.history
-        grains = json.loads((run / "compress" / "run.json").read_text())["bodies"]
-        speed = float(abs(history["top_displacement"][-1]) / history["time"][-1])
+        curve = load_curve(run)
+        results, history, speed = curve.results, curve.results.history, curve.speed
+        grains = curve.grains
         label = args.labels[k] if args.labels else f"{grains} grains, wall at {speed:.2g} m/s"
-        travel, stress = 1e3 * np.abs(history["top_displacement"]), history["top_stress"]
+        travel, stress = curve.travel, curve.stress
         ax.plot(travel, 1e-3 * stress, "-", label=f"granulate: {label}")
         print(
             f"{run}: {grains} grains, wall at {speed:.3g} m/s: stress "
@@ -74,7 +79,7 @@ def main() -> None:
             f"{int(history['broken_bonds'][-1])}"
         )
         if args.snapshots:
-            draw_snapshots(results, speed, FOLDER / args.snapshots[k])
+            draw_snapshots(results, speed, curve.start, FOLDER / args.snapshots[k])
     ax.plot(
         PAPER[:, 0],
         PAPER[:, 1],
@@ -92,11 +97,46 @@ def main() -> None:
     print(f"wrote {out}")
 
 
-def draw_snapshots(results: gr.Results, speed: float, out: Path) -> None:
+@dataclass
+class Curve:
+    """A compression run's load curve: wall travel [mm] and stress [Pa] per history row."""
+
+    results: gr.Results
+    travel: np.ndarray
+    stress: np.ndarray
+    speed: float  # the wall's [m/s]
+    start: float  # time at zero travel [s]
+    grains: int
+
+
+def load_curve(run: Path) -> Curve:
+    """The example's folder (its compress/ run: top_displacement, top_stress) or a deck's
+    (the loaded wall's pNNN_uy and pNNN_stress, travel from the first row)."""
+    if (run / "compress").is_dir():
+        results = gr.Results(run / "compress")
+        history = results.history
+        travel = 1e3 * np.abs(history["top_displacement"])
+        stress, start = history["top_stress"], 0.0
+    else:
+        results = gr.Results(run)
+        history = results.history
+        stressed = [name for name in history if name.endswith("_stress") and name[0] == "p"]
+        if len(stressed) != 1:
+            raise SystemExit(f"{run}: neither compress/ nor one loaded wall's _stress column")
+        wall = stressed[0].removesuffix("_stress")
+        travel = 1e3 * np.abs(history[f"{wall}_uy"] - history[f"{wall}_uy"][0])
+        stress, start = history[stressed[0]], float(history["time"][0])
+    speed = float(1e-3 * travel[-1] / (history["time"][-1] - start))
+    bodies = json.loads((results.directory / "run.json").read_text())["bodies"]
+    walls = [name for name in history if name[0] == "p" and name.endswith("_fx")]  # a deck's
+    return Curve(results, travel, stress, speed, start, bodies - len(walls))
+
+
+def draw_snapshots(results: gr.Results, speed: float, start: float, out: Path) -> None:
     """Four panels: the nodes coloured by damage at the frames nearest the paper's instants."""
     import matplotlib.pyplot as plt
 
-    frames = [results.frame(time=1e-3 * travel / speed) for travel in INSTANTS]
+    frames = [results.frame(time=start + 1e-3 * travel / speed) for travel in INSTANTS]
     span = np.ptp(frames[0].positions[:, :2], axis=0)
     height = 2 * 4.5 * span[1] / span[0] + 1.2  # two rows of panels 4.5 inches wide
     fig, axes = plt.subplots(
@@ -107,7 +147,7 @@ def draw_snapshots(results: gr.Results, speed: float, out: Path) -> None:
         shown = ax.scatter(
             points[:, 0], points[:, 1], c=frame["Damage"], s=0.3, cmap="inferno_r", vmin=0, vmax=1
         )
-        moved = 1e3 * speed * frame.time
+        moved = 1e3 * speed * (frame.time - start)
         ax.set_title(f"travel {moved:.2f} mm (paper's instant: {travel} mm)", fontsize=8)
         ax.set_aspect("equal")
     for ax in axes[-1]:
