@@ -8,6 +8,9 @@ from pathlib import Path
 
 import pytest
 
+from granulate.cli import main
+from granulate.parallel.launch import launched_ranks
+
 
 def granulate(*args: str, cwd: Path | None = None) -> subprocess.CompletedProcess[str]:
     return subprocess.run(
@@ -140,3 +143,47 @@ def test_a_long_set_up_is_announced_before_it_starts(
         cli._announce_setup(load_case(case_file))  # loads the case only: nothing is placed
         out = capsys.readouterr().out
         assert ("packing 200,000 grains: set-up takes about 60 s" in out) is said, out
+
+
+@pytest.mark.parametrize(
+    "environ",
+    [
+        {"OMPI_COMM_WORLD_SIZE": "2", "OMPI_COMM_WORLD_RANK": "{rank}"},  # Open MPI
+        {"PMI_SIZE": "2", "PMI_RANK": "{rank}"},  # MPICH, Intel MPI
+        {"SLURM_STEP_NUM_TASKS": "2", "SLURM_PROCID": "{rank}"},  # srun
+    ],
+    ids=["openmpi", "hydra", "srun"],
+)
+def test_a_case_started_as_several_mpi_ranks_is_refused_once(
+    environ: dict[str, str],
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """Distributed runs are not built (issue 17): K ranks of `granulate run case.yaml` would be
+    K serial runs writing one folder. Rank 0 says so once, every rank exits 2, nothing is
+    written; a Python script (which may use mpi4py itself) still runs."""
+    monkeypatch.chdir(tmp_path)
+    case = Path(__file__).parent / "cases" / "base.yaml"
+    for rank in (0, 1):
+        for name, value in environ.items():
+            monkeypatch.setenv(name, value.format(rank=rank))
+        assert main(["run", str(case)]) == 2
+        printed = capsys.readouterr()
+        if rank == 0:
+            assert "started as 2 MPI processes" in printed.err and "--threads N" in printed.err
+        else:
+            assert printed.err == "" and printed.out == ""
+    assert not (tmp_path / "out").exists()
+    script = tmp_path / "sweep.py"
+    script.write_text("print('ran')\n")
+    assert main(["run", str(script)]) == 0
+    assert capsys.readouterr().out == "ran\n"
+
+
+def test_a_batch_script_outside_srun_is_one_process() -> None:
+    """Slurm sets SLURM_STEP_NUM_TASKS = 1 for the batch script itself."""
+    slurm = {"SLURM_NTASKS": "8", "SLURM_STEP_NUM_TASKS": "1", "SLURM_PROCID": "0"}
+    assert launched_ranks(slurm) == (1, 0)
+    assert launched_ranks({}) == (1, 0)
+    assert launched_ranks({"PMI_SIZE": "3", "PMI_RANK": "2"}) == (3, 2)

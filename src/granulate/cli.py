@@ -12,7 +12,8 @@
     granulate info                             version, build options, threads
 
 Exit codes: 0 success, 2 invalid input, 1 failed run, 130 interrupted. User errors print one
-line (``--debug`` shows the traceback).
+line (``--debug`` shows the traceback). Commands that write files refuse to start as several
+MPI ranks (granulate.parallel.launch): distributed runs are not built yet.
 """
 
 from __future__ import annotations
@@ -30,6 +31,7 @@ from granulate._version import __version__
 from granulate.errors import InputError, InstabilityError
 from granulate.io.files import existing_file
 from granulate.io.run_folder import check_writable
+from granulate.parallel.launch import launched_ranks, serial_only_message
 from granulate.progress import ProgressReporter, duration
 
 
@@ -317,6 +319,14 @@ def _dispatch(options: argparse.Namespace) -> int:
     return 0
 
 
+def _writes_output(options: argparse.Namespace) -> bool:
+    """Whether a command writes files (so copies of it on several MPI ranks would collide); a
+    Python script is the user's own and may split its work over ranks."""
+    if options.command == "run":
+        return options.case.suffix != ".py"
+    return options.command not in ("info", "schema", "check")
+
+
 def _main(argv: list[str] | None) -> int:
     parser = _parser()
     options, extra = parser.parse_known_args(argv)
@@ -324,6 +334,12 @@ def _main(argv: list[str] | None) -> int:
         parser.error(f"unrecognized arguments: {' '.join(extra)}")
     if extra:
         options.args = [*options.args, *extra]
+    size, rank = launched_ranks()
+    if size > 1 and _writes_output(options):
+        if rank == 0:  # once, not once per rank
+            message = serial_only_message(options.command, size)
+            print(f"granulate: error: {message}", file=sys.stderr)
+        return 2
     try:
         if options.threads is not None:
             threads.set_num_threads(options.threads)

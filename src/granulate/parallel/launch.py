@@ -1,0 +1,40 @@
+"""Whether this process was started as one of several MPI ranks (mpirun, mpiexec, srun), read
+from the variables the launchers set, without importing MPI.
+
+granulate does not run a case over ranks yet (issue 17), so K ranks of `granulate run case.yaml`
+would be K copies of one serial run writing the same output folder at once. The command line
+refuses that with one message from rank 0 (the other ranks exit with the same code, silently).
+"""
+
+from __future__ import annotations
+
+import os
+
+# (size, rank) variables of each launcher: Open MPI, MPICH's and Intel MPI's Hydra, Slurm's srun
+# (SLURM_STEP_NUM_TASKS is the job step's: 1 in a batch script outside srun).
+_LAUNCHERS = (
+    ("OMPI_COMM_WORLD_SIZE", "OMPI_COMM_WORLD_RANK"),
+    ("PMI_SIZE", "PMI_RANK"),
+    ("SLURM_STEP_NUM_TASKS", "SLURM_PROCID"),
+)
+
+
+def launched_ranks(environ: dict[str, str] | None = None) -> tuple[int, int]:
+    """(number of ranks, this process's rank) as the launcher set them; (1, 0) if none did."""
+    env = os.environ if environ is None else environ
+    for size_name, rank_name in _LAUNCHERS:
+        size, rank = env.get(size_name, ""), env.get(rank_name, "")
+        if size.isdigit() and rank.isdigit() and int(size) > 1:
+            return int(size), int(rank)
+    return 1, 0
+
+
+def serial_only_message(command: str, size: int) -> str:
+    """What a user who started `granulate <command>` on `size` ranks is told."""
+    return (
+        f"'granulate {command}' was started as {size} MPI processes (mpirun, mpiexec or srun), "
+        "but granulate does not run a case over MPI ranks yet, and the copies would write the "
+        "same output at once. Start one process and give it threads instead: "
+        f"granulate --threads N {command} ... (a Python script run with 'granulate run "
+        "script.py' may use mpi4py itself, for a parameter sweep)"
+    )
