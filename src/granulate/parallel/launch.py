@@ -9,6 +9,7 @@ refuses that with one message from rank 0 (the other ranks exit with the same co
 from __future__ import annotations
 
 import os
+from collections.abc import Mapping
 
 # (size, rank) variables of each launcher: Open MPI, MPICH's and Intel MPI's Hydra, Slurm's srun
 # (SLURM_STEP_NUM_TASKS is the job step's: 1 in a batch script outside srun).
@@ -19,7 +20,7 @@ _LAUNCHERS = (
 )
 
 
-def launched_ranks(environ: dict[str, str] | None = None) -> tuple[int, int]:
+def launched_ranks(environ: Mapping[str, str] | None = None) -> tuple[int, int]:
     """(number of ranks, this process's rank) as the launcher set them; (1, 0) if none did."""
     env = os.environ if environ is None else environ
     for size_name, rank_name in _LAUNCHERS:
