@@ -67,8 +67,7 @@ def main() -> None:
     fig, ax = plt.subplots(figsize=(7, 4.2))
     for k, run in enumerate(map(Path, args.runs)):
         curve = load_curve(run)
-        results, history, speed = curve.results, curve.results.history, curve.speed
-        grains = curve.grains
+        results, history, speed, grains = curve.results, curve.history, curve.speed, curve.grains
         label = args.labels[k] if args.labels else f"{grains} grains, wall at {speed:.2g} m/s"
         travel, stress = curve.travel, curve.stress
         ax.plot(travel, 1e-3 * stress, "-", label=f"granulate: {label}")
@@ -102,6 +101,7 @@ class Curve:
     """A compression run's load curve: wall travel [mm] and stress [Pa] per history row."""
 
     results: gr.Results
+    history: dict[str, np.ndarray]  # history.csv, read once
     travel: np.ndarray
     stress: np.ndarray
     speed: float  # the wall's [m/s]
@@ -129,7 +129,7 @@ def load_curve(run: Path) -> Curve:
     speed = float(1e-3 * travel[-1] / (history["time"][-1] - start))
     bodies = json.loads((results.directory / "run.json").read_text())["bodies"]
     walls = [name for name in history if name[0] == "p" and name.endswith("_fx")]  # a deck's
-    return Curve(results, travel, stress, speed, start, bodies - len(walls))
+    return Curve(results, history, travel, stress, speed, start, bodies - len(walls))
 
 
 def draw_snapshots(results: gr.Results, speed: float, start: float, out: Path) -> None:
