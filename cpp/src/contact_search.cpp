@@ -22,7 +22,7 @@ bool intact_bond(const Model& model, const State& state, index_t i, index_t j) {
 }  // namespace
 
 void ContactModel::rebuild(const Model& model, const State& state, std::uint64_t broken_bonds, bool finish) {
-  if (skin_ < 0) skin_ = 0.5 * max_contact_radius_;
+  skin_ = list_skin();
   const KeptLists kept{std::move(pair_offsets_), std::move(pair_partner_), std::move(pair_spring_),
                        std::move(wall_offsets_), std::move(wall_entry_),   std::move(wall_spring_)};
   const real reach = largest_pair_reach(model) + skin_;

@@ -305,6 +305,36 @@ class Assembly:
                 spin = self.vector(angular_velocity, "angular_velocity")
         return linear, spin
 
+    def subset(self, grains: ArrayLike) -> tuple[Assembly, NDArray[np.int64]]:
+        """The bodies `grains` (indices, increasing) as an assembly of their own, renumbered in
+        that order, with their initial motions; and the map of this assembly's node indices to
+        the subset's (-1 for nodes left out). A distributed run's rank holds such a subset: the
+        grains it owns and its ghosts (granulate.parallel)."""
+        chosen = np.asarray(grains, dtype=np.int64).reshape(-1)
+        if len(chosen) == 0 or np.any(np.diff(chosen) <= 0) or chosen[0] < 0:
+            raise InputError("subset: give increasing body indices")
+        if chosen[-1] >= len(self.bodies):
+            raise InputError(f"subset: body {chosen[-1]} does not exist")
+        part = Assembly(self.dimension)
+        node_map = np.full(self.node_count, -1, dtype=np.int64)
+        renamed: dict[int, Body] = {}
+        for g in chosen:
+            body = self.bodies[g]
+            copy = replace(body, index=len(part.bodies), first_node=part.node_count)
+            node_map[body.node_slice] = copy.first_node + np.arange(body.node_count)
+            part.bodies.append(copy)
+            part._names[copy.name] = copy
+            part.positions.append(self.positions[g])
+            part.volumes.append(self.volumes[g])
+            part.surfaces.append(self.surfaces[g])
+            renamed[int(g)] = copy
+        part.initial_velocities = [
+            (renamed[body.index], linear, spin)
+            for body, linear, spin in self.initial_velocities
+            if body.index in renamed
+        ]
+        return part, node_map
+
     def body(self, body: Body | str) -> Body:
         """A body of this assembly, or the one of that name (InputError otherwise)."""
         if isinstance(body, Body):

@@ -60,6 +60,15 @@ class Interactions:
         self.skin: float | None = None
         self._deep_contact_level = 0  # 1: warned past half of Rc, 2: past Rc
 
+    def on(self, assembly: Assembly) -> Interactions:
+        """The same laws, walls and skin for another assembly (a subset of this one's)."""
+        other = Interactions(assembly)
+        other.contact = self.contact
+        other.pair_contacts = dict(self.pair_contacts)
+        other.walls = list(self.walls)
+        other.skin = self.skin
+        return other
+
     @property
     def wall_names(self) -> list[str]:
         return [name for name, _ in self.walls]

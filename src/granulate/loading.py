@@ -5,7 +5,7 @@ background damping act on every node and are the core's own settings."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass, fields
+from dataclasses import dataclass, fields, replace
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -146,6 +146,17 @@ class Loading:
         ids = self._nodes(nodes)
         density = self._assembly.vector(vector, "force density")
         self.loads.append(ForceDensity(ids, density, function or Constant(1.0)))
+
+    def subset(self, assembly: Assembly, node_map: NDArray[np.int64]) -> Loading:
+        """The loads on `assembly`, a subset of this one's (Assembly.subset and its node map):
+        each load on the nodes it keeps, renumbered; loads that keep no node are left out."""
+        part = Loading(assembly)
+        for load in self.loads:
+            kept = node_map[load.nodes]
+            kept = kept[kept >= 0].astype(np.uint32)
+            if len(kept):
+                part.loads.append(replace(load, nodes=kept))
+        return part
 
     def apply(self, core: _core.Simulation) -> None:
         """Hand the loads to the core, in order."""

@@ -185,6 +185,40 @@ class Simulation(SimulationSetup, SimulationResults):
             core_model.break_crossing_bonds(core, model, *crack)
         return core
 
+    def _subdomain(
+        self, grains: NDArray[np.int64], dt: float | None = None, skin: float | None = None
+    ) -> tuple[Simulation, NDArray[np.int64]]:
+        """A new simulation of the bodies `grains` (increasing indices) alone, set up as this
+        one is (loads on their nodes, contact, walls, gravity, damping, precracks, start
+        state), with the time step `dt` and neighbour skin `skin` when given; and the map of
+        this simulation's node indices to its own (-1: left out). For granulate.parallel,
+        whose ranks each hold their grains and ghosts; this simulation is not built."""
+        interactions = self._interactions
+        if interactions.peridem_damping or interactions.peridem_walls:
+            raise InputError(
+                "PeriDEM's damping (--peridem-compat decks) is not supported in distributed "
+                "runs; run the deck on one process"
+            )
+        part = Simulation(
+            self.dimension,
+            self.plane,
+            dt=dt if dt is not None else self._dt,
+            dt_safety=self._dt_safety,
+            viscous_damping=self._viscous_damping,
+        )
+        part._gravity = self._gravity.copy()
+        assembly, node_map = self._assembly.subset(grains)
+        part._assembly = assembly
+        part._loading = self._loading.subset(assembly, node_map)
+        part._interactions = interactions.on(assembly)
+        if skin is not None:
+            part._interactions.set_skin(skin)
+        part._precracks = list(self._precracks)
+        if self._start is not None:
+            kept = node_map >= 0  # kept nodes keep their order
+            part._start = (self._start[0][kept], self._start[1][kept])
+        return part, node_map
+
     def _set_time_step(self, core: _core.Simulation) -> None:
         """dt as given (warned above the stable estimate), or dt_safety times that estimate."""
         if self._dt is None:

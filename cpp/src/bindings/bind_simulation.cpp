@@ -112,6 +112,15 @@ void bind_loading(nb::class_<Simulation>& cls) {
             self.contact().set_wall_law(wall, material, law);
           },
           "wall"_a, "material"_a, "law"_a)
+      .def_prop_ro(
+          "contact_reach",
+          [](const Simulation& self) {
+            return self.contact().largest_pair_reach(self.model()) + self.contact().list_skin();
+          },
+          "The neighbour lists' cutoff [m]: the largest reach of a pair of nodes plus the skin.")
+      .def_prop_ro(
+          "contact_skin", [](const Simulation& self) { return self.contact().list_skin(); },
+          "The neighbour lists' skin [m]: as set, or half the largest contact radius.")
       .def(
           "set_contact_skin", [](Simulation& self, real skin) { self.contact().set_skin(skin); }, "skin"_a)
       .def(

@@ -1,8 +1,10 @@
-"""Distributed runs (DESIGN.md section 7). So far: the decomposition of an assembly over ranks,
-whole grains per rank with the ghosts contact needs (partition.py), and its measures; the
-engine that runs a case over MPI ranks is not built yet, so the command line refuses to start
-as several ranks (launch.py)."""
+"""Distributed runs (DESIGN.md section 7). The decomposition of an assembly over ranks, whole
+grains per rank with the ghosts contact needs (partition.py), and the engine that steps one
+simulation on the ranks of an MPI communicator with those ghosts (engine.py, DistributedRun:
+grains do not migrate yet, and outputs are gathered by hand). The command line does not run a
+case on several ranks yet and refuses to start as several (launch.py)."""
 
+from granulate.parallel.engine import DistributedRun
 from granulate.parallel.partition import Partition, bisect, ghosts, near_pairs
 
-__all__ = ["Partition", "bisect", "ghosts", "near_pairs"]
+__all__ = ["DistributedRun", "Partition", "bisect", "ghosts", "near_pairs"]

@@ -129,6 +129,10 @@ class ContactModel {
     bodies_labelled_ = false;
   }
   real skin() const { return skin_; }
+  /// The skin the lists are built with: as set, or half the largest contact radius [m].
+  real list_skin() const { return skin_ < 0 ? 0.5 * max_contact_radius_ : skin_; }
+  /// The largest pair_reach any two nodes can have [m] (the lists' cutoff less the skin).
+  real largest_pair_reach(const Model& model) const;
 
   bool active() const { return any_law_ || !walls_.empty(); }
 
@@ -318,8 +322,6 @@ class ContactModel {
   /// `radius` of the node: radius |o_i| for a surface point of a particle under the surface
   /// law (at_list is then the surface point), 0 otherwise.
   real list_offset(const Model& model, index_t i, real radius) const;
-  /// The largest pair_reach any two nodes can have.
-  real largest_pair_reach(const Model& model) const;
   SurfaceCentres centres_;
   std::vector<vec3> anchor_forces_;  // per contact node: the force on its anchored vector A_i
 

@@ -1,0 +1,74 @@
+"""Run under `mpiexec -n K python tests/mpi_check.py DIMENSION STEPS` (tests/test_mpi.py does):
+the locality test's assembly (tests/test_locality.py: grains pressed into each other and thrown
+at each other, friction, damping, the surface law), here also under gravity on a floor, run
+serially on every rank and distributed over the K ranks (granulate.parallel.DistributedRun).
+Rank 0 compares the two bit for bit and prints one line; the exit status is non-zero on any
+difference.
+
+`... DIMENSION STEPS MARGIN` instead runs the distributed run alone with that ghost margin [m],
+expecting every rank to stop with the InputError that says the grains moved too far for it."""
+
+from __future__ import annotations
+
+import sys
+import warnings
+from pathlib import Path
+
+import numpy as np
+from mpi4py import MPI
+
+sys.path.insert(0, str(Path(__file__).parent))
+import granulate as gr
+from granulate.parallel import DistributedRun
+from test_locality import RADIUS, assembly, layout
+
+
+def set_up(dimension: int) -> gr.Simulation:
+    """The locality assembly under gravity, on a floor just below its lowest grains."""
+    centres, _ = layout(dimension)
+    sim = assembly(dimension, np.arange(len(centres)))
+    sim.gravity = (0.0, -9.81, 0.0)
+    floor = centres[:, 1].min() - 0.99 * RADIUS
+    sim.add_wall(gr.Wall(gr.Plane((0.0, floor, 0.0), (0.0, 1.0, 0.0))), name="floor")
+    return sim
+
+
+def main() -> int:
+    dimension, steps = int(sys.argv[1]), int(sys.argv[2])
+    comm = MPI.COMM_WORLD
+    warnings.filterwarnings("ignore", message="contact.*bodies pressed")  # placed pressed
+    if len(sys.argv) > 3:
+        return check_margin(dimension, steps, float(sys.argv[3]), comm)
+    serial = set_up(dimension)
+    serial.core.run(steps)
+    distributed = DistributedRun(set_up(dimension), comm)
+    distributed.run(steps)
+    fields = {name: distributed.gather(name) for name in ("positions", "velocities", "forces")}
+    if comm.Get_rank() != 0:
+        return 0
+    worst = {name: float(np.abs(fields[name] - getattr(serial, name)).max()) for name in fields}
+    same_dt = distributed.dt == serial.dt
+    ghosts = [len(g) for g in distributed.ghosts]
+    print(
+        f"ranks {comm.Get_size()}, {dimension}D, {steps} steps, dt equal {same_dt}, ghosts per "
+        f"rank {ghosts}, largest differences {worst}"
+    )
+    return 0 if same_dt and not any(worst.values()) else 1
+
+
+def check_margin(dimension: int, steps: int, margin: float, comm: MPI.Comm) -> int:
+    """0 when every rank raised the margin's InputError within `steps` steps."""
+    try:
+        DistributedRun(set_up(dimension), comm, margin=margin).run(steps)
+        message = ""
+    except gr.InputError as error:
+        message = str(error)
+    messages = comm.gather(message, root=0)
+    if comm.Get_rank() != 0:
+        return 0
+    print(messages[0])
+    return 0 if all("ghost margin" in m for m in messages) else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,60 @@
+"""A rank's part of a simulation (Simulation._subdomain, for granulate.parallel): the grains it
+holds, renumbered in the serial order, set up as the whole (loads on their nodes, initial
+motion, contact, walls), and nothing else."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import granulate as gr
+
+ROCK = gr.Material(density=2000, bulk_modulus=1e7, shear_modulus=6e6, fracture_energy=10)
+
+
+def row_of_discs() -> gr.Simulation:
+    """Four discs in a row; the last one moving, the first one's left half fixed."""
+    sim = gr.Simulation(2, gravity=(0, -9.81, 0))
+    for k in range(4):
+        velocity = (0.3, 0.0) if k == 3 else None
+        sim.add_body(gr.Disc((2.2e-3 * k, 0.0), 1e-3), ROCK, 2.5e-4, velocity=velocity)
+    sim.fix(sim.select(gr.Rectangle((-2e-3, -2e-3), (-0.5e-3, 2e-3))), "xy")
+    sim.add_wall(gr.Wall(gr.Plane((0, -1.2e-3, 0), (0, 1, 0))), name="floor")
+    return sim
+
+
+def test_a_subdomain_holds_its_grains_renumbered_with_their_set_up() -> None:
+    whole = row_of_discs()
+    part, node_map = whole._subdomain(np.array([0, 3]), dt=1e-8, skin=1e-4)
+    a, d = whole.bodies[0], whole.bodies[3]
+    assert [b.node_count for b in part.bodies] == [a.node_count, d.node_count]
+    assert part.bodies[1].first_node == a.node_count
+    np.testing.assert_array_equal(node_map[d.node_slice], part.bodies[1].nodes)
+    assert np.all(node_map[whole.bodies[1].node_slice] == -1)
+    kept = np.r_[a.nodes, d.nodes]
+    np.testing.assert_array_equal(part.positions, whole.positions[kept])
+    np.testing.assert_array_equal(part.velocities, whole.velocities[kept])  # disc 3's motion
+    assert part.dt == 1e-8 and part.core.contact_skin == 1e-4
+    assert part.walls == whole.walls
+    part.run(20)  # gravity and the fixed half, on the renumbered nodes
+    held = whole._loading.loads[0].nodes
+    np.testing.assert_array_equal(part.positions[held], whole.positions[held])
+    assert part.velocities[part.bodies[1].nodes, 1].mean() < 0
+
+
+def test_loads_on_grains_left_out_are_left_out() -> None:
+    part, _ = row_of_discs()._subdomain(np.array([2]))
+    assert part._loading.loads == []
+
+
+@pytest.mark.parametrize("grains", [[], [2, 1], [4], [-1, 0]])
+def test_a_subdomain_takes_increasing_grains_that_exist(grains: list[int]) -> None:
+    with pytest.raises(gr.InputError, match="subset"):
+        row_of_discs()._subdomain(np.array(grains, dtype=np.int64))
+
+
+def test_peridem_damping_is_refused_for_distributed_runs() -> None:
+    sim = row_of_discs()
+    sim.set_peridem_damping(ROCK, ROCK, epsilon=0.9)
+    with pytest.raises(gr.InputError, match="one process"):
+        sim._subdomain(np.array([0]))
