@@ -65,7 +65,8 @@ class DistributedRun:
         self._plan(sim, node_map, owned)
         self.local.core.run(0)  # the first forces, then the owners' values for the ghosts
         self._exchange()
-        self._start = self.local.positions[self._owned_nodes].copy()
+        self._start = self.local.core.positions.copy()  # every node held: ghosts are exact
+        self._moved = np.empty_like(self._start)
         #: Wall-clock seconds of this rank in its steps, ghost exchanges and partition checks.
         self.seconds = {"steps": 0.0, "exchange": 0.0, "check": 0.0}
 
@@ -119,14 +120,15 @@ class DistributedRun:
             self.seconds["check"] += time.perf_counter() - exchanged
 
     def _check_partition(self, step: int) -> None:
-        moved = self.local.positions[self._owned_nodes] - self._start
-        farthest = float(np.sqrt((moved**2).sum(axis=1).max())) if len(moved) else 0.0
+        """Stop every rank once a node has moved half the margin from its start."""
+        moved = np.subtract(self.local.core.positions, self._start, out=self._moved)
+        farthest = float(np.sqrt(np.einsum("ij,ij->i", moved, moved).max(initial=0.0)))
         farthest = self.comm.allreduce(farthest, op=self._mpi.MAX)
         if farthest > 0.5 * self.margin:
             raise InputError(
-                f"step {step}: a node moved {farthest:.3g} m from its start, more than half the "
-                f"ghost margin ({self.margin:.3g} m); grains do not migrate between ranks yet, "
-                "so give DistributedRun a larger margin or run on one process"
+                f"step {step}: a node moved {farthest:.3g} m from its start, more than "
+                f"half the ghost margin ({self.margin:.3g} m); grains do not migrate between "
+                "ranks yet, so give DistributedRun a larger margin or run on one process"
             )
 
     @property
