@@ -3,9 +3,9 @@ README): a copy of the stage-1 deck that restarts from stage 1's last frame (ste
 t = 0.06 s), runs to Final_Time 0.15 s at dt 1e-7 s, with the moving wall's zone re-placed as
 PeriDEM's run2 does ([-0.22, 34.82] to [68.72, 35.42] mm) and its mesh moved down 6.4 mm.
 
-    python examples/compression_2d/peridem_stage2.py STAGE1_DECK_FOLDER FRAME.vtu STAGE2_FOLDER
+    python docs/validation/peridem_stage2.py STAGE1_DECK_FOLDER FRAME.vtu STAGE2_FOLDER
 
-The commands of the whole run are in this folder's README.
+The commands of the whole run: examples/compression_2d/README.md.
 """
 
 from __future__ import annotations
