@@ -6,7 +6,8 @@ Rank 0 compares the two bit for bit and prints one line; the exit status is non-
 difference.
 
 `... DIMENSION STEPS MARGIN` instead runs the distributed run alone with that ghost margin [m],
-expecting every rank to stop with the InputError that says the grains moved too far for it."""
+expecting every rank to stop with the InputError that says the grains moved too far for it;
+`... DIMENSION STEPS fail` blows up one rank's step and expects every rank to stop."""
 
 from __future__ import annotations
 
@@ -37,6 +38,8 @@ def main() -> int:
     dimension, steps = int(sys.argv[1]), int(sys.argv[2])
     comm = MPI.COMM_WORLD
     warnings.filterwarnings("ignore", message="contact.*bodies pressed")  # placed pressed
+    if len(sys.argv) > 3 and sys.argv[3] == "fail":
+        return check_failure(dimension, steps, comm)
     if len(sys.argv) > 3:
         return check_margin(dimension, steps, float(sys.argv[3]), comm)
     serial = set_up(dimension)
@@ -68,6 +71,26 @@ def check_margin(dimension: int, steps: int, margin: float, comm: MPI.Comm) -> i
         return 0
     print(messages[0])
     return 0 if all("ghost margin" in m for m in messages) else 1
+
+
+def check_failure(dimension: int, steps: int, comm: MPI.Comm) -> int:
+    """0 when a blow-up on the last rank alone ends every rank: it with its InstabilityError,
+    the others with the RuntimeError naming it."""
+    run = DistributedRun(set_up(dimension), comm)
+    last = comm.Get_size() - 1
+    if comm.Get_rank() == last:
+        run.local.velocities[run._owned_nodes[0]] = 1e6  # moves a mesh size in a step
+    try:
+        run.run(steps)
+        message = ""
+    except (gr.InstabilityError, RuntimeError) as error:
+        message = f"{type(error).__name__}: {error}"
+    messages = comm.gather(message, root=0)
+    if comm.Get_rank() != 0:
+        return 0
+    print(messages)
+    others = all(f"rank {last} failed" in m for m in messages[:last])
+    return 0 if others and messages[last].startswith("InstabilityError") else 1
 
 
 if __name__ == "__main__":

@@ -25,9 +25,10 @@ def mpiexec() -> str:
 
 
 def run_ranks(ranks: int, *arguments: str) -> subprocess.CompletedProcess[str]:
+    """mpi_check.py on `ranks` ranks; a hang fails the test after 5 minutes."""
     environment = {**os.environ, "OMP_NUM_THREADS": "1"}
     command = [mpiexec(), "-n", str(ranks), sys.executable, str(CHECK), *arguments]
-    return subprocess.run(command, capture_output=True, text=True, timeout=600, env=environment)
+    return subprocess.run(command, capture_output=True, text=True, timeout=300, env=environment)
 
 
 @pytest.mark.parametrize(
@@ -46,3 +47,9 @@ def test_grains_moving_past_the_ghost_margin_stop_every_rank_with_the_reason() -
     done = run_ranks(3, "2", "50", "1e-6")  # the grains are thrown at up to 0.5 m/s
     assert done.returncode == 0, done.stdout + done.stderr
     assert "more than half the ghost margin" in done.stdout
+
+
+def test_a_blow_up_on_one_rank_ends_every_rank_without_a_hang() -> None:
+    done = run_ranks(3, "2", "20", "fail")
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert "rank 2 failed" in done.stdout and "InstabilityError" in done.stdout

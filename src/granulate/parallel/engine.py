@@ -106,27 +106,44 @@ class DistributedRun:
 
     def run(self, steps: int) -> None:
         """Advance every rank `steps` time steps. Raises InputError (on every rank) when a
-        node has moved more than half the margin: the ghosts would no longer be enough."""
+        node has moved more than half the margin: the ghosts would no longer be enough. An
+        error in one rank's step ends every rank: that rank raises its own, the others a
+        RuntimeError naming it (no rank is left waiting for a message)."""
         core = self.local.core
         for _ in range(steps):
             start = time.perf_counter()
-            core.run(1)
+            failure = None
+            try:
+                core.run(1)
+            except Exception as error:  # re-raised below, after the ranks agree to stop
+                failure = error
             stepped = time.perf_counter()
+            self._check_step(int(core.step), failure)
+            checked = time.perf_counter()
             self._exchange()
-            exchanged = time.perf_counter()
-            self._check_partition(int(core.step))
             self.seconds["steps"] += stepped - start
-            self.seconds["exchange"] += exchanged - stepped
-            self.seconds["check"] += time.perf_counter() - exchanged
+            self.seconds["check"] += checked - stepped
+            self.seconds["exchange"] += time.perf_counter() - checked
 
-    def _check_partition(self, step: int) -> None:
-        """Stop every rank once a node has moved half the margin from its start."""
+    def _check_step(self, step: int, failure: Exception | None) -> None:
+        """One reduction after each step, before the exchange: the first rank whose step
+        failed, and the largest distance of a node from its start (the ghosts' positions are
+        already exact here: they drifted from exact values). Stops every rank on either."""
         moved = np.subtract(self.local.core.positions, self._start, out=self._moved)
         farthest = float(np.sqrt(np.einsum("ij,ij->i", moved, moved).max(initial=0.0)))
-        farthest = self.comm.allreduce(farthest, op=self._mpi.MAX)
-        if farthest > 0.5 * self.margin:
+        size = self.comm.Get_size()
+        failed_rank = self.comm.Get_rank() if failure is not None else size
+        mine = np.array([failed_rank, -farthest])  # elementwise minima: both in one reduction
+        least = np.empty(2)
+        self.comm.Allreduce(mine, least, op=self._mpi.MIN)
+        first_failed, farthest = int(least[0]), float(least[1])
+        if failure is not None:
+            raise failure
+        if first_failed < size:
+            raise RuntimeError(f"step {step}: rank {first_failed} failed; every rank stops")
+        if -farthest > 0.5 * self.margin:
             raise InputError(
-                f"step {step}: a node moved {farthest:.3g} m from its start, more than "
+                f"step {step}: a node moved {-farthest:.3g} m from its start, more than "
                 f"half the ghost margin ({self.margin:.3g} m); grains do not migrate between "
                 "ranks yet, so give DistributedRun a larger margin or run on one process"
             )
