@@ -65,8 +65,7 @@ def main() -> None:
     run.run(arguments.steps)
     wall = time.perf_counter() - start
     owned = len(run.partition.grains_of(comm.Get_rank()))
-    owned_nodes = sum(b.node_count for b in run.local.bodies) - ghost_nodes(run)
-    row = (owned, owned_nodes, ghost_nodes(run), wall, run.seconds)
+    row = (owned, run.owned_node_count, run.ghost_node_count, wall, run.seconds)
     rows = comm.gather(row, root=0)
     if comm.Get_rank() != 0:
         return
@@ -79,15 +78,6 @@ def main() -> None:
             f"| {rank} | {grains} | {nodes:,} | {ghosts:,} | {speed / 1e6:.2f} M | "
             f"{100 * parts['exchange'] / seconds:.1f} | {100 * parts['check'] / seconds:.1f} |"
         )
-
-
-def ghost_nodes(run: DistributedRun) -> int:
-    """The nodes of the grains a rank holds as ghosts."""
-    owner = run.partition.owner
-    rank = run.comm.Get_rank()
-    held = np.union1d(run.partition.grains_of(rank), run.ghosts[rank])
-    bodies = zip(run.local.bodies, held, strict=True)
-    return sum(body.node_count for body, g in bodies if owner[g] != rank)
 
 
 if __name__ == "__main__":

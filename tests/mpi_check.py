@@ -59,15 +59,21 @@ def main() -> int:
     return 0 if same_dt and not any(worst.values()) else 1
 
 
+def stop_messages(run: DistributedRun, steps: int, comm: MPI.Comm) -> list[str] | None:
+    """Run `steps` steps; on rank 0 each rank's "ErrorType: message" (empty if it finished)."""
+    try:
+        run.run(steps)
+        message = ""
+    except (gr.InputError, RuntimeError) as error:  # InstabilityError is a RuntimeError
+        message = f"{type(error).__name__}: {error}"
+    return comm.gather(message, root=0)
+
+
 def check_margin(dimension: int, steps: int, margin: float, comm: MPI.Comm) -> int:
     """0 when every rank raised the margin's InputError within `steps` steps."""
-    try:
-        DistributedRun(set_up(dimension), comm, margin=margin).run(steps)
-        message = ""
-    except gr.InputError as error:
-        message = str(error)
-    messages = comm.gather(message, root=0)
-    if comm.Get_rank() != 0:
+    run = DistributedRun(set_up(dimension), comm, margin=margin)
+    messages = stop_messages(run, steps, comm)
+    if messages is None:
         return 0
     print(messages[0])
     return 0 if all("ghost margin" in m for m in messages) else 1
@@ -80,13 +86,8 @@ def check_failure(dimension: int, steps: int, comm: MPI.Comm) -> int:
     last = comm.Get_size() - 1
     if comm.Get_rank() == last:
         run.local.velocities[run._owned_nodes[0]] = 1e6  # moves a mesh size in a step
-    try:
-        run.run(steps)
-        message = ""
-    except (gr.InstabilityError, RuntimeError) as error:
-        message = f"{type(error).__name__}: {error}"
-    messages = comm.gather(message, root=0)
-    if comm.Get_rank() != 0:
+    messages = stop_messages(run, steps, comm)
+    if messages is None:
         return 0
     print(messages)
     others = all(f"rank {last} failed" in m for m in messages[:last])

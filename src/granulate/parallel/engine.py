@@ -71,38 +71,59 @@ class DistributedRun:
         self.seconds = {"steps": 0.0, "exchange": 0.0, "check": 0.0}
 
     def _plan(self, sim: Simulation, node_map: NDArray[np.int64], owned: NDArray[np.int64]) -> None:
-        """Which local nodes go to which rank and come from which, in grain order."""
+        """Which local nodes go to which rank and come from which, in grain order, with the
+        message buffers (9 numbers a node: x, v, f), made once."""
         rank = self.comm.Get_rank()
         owner = self.partition.owner
-        self._global_nodes = [sim.bodies[g].nodes.astype(np.int64) for g in range(len(owner))]
+        self._slices = [body.node_slice for body in sim.bodies]  # each grain's global nodes
+        self._node_count = sim._assembly.node_count
         self._owned = owned
-        self._owned_nodes = self._local(node_map, owned)
+        self._owned_nodes = self._nodes_of(owned, node_map)
         self._send = {
-            q: self._local(node_map, held[owner[held] == rank])
+            q: self._nodes_of(held[owner[held] == rank], node_map)
             for q, held in enumerate(self.ghosts)
             if q != rank and np.any(owner[held] == rank)
         }
         mine = self.ghosts[rank]
         self._receive = {
-            int(q): self._local(node_map, mine[owner[mine] == q]) for q in np.unique(owner[mine])
+            int(q): self._nodes_of(mine[owner[mine] == q], node_map) for q in np.unique(owner[mine])
         }
+        self._outbox = {q: np.empty((len(n), 9)) for q, n in self._send.items()}
+        self._inbox = {q: np.empty((len(n), 9)) for q, n in self._receive.items()}
 
-    def _local(self, node_map: NDArray[np.int64], grains: NDArray[np.int64]) -> NDArray[np.int64]:
-        nodes = [self._global_nodes[g] for g in grains]
-        return node_map[np.concatenate(nodes)] if nodes else np.zeros(0, dtype=np.int64)
+    def _nodes_of(
+        self, grains: NDArray[np.int64], node_map: NDArray[np.int64] | None = None
+    ) -> NDArray[np.int64]:
+        """The global indices of the nodes of `grains` in grain order; their local indices
+        when `node_map` (global to local) is given."""
+        nodes = [np.arange(self._slices[g].start, self._slices[g].stop) for g in grains]
+        index = np.concatenate(nodes) if nodes else np.zeros(0, dtype=np.int64)
+        return index if node_map is None else node_map[index]
+
+    @property
+    def owned_node_count(self) -> int:
+        """The nodes of the grains this rank owns."""
+        return len(self._owned_nodes)
+
+    @property
+    def ghost_node_count(self) -> int:
+        """The nodes of the other ranks' grains this rank holds as ghosts."""
+        return self.local._assembly.node_count - len(self._owned_nodes)
 
     def _exchange(self) -> None:
         """Owners' positions, velocities and forces to the ranks that hold their grains as
         ghosts (one message per pair of neighbouring ranks)."""
         core = self.local.core
         x, v, f = core.positions, core.velocities, core.forces
-        inbox = {q: np.empty((len(nodes), 9)) for q, nodes in self._receive.items()}
-        requests = [self.comm.Irecv(inbox[q], source=q, tag=_TAG) for q in inbox]
-        outbox = {q: np.hstack([x[n], v[n], f[n]]) for q, n in self._send.items()}
-        requests += [self.comm.Isend(outbox[q], dest=q, tag=_TAG) for q in outbox]
+        requests = [self.comm.Irecv(box, source=q, tag=_TAG) for q, box in self._inbox.items()]
+        for q, nodes in self._send.items():
+            box = self._outbox[q]
+            box[:, :3], box[:, 3:6], box[:, 6:] = x[nodes], v[nodes], f[nodes]
+            requests.append(self.comm.Isend(box, dest=q, tag=_TAG))
         self._mpi.Request.Waitall(requests)
         for q, nodes in self._receive.items():
-            x[nodes], v[nodes], f[nodes] = inbox[q][:, :3], inbox[q][:, 3:6], inbox[q][:, 6:]
+            box = self._inbox[q]
+            x[nodes], v[nodes], f[nodes] = box[:, :3], box[:, 3:6], box[:, 6:]
 
     def run(self, steps: int) -> None:
         """Advance every rank `steps` time steps. Raises InputError (on every rank) when a
@@ -162,12 +183,9 @@ class DistributedRun:
         parts = self.comm.gather((self._owned, mine), root=root)
         if parts is None:
             return None
-        total = sum(len(nodes) for nodes in self._global_nodes)
-        whole = np.empty((total, 3))
+        whole = np.empty((self._node_count, 3))
         for grains, values in parts:
-            nodes = [self._global_nodes[g] for g in grains]
-            if nodes:
-                whole[np.concatenate(nodes)] = values
+            whole[self._nodes_of(grains)] = values
         return whole
 
 
