@@ -58,3 +58,20 @@ def test_peridem_damping_is_refused_for_distributed_runs() -> None:
     sim.set_peridem_damping(ROCK, ROCK, epsilon=0.9)
     with pytest.raises(gr.InputError, match="one process"):
         sim._subdomain(np.array([0]))
+
+
+def test_translated_copies_in_a_subdomain_keep_the_whole_assemblys_bonds() -> None:
+    """The four discs are translated copies: the whole run builds one bond family from disc
+    0's nodes, whose lengths differ from disc 2's own by round-off. A part without disc 0 must
+    use the same family (its first copy would otherwise make one from disc 2's nodes), or its
+    dilatations differ in the last bits."""
+    whole = row_of_discs()
+    whole.core.run(0)
+    part, node_map = whole._subdomain(np.array([2, 3]))
+    part.core.run(0)
+    disc = whole.bodies[2].node_slice
+    np.testing.assert_array_equal(part.core.dilatation[node_map[disc]], whole.core.dilatation[disc])
+    alone = row_of_discs()._subdomain(np.array([2, 3]))[0]
+    alone._assembly.parent = None  # the part as if it were a whole assembly of its own
+    alone.core.run(0)
+    assert np.any(alone.core.dilatation[node_map[disc]] != whole.core.dilatation[disc])

@@ -96,6 +96,9 @@ class Assembly:
         self.surfaces: list[ReferenceShape | None] = []
         self.initial_velocities: list[InitialVelocity] = []
         self._names: dict[str, Body] = {}  # every body by name (adding one is O(1))
+        #: For a subset (subset()): the assembly it was taken from and each body's index
+        #: there; its bodies take their core shapes from that one's (core_model.py).
+        self.parent: tuple[Assembly, NDArray[np.int64]] | None = None
 
     @property
     def node_count(self) -> int:
@@ -309,13 +312,18 @@ class Assembly:
         """The bodies `grains` (indices, increasing) as an assembly of their own, renumbered in
         that order, with their initial motions; and the map of this assembly's node indices to
         the subset's (-1 for nodes left out). A distributed run's rank holds such a subset: the
-        grains it owns and its ghosts (granulate.parallel)."""
+        grains it owns and its ghosts (granulate.parallel). The subset's bodies take their core
+        shapes from this assembly's (`parent`), so translated copies share the bond lengths of
+        the same body here, whichever grains the subset holds."""
         chosen = np.asarray(grains, dtype=np.int64).reshape(-1)
         if len(chosen) == 0 or np.any(np.diff(chosen) <= 0) or chosen[0] < 0:
             raise InputError("subset: give increasing body indices")
         if chosen[-1] >= len(self.bodies):
             raise InputError(f"subset: body {chosen[-1]} does not exist")
         part = Assembly(self.dimension)
+        part.parent = (
+            (self, chosen) if self.parent is None else (self.parent[0], self.parent[1][chosen])
+        )
         node_map = np.full(self.node_count, -1, dtype=np.int64)
         renamed: dict[int, Body] = {}
         for g in chosen:

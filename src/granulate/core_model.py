@@ -5,7 +5,9 @@ pre-cracks, bonds broken across a plane once the bonds exist."""
 
 from __future__ import annotations
 
+import weakref
 from collections.abc import Mapping
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
@@ -32,34 +34,27 @@ def build_model(
     discretisations' outer layers carry surface points (the node-sphere law sees those nodes at
     themselves: no anchors)."""
     model = _core.Model(assembly.dimension, getattr(_core.PlaneMode, plane))
-    # Surface data of the bodies without a reference shape (theirs are their shapes').
-    surfaces = [
-        _surface_arrays(surface, outer_layers) if body.reference is None else None
-        for body, surface in zip(assembly.bodies, assembly.surfaces, strict=True)
-    ]
-    copy_of = _translated_copies(assembly, surfaces)
-    _require_memory_for_model(assembly, plane, copy_of)
+    sources = _shape_sources(assembly, outer_layers)
+    _require_memory_for_model(assembly, plane, {b: source.key for b, source in sources.items()})
     material_ids: dict[int, int] = {}
     core_materials: list[Material] = []
     shape_ids: dict[int, int] = {}
-    shape_of_body: dict[int, int] = {}  # bodies without a reference shape
-    for body, positions, volumes, surface_arrays in zip(
-        assembly.bodies, assembly.positions, assembly.volumes, surfaces, strict=True
-    ):
+    shape_of_source: dict[int, int] = {}  # bodies without a reference shape
+    for body, positions in zip(assembly.bodies, assembly.positions, strict=True):
         horizon = body.material.resolved_horizon(body.mesh_size)
         key = id(body.material)
         if key not in material_ids:
             material_ids[key] = model.add_material(body.material.core_params(body.mesh_size))
             core_materials.append(body.material)
         if body.reference is None:
-            original = copy_of.get(body.index)
-            if original is None:
-                assert surface_arrays is not None
-                shape = model.add_shape(positions, volumes, body.mesh_size, *surface_arrays)
-            else:
-                shape = shape_of_body[original]
-            shape_of_body[body.index] = shape
-            model.place_shape(shape, material_ids[key], positions, 1.0, horizon)
+            source = sources[body.index]
+            if source.key not in shape_of_source:
+                shape_of_source[source.key] = model.add_shape(
+                    source.positions, source.volumes, source.mesh_size, *source.surface
+                )
+            model.place_shape(
+                shape_of_source[source.key], material_ids[key], positions, 1.0, horizon
+            )
             continue
         reference = body.reference
         if id(reference) not in shape_ids:
@@ -76,37 +71,80 @@ def build_model(
     return model, core_materials
 
 
-def _translated_copies(
-    assembly: Assembly, surfaces: list[tuple[NDArray[np.float64], NDArray[np.float64]] | None]
-) -> dict[int, int]:
-    """Bodies without a reference shape that are translated copies of an earlier one
-    (shape_sharing.py), given each body's surface data (`surfaces`, None for those with a
-    reference shape): body index -> the earlier body's index. They share its core shape and
-    bond family."""
-    copies, copy_of = TranslatedShapes(), {}
-    for body, positions, volumes, surface_arrays in zip(
-        assembly.bodies, assembly.positions, assembly.volumes, surfaces, strict=True
-    ):
-        if surface_arrays is None:
+@dataclass(frozen=True)
+class _ShapeSource:
+    """The nodes a body's core shape is made from: its own, or those of the earlier body it is
+    a translated copy of (shape_sharing.py). ``key``: that body's index in the assembly, or in
+    its parent for a subset (Assembly.subset), so that a subset's grains share the shapes of
+    the whole assembly's and so its bond lengths, to the last bit."""
+
+    key: int
+    positions: NDArray[np.float64]
+    volumes: NDArray[np.float64]
+    mesh_size: float
+    surface: tuple[NDArray[np.float64], NDArray[np.float64]]
+
+
+def _shape_sources(assembly: Assembly, outer_layers: bool) -> dict[int, _ShapeSource]:
+    """Per body without a reference shape, the nodes of its core shape."""
+    home, index = assembly.parent or (assembly, np.arange(len(assembly.bodies)))
+    copy_of = _translated_copies(home, outer_layers)
+    sources = {}
+    for body in assembly.bodies:
+        if body.reference is not None:
             continue
+        donor = copy_of.get(int(index[body.index]), int(index[body.index]))
+        sources[body.index] = _ShapeSource(
+            donor,
+            home.positions[donor],
+            home.volumes[donor],
+            home.bodies[donor].mesh_size,
+            _surface_arrays(home.surfaces[donor], outer_layers),
+        )
+    return sources
+
+
+# Translated copies found in an assembly, by the assembly and (outer_layers, bodies): a
+# distributed run builds many subsets of one assembly and looks them up there each time.
+_COPIES: weakref.WeakKeyDictionary[Assembly, dict[tuple[bool, int], dict[int, int]]] = (
+    weakref.WeakKeyDictionary()
+)
+
+
+def _translated_copies(assembly: Assembly, outer_layers: bool) -> dict[int, int]:
+    """Bodies without a reference shape that are translated copies of an earlier one
+    (shape_sharing.py): body index -> the earlier body's index. They share its core shape and
+    bond family."""
+    known = _COPIES.setdefault(assembly, {})
+    key = (outer_layers, len(assembly.bodies))
+    if key in known:
+        return known[key]
+    copies, copy_of = TranslatedShapes(), {}
+    for body, positions, volumes, surface in zip(
+        assembly.bodies, assembly.positions, assembly.volumes, assembly.surfaces, strict=True
+    ):
+        if body.reference is not None:
+            continue
+        surface_arrays = _surface_arrays(surface, outer_layers)
         original = copies.find(positions, volumes, body.mesh_size, surface_arrays)
         if original is None:
             copies.remember(body.index, positions, volumes, body.mesh_size, surface_arrays)
         else:
             copy_of[body.index] = original
+    known[key] = copy_of
     return copy_of
 
 
-def _require_memory_for_model(assembly: Assembly, plane: str, copy_of: Mapping[int, int]) -> None:
+def _require_memory_for_model(assembly: Assembly, plane: str, shapes: Mapping[int, int]) -> None:
     """InputError before the bonds are built when the model would not fit in memory: every
     node's state, and one bond family per reference shape and horizon ratio (particles placed
-    from one shape share it) or per body not a translated copy of an earlier one
-    (`copy_of`)."""
+    from one shape share it) or per shape of bodies without one (`shapes`: body index -> the
+    index of the body whose nodes make its shape)."""
     families: dict[tuple[int, float], float] = {}
     for body in assembly.bodies:
         ratio = body.material.resolved_horizon(body.mesh_size) / body.mesh_size
         _check_material_for(body, ratio * body.mesh_size, assembly.dimension, plane)
-        own = -1 - copy_of.get(body.index, body.index)
+        own = -1 - shapes.get(body.index, body.index)
         key = (id(body.reference) if body.reference is not None else own, ratio)
         family = body.node_count * resources.bonds_per_node(assembly.dimension, ratio)
         families[key] = family
