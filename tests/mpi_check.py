@@ -5,14 +5,22 @@ serially on every rank and distributed over the K ranks (granulate.parallel.Dist
 Rank 0 compares the two bit for bit and prints one line; the exit status is non-zero on any
 difference.
 
-`... DIMENSION STEPS MARGIN` instead runs the distributed run alone with that ghost margin [m],
-expecting every rank to stop with the InputError that says the grains moved too far for it;
+`... drum VARIANT STEPS` runs the checkpoint tests' tumbling drum (tests/test_checkpoint.py:
+four grains tumbling and breaking in a rotating drum with a lifter; VARIANT lattice, grid,
+surface or rolling) the same way: the grains move far, so the ranks migrate them many times,
+handing grains over with their bonds, collisions and friction springs.
+
+`... DIMENSION STEPS MARGIN [migrate]` instead runs the distributed run alone with that ghost
+margin [m], without migrating grains (or with), expecting every rank to stop with the
+InputError that says the grains moved too far for it;
 `... DIMENSION STEPS fail` blows up one rank's step and expects every rank to stop."""
 
 from __future__ import annotations
 
 import sys
+import tempfile
 import warnings
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -21,6 +29,7 @@ from mpi4py import MPI
 sys.path.insert(0, str(Path(__file__).parent))
 import granulate as gr
 from granulate.parallel import DistributedRun
+from test_checkpoint import tumbling_drum
 from test_locality import RADIUS, assembly, layout
 
 
@@ -34,17 +43,40 @@ def set_up(dimension: int) -> gr.Simulation:
     return sim
 
 
+def drum(variant: str, folder: Path) -> gr.Simulation:
+    """The tumbling drum of tests/test_checkpoint.py (its outputs planned in `folder`, not
+    written: the runs here call the core)."""
+    options = {
+        "lattice": {},
+        "grid": {"grid": True},
+        "surface": {"grid": True, "law": "surface"},
+        "rolling": {"rolling": 0.3},
+    }
+    return tumbling_drum(folder, **options[variant])
+
+
 def main() -> int:
-    dimension, steps = int(sys.argv[1]), int(sys.argv[2])
     comm = MPI.COMM_WORLD
     warnings.filterwarnings("ignore", message="contact.*bodies pressed")  # placed pressed
+    if sys.argv[1] == "drum":
+        variant, steps = sys.argv[2], int(sys.argv[3])
+        with tempfile.TemporaryDirectory() as folder:
+            return compare(lambda: drum(variant, Path(folder)), f"drum {variant}", steps, comm)
+    dimension, steps = int(sys.argv[1]), int(sys.argv[2])
     if len(sys.argv) > 3 and sys.argv[3] == "fail":
         return check_failure(dimension, steps, comm)
     if len(sys.argv) > 3:
-        return check_margin(dimension, steps, float(sys.argv[3]), comm)
-    serial = set_up(dimension)
+        migrate = len(sys.argv) > 4 and sys.argv[4] == "migrate"
+        return check_margin(dimension, steps, float(sys.argv[3]), migrate, comm)
+    return compare(lambda: set_up(dimension), f"{dimension}D", steps, comm)
+
+
+def compare(make: Callable[[], gr.Simulation], name: str, steps: int, comm: MPI.Comm) -> int:
+    """0 when `steps` steps of make() distributed over the ranks end with every node's
+    position, velocity and force equal to the serial run's, at the same dt."""
+    serial = make()
     serial.core.run(steps)
-    distributed = DistributedRun(set_up(dimension), comm)
+    distributed = DistributedRun(make(), comm)
     distributed.run(steps)
     fields = {name: distributed.gather(name) for name in ("positions", "velocities", "forces")}
     if comm.Get_rank() != 0:
@@ -53,8 +85,10 @@ def main() -> int:
     same_dt = distributed.dt == serial.dt
     ghosts = [len(g) for g in distributed.ghosts]
     print(
-        f"ranks {comm.Get_size()}, {dimension}D, {steps} steps, dt equal {same_dt}, ghosts per "
-        f"rank {ghosts}, largest differences {worst}"
+        f"ranks {comm.Get_size()}, {name}, {steps} steps, dt equal {same_dt}, ghosts per "
+        f"rank {ghosts}, migrations {distributed.migrations}, grains handed over "
+        f"{distributed.handed_over}, bonds broken {serial.broken_bonds()}, largest "
+        f"differences {worst}"
     )
     return 0 if same_dt and not any(worst.values()) else 1
 
@@ -69,9 +103,10 @@ def stop_messages(run: DistributedRun, steps: int, comm: MPI.Comm) -> list[str] 
     return comm.gather(message, root=0)
 
 
-def check_margin(dimension: int, steps: int, margin: float, comm: MPI.Comm) -> int:
-    """0 when every rank raised the margin's InputError within `steps` steps."""
-    run = DistributedRun(set_up(dimension), comm, margin=margin)
+def check_margin(dimension: int, steps: int, margin: float, migrate: bool, comm: MPI.Comm) -> int:
+    """0 when every rank raised the margin's InputError within `steps` steps (with or
+    without migrating grains)."""
+    run = DistributedRun(set_up(dimension), comm, margin=margin, migrate=migrate)
     messages = stop_messages(run, steps, comm)
     if messages is None:
         return 0

@@ -43,10 +43,35 @@ def test_a_distributed_run_is_the_serial_run_bit_for_bit(
     assert "'positions': 0.0, 'velocities': 0.0, 'forces': 0.0" in done.stdout
 
 
-def test_grains_moving_past_the_ghost_margin_stop_every_rank_with_the_reason() -> None:
-    done = run_ranks(3, "2", "50", "1e-6")  # the grains are thrown at up to 0.5 m/s
+@pytest.mark.parametrize(
+    ("ranks", "variant"), [(3, "lattice"), (3, "grid"), (3, "surface"), (2, "rolling")]
+)
+def test_grains_migrating_between_ranks_keep_the_serial_run_bit_for_bit(
+    ranks: int, variant: str
+) -> None:
+    """3,000 steps of four grains tumbling and breaking in a rotating drum: the ranks cut the
+    drum anew some 25-30 times, and on 3 ranks hand grains over (with their broken bonds,
+    collisions in progress and friction springs; under the surface law, the new anchors of
+    surface nodes whose bonds broke)."""
+    done = run_ranks(ranks, "drum", variant, "3000")
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert "'positions': 0.0, 'velocities': 0.0, 'forces': 0.0" in done.stdout
+    migrations = int(done.stdout.split("migrations ")[1].split(",")[0])
+    handed = int(done.stdout.split("grains handed over ")[1].split(",")[0])
+    assert migrations >= 20
+    assert handed > 0 or ranks == 2
+
+
+@pytest.mark.parametrize("migrate", [False, True])
+def test_grains_moving_past_the_ghost_margin_stop_every_rank_with_the_reason(
+    migrate: bool,
+) -> None:
+    """1e-6 m of margin: the grains, thrown at up to 0.5 m/s, move more than half of it in
+    one step, which no migration can follow."""
+    done = run_ranks(3, "2", "50", "1e-6", *(["migrate"] if migrate else []))
     assert done.returncode == 0, done.stdout + done.stderr
     assert "more than half the ghost margin" in done.stdout
+    assert ("larger margin" in done.stdout) and (("let it migrate" in done.stdout) != migrate)
 
 
 def test_a_blow_up_on_one_rank_ends_every_rank_without_a_hang() -> None:

@@ -228,6 +228,13 @@ bool ContactModel::slot_in_contact(std::size_t slot) const {
   return dot(sum, sum) > 0 && slot_force_[touch] > 0;
 }
 
+void ContactModel::search(const Model& model, const State& state, std::uint64_t broken_bonds) {
+  if (!active()) return;
+  if (!centres_.found()) centres_.find(model, state, centring_depths(model), surface_particles_);
+  centres_.fill_positions(model, state, positions_at_build_);
+  rebuild(model, state, broken_bonds);
+}
+
 vec3 ContactModel::slot_contact_point(index_t touch) const {
   const real force = slot_force_[touch];
   return {slot_point_[touch][0] / force, slot_point_[touch][1] / force, slot_point_[touch][2] / force};
@@ -241,8 +248,7 @@ void ContactModel::add_forces(const Model& model, State& state, std::uint64_t br
   const bool broke = broken_bonds != broken_at_build_;
   std::vector<index_t> relist;
   if (needs_search(model, state, broke, moved, relist)) {
-    centres_.fill_positions(model, state, positions_at_build_);
-    rebuild(model, state, broken_bonds);
+    search(model, state, broken_bonds);
   } else if (broke || !relist.empty()) {
     update_lists(model, state, broken_bonds, moved, relist);
   }

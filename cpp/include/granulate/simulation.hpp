@@ -95,6 +95,9 @@ class Simulation {
   /// step) and the contact model's history. The model, loading and walls must be the ones the
   /// checkpoint was taken with (the caller checks; sizes are checked here).
   void restore(const State& state, const ContactCheckpoint& contact);
+  /// Lists every node's contact partners again now (ContactModel::search); the forces of the
+  /// last step stay. For a distributed run, whose ranks re-list the grains they receive.
+  void search_contacts() { contact_.search(*model_, state_, broken_bond_copies_); }
 
  private:
   // The phases of compute_forces, in order.

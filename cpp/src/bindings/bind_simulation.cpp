@@ -123,6 +123,17 @@ void bind_loading(nb::class_<Simulation>& cls) {
           "The neighbour lists' skin [m]: as set, or half the largest contact radius.")
       .def(
           "set_contact_skin", [](Simulation& self, real skin) { self.contact().set_skin(skin); }, "skin"_a)
+      .def("search_contacts", &Simulation::search_contacts,
+           "List every node's contact partners again now, carrying collisions and friction springs over.")
+      .def(
+          "contact_wall_entries",
+          [](const Simulation& self) {
+            std::vector<index_t> entries;
+            for (const auto& entry : self.contact().wall_entries())
+              entries.insert(entries.end(), entry.begin(), entry.end());
+            return nb::make_tuple(copy_out(self.contact().wall_offsets()), copy_out(entries));
+          },
+          "The wall lists: (offsets per node, n + 1; (wall, surface) pairs, flat).")
       .def(
           "set_contact_relisting",
           [](Simulation& self, bool relisting) { self.contact().set_relisting(relisting); }, "relisting"_a);

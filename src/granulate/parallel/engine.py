@@ -20,6 +20,7 @@ either: the state is gathered on one rank with `gather`.
 from __future__ import annotations
 
 import time
+import warnings
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -27,6 +28,7 @@ from numpy.typing import NDArray
 
 from granulate.errors import InputError
 from granulate.parallel.partition import Partition, bisect, ghosts, near_pairs
+from granulate.parallel.transplant import GrainState, grain_states, restore_grains
 
 if TYPE_CHECKING:
     from granulate.simulation import Simulation
@@ -37,48 +39,68 @@ _TAG = 17
 class DistributedRun:
     """`sim` (set up, not built) stepped on the ranks of `comm` (an mpi4py communicator).
 
-    ``margin`` [m]: how much farther than the contact lists' cutoff a ghost is taken, so that
-    the partition holds while every node stays within margin/2 of its start; default the
-    largest grain's bounding radius. Every rank calls the constructor and each method
-    together.
+    ``margin`` [m]: how much farther than the contact lists' cutoff a ghost is taken; default
+    the largest grain's bounding radius. The ghosts hold while every node stays within margin/2
+    of where it was when the grains were last distributed; once one has moved margin/4, the
+    ranks ``migrate`` (cut the assembly anew and hand grains over with their whole state), or
+    with ``migrate=False`` stop with an InputError past margin/2. Every rank calls the
+    constructor and each method together.
     """
 
-    def __init__(self, sim: Simulation, comm: Any, margin: float | None = None) -> None:
+    def __init__(
+        self, sim: Simulation, comm: Any, margin: float | None = None, migrate: bool = True
+    ) -> None:
         from mpi4py import MPI
 
         self._mpi = MPI
         self.comm = comm
-        rank, size = comm.Get_rank(), comm.Get_size()
-        centres, radii = _bounding_spheres(sim)
-        counts = np.array([body.node_count for body in sim.bodies], dtype=float)
-        self.partition: Partition = bisect(centres, counts, size)
-        owned = self.partition.grains_of(rank)
-        probe = sim._subdomain(owned)[0].core  # the cutoff, skin and dt of the owned grains
-        skin = comm.allreduce(probe.contact_skin, op=MPI.MAX)
-        cutoff = comm.allreduce(probe.contact_reach - probe.contact_skin, op=MPI.MAX) + skin
-        dt = comm.allreduce(probe.time_step, op=MPI.MIN)
-        self.margin = float(radii.max() if margin is None else margin)
-        pairs = near_pairs(centres, radii, cutoff + self.margin)
-        self.ghosts = ghosts(self.partition, pairs)
-        held = np.union1d(owned, self.ghosts[rank])
-        self.local, node_map = sim._subdomain(held, dt=dt, skin=skin)
-        self._plan(sim, node_map, owned)
-        self.local.core.run(0)  # the first forces, then the owners' values for the ghosts
-        self._exchange()
-        self._start = self.local.core.positions.copy()  # every node held: ghosts are exact
-        self._moved = np.empty_like(self._start)
-        #: Wall-clock seconds of this rank in its steps, ghost exchanges and partition checks.
-        self.seconds = {"steps": 0.0, "exchange": 0.0, "check": 0.0}
-
-    def _plan(self, sim: Simulation, node_map: NDArray[np.int64], owned: NDArray[np.int64]) -> None:
-        """Which local nodes go to which rank and come from which, in grain order, with the
-        message buffers (9 numbers a node: x, v, f), made once."""
-        rank = self.comm.Get_rank()
-        owner = self.partition.owner
+        self._sim = sim
         self._slices = [body.node_slice for body in sim.bodies]  # each grain's global nodes
         self._node_count = sim._assembly.node_count
-        self._owned = owned
-        self._owned_nodes = self._nodes_of(owned, node_map)
+        self._weights = np.array([body.node_count for body in sim.bodies], dtype=float)
+        centres, radii = _bounding_spheres(sim)
+        first = bisect(centres, self._weights, comm.Get_size()).grains_of(comm.Get_rank())
+        # The cutoff, skin and dt of the first grains, each met by a grain of every kind.
+        probe = sim._subdomain(np.union1d(first, _kinds(sim)))[0].core
+        self._skin = comm.allreduce(probe.contact_skin, op=MPI.MAX)
+        cutoff = comm.allreduce(probe.contact_reach - probe.contact_skin, op=MPI.MAX) + self._skin
+        self._dt = comm.allreduce(probe.time_step, op=MPI.MIN)
+        self.margin = float(radii.max() if margin is None else margin)
+        self._reach = cutoff + self.margin
+        self._migrates = migrate
+        #: How many times the grains were distributed anew (migrate()), and how many grains
+        #: changed owner then, in all.
+        self.migrations = 0
+        self.handed_over = 0
+        held = self._distribute(centres, radii)
+        self.local, node_map = sim._subdomain(held, dt=self._dt, skin=self._skin)
+        self._plan(node_map)
+        self.local.core.run(0)  # the first forces, then the owners' values for the ghosts
+        self._exchange()
+        #: Wall-clock seconds of this rank in its steps, ghost exchanges, partition checks and
+        #: migrations.
+        self.seconds = {"steps": 0.0, "exchange": 0.0, "check": 0.0, "migrate": 0.0}
+
+    def _distribute(
+        self, centres: NDArray[np.float64], radii: NDArray[np.float64]
+    ) -> NDArray[np.int64]:
+        """Owners by recursive coordinate bisection of the grains' `centres` and the ghosts of
+        every rank from their bounding spheres; the grains this rank holds (sorted)."""
+        rank = self.comm.Get_rank()
+        self.partition: Partition = bisect(centres, self._weights, self.comm.Get_size())
+        self.ghosts = ghosts(self.partition, near_pairs(centres, radii, self._reach))
+        return np.union1d(self.partition.grains_of(rank), self.ghosts[rank])
+
+    def _plan(self, node_map: NDArray[np.int64]) -> None:
+        """Which local nodes go to which rank and come from which, in grain order, with the
+        message buffers (9 numbers a node: x, v, f), made once per partition; the positions
+        the nodes' travel is measured from."""
+        rank = self.comm.Get_rank()
+        owner = self.partition.owner
+        self._node_map = node_map
+        self._to_global = np.flatnonzero(node_map >= 0)  # subsets keep the serial order
+        self._owned = self.partition.grains_of(rank)
+        self._owned_nodes = self._nodes_of(self._owned, node_map)
         self._send = {
             q: self._nodes_of(held[owner[held] == rank], node_map)
             for q, held in enumerate(self.ghosts)
@@ -90,6 +112,13 @@ class DistributedRun:
         }
         self._outbox = {q: np.empty((len(n), 9)) for q, n in self._send.items()}
         self._inbox = {q: np.empty((len(n), 9)) for q, n in self._receive.items()}
+        self._start = self.local.core.positions.copy()
+        self._moved = np.empty_like(self._start)
+
+    def _local_slice(self, grain: int) -> slice:
+        """The local nodes of a held grain."""
+        first = int(self._node_map[self._slices[grain].start])
+        return slice(first, first + self._slices[grain].stop - self._slices[grain].start)
 
     def _nodes_of(
         self, grains: NDArray[np.int64], node_map: NDArray[np.int64] | None = None
@@ -126,10 +155,11 @@ class DistributedRun:
             x[nodes], v[nodes], f[nodes] = box[:, :3], box[:, 3:6], box[:, 6:]
 
     def run(self, steps: int) -> None:
-        """Advance every rank `steps` time steps. Raises InputError (on every rank) when a
-        node has moved more than half the margin: the ghosts would no longer be enough. An
-        error in one rank's step ends every rank: that rank raises its own, the others a
-        RuntimeError naming it (no rank is left waiting for a message)."""
+        """Advance every rank `steps` time steps, migrating grains when a node has moved a
+        quarter of the margin. Raises InputError (on every rank) when a node has moved more
+        than half the margin: the ghosts would no longer be enough. An error in one rank's
+        step ends every rank: that rank raises its own, the others a RuntimeError naming it
+        (no rank is left waiting for a message)."""
         core = self.local.core
         for _ in range(steps):
             start = time.perf_counter()
@@ -139,17 +169,21 @@ class DistributedRun:
             except Exception as error:  # re-raised below, after the ranks agree to stop
                 failure = error
             stepped = time.perf_counter()
-            self._check_step(int(core.step), failure)
+            farthest = self._check_step(int(core.step), failure)
             checked = time.perf_counter()
             self._exchange()
             self.seconds["steps"] += stepped - start
             self.seconds["check"] += checked - stepped
             self.seconds["exchange"] += time.perf_counter() - checked
+            if self._migrates and farthest > 0.25 * self.margin:
+                self.migrate()
+                core = self.local.core
 
-    def _check_step(self, step: int, failure: Exception | None) -> None:
+    def _check_step(self, step: int, failure: Exception | None) -> float:
         """One reduction after each step, before the exchange: the first rank whose step
-        failed, and the largest distance of a node from its start (the ghosts' positions are
-        already exact here: they drifted from exact values). Stops every rank on either."""
+        failed, and the largest distance of a node from where it was when the grains were
+        distributed (the ghosts' positions are already exact here: they drifted from exact
+        values). Stops every rank on either; returns that distance [m]."""
         moved = np.subtract(self.local.core.positions, self._start, out=self._moved)
         farthest = float(np.sqrt(np.einsum("ij,ij->i", moved, moved).max(initial=0.0)))
         size = self.comm.Get_size()
@@ -157,17 +191,60 @@ class DistributedRun:
         mine = np.array([failed_rank, -farthest])  # elementwise minima: both in one reduction
         least = np.empty(2)
         self.comm.Allreduce(mine, least, op=self._mpi.MIN)
-        first_failed, farthest = int(least[0]), float(least[1])
+        first_failed, farthest = int(least[0]), -float(least[1])
         if failure is not None:
             raise failure
         if first_failed < size:
             raise RuntimeError(f"step {step}: rank {first_failed} failed; every rank stops")
-        if -farthest > 0.5 * self.margin:
-            raise InputError(
-                f"step {step}: a node moved {-farthest:.3g} m from its start, more than "
-                f"half the ghost margin ({self.margin:.3g} m); grains do not migrate between "
-                "ranks yet, so give DistributedRun a larger margin or run on one process"
+        if farthest > 0.5 * self.margin:
+            advice = (
+                "a node moved that far within one distribution of the grains; give "
+                "DistributedRun a larger margin"
+                if self._migrates
+                else "grains migrate only with migrate=True; give DistributedRun a larger "
+                "margin, or let it migrate"
             )
+            raise InputError(
+                f"step {step}: a node moved {farthest:.3g} m from where the grains were "
+                f"distributed, more than half the ghost margin ({self.margin:.3g} m): {advice}"
+            )
+        return farthest
+
+    def migrate(self) -> None:
+        """Cut the assembly anew where the grains are now (recursive coordinate bisection of
+        their current bounding spheres, which also rebalances the ranks) and hand each rank
+        the grains it now owns or needs as ghosts, with their whole state (transplant.py):
+        the run goes on as the serial run, bit for bit."""
+        start = time.perf_counter()
+        core = self.local.core
+        saved = dict(core.checkpoint())
+        owned = {int(g): self._local_slice(g) for g in self._owned}
+        states = grain_states(self.local, saved, self._to_global, owned)
+        positions = np.asarray(saved["positions"]).reshape(-1, 3)
+        spheres = [_sphere(positions[nodes], self._sim.dimension) for nodes in owned.values()]
+        centres = np.empty((len(self._slices), self._sim.dimension))
+        radii = np.empty(len(self._slices))
+        for grains, mine in self.comm.allgather((self._owned, spheres)):
+            for grain, (centre, radius) in zip(grains, mine, strict=True):
+                centres[grain], radii[grain] = centre, radius
+        before = self.partition.owner
+        held = self._distribute(centres, radii)
+        self.handed_over += int(np.count_nonzero(self.partition.owner != before))
+        outgoing = []
+        for q in range(self.comm.Get_size()):
+            theirs = np.union1d(self.partition.grains_of(q), self.ghosts[q])
+            outgoing.append({g: states[g] for g in np.intersect1d(theirs, self._owned)})
+        received: dict[int, GrainState] = {}
+        for box in self.comm.alltoall(outgoing):
+            received |= box
+        with warnings.catch_warnings():  # the start checks were made when the run was set up
+            warnings.simplefilter("ignore")
+            local, node_map = self._sim._subdomain(held, dt=self._dt, skin=self._skin)
+            restore_grains(local.core, [received[g] for g in held], node_map, saved)
+        self.local = local
+        self._plan(node_map)
+        self.migrations += 1
+        self.seconds["migrate"] += time.perf_counter() - start
 
     @property
     def dt(self) -> float:
@@ -189,14 +266,26 @@ class DistributedRun:
         return whole
 
 
+def _kinds(sim: Simulation) -> NDArray[np.int64]:
+    """The first grain of each kind: material, mesh size and largest node volume. The contact
+    springs' stable time step of a grain (ContactModel::stable_time_step) depends on the
+    others through these alone, so a rank that holds its grains and one of each kind finds
+    their serial estimates, and the least over the ranks is the serial time step."""
+    first: dict[tuple[int, float, float], int] = {}
+    for body, volumes in zip(sim.bodies, sim._assembly.volumes, strict=True):
+        first.setdefault((id(body.material), body.mesh_size, float(volumes.max())), body.index)
+    return np.array(sorted(first.values()), dtype=np.int64)
+
+
 def _bounding_spheres(sim: Simulation) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """Per grain, the centre of its nodes' box and the radius of the sphere about it that
-    holds them, at the start (its start state when one is set) [m]."""
+    """Per grain its bounding sphere (_sphere) at the start (its start state when one is set)."""
     start = sim._start[0] if sim._start is not None else sim._assembly.reference_positions()
-    centres, radii = [], []
-    for body in sim.bodies:
-        nodes = start[body.node_slice]
-        centre = 0.5 * (nodes.min(axis=0) + nodes.max(axis=0))
-        centres.append(centre[: sim.dimension])
-        radii.append(float(np.linalg.norm(nodes - centre, axis=1).max()))
-    return np.array(centres), np.array(radii)
+    spheres = [_sphere(start[body.node_slice], sim.dimension) for body in sim.bodies]
+    return np.array([c for c, _ in spheres]), np.array([r for _, r in spheres])
+
+
+def _sphere(nodes: NDArray[np.float64], dimension: int) -> tuple[NDArray[np.float64], float]:
+    """The centre of the box of `nodes` (its first `dimension` coordinates) and the radius of
+    the sphere about it that holds them [m]."""
+    centre = 0.5 * (nodes.min(axis=0) + nodes.max(axis=0))
+    return centre[:dimension], float(np.linalg.norm(nodes - centre, axis=1).max())

@@ -151,6 +151,14 @@ class ContactModel {
 
   /// Adds contact force densities to state.forces at time t; updates wall reactions.
   void add_forces(const Model& model, State& state, std::uint64_t broken_bonds);
+  /// Lists every node again at its contact position now (a search, as add_forces makes when
+  /// the nodes moved too far), carrying the collisions and friction springs of the pairs the
+  /// lists held over to the new lists. No-op without laws or walls.
+  void search(const Model& model, const State& state, std::uint64_t broken_bonds);
+  /// The wall lists: per node (CSR offsets, n + 1) its (wall, surface) candidates, in the order
+  /// of the checkpoint's wall_springs.
+  const std::vector<index_t>& wall_offsets() const { return wall_offsets_; }
+  const std::vector<std::array<index_t, 2>>& wall_entries() const { return wall_entry_; }
   /// Bonds (i, j) that broke since the last evaluation: the candidates the next list update
   /// inserts (a pair broken earlier and not inserted then cannot reach its Rc before the next
   /// rebuild; see broken_pairs).
