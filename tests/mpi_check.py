@@ -5,10 +5,12 @@ serially on every rank and distributed over the K ranks (granulate.parallel.Dist
 Rank 0 compares the two bit for bit and prints one line; the exit status is non-zero on any
 difference.
 
-`... drum VARIANT STEPS` runs the checkpoint tests' tumbling drum (tests/test_checkpoint.py:
+`... drum VARIANT STEPS [renew]` runs the checkpoint tests' tumbling drum (tests/test_checkpoint.py:
 four grains tumbling and breaking in a rotating drum with a lifter; VARIANT lattice, grid,
 surface or rolling) the same way: the grains move far, so the ranks migrate them many times,
-handing grains over with their bonds, collisions and friction springs.
+handing grains over with their bonds, collisions and friction springs (with `renew`, every
+rank builds its part anew from the owners' states at every migration, rather than only when
+the grains it holds change).
 
 `... DIMENSION STEPS MARGIN [migrate]` instead runs the distributed run alone with that ghost
 margin [m], without migrating grains (or with), expecting every rank to stop with the
@@ -17,6 +19,7 @@ InputError that says the grains moved too far for it;
 
 from __future__ import annotations
 
+import functools
 import sys
 import tempfile
 import warnings
@@ -59,9 +62,10 @@ def main() -> int:
     comm = MPI.COMM_WORLD
     warnings.filterwarnings("ignore", message="contact.*bodies pressed")  # placed pressed
     if sys.argv[1] == "drum":
-        variant, steps = sys.argv[2], int(sys.argv[3])
+        variant, steps, renew = sys.argv[2], int(sys.argv[3]), sys.argv[4:] == ["renew"]
         with tempfile.TemporaryDirectory() as folder:
-            return compare(lambda: drum(variant, Path(folder)), f"drum {variant}", steps, comm)
+            make = functools.partial(drum, variant, Path(folder))
+            return compare(make, f"drum {variant}", steps, comm, renew)
     dimension, steps = int(sys.argv[1]), int(sys.argv[2])
     if len(sys.argv) > 3 and sys.argv[3] == "fail":
         return check_failure(dimension, steps, comm)
@@ -71,14 +75,19 @@ def main() -> int:
     return compare(lambda: set_up(dimension), f"{dimension}D", steps, comm)
 
 
-def compare(make: Callable[[], gr.Simulation], name: str, steps: int, comm: MPI.Comm) -> int:
+def compare(
+    make: Callable[[], gr.Simulation], name: str, steps: int, comm: MPI.Comm, renew: bool = False
+) -> int:
     """0 when `steps` steps of make() distributed over the ranks end with every node's
-    position, velocity and force equal to the serial run's, at the same dt."""
+    position, velocity and force equal to the serial run's, at the same dt. `renew`: every
+    rank builds its part anew from the owners' states at every migration."""
     serial = make()
     serial.core.run(steps)
     distributed = DistributedRun(make(), comm)
+    distributed.always_renew = renew
     distributed.run(steps)
     fields = {name: distributed.gather(name) for name in ("positions", "velocities", "forces")}
+    renewals = comm.gather(distributed.renewals, root=0)
     if comm.Get_rank() != 0:
         return 0
     worst = {name: float(np.abs(fields[name] - getattr(serial, name)).max()) for name in fields}
@@ -87,8 +96,8 @@ def compare(make: Callable[[], gr.Simulation], name: str, steps: int, comm: MPI.
     print(
         f"ranks {comm.Get_size()}, {name}, {steps} steps, dt equal {same_dt}, ghosts per "
         f"rank {ghosts}, migrations {distributed.migrations}, grains handed over "
-        f"{distributed.handed_over}, bonds broken {serial.broken_bonds()}, largest "
-        f"differences {worst}"
+        f"{distributed.handed_over}, parts built anew per rank {renewals}, bonds broken "
+        f"{serial.broken_bonds()}, largest differences {worst}"
     )
     return 0 if same_dt and not any(worst.values()) else 1
 

@@ -44,22 +44,32 @@ def test_a_distributed_run_is_the_serial_run_bit_for_bit(
 
 
 @pytest.mark.parametrize(
-    ("ranks", "variant"), [(3, "lattice"), (3, "grid"), (3, "surface"), (2, "rolling")]
+    ("ranks", "variant", "renew"),
+    [
+        (3, "lattice", False),
+        (3, "surface", False),
+        (3, "grid", True),
+        (3, "surface", True),
+        (2, "rolling", True),
+    ],
 )
 def test_grains_migrating_between_ranks_keep_the_serial_run_bit_for_bit(
-    ranks: int, variant: str
+    ranks: int, variant: str, renew: bool
 ) -> None:
     """3,000 steps of four grains tumbling and breaking in a rotating drum: the ranks cut the
-    drum anew some 25-30 times, and on 3 ranks hand grains over (with their broken bonds,
-    collisions in progress and friction springs; under the surface law, the new anchors of
-    surface nodes whose bonds broke)."""
-    done = run_ranks(ranks, "drum", variant, "3000")
+    drum anew some 25-30 times, and on 3 ranks hand grains over. A rank whose grains change
+    builds its part anew from the owners' states (broken bonds, collisions in progress,
+    friction springs; under the surface law, the new anchors of surface nodes whose bonds
+    broke); with `renew` every rank does so at every migration, the others keep their part."""
+    done = run_ranks(ranks, "drum", variant, "3000", *(["renew"] if renew else []))
     assert done.returncode == 0, done.stdout + done.stderr
     assert "'positions': 0.0, 'velocities': 0.0, 'forces': 0.0" in done.stdout
     migrations = int(done.stdout.split("migrations ")[1].split(",")[0])
     handed = int(done.stdout.split("grains handed over ")[1].split(",")[0])
+    renewals = done.stdout.split("parts built anew per rank [")[1].split("]")[0]
     assert migrations >= 20
     assert handed > 0 or ranks == 2
+    assert renewals == ", ".join([str(migrations)] * ranks) if renew else renewals != "0, 0, 0"
 
 
 @pytest.mark.parametrize("migrate", [False, True])

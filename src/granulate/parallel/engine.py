@@ -72,6 +72,11 @@ class DistributedRun:
         #: changed owner then, in all.
         self.migrations = 0
         self.handed_over = 0
+        #: How many of the migrations built this rank's part anew (it held other grains).
+        self.renewals = 0
+        #: Build every rank's part anew at every migration, held grains changed or not (for
+        #: tests of the hand-over, tests/mpi_check.py).
+        self.always_renew = False
         held = self._distribute(centres, radii)
         self.local, node_map = sim._subdomain(held, dt=self._dt, skin=self._skin)
         self._plan(node_map)
@@ -212,39 +217,76 @@ class DistributedRun:
 
     def migrate(self) -> None:
         """Cut the assembly anew where the grains are now (recursive coordinate bisection of
-        their current bounding spheres, which also rebalances the ranks) and hand each rank
-        the grains it now owns or needs as ghosts, with their whole state (transplant.py):
-        the run goes on as the serial run, bit for bit."""
+        their current bounding spheres, which also rebalances the ranks). A rank that now
+        holds other grains than before builds its part anew from the owners' states of them
+        (transplant.py); a rank that holds the same grains keeps its part, whose every grain
+        is exact (the ghosts' own bonds, collisions and springs among the grains it holds
+        follow from their exact motion). Either way the run goes on as the serial run, bit
+        for bit."""
         start = time.perf_counter()
-        core = self.local.core
-        saved = dict(core.checkpoint())
-        owned = {int(g): self._local_slice(g) for g in self._owned}
-        states = grain_states(self.local, saved, self._to_global, owned)
-        positions = np.asarray(saved["positions"]).reshape(-1, 3)
-        spheres = [_sphere(positions[nodes], self._sim.dimension) for nodes in owned.values()]
-        centres = np.empty((len(self._slices), self._sim.dimension))
+        before, owners_before = self._held_by_rank(), self.partition.owner
+        held = self._distribute(*self._current_spheres())
+        self.handed_over += int(np.count_nonzero(self.partition.owner != owners_before))
+        after = self._held_by_rank()
+        renewed = [
+            self.always_renew or not np.array_equal(old, new)
+            for old, new in zip(before, after, strict=True)
+        ]
+        rank = self.comm.Get_rank()
+        wanted = [
+            np.intersect1d(after[q], self._owned) if renewed[q] else np.zeros(0, np.int64)
+            for q in range(self.comm.Get_size())
+        ]
+        if any(renewed):
+            self._hand_over(held, wanted, renewed[rank])
+        else:
+            self._plan(self._node_map)
+        self.migrations += 1
+        self.seconds["migrate"] += time.perf_counter() - start
+
+    def _held_by_rank(self) -> list[NDArray[np.int64]]:
+        """The grains each rank holds (owned and ghosts), sorted."""
+        return [
+            np.union1d(self.partition.grains_of(q), self.ghosts[q])
+            for q in range(self.comm.Get_size())
+        ]
+
+    def _current_spheres(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """Every grain's bounding sphere now, from its owner (one allgather)."""
+        positions = self.local.core.positions
+        dimension = self._sim.dimension
+        spheres = [_sphere(positions[self._local_slice(g)], dimension) for g in self._owned]
+        centres = np.empty((len(self._slices), dimension))
         radii = np.empty(len(self._slices))
-        for grains, mine in self.comm.allgather((self._owned, spheres)):
-            for grain, (centre, radius) in zip(grains, mine, strict=True):
+        for grains, theirs in self.comm.allgather((self._owned, spheres)):
+            for grain, (centre, radius) in zip(grains, theirs, strict=True):
                 centres[grain], radii[grain] = centre, radius
-        before = self.partition.owner
-        held = self._distribute(centres, radii)
-        self.handed_over += int(np.count_nonzero(self.partition.owner != before))
-        outgoing = []
-        for q in range(self.comm.Get_size()):
-            theirs = np.union1d(self.partition.grains_of(q), self.ghosts[q])
-            outgoing.append({g: states[g] for g in np.intersect1d(theirs, self._owned)})
+        return centres, radii
+
+    def _hand_over(
+        self, held: NDArray[np.int64], wanted: list[NDArray[np.int64]], renew: bool
+    ) -> None:
+        """Send each rank the states of the grains it `wanted` of this rank's own; with
+        `renew`, build this rank's part of the grains it now `held` from the states received."""
+        core = self.local.core
+        giving = np.unique(np.concatenate(wanted))
+        saved = dict(core.checkpoint()) if renew or len(giving) else {}
+        owned = {int(g): self._local_slice(g) for g in giving}
+        states = grain_states(self.local, saved, self._to_global, owned) if owned else {}
+        outgoing = [{int(g): states[int(g)] for g in grains} for grains in wanted]
         received: dict[int, GrainState] = {}
         for box in self.comm.alltoall(outgoing):
             received |= box
+        if not renew:
+            self._plan(self._node_map)
+            return
         with warnings.catch_warnings():  # the start checks were made when the run was set up
             warnings.simplefilter("ignore")
             local, node_map = self._sim._subdomain(held, dt=self._dt, skin=self._skin)
-            restore_grains(local.core, [received[g] for g in held], node_map, saved)
+            restore_grains(local.core, [received[int(g)] for g in held], node_map, saved)
         self.local = local
         self._plan(node_map)
-        self.migrations += 1
-        self.seconds["migrate"] += time.perf_counter() - start
+        self.renewals += 1
 
     @property
     def dt(self) -> float:
