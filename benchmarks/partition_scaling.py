@@ -4,7 +4,7 @@ their measured ghosts, and a model of the communication share of a step, on pape
     python benchmarks/partition_scaling.py                   # 10^5 grains, R/h = 6, K = 2 ... 2048
     python benchmarks/partition_scaling.py --json out.json   # the table as JSON too
 
-No distributed run is made (the MPI engine does not exist yet). The packing (granulate.pack,
+No distributed run is made: these are partitions and a model. The packing (granulate.pack,
 lattice sites in a cube, radii 0.9-1.1 mm) is cut into K ranks by recursive coordinate bisection
 of whole grains (granulate.parallel), and each rank's ghosts are the other ranks' grains whose
 bounding spheres come within `--reach` of its own: all twelve lattice neighbours, as many as a
@@ -26,6 +26,10 @@ A second table splits one body at node level (`--block N`: an N^3 simple-cubic b
 nodes of other ranks within one horizon (its bonds' partners). An LPS step exchanges twice:
 positions (24 bytes) before the dilatation pass and the dilatations (8 bytes) before the force
 pass; compute is one core's node-steps per second on a 20^3 block of that lattice (measured).
+
+A third table models the engine as built (granulate.parallel.DistributedRun): whole ghost
+grains within the reach plus its margin, stepped in full, all their nodes' x, v and f
+exchanged (see as_built).
 """
 
 from __future__ import annotations
@@ -41,6 +45,9 @@ import granulate as gr
 from granulate.parallel import bisect, ghosts, near_pairs
 
 RADIUS = 1e-3
+#: The check after each step (a pass over the positions), as a share of a step: 4.4 % on one
+#: rank of benchmarks/distributed.py's pile3d (1,000 grains, 258,624 nodes; measured).
+CHECK_SHARE = 0.044
 MATERIAL = gr.Material(density=1200, bulk_modulus=2.16e7, shear_modulus=1.296e7, fracture_energy=50)
 
 
@@ -173,6 +180,42 @@ def modelled(
     }
 
 
+def as_built(
+    centres: np.ndarray,
+    pairs,
+    ranks: int,
+    nodes_per_grain: int,
+    rate: float,
+    args: argparse.Namespace,
+) -> dict[str, float]:
+    """The engine as built (granulate.parallel.DistributedRun), for the rank with the most ghost
+    grains per owned grain: its ghosts are whole grains within the reach plus the margin (the
+    largest bounding radius; `pairs`: near_pairs at that distance), stepped in full and then
+    overwritten; it receives 72 bytes (x, v, f) of every ghost node, one message per
+    neighbouring rank, passes over its positions after each step (CHECK_SHARE of a step,
+    measured) and reduces once. Efficiency: its own nodes' compute over its step; and the same
+    if ghosts were not stepped (not built)."""
+    partition = bisect(centres, np.ones(len(centres)), ranks)
+    needed = ghosts(partition, pairs)
+    owned = np.bincount(partition.owner, minlength=ranks)
+    worst = int(np.argmax([len(g) / o for g, o in zip(needed, owned, strict=True)]))
+    own, ghost = owned[worst] * nodes_per_grain, len(needed[worst]) * nodes_per_grain
+    neighbours = len(np.unique(partition.owner[needed[worst]]))
+    exchange, reduction = communication_seconds(1, neighbours, 72.0 * ghost, ranks, args)
+    useful = own / rate
+    stepped = (own + ghost) / rate * (1 + CHECK_SHARE)
+    lean = useful * (1 + CHECK_SHARE)
+    return {
+        "ranks": ranks,
+        "ghost_grains_over_owned": len(needed[worst]) / owned[worst],
+        "neighbours": neighbours,
+        "exchange_bytes": 72.0 * ghost,
+        "communication_share": (exchange + reduction) / (stepped + exchange + reduction),
+        "efficiency": useful / (stepped + exchange + reduction),
+        "efficiency_without_ghost_steps": useful / (lean + exchange + reduction),
+    }
+
+
 def lps_node_steps_per_second(steps: int = 30) -> float:
     """One core's node-steps per second of LPS on a 20^3 simple-cubic block (no contact)."""
     gr.set_num_threads(1)
@@ -189,6 +232,35 @@ def lps_node_steps_per_second(steps: int = 30) -> float:
     start = time.perf_counter()
     sim.run(steps)
     return sim.node_count * steps / (time.perf_counter() - start)
+
+
+def engine_as_built(
+    pack: gr.Packing, unit_nodes: np.ndarray, rate: float, args: argparse.Namespace
+) -> list[dict[str, float]]:
+    """The table of as_built for 2, 4, ... ranks."""
+    margin = float(pack.radii.max())
+    pairs = near_pairs(pack.positions, pack.radii, args.reach + margin)
+    print(
+        f"\nthe engine as built: whole ghost grains within {1e3 * (args.reach + margin):.2f} mm "
+        "(reach + margin) stepped in full, x, v, f of every ghost node exchanged, a positions "
+        f"pass ({100 * CHECK_SHARE:.1f} % of a step) and one reduction"
+    )
+    print(
+        f"{'ranks':>6} {'ghost/own':>9} {'neighbours':>10} {'exchange kB':>11} {'comm %':>6} "
+        f"{'efficiency':>10} {'no ghost steps':>14}"
+    )
+    rows = []
+    ranks = 2
+    while ranks <= min(args.largest, args.grains):
+        row = as_built(pack.positions, pairs, ranks, len(unit_nodes), rate, args)
+        rows.append(row)
+        print(
+            f"{ranks:6d} {row['ghost_grains_over_owned']:9.2f} {row['neighbours']:10d} "
+            f"{row['exchange_bytes'] / 1e3:11.1f} {100 * row['communication_share']:6.1f} "
+            f"{row['efficiency']:10.2f} {row['efficiency_without_ghost_steps']:14.2f}"
+        )
+        ranks *= 2
+    return rows
 
 
 def single_body(args: argparse.Namespace) -> list[dict[str, float]]:
@@ -284,10 +356,11 @@ def main() -> None:
         )
         ranks *= 2
     print(f"broad phase: {rows[0]['candidates_per_grain']:.1f} candidate partners per grain")
+    built = engine_as_built(pack, unit_nodes, rate, args)
     body = single_body(args) if args.block else []
     if args.json is not None:
         settings = vars(args) | {"json": None, "rate": rate, "bond_share": bond_share}
-        result = {"arguments": settings, "grains": rows, "one_body": body}
+        result = {"arguments": settings, "grains": rows, "as_built": built, "one_body": body}
         args.json.write_text(json.dumps(result, indent=1))
 
 
