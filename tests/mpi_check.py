@@ -12,6 +12,10 @@ handing grains over with their bonds, collisions and friction springs (with `ren
 rank builds its part anew from the owners' states at every migration, rather than only when
 the grains it holds change).
 
+`... restart VARIANT STEPS` runs the drum on the K ranks to half the steps, saves a
+distributed checkpoint, and continues from it on K - 1 ranks (one rank fewer: a checkpoint
+restarts on another number of ranks), comparing the end with the serial run's bit for bit.
+
 `... DIMENSION STEPS MARGIN [migrate]` instead runs the distributed run alone with that ghost
 margin [m], without migrating grains (or with), expecting every rank to stop with the
 InputError that says the grains moved too far for it;
@@ -20,6 +24,7 @@ InputError that says the grains moved too far for it;
 from __future__ import annotations
 
 import functools
+import shutil
 import sys
 import tempfile
 import warnings
@@ -61,6 +66,10 @@ def drum(variant: str, folder: Path) -> gr.Simulation:
 def main() -> int:
     comm = MPI.COMM_WORLD
     warnings.filterwarnings("ignore", message="contact.*bodies pressed")  # placed pressed
+    if sys.argv[1] == "restart":
+        variant, steps = sys.argv[2], int(sys.argv[3])
+        with tempfile.TemporaryDirectory() as folder:
+            return check_restart(functools.partial(drum, variant, Path(folder)), steps, comm)
     if sys.argv[1] == "drum":
         variant, steps, renew = sys.argv[2], int(sys.argv[3]), sys.argv[4:] == ["renew"]
         with tempfile.TemporaryDirectory() as folder:
@@ -100,6 +109,46 @@ def compare(
         f"{serial.broken_bonds()}, largest differences {worst}"
     )
     return 0 if same_dt and not any(worst.values()) else 1
+
+
+def check_restart(make: Callable[[], gr.Simulation], steps: int, comm: MPI.Comm) -> int:
+    """0 when a run on all K ranks that saves a checkpoint half way, continued from it on K - 1
+    ranks, ends bit for bit where the serial run does; and a checkpoint of another set-up is
+    refused on every rank."""
+    serial = make()
+    serial.core.run(steps)
+    first = DistributedRun(make(), comm)
+    first.run(steps // 2)
+    folder = Path(tempfile.gettempdir()) if comm.Get_rank() else Path(tempfile.mkdtemp())
+    path = comm.bcast(folder / "distributed.npz")
+    first.save_checkpoint(path)
+    fewer = comm.Split(0 if comm.Get_rank() < comm.Get_size() - 1 else 1, comm.Get_rank())
+    if comm.Get_rank() == comm.Get_size() - 1:
+        comm.Barrier()
+        return 0
+    second = DistributedRun(make(), fewer)
+    second.load_checkpoint(path)
+    second.run(steps - steps // 2)
+    fields = {name: second.gather(name) for name in ("positions", "velocities", "forces")}
+    other = set_up(2)  # the locality assembly: other grains
+    try:
+        DistributedRun(other, fewer).load_checkpoint(path)
+        refused = ""
+    except gr.InputError as error:
+        refused = str(error)
+    refusals = fewer.gather(refused, root=0)
+    comm.Barrier()
+    if fewer.Get_rank() != 0:
+        return 0
+    shutil.rmtree(folder)
+    worst = {name: float(np.abs(fields[name] - getattr(serial, name)).max()) for name in fields}
+    print(
+        f"saved at step {steps // 2} on {comm.Get_size()} ranks, continued on "
+        f"{fewer.Get_size()} to step {second.local.core.step}: largest differences {worst}; "
+        f"another set-up: {refusals[0]}"
+    )
+    same = not any(worst.values()) and second.local.core.step == steps
+    return 0 if same and all("other grains" in r for r in refusals) else 1
 
 
 def stop_messages(run: DistributedRun, steps: int, comm: MPI.Comm) -> list[str] | None:

@@ -72,6 +72,17 @@ def test_grains_migrating_between_ranks_keep_the_serial_run_bit_for_bit(
     assert renewals == ", ".join([str(migrations)] * ranks) if renew else renewals != "0, 0, 0"
 
 
+@pytest.mark.parametrize("ranks", [2, 3])
+def test_a_distributed_checkpoint_restarts_on_fewer_ranks_bit_for_bit(ranks: int) -> None:
+    """The surface-law drum saved at step 1,500 on `ranks` ranks and continued on one rank
+    fewer (on 2 ranks: on one) ends at step 3,000 as the serial run does; a checkpoint of other
+    grains is refused with one message on every rank."""
+    done = run_ranks(ranks, "restart", "surface", "3000")
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert f"on {ranks} ranks, continued on {ranks - 1} to step 3000" in done.stdout
+    assert "'positions': 0.0, 'velocities': 0.0, 'forces': 0.0" in done.stdout
+
+
 @pytest.mark.parametrize("migrate", [False, True])
 def test_grains_moving_past_the_ghost_margin_stop_every_rank_with_the_reason(
     migrate: bool,

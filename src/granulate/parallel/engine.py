@@ -19,6 +19,8 @@ either: the state is gathered on one rank with `gather`.
 
 from __future__ import annotations
 
+import io
+import os
 import time
 import warnings
 from typing import TYPE_CHECKING, Any
@@ -27,8 +29,16 @@ import numpy as np
 from numpy.typing import NDArray
 
 from granulate.errors import InputError
+from granulate.io.atomic import atomic_write
 from granulate.parallel.partition import Partition, bisect, ghosts, near_pairs
-from granulate.parallel.transplant import GrainState, grain_states, restore_grains
+from granulate.parallel.transplant import (
+    CHECKPOINT_FORMAT,
+    GrainState,
+    grain_states,
+    pack_states,
+    restore_grains,
+    unpack_states,
+)
 
 if TYPE_CHECKING:
     from granulate.simulation import Simulation
@@ -287,6 +297,69 @@ class DistributedRun:
         self.local = local
         self._plan(node_map)
         self.renewals += 1
+
+    def save_checkpoint(self, path: str | os.PathLike[str]) -> None:
+        """Write every grain's whole state (transplant.py's, in global numbering) to one .npz
+        at `path`, from rank 0: a run restarts from it on any number of ranks
+        (load_checkpoint), bit for bit. Every rank calls it; a failure to write is raised on
+        every rank."""
+        saved = dict(self.local.core.checkpoint())
+        owned = {int(g): self._local_slice(g) for g in self._owned}
+        parts = self.comm.gather(grain_states(self.local, saved, self._to_global, owned), root=0)
+        problem = None
+        if parts is not None:
+            states = {grain: state for part in parts for grain, state in part.items()}
+            try:
+                buffer = io.BytesIO()
+                np.savez(buffer, **pack_states(states, saved))
+                atomic_write(path, buffer.getvalue())
+            except OSError as error:
+                problem = f"could not write the checkpoint {os.fspath(path)!r}: {error}"
+        problem = self.comm.bcast(problem, root=0)
+        if problem is not None:
+            raise InputError(problem)
+
+    def load_checkpoint(self, path: str | os.PathLike[str]) -> None:
+        """Continue from a checkpoint of save_checkpoint, written on any number of ranks (this
+        set-up's grains): the grains are cut anew where the checkpoint has them and each rank
+        builds its part from their states. Every rank calls it and reads the file."""
+        try:
+            with np.load(path) as data:
+                arrays = dict(data)
+            problem = self._checkpoint_problem(arrays)
+        except (OSError, ValueError, KeyError) as error:
+            problem = f"could not read the checkpoint {os.fspath(path)!r}: {error}"
+        problems = [p for p in self.comm.allgather(problem) if p is not None]
+        if problems:
+            raise InputError(problems[0])
+        start = time.perf_counter()
+        every = np.arange(len(self._slices))
+        states, moment = unpack_states(arrays, every)
+        spheres = [_sphere(states[g].positions, self._sim.dimension) for g in every]
+        held = self._distribute(
+            np.array([c for c, _ in spheres]), np.array([r for _, r in spheres])
+        )
+        with warnings.catch_warnings():  # the start checks were made when the run was set up
+            warnings.simplefilter("ignore")
+            local, node_map = self._sim._subdomain(held, dt=self._dt, skin=self._skin)
+            restore_grains(local.core, [states[int(g)] for g in held], node_map, moment)
+        self.local = local
+        self._plan(node_map)
+        self.seconds["migrate"] += time.perf_counter() - start
+
+    def _checkpoint_problem(self, arrays: dict[str, NDArray[Any]]) -> str | None:
+        """What makes a distributed checkpoint's arrays unfit for this set-up, or None."""
+        if int(arrays["format"]) != CHECKPOINT_FORMAT:
+            return f"the checkpoint's format is {int(arrays['format'])}, not {CHECKPOINT_FORMAT}"
+        nodes = [s.stop - s.start for s in self._slices]
+        if not np.array_equal(arrays["grains"], np.arange(len(nodes))) or not np.array_equal(
+            arrays["positions_rows"], nodes
+        ):
+            return (
+                "the checkpoint holds other grains than this set-up (their number or nodes "
+                "differ): load it into the simulation it was written from"
+            )
+        return None
 
     @property
     def dt(self) -> float:
