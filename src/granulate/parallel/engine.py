@@ -9,12 +9,13 @@ as ghosts, which overwrite their own copies. An owned grain's next step then nee
 partners' exact state, which it has (tests/test_locality.py): the owned grains move bit for bit
 as in the serial run, for any number of ranks (tests/test_mpi.py).
 
-What is not built yet: grains do not migrate and the partition is not rebalanced. The ghost
-sets hold while no node has moved more than half the margin from where it was at the start,
-since then no pair left out can come within the cutoff; the run checks that every step and
-raises an InputError naming the step once a node has, rather than continue with a wrong
-answer. Outputs, stop criteria, checkpoints and wall reactions across ranks are not built
-either: the state is gathered on one rank with `gather`.
+The ghost sets hold while no node has moved more than half the margin from where it was when
+the grains were last distributed, since then no pair left out can come within the cutoff. The
+run checks that every step; past a quarter of the margin the ranks cut the grains anew where
+they are (which also rebalances) and hand grains over with their whole state (transplant.py),
+and the same states make checkpoints that restart on any number of ranks. Outputs, stop
+criteria and wall reactions across ranks are not built: the state is gathered on one rank
+with `gather`.
 """
 
 from __future__ import annotations
