@@ -291,13 +291,20 @@ class DistributedRun:
         if not renew:
             self._plan(self._node_map)
             return
+        self._rebuild(held, received, saved)
+        self.renewals += 1
+
+    def _rebuild(
+        self, held: NDArray[np.int64], states: dict[int, GrainState], moment: dict[str, Any]
+    ) -> None:
+        """This rank's part made anew of the grains `held`, from their `states` at `moment`
+        (the time, step and contact scalars of a checkpoint)."""
         with warnings.catch_warnings():  # the start checks were made when the run was set up
             warnings.simplefilter("ignore")
             local, node_map = self._sim._subdomain(held, dt=self._dt, skin=self._skin)
-            restore_grains(local.core, [received[int(g)] for g in held], node_map, saved)
+            restore_grains(local.core, [states[int(g)] for g in held], node_map, moment)
         self.local = local
         self._plan(node_map)
-        self.renewals += 1
 
     def save_checkpoint(self, path: str | os.PathLike[str]) -> None:
         """Write every grain's whole state (transplant.py's, in global numbering) to one .npz
@@ -340,12 +347,7 @@ class DistributedRun:
         held = self._distribute(
             np.array([c for c, _ in spheres]), np.array([r for _, r in spheres])
         )
-        with warnings.catch_warnings():  # the start checks were made when the run was set up
-            warnings.simplefilter("ignore")
-            local, node_map = self._sim._subdomain(held, dt=self._dt, skin=self._skin)
-            restore_grains(local.core, [states[int(g)] for g in held], node_map, moment)
-        self.local = local
-        self._plan(node_map)
+        self._rebuild(held, states, moment)
         self.seconds["migrate"] += time.perf_counter() - start
 
     def _checkpoint_problem(self, arrays: dict[str, NDArray[Any]]) -> str | None:
