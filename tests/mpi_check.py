@@ -19,7 +19,9 @@ restarts on another number of ranks), comparing the end with the serial run's bi
 `... DIMENSION STEPS MARGIN [migrate]` instead runs the distributed run alone with that ghost
 margin [m], without migrating grains (or with), expecting every rank to stop with the
 InputError that says the grains moved too far for it;
-`... DIMENSION STEPS fail` blows up one rank's step and expects every rank to stop."""
+`... DIMENSION STEPS fail` blows up one rank's step and expects every rank to stop;
+`... DIMENSION STEPS fail-start` (`fail-migration`) makes the last rank fail to build its part
+at the start (in a migration) and expects every rank to stop."""
 
 from __future__ import annotations
 
@@ -78,6 +80,8 @@ def main() -> int:
     dimension, steps = int(sys.argv[1]), int(sys.argv[2])
     if len(sys.argv) > 3 and sys.argv[3] == "fail":
         return check_failure(dimension, steps, comm)
+    if len(sys.argv) > 3 and sys.argv[3] in ("fail-start", "fail-migration"):
+        return check_build_failure(dimension, sys.argv[3].removeprefix("fail-"), comm)
     if len(sys.argv) > 3:
         migrate = len(sys.argv) > 4 and sys.argv[4] == "migrate"
         return check_margin(dimension, steps, float(sys.argv[3]), migrate, comm)
@@ -185,6 +189,35 @@ def check_failure(dimension: int, steps: int, comm: MPI.Comm) -> int:
     print(messages)
     others = all(f"rank {last} failed" in m for m in messages[:last])
     return 0 if others and messages[last].startswith("InstabilityError") else 1
+
+
+def check_build_failure(dimension: int, during: str, comm: MPI.Comm) -> int:
+    """0 when an error while the last rank builds its part (at the start, or in a migration)
+    ends every rank: it with its own InputError, the others with the RuntimeError naming it."""
+    last = comm.Get_size() - 1
+    sim = set_up(dimension)
+
+    def broken(*_: object, **__: object) -> None:
+        raise gr.InputError("an injected failure")
+
+    if during == "start" and comm.Get_rank() == last:
+        sim._subdomain = broken  # type: ignore[method-assign]
+    try:
+        run = DistributedRun(sim, comm)
+        if during == "migration":
+            if comm.Get_rank() == last:
+                sim._subdomain = broken  # type: ignore[method-assign]
+            run.always_renew = True
+            run.migrate()
+        message = ""
+    except (gr.InputError, RuntimeError) as error:
+        message = f"{type(error).__name__}: {error}"
+    messages = comm.gather(message, root=0)
+    if messages is None:
+        return 0
+    print(during, messages)
+    others = all(f"rank {last} failed while building" in m for m in messages[:last])
+    return 0 if others and messages[last] == "InputError: an injected failure" else 1
 
 
 if __name__ == "__main__":

@@ -99,3 +99,10 @@ def test_a_blow_up_on_one_rank_ends_every_rank_without_a_hang() -> None:
     done = run_ranks(3, "2", "20", "fail")
     assert done.returncode == 0, done.stdout + done.stderr
     assert "rank 2 failed" in done.stdout and "InstabilityError" in done.stdout
+
+
+@pytest.mark.parametrize("during", ["start", "migration"])
+def test_a_failure_building_one_ranks_part_ends_every_rank_without_a_hang(during: str) -> None:
+    done = run_ranks(3, "2", "0", f"fail-{during}")
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert "rank 2 failed while building its part" in done.stdout

@@ -24,7 +24,8 @@ import io
 import os
 import time
 import warnings
-from typing import TYPE_CHECKING, Any
+from collections.abc import Callable
+from typing import TYPE_CHECKING, Any, TypeVar
 
 import numpy as np
 from numpy.typing import NDArray
@@ -45,6 +46,7 @@ if TYPE_CHECKING:
     from granulate.simulation import Simulation
 
 _TAG = 17
+T = TypeVar("T")
 
 
 class DistributedRun:
@@ -72,7 +74,7 @@ class DistributedRun:
         centres, radii = _bounding_spheres(sim)
         first = bisect(centres, self._weights, comm.Get_size()).grains_of(comm.Get_rank())
         # The cutoff, skin and dt of the first grains, each met by a grain of every kind.
-        probe = sim._subdomain(np.union1d(first, _kinds(sim)))[0].core
+        probe = self._together(lambda: sim._subdomain(np.union1d(first, _kinds(sim)))[0].core)
         self._skin = comm.allreduce(probe.contact_skin, op=MPI.MAX)
         cutoff = comm.allreduce(probe.contact_reach - probe.contact_skin, op=MPI.MAX) + self._skin
         self._dt = comm.allreduce(probe.time_step, op=MPI.MIN)
@@ -89,13 +91,36 @@ class DistributedRun:
         #: tests of the hand-over, tests/mpi_check.py).
         self.always_renew = False
         held = self._distribute(centres, radii)
-        self.local, node_map = sim._subdomain(held, dt=self._dt, skin=self._skin)
-        self._plan(node_map)
-        self.local.core.run(0)  # the first forces, then the owners' values for the ghosts
+        self._together(lambda: self._build(held))
         self._exchange()
         #: Wall-clock seconds of this rank in its steps, ghost exchanges, partition checks and
         #: migrations.
         self.seconds = {"steps": 0.0, "exchange": 0.0, "check": 0.0, "migrate": 0.0}
+
+    def _build(self, held: NDArray[np.int64]) -> None:
+        """This rank's part of the grains `held` at the start, with its first forces (the
+        owners' values for the ghosts come with the first exchange)."""
+        self.local, node_map = self._sim._subdomain(held, dt=self._dt, skin=self._skin)
+        self._plan(node_map)
+        self.local.core.run(0)
+
+    def _together(self, action: Callable[[], T]) -> T:
+        """action() on every rank; when it raised on some rank, every rank stops: the first
+        such rank with its own error, the others with a RuntimeError naming it (one reduction;
+        no rank is left waiting in a later message)."""
+        failure, result = None, None
+        try:
+            result = action()
+        except Exception as error:  # re-raised below, once every rank knows
+            failure = error
+        size = self.comm.Get_size()
+        mine = self.comm.Get_rank() if failure is not None else size
+        first = self.comm.allreduce(mine, op=self._mpi.MIN)
+        if failure is not None:
+            raise failure
+        if first < size:
+            raise RuntimeError(f"rank {first} failed while building its part; every rank stops")
+        return result  # type: ignore[return-value]
 
     def _distribute(
         self, centres: NDArray[np.float64], radii: NDArray[np.float64]
@@ -289,9 +314,9 @@ class DistributedRun:
         for box in self.comm.alltoall(outgoing):
             received |= box
         if not renew:
-            self._plan(self._node_map)
+            self._together(lambda: self._plan(self._node_map))
             return
-        self._rebuild(held, received, saved)
+        self._together(lambda: self._rebuild(held, received, saved))
         self.renewals += 1
 
     def _rebuild(
@@ -347,7 +372,7 @@ class DistributedRun:
         held = self._distribute(
             np.array([c for c, _ in spheres]), np.array([r for _, r in spheres])
         )
-        self._rebuild(held, states, moment)
+        self._together(lambda: self._rebuild(held, states, moment))
         self.seconds["migrate"] += time.perf_counter() - start
 
     def _checkpoint_problem(self, arrays: dict[str, NDArray[Any]]) -> str | None:
