@@ -16,6 +16,9 @@ the grains it holds change).
 distributed checkpoint, and continues from it on K - 1 ranks (one rank fewer: a checkpoint
 restarts on another number of ranks), comparing the end with the serial run's bit for bit.
 
+`... DIMENSION STEPS MARGIN compare` compares as the first form does, with that ghost margin
+[m] and every rank building its part anew at every migration (a small margin: many).
+
 `... DIMENSION STEPS MARGIN [migrate]` instead runs the distributed run alone with that ghost
 margin [m], without migrating grains (or with), expecting every rank to stop with the
 InputError that says the grains moved too far for it;
@@ -82,6 +85,9 @@ def main() -> int:
         return check_failure(dimension, steps, comm)
     if len(sys.argv) > 3 and sys.argv[3] in ("fail-start", "fail-migration"):
         return check_build_failure(dimension, sys.argv[3].removeprefix("fail-"), comm)
+    if len(sys.argv) > 4 and sys.argv[4] == "compare":
+        make = functools.partial(set_up, dimension)
+        return compare(make, f"{dimension}D", steps, comm, True, float(sys.argv[3]))
     if len(sys.argv) > 3:
         migrate = len(sys.argv) > 4 and sys.argv[4] == "migrate"
         return check_margin(dimension, steps, float(sys.argv[3]), migrate, comm)
@@ -89,14 +95,20 @@ def main() -> int:
 
 
 def compare(
-    make: Callable[[], gr.Simulation], name: str, steps: int, comm: MPI.Comm, renew: bool = False
+    make: Callable[[], gr.Simulation],
+    name: str,
+    steps: int,
+    comm: MPI.Comm,
+    renew: bool = False,
+    margin: float | None = None,
 ) -> int:
     """0 when `steps` steps of make() distributed over the ranks end with every node's
     position, velocity and force equal to the serial run's, at the same dt. `renew`: every
-    rank builds its part anew from the owners' states at every migration."""
+    rank builds its part anew from the owners' states at every migration; `margin`: the
+    ghost margin [m] (default DistributedRun's)."""
     serial = make()
     serial.core.run(steps)
-    distributed = DistributedRun(make(), comm)
+    distributed = DistributedRun(make(), comm, margin=margin)
     distributed.always_renew = renew
     distributed.run(steps)
     fields = {name: distributed.gather(name) for name in ("positions", "velocities", "forces")}

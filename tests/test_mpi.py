@@ -72,6 +72,15 @@ def test_grains_migrating_between_ranks_keep_the_serial_run_bit_for_bit(
     assert renewals == ", ".join([str(migrations)] * ranks) if renew else renewals != "0, 0, 0"
 
 
+def test_grains_migrating_in_3d_under_the_surface_law_keep_the_serial_run_bit_for_bit() -> None:
+    """The 3D locality assembly (spheres pressed and thrown, the surface law by default) with a
+    ghost margin of 2e-5 m: a migration every few steps, every part built anew each time."""
+    done = run_ranks(3, "3", "60", "2e-5", "compare")
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert int(done.stdout.split("migrations ")[1].split(",")[0]) >= 5
+    assert "'positions': 0.0, 'velocities': 0.0, 'forces': 0.0" in done.stdout
+
+
 @pytest.mark.parametrize("ranks", [2, 3])
 def test_a_distributed_checkpoint_restarts_on_fewer_ranks_bit_for_bit(ranks: int) -> None:
     """The surface-law drum saved at step 1,500 on `ranks` ranks and continued on one rank
