@@ -112,10 +112,12 @@ def compare(
     distributed.always_renew = renew
     distributed.run(steps)
     fields = {name: distributed.gather(name) for name in ("positions", "velocities", "forces")}
+    walls = distributed.wall_reactions()
     renewals = comm.gather(distributed.renewals, root=0)
     if comm.Get_rank() != 0:
         return 0
     worst = {name: float(np.abs(fields[name] - getattr(serial, name)).max()) for name in fields}
+    worst["walls"] = float(np.abs(walls - np.array(serial.core.wall_reactions())).max())
     same_dt = distributed.dt == serial.dt
     ghosts = [len(g) for g in distributed.ghosts]
     print(
@@ -146,6 +148,7 @@ def check_restart(make: Callable[[], gr.Simulation], steps: int, comm: MPI.Comm)
     second.load_checkpoint(path)
     second.run(steps - steps // 2)
     fields = {name: second.gather(name) for name in ("positions", "velocities", "forces")}
+    walls = second.wall_reactions()
     other = set_up(2)  # the locality assembly: other grains
     try:
         DistributedRun(other, fewer).load_checkpoint(path)
@@ -158,6 +161,7 @@ def check_restart(make: Callable[[], gr.Simulation], steps: int, comm: MPI.Comm)
         return 0
     shutil.rmtree(folder)
     worst = {name: float(np.abs(fields[name] - getattr(serial, name)).max()) for name in fields}
+    worst["walls"] = float(np.abs(walls - np.array(serial.core.wall_reactions())).max())
     print(
         f"saved at step {steps // 2} on {comm.Get_size()} ranks, continued on "
         f"{fewer.Get_size()} to step {second.local.core.step}: largest differences {worst}; "

@@ -37,10 +37,12 @@ def run_ranks(ranks: int, *arguments: str) -> subprocess.CompletedProcess[str]:
 def test_a_distributed_run_is_the_serial_run_bit_for_bit(
     ranks: int, dimension: int, steps: int
 ) -> None:
+    """Every node's position, velocity and force and the floor's reaction (summed on rank 0
+    in the serial order) after `steps` steps."""
     done = run_ranks(ranks, str(dimension), str(steps))
     assert done.returncode == 0, done.stdout + done.stderr
     assert f"ranks {ranks}, {dimension}D" in done.stdout
-    assert "'positions': 0.0, 'velocities': 0.0, 'forces': 0.0" in done.stdout
+    assert "'positions': 0.0, 'velocities': 0.0, 'forces': 0.0, 'walls': 0.0}" in done.stdout
 
 
 @pytest.mark.parametrize(
@@ -63,7 +65,7 @@ def test_grains_migrating_between_ranks_keep_the_serial_run_bit_for_bit(
     broke); with `renew` every rank does so at every migration, the others keep their part."""
     done = run_ranks(ranks, "drum", variant, "3000", *(["renew"] if renew else []))
     assert done.returncode == 0, done.stdout + done.stderr
-    assert "'positions': 0.0, 'velocities': 0.0, 'forces': 0.0" in done.stdout
+    assert "'positions': 0.0, 'velocities': 0.0, 'forces': 0.0, 'walls': 0.0}" in done.stdout
     migrations = int(done.stdout.split("migrations ")[1].split(",")[0])
     handed = int(done.stdout.split("grains handed over ")[1].split(",")[0])
     renewals = done.stdout.split("parts built anew per rank [")[1].split("]")[0]
@@ -78,7 +80,7 @@ def test_grains_migrating_in_3d_under_the_surface_law_keep_the_serial_run_bit_fo
     done = run_ranks(3, "3", "60", "2e-5", "compare")
     assert done.returncode == 0, done.stdout + done.stderr
     assert int(done.stdout.split("migrations ")[1].split(",")[0]) >= 5
-    assert "'positions': 0.0, 'velocities': 0.0, 'forces': 0.0" in done.stdout
+    assert "'positions': 0.0, 'velocities': 0.0, 'forces': 0.0, 'walls': 0.0}" in done.stdout
 
 
 @pytest.mark.parametrize("ranks", [2, 3])
@@ -89,7 +91,7 @@ def test_a_distributed_checkpoint_restarts_on_fewer_ranks_bit_for_bit(ranks: int
     done = run_ranks(ranks, "restart", "surface", "3000")
     assert done.returncode == 0, done.stdout + done.stderr
     assert f"on {ranks} ranks, continued on {ranks - 1} to step 3000" in done.stdout
-    assert "'positions': 0.0, 'velocities': 0.0, 'forces': 0.0" in done.stdout
+    assert "'positions': 0.0, 'velocities': 0.0, 'forces': 0.0, 'walls': 0.0}" in done.stdout
 
 
 @pytest.mark.parametrize("migrate", [False, True])

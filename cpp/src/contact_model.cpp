@@ -293,7 +293,7 @@ std::size_t ContactModel::memory_bytes() const {
          bytes(body_touch_) + bytes(touching_bodies_) + bytes(slot_touch_) + bytes(body_motion_) +
          bytes(body_rotation_) + bytes(body_rotated_) + bytes(rotated_bodies_) + bytes(body_rotation_slot_) +
          bytes(body_load_) + bytes(slot_force_) + bytes(slot_normal_) + bytes(slot_point_) +
-         bytes(slot_load_) + bytes(damping_tables_) + bytes(wall_damping_tables_) +
+         bytes(slot_load_) + bytes(damping_tables_) + bytes(wall_damping_tables_) + bytes(wall_slot_terms_) +
          bytes(slot_surface_normal_) + bytes(touching_nodes_) + bytes(touching_normals_) +
          centres_.memory_bytes() + bytes(anchor_forces_) + bytes(entry_group_) + bytes(entry_target_) +
          bytes(taking_part_) + bytes(opened_rest_) + bytes(surface_nodes_) + bytes(surface_slot_) +

@@ -20,6 +20,7 @@ void ContactModel::slot_dashpots(const State& state, real dt) {
   // dashpot would then overdamp.
   const real t = state.time;
   std::fill(wall_damping_.begin(), wall_damping_.end(), std::array<real, 6>{0, 0, 0, 0, 0, 0});
+  wall_slot_terms_.assign(slots_.size() - particle_slot_count_, {0, 0, 0, 0, 0, 0, 0, 0, 0});
   for (std::size_t slot = 0; slot < slots_.size(); ++slot) {
     const bool wall_slot = slot >= particle_slot_count_;
     const index_t p = slots_[slot][0], q = slots_[slot][1];
@@ -79,9 +80,12 @@ void ContactModel::slot_dashpots(const State& state, real dt) {
                     point[2] - walls_[q].center[2]};
       const vec on_wall{-damping * normal[0], -damping * normal[1], -damping * normal[2]};
       const vec torque = cross(arm, on_wall);
+      auto& terms = wall_slot_terms_[slot - particle_slot_count_];
       for (int k = 0; k < 3; ++k) {
         wall_damping_[q][k] += on_wall[k];
         wall_damping_[q][3 + k] += torque[k];
+        terms[k] = on_wall[k];
+        terms[3 + k] = torque[k];
       }
     } else {
       add_body_load(p, point, {-damping * normal[0], -damping * normal[1], -damping * normal[2]});
@@ -110,6 +114,7 @@ void ContactModel::slot_rolling_resistance(const State& state, real dt) {
     for (int k = 0; k < 3; ++k) {
       if (slot >= particle_slot_count_) {
         wall_damping_[q][3 + k] -= torque[k];
+        wall_slot_terms_[slot - particle_slot_count_][6 + k] = torque[k];
       } else {
         body_load_[body_touch_[q]][3 + k] -= torque[k];
       }

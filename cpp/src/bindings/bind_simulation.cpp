@@ -143,6 +143,20 @@ void bind_loading(nb::class_<Simulation>& cls) {
 void bind_results(nb::class_<Simulation>& cls) {
   cls.def("wall_reactions", [](const Simulation& self) { return self.contact().wall_reactions(); })
       .def(
+          "wall_reaction_terms",
+          [](const Simulation& self) {
+            const ContactModel& c = self.contact();
+            std::vector<index_t> slots;
+            for (std::size_t k = c.particle_slot_count(); k < c.slots().size(); ++k)
+              slots.insert(slots.end(), c.slots()[k].begin(), c.slots()[k].end());
+            std::vector<real> terms, entries;
+            for (const auto& t : c.wall_slot_terms()) terms.insert(terms.end(), t.begin(), t.end());
+            for (const auto& r : c.wall_entry_reactions()) entries.insert(entries.end(), r.begin(), r.end());
+            return nb::make_tuple(copy_out(slots), copy_out(terms), copy_out(entries));
+          },
+          "The terms of wall_reactions (ContactModel::wall_slot_terms): the wall slots' (body, wall) "
+          "pairs, their 9 terms, and each wall entry's reaction (6), all flat.")
+      .def(
           "contact_network",
           [](const Simulation& self) {
             const ContactNetwork net = self.contact().network(self.model(), self.state());

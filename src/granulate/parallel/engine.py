@@ -13,9 +13,9 @@ The ghost sets hold while no node has moved more than half the margin from where
 the grains were last distributed, since then no pair left out can come within the cutoff. The
 run checks that every step; past a quarter of the margin the ranks cut the grains anew where
 they are (which also rebalances) and hand grains over with their whole state (transplant.py),
-and the same states make checkpoints that restart on any number of ranks. Outputs, stop
-criteria and wall reactions across ranks are not built: the state is gathered on one rank
-with `gather`.
+and the same states make checkpoints that restart on any number of ranks. Wall reactions are
+summed on rank 0 in the serial order. Outputs and stop criteria across ranks are not built:
+the state is gathered on one rank with `gather`.
 """
 
 from __future__ import annotations
@@ -36,6 +36,7 @@ from granulate.parallel.partition import Partition, bisect, ghosts, near_pairs
 from granulate.parallel.transplant import (
     CHECKPOINT_FORMAT,
     GrainState,
+    body_first_nodes,
     grain_states,
     pack_states,
     restore_grains,
@@ -90,6 +91,9 @@ class DistributedRun:
         #: Build every rank's part anew at every migration, held grains changed or not (for
         #: tests of the hand-over, tests/mpi_check.py).
         self.always_renew = False
+        self._migration_due = False
+        # The wall reactions a loaded checkpoint holds, until the next step evaluates them.
+        self._loaded_walls: NDArray[np.float64] | None = None
         held = self._distribute(centres, radii)
         self._together(lambda: self._build(held))
         self._exchange()
@@ -142,6 +146,8 @@ class DistributedRun:
         self._to_global = np.flatnonzero(node_map >= 0)  # subsets keep the serial order
         self._owned = self.partition.grains_of(rank)
         self._owned_nodes = self._nodes_of(self._owned, node_map)
+        self._is_owned = np.zeros(len(self._to_global), dtype=bool)
+        self._is_owned[self._owned_nodes] = True
         self._send = {
             q: self._nodes_of(held[owner[held] == rank], node_map)
             for q, held in enumerate(self.ghosts)
@@ -196,13 +202,15 @@ class DistributedRun:
             x[nodes], v[nodes], f[nodes] = box[:, :3], box[:, 3:6], box[:, 6:]
 
     def run(self, steps: int) -> None:
-        """Advance every rank `steps` time steps, migrating grains when a node has moved a
-        quarter of the margin. Raises InputError (on every rank) when a node has moved more
-        than half the margin: the ghosts would no longer be enough. An error in one rank's
-        step ends every rank: that rank raises its own, the others a RuntimeError naming it
-        (no rank is left waiting for a message)."""
-        core = self.local.core
+        """Advance every rank `steps` time steps, migrating grains before a step once a node
+        has moved a quarter of the margin. Raises InputError (on every rank) when a node has
+        moved more than half the margin: the ghosts would no longer be enough. An error in one
+        rank's step ends every rank: that rank raises its own, the others a RuntimeError naming
+        it (no rank is left waiting for a message)."""
         for _ in range(steps):
+            if self._migration_due:  # before the step, so the parts hold its evaluation after
+                self.migrate()
+            core = self.local.core
             start = time.perf_counter()
             failure = None
             try:
@@ -213,12 +221,11 @@ class DistributedRun:
             farthest = self._check_step(int(core.step), failure)
             checked = time.perf_counter()
             self._exchange()
+            self._loaded_walls = None
+            self._migration_due = self._migrates and farthest > 0.25 * self.margin
             self.seconds["steps"] += stepped - start
             self.seconds["check"] += checked - stepped
             self.seconds["exchange"] += time.perf_counter() - checked
-            if self._migrates and farthest > 0.25 * self.margin:
-                self.migrate()
-                core = self.local.core
 
     def _check_step(self, step: int, failure: Exception | None) -> float:
         """One reduction after each step, before the exchange: the first rank whose step
@@ -260,6 +267,7 @@ class DistributedRun:
         follow from their exact motion). Either way the run goes on as the serial run, bit
         for bit."""
         start = time.perf_counter()
+        self._migration_due = False
         before, owners_before = self._held_by_rank(), self.partition.owner
         held = self._distribute(*self._current_spheres())
         self.handed_over += int(np.count_nonzero(self.partition.owner != owners_before))
@@ -337,6 +345,7 @@ class DistributedRun:
         (load_checkpoint), bit for bit. Every rank calls it; a failure to write is raised on
         every rank."""
         saved = dict(self.local.core.checkpoint())
+        saved["contact_wall_reactions"] = self.wall_reactions().ravel()  # the whole run's
         owned = {int(g): self._local_slice(g) for g in self._owned}
         parts = self.comm.gather(grain_states(self.local, saved, self._to_global, owned), root=0)
         problem = None
@@ -373,6 +382,8 @@ class DistributedRun:
             np.array([c for c, _ in spheres]), np.array([r for _, r in spheres])
         )
         self._together(lambda: self._rebuild(held, states, moment))
+        self._loaded_walls = np.asarray(moment["contact_wall_reactions"]).reshape(-1, 6)
+        self._migration_due = False
         self.seconds["migrate"] += time.perf_counter() - start
 
     def _checkpoint_problem(self, arrays: dict[str, NDArray[Any]]) -> str | None:
@@ -388,6 +399,49 @@ class DistributedRun:
                 "differ): load it into the simulation it was written from"
             )
         return None
+
+    def wall_reactions(self) -> NDArray[np.float64]:
+        """(walls, 6): the force and torque on each wall from the last step [N, N m; per unit
+        thickness in 2D], on every rank, the serial run's to the bit. Each term comes from the
+        rank that owns its body or node (ContactModel::wall_slot_terms) and rank 0 sums them in
+        the serial order: the dashpots' per slot in body order, less the rolling couples in the
+        same order, plus the wall entries' reactions in node order."""
+        if self._loaded_walls is not None:
+            return self._loaded_walls.copy()
+        core = self.local.core
+        slots, terms, reactions = (np.asarray(a) for a in core.wall_reaction_terms())
+        slots, terms = slots.reshape(-1, 2).astype(np.int64), terms.reshape(-1, 9)
+        evaluated = len(terms) == len(slots) and len(reactions) == 6 * len(self._wall_rows())
+        if not self.comm.allreduce(evaluated, op=self._mpi.LAND):
+            raise RuntimeError(
+                "wall reactions are known once a step has evaluated them on the parts built in "
+                "the last migration: run a step first"
+            )
+        first = body_first_nodes(self.local)[slots[:, 0]]
+        mine = self._is_owned[first]
+        offsets, flat = (np.asarray(a, dtype=np.int64) for a in core.contact_wall_entries())
+        flat = flat.reshape(-1, 2)
+        rows = self._wall_rows()
+        kept = self._is_owned[rows]
+        place = np.arange(len(rows)) - offsets[rows]  # an entry's place among its node's
+        parts = self.comm.gather(
+            (
+                np.column_stack([self._to_global[first[mine]], slots[mine, 1]]),
+                terms[mine],
+                np.column_stack([self._to_global[rows[kept]], place[kept], flat[kept, 0]]),
+                reactions.reshape(-1, 6)[kept],
+            ),
+            root=0,
+        )
+        total = None
+        if parts is not None:
+            total = _sum_wall_terms(parts, len(core.wall_reactions()))
+        return self.comm.bcast(total, root=0)
+
+    def _wall_rows(self) -> NDArray[np.int64]:
+        """The local node of each wall entry of this rank's lists."""
+        offsets = np.asarray(self.local.core.contact_wall_entries()[0], dtype=np.int64)
+        return np.repeat(np.arange(len(offsets) - 1), np.diff(offsets))
 
     @property
     def dt(self) -> float:
@@ -407,6 +461,23 @@ class DistributedRun:
         for grains, values in parts:
             whole[self._nodes_of(grains)] = values
         return whole
+
+
+def _sum_wall_terms(parts: list[tuple[NDArray[Any], ...]], walls: int) -> NDArray[np.float64]:
+    """The ranks' wall terms (slot keys (first node, wall), slot terms, entry keys (node,
+    place, wall), entry reactions) summed per wall in the serial order, one term at a time."""
+    slot_keys, slot_terms, entry_keys, entry_terms = (
+        np.concatenate([part[k] for part in parts]) for k in range(4)
+    )
+    total = np.zeros((walls, 6))
+    by_slot = np.lexsort((slot_keys[:, 1], slot_keys[:, 0]))
+    for k in by_slot:
+        total[slot_keys[k, 1]] += slot_terms[k, :6]
+    for k in by_slot:
+        total[slot_keys[k, 1], 3:] -= slot_terms[k, 6:]
+    for k in np.lexsort((entry_keys[:, 1], entry_keys[:, 0])):
+        total[entry_keys[k, 2]] += entry_terms[k]
+    return total
 
 
 def _kinds(sim: Simulation) -> NDArray[np.int64]:

@@ -59,7 +59,7 @@ def grain_states(
     whose local node i is global node to_global[i]; `saved`: its core's checkpoint()."""
     core = part.core
     node_count = len(to_global)
-    bodies_first = _body_first_nodes(part)
+    bodies_first = body_first_nodes(part)
     collisions, values = _collisions(saved, bodies_first, to_global)
     owner_node = np.full(node_count, -1, dtype=np.int64)  # the grain of each local node
     for grain, nodes in grains.items():
@@ -99,7 +99,7 @@ def grain_states(
     return states
 
 
-def _body_first_nodes(part: Simulation) -> NDArray[np.int64]:
+def body_first_nodes(part: Simulation) -> NDArray[np.int64]:
     """Each body's smallest local node, in the core's body numbering: the particles while no
     bond has broken on this rank, else the fragments in the order of their smallest node
     (ContactModel::label_bodies)."""

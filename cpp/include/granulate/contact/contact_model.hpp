@@ -170,6 +170,15 @@ class ContactModel {
   /// Per wall: force (x, y, z) and torque about its centre (x, y, z) exerted by the particles
   /// [N, N m; per unit thickness in 2D], from the last evaluation.
   const std::vector<std::array<real, 6>>& wall_reactions() const { return wall_reactions_; }
+  /// The terms wall_reactions sums, from the last evaluation, for a distributed run to sum
+  /// them in the serial order: per wall slot (slots() past particle_slot_count()) the dashpot's
+  /// force and torque on the wall and the rolling couple taken from it (9); per wall entry
+  /// (wall_entries()) its reaction (6). A wall's reaction is the slots' dashpot terms in slot
+  /// order, less their rolling couples in slot order, plus the entries' in entry order.
+  const std::vector<std::array<real, 9>>& wall_slot_terms() const { return wall_slot_terms_; }
+  const std::vector<std::array<real, 6>>& wall_entry_reactions() const { return wall_entry_reaction_; }
+  const std::vector<std::array<index_t, 2>>& slots() const { return slots_; }
+  std::size_t particle_slot_count() const { return particle_slot_count_; }
   const ContactStatistics& statistics() const { return statistics_; }
   /// The contacts of the last force evaluation (see ContactNetwork), in slot order: particle
   /// pairs, then particle-wall pairs. `state` must be the state that evaluation saw.
@@ -712,7 +721,8 @@ class ContactModel {
     static constexpr vec3 none{0, 0, 0};
     return body_touch_[body] == not_touching ? none : body_motion_[body_touch_[body]].angular_velocity;
   }
-  std::vector<std::array<real, 6>> wall_damping_;  // per wall: the dashpots' and rolling torques' share
+  std::vector<std::array<real, 6>> wall_damping_;     // per wall: the dashpots' and rolling torques' share
+  std::vector<std::array<real, 9>> wall_slot_terms_;  // per wall slot: its share (wall_slot_terms)
   real last_time_ = 0;
   bool has_last_time_ = false;
   // Scratch, per entry: the spring stiffness k of the pair in contact, 0 if apart (single
