@@ -335,6 +335,7 @@ class DistributedRun:
         with warnings.catch_warnings():  # the start checks were made when the run was set up
             warnings.simplefilter("ignore")
             local, node_map = self._sim._subdomain(held, dt=self._dt, skin=self._skin)
+            local._assembly.initial_velocities = []  # the states overwrite them
             restore_grains(local.core, [states[int(g)] for g in held], node_map, moment)
         self.local = local
         self._plan(node_map)
