@@ -171,10 +171,11 @@ def check_restart(make: Callable[[], gr.Simulation], steps: int, comm: MPI.Comm)
     return 0 if same and all("other grains" in r for r in refusals) else 1
 
 
-def stop_messages(run: DistributedRun, steps: int, comm: MPI.Comm) -> list[str] | None:
-    """Run `steps` steps; on rank 0 each rank's "ErrorType: message" (empty if it finished)."""
+def stop_messages(action: Callable[[], object], comm: MPI.Comm) -> list[str] | None:
+    """action() on every rank; on rank 0 each rank's "ErrorType: message" (empty if it
+    finished)."""
     try:
-        run.run(steps)
+        action()
         message = ""
     except (gr.InputError, RuntimeError) as error:  # InstabilityError is a RuntimeError
         message = f"{type(error).__name__}: {error}"
@@ -185,7 +186,7 @@ def check_margin(dimension: int, steps: int, margin: float, migrate: bool, comm:
     """0 when every rank raised the margin's InputError within `steps` steps (with or
     without migrating grains)."""
     run = DistributedRun(set_up(dimension), comm, margin=margin, migrate=migrate)
-    messages = stop_messages(run, steps, comm)
+    messages = stop_messages(lambda: run.run(steps), comm)
     if messages is None:
         return 0
     print(messages[0])
@@ -199,7 +200,7 @@ def check_failure(dimension: int, steps: int, comm: MPI.Comm) -> int:
     last = comm.Get_size() - 1
     if comm.Get_rank() == last:
         run.local.velocities[run._owned_nodes[0]] = 1e6  # moves a mesh size in a step
-    messages = stop_messages(run, steps, comm)
+    messages = stop_messages(lambda: run.run(steps), comm)
     if messages is None:
         return 0
     print(messages)
@@ -216,19 +217,17 @@ def check_build_failure(dimension: int, during: str, comm: MPI.Comm) -> int:
     def broken(*_: object, **__: object) -> None:
         raise gr.InputError("an injected failure")
 
-    if during == "start" and comm.Get_rank() == last:
-        sim._subdomain = broken  # type: ignore[method-assign]
-    try:
+    def build_and_migrate() -> None:
+        if during == "start" and comm.Get_rank() == last:
+            sim._subdomain = broken  # type: ignore[method-assign]
         run = DistributedRun(sim, comm)
         if during == "migration":
             if comm.Get_rank() == last:
                 sim._subdomain = broken  # type: ignore[method-assign]
             run.always_renew = True
             run.migrate()
-        message = ""
-    except (gr.InputError, RuntimeError) as error:
-        message = f"{type(error).__name__}: {error}"
-    messages = comm.gather(message, root=0)
+
+    messages = stop_messages(build_and_migrate, comm)
     if messages is None:
         return 0
     print(during, messages)

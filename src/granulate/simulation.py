@@ -186,12 +186,17 @@ class Simulation(SimulationSetup, SimulationResults):
         return core
 
     def _subdomain(
-        self, grains: NDArray[np.int64], dt: float | None = None, skin: float | None = None
+        self,
+        grains: NDArray[np.int64],
+        dt: float | None = None,
+        skin: float | None = None,
+        initial_motion: bool = True,
     ) -> tuple[Simulation, NDArray[np.int64]]:
         """A new simulation of the bodies `grains` (increasing indices) alone, set up as this
         one is (loads on their nodes, contact, walls, gravity, damping, precracks, start
-        state), with the time step `dt` and neighbour skin `skin` when given; and the map of
-        this simulation's node indices to its own (-1: left out). For granulate.parallel,
+        state; the initial velocities unless `initial_motion` is False, for a part whose state
+        is restored), with the time step `dt` and neighbour skin `skin` when given; and the map
+        of this simulation's node indices to its own (-1: left out). For granulate.parallel,
         whose ranks each hold their grains and ghosts; this simulation is not built."""
         interactions = self._interactions
         if interactions.peridem_damping or interactions.peridem_walls:
@@ -208,6 +213,8 @@ class Simulation(SimulationSetup, SimulationResults):
         )
         part._gravity = self._gravity.copy()
         assembly, node_map = self._assembly.subset(grains)
+        if not initial_motion:
+            assembly.initial_velocities = []
         part._assembly = assembly
         part._loading = self._loading.subset(assembly, node_map)
         part._interactions = interactions.on(assembly)

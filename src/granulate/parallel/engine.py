@@ -41,6 +41,7 @@ from granulate.parallel.transplant import (
     pack_states,
     restore_grains,
     unpack_states,
+    wall_lists,
 )
 
 if TYPE_CHECKING:
@@ -298,13 +299,11 @@ class DistributedRun:
     def _current_spheres(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Every grain's bounding sphere now, from its owner (one allgather)."""
         positions = self.local.core.positions
-        dimension = self._sim.dimension
-        spheres = [_sphere(positions[self._local_slice(g)], dimension) for g in self._owned]
-        centres = np.empty((len(self._slices), dimension))
+        mine = _spheres([positions[self._local_slice(g)] for g in self._owned], self._sim.dimension)
+        centres = np.empty((len(self._slices), self._sim.dimension))
         radii = np.empty(len(self._slices))
-        for grains, theirs in self.comm.allgather((self._owned, spheres)):
-            for grain, (centre, radius) in zip(grains, theirs, strict=True):
-                centres[grain], radii[grain] = centre, radius
+        for grains, (their_centres, their_radii) in self.comm.allgather((self._owned, mine)):
+            centres[grains], radii[grains] = their_centres, their_radii
         return centres, radii
 
     def _hand_over(
@@ -334,8 +333,9 @@ class DistributedRun:
         (the time, step and contact scalars of a checkpoint)."""
         with warnings.catch_warnings():  # the start checks were made when the run was set up
             warnings.simplefilter("ignore")
-            local, node_map = self._sim._subdomain(held, dt=self._dt, skin=self._skin)
-            local._assembly.initial_velocities = []  # the states overwrite them
+            local, node_map = self._sim._subdomain(
+                held, dt=self._dt, skin=self._skin, initial_motion=False
+            )
             restore_grains(local.core, [states[int(g)] for g in held], node_map, moment)
         self.local = local
         self._plan(node_map)
@@ -378,9 +378,8 @@ class DistributedRun:
         start = time.perf_counter()
         every = np.arange(len(self._slices))
         states, moment = unpack_states(arrays, every)
-        spheres = [_sphere(states[g].positions, self._sim.dimension) for g in every]
         held = self._distribute(
-            np.array([c for c, _ in spheres]), np.array([r for _, r in spheres])
+            *_spheres([states[g].positions for g in every], self._sim.dimension)
         )
         self._together(lambda: self._rebuild(held, states, moment))
         self._loaded_walls = np.asarray(moment["contact_wall_reactions"]).reshape(-1, 6)
@@ -412,7 +411,8 @@ class DistributedRun:
         core = self.local.core
         slots, terms, reactions = (np.asarray(a) for a in core.wall_reaction_terms())
         slots, terms = slots.reshape(-1, 2).astype(np.int64), terms.reshape(-1, 9)
-        evaluated = len(terms) == len(slots) and len(reactions) == 6 * len(self._wall_rows())
+        offsets, rows, keys = wall_lists(core)
+        evaluated = len(terms) == len(slots) and len(reactions) == 6 * len(rows)
         if not self.comm.allreduce(evaluated, op=self._mpi.LAND):
             raise RuntimeError(
                 "wall reactions are known once a step has evaluated them on the parts built in "
@@ -420,16 +420,13 @@ class DistributedRun:
             )
         first = body_first_nodes(self.local)[slots[:, 0]]
         mine = self._is_owned[first]
-        offsets, flat = (np.asarray(a, dtype=np.int64) for a in core.contact_wall_entries())
-        flat = flat.reshape(-1, 2)
-        rows = self._wall_rows()
         kept = self._is_owned[rows]
         place = np.arange(len(rows)) - offsets[rows]  # an entry's place among its node's
         parts = self.comm.gather(
             (
                 np.column_stack([self._to_global[first[mine]], slots[mine, 1]]),
                 terms[mine],
-                np.column_stack([self._to_global[rows[kept]], place[kept], flat[kept, 0]]),
+                np.column_stack([self._to_global[rows[kept]], place[kept], keys[kept, 0]]),
                 reactions.reshape(-1, 6)[kept],
             ),
             root=0,
@@ -438,11 +435,6 @@ class DistributedRun:
         if parts is not None:
             total = _sum_wall_terms(parts, len(core.wall_reactions()))
         return self.comm.bcast(total, root=0)
-
-    def _wall_rows(self) -> NDArray[np.int64]:
-        """The local node of each wall entry of this rank's lists."""
-        offsets = np.asarray(self.local.core.contact_wall_entries()[0], dtype=np.int64)
-        return np.repeat(np.arange(len(offsets) - 1), np.diff(offsets))
 
     @property
     def dt(self) -> float:
@@ -493,14 +485,20 @@ def _kinds(sim: Simulation) -> NDArray[np.int64]:
 
 
 def _bounding_spheres(sim: Simulation) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """Per grain its bounding sphere (_sphere) at the start (its start state when one is set)."""
+    """Every grain's bounding sphere (_spheres) at the start (its start state when one is
+    set)."""
     start = sim._start[0] if sim._start is not None else sim._assembly.reference_positions()
-    spheres = [_sphere(start[body.node_slice], sim.dimension) for body in sim.bodies]
-    return np.array([c for c, _ in spheres]), np.array([r for _, r in spheres])
+    return _spheres([start[body.node_slice] for body in sim.bodies], sim.dimension)
 
 
-def _sphere(nodes: NDArray[np.float64], dimension: int) -> tuple[NDArray[np.float64], float]:
-    """The centre of the box of `nodes` (its first `dimension` coordinates) and the radius of
-    the sphere about it that holds them [m]."""
-    centre = 0.5 * (nodes.min(axis=0) + nodes.max(axis=0))
-    return centre[:dimension], float(np.linalg.norm(nodes - centre, axis=1).max())
+def _spheres(
+    grains: list[NDArray[np.float64]], dimension: int
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Per grain (its nodes' positions) the centre of their box (its first `dimension`
+    coordinates) and the radius of the sphere about it that holds them [m]."""
+    centres = np.empty((len(grains), dimension))
+    radii = np.empty(len(grains))
+    for k, nodes in enumerate(grains):
+        centre = 0.5 * (nodes.min(axis=0) + nodes.max(axis=0))
+        centres[k], radii[k] = centre[:dimension], np.linalg.norm(nodes - centre, axis=1).max()
+    return centres, radii

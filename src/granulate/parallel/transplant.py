@@ -58,55 +58,85 @@ def grain_states(
     """The state of `grains` (grain -> its local node slice) of `part`, a rank's simulation
     whose local node i is global node to_global[i]; `saved`: its core's checkpoint()."""
     core = part.core
-    node_count = len(to_global)
-    bodies_first = body_first_nodes(part)
-    collisions, values = _collisions(saved, bodies_first, to_global)
-    owner_node = np.full(node_count, -1, dtype=np.int64)  # the grain of each local node
+    fragments = np.asarray(core.fragments(), dtype=np.int64)
+    collisions, values = _collisions(saved, body_first_nodes(part, fragments), to_global)
+    grain_of_node = np.full(len(to_global), -1, dtype=np.int64)
     for grain, nodes in grains.items():
-        owner_node[nodes] = grain
+        grain_of_node[nodes] = grain
     pair_rows, pair_columns, pair_springs = _pair_springs(saved)
     wall_rows, wall_keys, wall_springs = _wall_springs(core, saved)
+    pairs = _by_grain(grain_of_node[pair_rows], grains)
+    walls = _by_grain(grain_of_node[wall_rows], grains)
+    mine = _by_grain(grain_of_node[collisions[:, 0]], grains)
     bond_offsets = np.asarray(part.model.bond_offsets)
-    roots = to_global[np.asarray(core.fragments(), dtype=np.int64)]
+    roots = to_global[fragments]
     opened = np.asarray(saved["contact_opened_rest"])
     if len(opened) == 0:
-        opened = np.zeros(node_count)
-    collision_grain = owner_node[collisions[:, 0]] if len(collisions) else np.zeros(0, np.int64)
-    states = {}
-    for grain, nodes in grains.items():
-        pairs = owner_node[pair_rows] == grain
-        walls = owner_node[wall_rows] == grain
-        mine = collision_grain == grain
-        states[grain] = GrainState(
-            positions=np.asarray(saved["positions"]).reshape(-1, 3)[nodes],
-            velocities=np.asarray(saved["velocities"]).reshape(-1, 3)[nodes],
-            forces=np.asarray(saved["forces"]).reshape(-1, 3)[nodes],
-            dilatation=np.asarray(saved["dilatation"])[nodes],
+        opened = np.zeros(len(to_global))
+    x, v, f = (
+        np.asarray(saved[key]).reshape(-1, 3) for key in ("positions", "velocities", "forces")
+    )
+    dilatation, bonds = np.asarray(saved["dilatation"]), np.asarray(saved["bond_intact"])
+    return {
+        grain: GrainState(
+            positions=x[nodes],
+            velocities=v[nodes],
+            forces=f[nodes],
+            dilatation=dilatation[nodes],
             opened_rest=opened[nodes],
-            bonds=np.asarray(saved["bond_intact"])[
-                bond_offsets[nodes.start] : bond_offsets[nodes.stop]
-            ],
+            bonds=bonds[bond_offsets[nodes.start] : bond_offsets[nodes.stop]],
             roots=roots[nodes],
-            pair_springs=np.stack([to_global[pair_rows[pairs]], to_global[pair_columns[pairs]]], 1),
-            pair_spring_values=pair_springs[pairs],
-            wall_springs=np.column_stack([to_global[wall_rows[walls]], wall_keys[walls]]),
-            wall_spring_values=wall_springs[walls],
+            pair_springs=np.column_stack(
+                [to_global[pair_rows[pairs[grain]]], to_global[pair_columns[pairs[grain]]]]
+            ),
+            pair_spring_values=pair_springs[pairs[grain]],
+            wall_springs=np.column_stack(
+                [to_global[wall_rows[walls[grain]]], wall_keys[walls[grain]]]
+            ),
+            wall_spring_values=wall_springs[walls[grain]],
             collisions=np.column_stack(
-                [to_global[collisions[mine, 0]], collisions[mine, 1:]]
-            ).astype(np.int64),
-            collision_values=values[mine],
+                [to_global[collisions[mine[grain], 0]], collisions[mine[grain], 1:]]
+            ),
+            collision_values=values[mine[grain]],
         )
-    return states
+        for grain, nodes in grains.items()
+    }
 
 
-def body_first_nodes(part: Simulation) -> NDArray[np.int64]:
+def _by_grain(labels: NDArray[np.int64], grains: dict[int, slice]) -> dict[int, NDArray[np.int64]]:
+    """Per grain, the indices of the items labelled with it, in their order (one sort, not a
+    pass over the items per grain)."""
+    order = np.argsort(labels, kind="stable")
+    ordered = labels[order]
+    return {
+        grain: order[np.searchsorted(ordered, grain) : np.searchsorted(ordered, grain, "right")]
+        for grain in grains
+    }
+
+
+def body_first_nodes(
+    part: Simulation, fragments: NDArray[np.int64] | None = None
+) -> NDArray[np.int64]:
     """Each body's smallest local node, in the core's body numbering: the particles while no
     bond has broken on this rank, else the fragments in the order of their smallest node
-    (ContactModel::label_bodies)."""
+    (ContactModel::label_bodies). `fragments`: core.fragments(), when already at hand."""
     if part.core.broken_bonds() == 0:
         particle = np.asarray(part.model.node_particle, dtype=np.int64)
         return np.flatnonzero(np.diff(particle, prepend=-1) != 0)
-    return np.unique(np.asarray(part.core.fragments(), dtype=np.int64))
+    labels = part.core.fragments() if fragments is None else fragments
+    return np.unique(np.asarray(labels, dtype=np.int64))
+
+
+def csr_rows(offsets: NDArray[np.int64]) -> NDArray[np.int64]:
+    """The row of each entry of CSR lists with these offsets (rows + 1 of them)."""
+    return np.repeat(np.arange(len(offsets) - 1), np.diff(offsets))
+
+
+def wall_lists(core: Any) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.int64]]:
+    """The core's wall lists: per node the offsets of its entries, each entry's node and its
+    (wall, surface), (entries, 2)."""
+    offsets, flat = (np.asarray(a, dtype=np.int64) for a in core.contact_wall_entries())
+    return offsets, csr_rows(offsets), flat.reshape(-1, 2)
 
 
 def _collisions(
@@ -140,31 +170,27 @@ def _pair_springs(
 ) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.float64]]:
     """The list entries that hold a friction spring: local rows, partners and spring values."""
     offsets = np.asarray(saved["contact_pair_offsets"], dtype=np.int64)
-    entries = np.asarray(saved["contact_pair_springs"], dtype=np.int64)
     if len(offsets) == 0:
         empty = np.zeros(0, dtype=np.int64)
         return empty, empty, np.zeros((0, 3))
-    rows = np.repeat(np.arange(len(offsets) - 1), np.diff(offsets))
-    held = entries != NO_SPRING
+    held = np.asarray(saved["contact_pair_springs"], dtype=np.int64)
+    has = held != NO_SPRING
     pool = np.asarray(saved["contact_springs"]).reshape(-1, 3)
     partners = np.asarray(saved["contact_pair_partners"], dtype=np.int64)
-    return rows[held], partners[held], pool[entries[held]]
+    return csr_rows(offsets)[has], partners[has], pool[held[has]]
 
 
 def _wall_springs(
     core: Any, saved: dict[str, Any]
 ) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.float64]]:
     """The wall entries that hold a friction spring: local rows, (wall, surface) and values."""
-    offsets, flat = core.contact_wall_entries()
-    offsets = np.asarray(offsets, dtype=np.int64)
-    entries = np.asarray(saved["contact_wall_springs"], dtype=np.int64)
-    if len(offsets) == 0 or len(entries) == 0:
+    held = np.asarray(saved["contact_wall_springs"], dtype=np.int64)
+    if len(held) == 0:
         return np.zeros(0, np.int64), np.zeros((0, 2), np.int64), np.zeros((0, 3))
-    rows = np.repeat(np.arange(len(offsets) - 1), np.diff(offsets))
-    keys = np.asarray(flat, dtype=np.int64).reshape(-1, 2)
-    held = entries != NO_SPRING
+    _, rows, keys = wall_lists(core)
+    has = held != NO_SPRING
     pool = np.asarray(saved["contact_springs"]).reshape(-1, 3)
-    return rows[held], keys[held], pool[entries[held]]
+    return rows[has], keys[has], pool[held[has]]
 
 
 def restore_grains(
@@ -264,14 +290,10 @@ def _give_springs(
     """Each friction spring of `states` to the entry of its pair (or node and wall surface) in
     the freshly searched lists of `listed`, in place. A spring of two held nodes whose pair the
     search did not list would be lost contact: an error, not a silent difference."""
-    offsets = np.asarray(listed["contact_pair_offsets"], dtype=np.int64)
-    rows = np.repeat(np.arange(len(offsets) - 1), np.diff(offsets))
+    rows = csr_rows(np.asarray(listed["contact_pair_offsets"], dtype=np.int64))
     pair_entries = np.column_stack([rows, np.asarray(listed["contact_pair_partners"], np.int64)])
-    wall_offsets, flat = core.contact_wall_entries()
-    wall_rows = np.repeat(
-        np.arange(len(wall_offsets) - 1), np.diff(np.asarray(wall_offsets, np.int64))
-    )
-    wall_entries = np.column_stack([wall_rows, np.asarray(flat, np.int64).reshape(-1, 2)])
+    _, wall_rows, wall_keys_listed = wall_lists(core)
+    wall_entries = np.column_stack([wall_rows, wall_keys_listed])
     pair_keys = to_local[np.concatenate([s.pair_springs for s in states]).reshape(-1, 2)]
     pair_values = np.concatenate([s.pair_spring_values for s in states]).reshape(-1, 3)
     walls = np.concatenate([s.wall_springs for s in states]).reshape(-1, 3)
