@@ -1,7 +1,7 @@
 """Per-rank speed and communication share of a distributed run (granulate.parallel).
 
     mpiexec -n K python benchmarks/distributed.py [--case pile|drum|pile3d] [--grains N]
-                                                  [--steps S]
+                                                  [--steps S] [--collect-every N]
 
 pile (default 400 grains): compression-like, at rest: discs and hexagons of radius 0.98-1 mm
 (R/h = 5) on a hexagonal lattice 2 mm apart, touching their neighbours, under gravity on a
@@ -14,8 +14,10 @@ on a cubic lattice 2 mm apart, 10 x 10 columns, on a floor.
 
 Rank 0 prints a table: per rank the grains and nodes it owns at the end, the ghost nodes it
 holds besides, its owned node-steps per second, and the shares of its wall-clock time spent in
-the ghost exchange, in the partition check (a reduction) and in migrations; then the
-migrations and grains handed over. On fewer cores than ranks (oversubscribed) the shares
+the ghost exchange, in the partition check (a reduction), in migrations and, with
+--collect-every N, in gathering the whole state into rank 0's simulation every N steps (as a run
+with outputs or stop criteria every N steps does, DistributedRun.collect; nothing is written);
+then the migrations and grains handed over. On fewer cores than ranks (oversubscribed) the shares
 include waiting for the other ranks and are an upper bound.
 """
 
@@ -120,6 +122,7 @@ def main() -> None:
     parser.add_argument("--case", choices=sorted(CASES), default="pile")
     parser.add_argument("--grains", type=int, default=None)
     parser.add_argument("--steps", type=int, default=300)
+    parser.add_argument("--collect-every", type=int, default=0, help="steps (0: never)")
     arguments = parser.parse_args()
     make, default_grains = CASES[arguments.case]
     grains = arguments.grains or default_grains
@@ -127,10 +130,16 @@ def main() -> None:
     warnings.filterwarnings("ignore", message="contact.*bodies pressed")  # placed pressed
     run = DistributedRun(make(grains), comm)
     run.run(20)  # lists built, caches warm
+    every = arguments.collect_every or arguments.steps
+    if arguments.collect_every:
+        run.collect()  # rank 0 builds the whole simulation once
     run.seconds = dict.fromkeys(run.seconds, 0.0)
     migrations, handed = run.migrations, run.handed_over
     start = time.perf_counter()
-    run.run(arguments.steps)
+    for done in range(0, arguments.steps, every):
+        run.run(min(every, arguments.steps - done))
+        if arguments.collect_every:
+            run.collect()
     wall = time.perf_counter() - start
     owned = len(run.partition.grains_of(comm.Get_rank()))
     row = (owned, run.owned_node_count, run.ghost_node_count, wall, run.seconds)
@@ -139,13 +148,15 @@ def main() -> None:
         return
     print(f"{arguments.case}: {grains} grains, {arguments.steps} steps, {comm.Get_size()} ranks")
     print(
-        "| rank | grains | nodes | ghost nodes | node-steps/s | exchange % | check % | migrate % |"
+        "| rank | grains | nodes | ghost nodes | node-steps/s | exchange % | check % | migrate % "
+        "| collect % |"
     )
-    print("|---:|---:|---:|---:|---:|---:|---:|---:|")
+    print("|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
     for rank, (owned, nodes, ghosts, seconds, parts) in enumerate(rows):
         speed = nodes * arguments.steps / seconds
         shares = " | ".join(
-            f"{100 * parts[name] / seconds:.1f}" for name in ("exchange", "check", "migrate")
+            f"{100 * parts[name] / seconds:.1f}"
+            for name in ("exchange", "check", "migrate", "collect")
         )
         print(f"| {rank} | {owned} | {nodes:,} | {ghosts:,} | {speed / 1e6:.2f} M | {shares} |")
     print(

@@ -23,6 +23,7 @@ def tumbling_drum(
     grid: bool = False,
     law: str = "granulate",
     rolling: float = 0.0,
+    comm: object | None = None,
 ) -> gr.Simulation:
     """Grains breaking in a rotating drum: contact, friction, damping, walls and fracture.
     ``grid``: the fourth grain is a brittle grid-meshed square instead of a lattice triangle:
@@ -30,9 +31,10 @@ def tumbling_drum(
     they lose them as its bonds break (it is damaged all through by step 2,000). ``law``: the
     contact's pair_law ("surface": probes of the grains' smooth surfaces, with their groups
     and the nodes opened by cracks joining the lists). ``rolling``: mu_r, the rolling
-    resistance (its springs carried through the checkpoint)."""
+    resistance (its springs carried through the checkpoint). ``comm``: run it on MPI ranks
+    (tests/mpi_check.py)."""
     rock = gr.Material(density=2000, youngs_modulus=1e8, poisson_ratio=0.25, fracture_energy=0.5)
-    sim = gr.Simulation(2, gravity=(0, -9.81))
+    sim = gr.Simulation(2, gravity=(0, -9.81), comm=comm)
     sim.contact = gr.Contact(restitution=0.5, friction=0.4, pair_law=law, rolling_friction=rolling)
     for k, (x, y) in enumerate([(-3e-3, -2e-3), (0, -4e-3), (3e-3, -2e-3), (0, 0)]):
         velocity = (0.2 * k - 0.3, -4.0)

@@ -154,27 +154,32 @@ def test_a_long_set_up_is_announced_before_it_starts(
     ],
     ids=["openmpi", "hydra", "srun"],
 )
-def test_a_case_started_as_several_mpi_ranks_is_refused_once(
+def test_commands_started_as_several_mpi_ranks_say_what_is_wrong_once(
     environ: dict[str, str],
     tmp_path: Path,
     monkeypatch: pytest.MonkeyPatch,
     capsys: pytest.CaptureFixture[str],
 ) -> None:
-    """Distributed runs are not built (issue 17): K ranks of `granulate run case.yaml` would be
-    K serial runs writing one folder. Rank 0 says so once, every rank exits 2, nothing is
-    written; a Python script (which may use mpi4py itself) still runs."""
+    """Under a launcher's K ranks, `granulate convert` (K copies would write one file) is
+    refused, and `granulate run case.yaml` without mpi4py is told to install the mpi extra
+    (tests/test_mpi_cli.py runs real ranks): rank 0 says so once, every rank exits 2, nothing is
+    written. A Python script (which may use mpi4py itself) still runs."""
     monkeypatch.chdir(tmp_path)
+    monkeypatch.setitem(sys.modules, "mpi4py", None)  # import mpi4py fails
     case = Path(__file__).parent / "cases" / "base.yaml"
     for rank in (0, 1):
         for name, value in environ.items():
             monkeypatch.setenv(name, value.format(rank=rank))
+        assert main(["convert", "input_0.yaml", "-o", "case.yaml"]) == 2
         assert main(["run", str(case)]) == 2
         printed = capsys.readouterr()
         if rank == 0:
-            assert "started as 2 MPI processes" in printed.err and "--threads N" in printed.err
+            refused, missing = printed.err.splitlines()
+            assert "'granulate convert' was started as 2 MPI processes" in refused
+            assert "mpi4py is not installed: pip install 'granulate[mpi]'" in missing
         else:
             assert printed.err == "" and printed.out == ""
-    assert not (tmp_path / "out").exists()
+    assert sorted(tmp_path.iterdir()) == []
     script = tmp_path / "sweep.py"
     script.write_text("print('ran')\n")
     assert main(["run", str(script)]) == 0

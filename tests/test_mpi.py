@@ -86,12 +86,29 @@ def test_grains_migrating_in_3d_under_the_surface_law_keep_the_serial_run_bit_fo
 @pytest.mark.parametrize("ranks", [2, 3])
 def test_a_distributed_checkpoint_restarts_on_fewer_ranks_bit_for_bit(ranks: int) -> None:
     """The surface-law drum saved at step 1,500 on `ranks` ranks and continued on one rank
-    fewer (on 2 ranks: on one) ends at step 3,000 as the serial run does; a checkpoint of other
-    grains is refused with one message on every rank."""
+    fewer (on 2 ranks: on one) ends at step 3,000 as the serial run does, and so does a serial
+    run continued from the same checkpoint (one format for both); a checkpoint of another
+    set-up is refused with one message on every rank."""
     done = run_ranks(ranks, "restart", "surface", "3000")
     assert done.returncode == 0, done.stdout + done.stderr
     assert f"on {ranks} ranks, continued on {ranks - 1} to step 3000" in done.stdout
     assert "'positions': 0.0, 'velocities': 0.0, 'forces': 0.0, 'walls': 0.0}" in done.stdout
+    assert "serially: {'positions': 0.0, 'velocities': 0.0, 'forces': 0.0}" in done.stdout
+
+
+@pytest.mark.parametrize(("ranks", "variant"), [(3, "surface"), (2, "rolling")])
+def test_a_simulation_given_a_communicator_writes_the_serial_outputs(
+    ranks: int, variant: str
+) -> None:
+    """gr.Simulation(comm=...) with outputs every 250 steps, checkpoints every 1,000 and a stop
+    check every 500: the drum's output folder is the serial run's byte for byte (but run.json,
+    the checkpoint and history.csv's list_rebuilds); rank 0's simulation holds the serial
+    run's nodes, contact table and wall reactions, the other ranks refuse to give results,
+    and a serial run continues from the distributed checkpoint bit for bit."""
+    done = run_ranks(ranks, "api", variant, "3000")
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert f"api {variant} on {ranks} ranks: 70 files, differing []" in done.stdout
+    assert "list_rebuilds True (13 rows)" in done.stdout and "resumed serially True" in done.stdout
 
 
 @pytest.mark.parametrize("migrate", [False, True])

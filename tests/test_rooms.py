@@ -130,8 +130,9 @@ def test_the_run_loop_drives_the_parts_it_is_given(tmp_path) -> None:
     chunks = []
     plan = CheckpointPlan.create(40, None, tmp_path / "loop.npz", None)
     record = RunRecord()
-    parts = LoopParts(None, record, plan, None, lambda: chunks.append(sim.step))
-    steps = run_loop.steps_to_run(sim.core, 100, None, 100)
+    stepper = run_loop.CoreStepper(sim.core)
+    parts = LoopParts(None, record, plan, None, lambda: chunks.append(sim.step), stepper)
+    steps = run_loop.steps_to_run(sim.time, sim.dt, 100, None, 100)
     run_plan = RunPlan(steps, (), 100, None, write_final=True)
     assert run_loop.run_in_folder(sim, run_plan, parts) is None
     assert (sim.step, record.steps_run, sim.summary()["steps_run"]) == (100, 100, 0)

@@ -809,30 +809,49 @@ void ContactModel::sum_probe_springs() {
 }
 
 real ContactModel::spring_energy(const Model& model, const State& state) const {
-  if (!built_) return 0;
-  real energy = 0;
+  const index_t n = model.node_count();
+  std::vector<real> energy(n);
+  std::vector<std::uint32_t> pairs(n), walls(n);
+  node_contact_terms(model, state, energy.data(), pairs.data(), walls.data());
+  real total = 0;
+  for (index_t i = 0; i < n; ++i) total += energy[i];
+  return total;
+}
+
+void ContactModel::node_contact_terms(const Model& model, const State& state, real* energy,
+                                      std::uint32_t* pairs, std::uint32_t* walls) const {
+  const index_t n = model.node_count();
+  std::fill(energy, energy + n, 0.0);
+  std::fill(pairs, pairs + n, 0u);
+  std::fill(walls, walls + n, 0u);
+  if (!built_) return;
   for (const index_t i : contact_nodes_) {
     for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
-      if (pair_partner_[e] < i) continue;        // each pair once: the lists hold both directions
+      if (pair_partner_[e] < i) continue;  // each pair once: the lists hold both directions
+      if (e < pair_stiffness_.size() && pair_stiffness_[e] > 0 && !probe_entry(e)) ++pairs[i];
       if (surface_entry(model, i, e)) continue;  // the probes below
       const real overlap = pair_geometry(model, state, i, e).overlap;
-      if (overlap > 0) energy += 0.5 * entry_stiffness(model, i, e) * overlap * overlap;
+      if (overlap > 0) energy[i] += 0.5 * entry_stiffness(model, i, e) * overlap * overlap;
     }
     for (index_t e = wall_offsets_[i]; e < wall_offsets_[i + 1]; ++e) {
+      if (e < wall_entry_stiffness_.size() && wall_entry_stiffness_[e] > 0) ++walls[i];
       const WallPoints& points = wall_points_[e];
       const real contact_radius = slot_law(wall_slot_[e]).contact_radius;
       for (std::size_t k = 0; k < points.count; ++k) {
         const real overlap = (sphere_of(points, k) == 1 ? points.osculating_radius : contact_radius) -
                              points.points[k].distance;
         if (overlap > 0)
-          energy += 0.5 * points.weights[k] * wall_spring_stiffness(model, i, e) * overlap * overlap;
+          energy[i] += 0.5 * points.weights[k] * wall_spring_stiffness(model, i, e) * overlap * overlap;
       }
     }
   }
   // The surface probes, from their last evaluation: k delta^2 tau / 2 = P^2 / (2 k tau).
-  for (const ProbeState& probe : probes_)
-    energy += 0.5 * probe.push * probe.push / (probe.stiffness * contact::surface_taper(probe.sums.weight));
-  return energy;
+  for (const ProbeState& probe : probes_) {
+    const index_t i = groups_[probe.group].probe;
+    ++pairs[i];
+    energy[i] +=
+        0.5 * probe.push * probe.push / (probe.stiffness * contact::surface_taper(probe.sums.weight));
+  }
 }
 
 }  // namespace granulate

@@ -79,17 +79,16 @@ class CheckpointPlan:
                 "every few minutes (every_minutes)"
             )
 
-    def save_if_due(self, sim: Simulation, outputs: Outputs | None) -> None:
-        """The checkpoint, at a checkpoint step or when its minutes have passed."""
-        step = sim.core.step
-        due = bool(self.every_steps) and step % self.every_steps == 0  # type: ignore[operator]
-        now = wallclock.perf_counter()
-        due = due or (
-            self.every_seconds is not None and now - self.last_wall_time >= self.every_seconds
-        )
-        if due:
-            save(sim, self.path, outputs)
-            self.last_wall_time = now
+    def is_due(self, step: int) -> bool:
+        """Whether a checkpoint is due at `step`: a checkpoint step, or its minutes passed."""
+        if self.every_steps and step % self.every_steps == 0:
+            return True
+        elapsed = wallclock.perf_counter() - self.last_wall_time
+        return self.every_seconds is not None and elapsed >= self.every_seconds
+
+    def saved(self) -> None:
+        """A checkpoint was written now: the minutes count from here."""
+        self.last_wall_time = wallclock.perf_counter()
 
 
 def save(sim: Simulation, path: str | Path, outputs: Outputs | None) -> Path:
@@ -143,15 +142,11 @@ def load(sim: Simulation, path: str | Path, outputs: Outputs | None) -> None:
     outputs.resume(int(saved["frames"]), saved["pvd"], int(core.step))
 
 
-def save_on_interrupt(
-    sim: Simulation, plan: CheckpointPlan | None, outputs: Outputs | None
-) -> Path | None:
-    """The checkpoint a run interrupted by Ctrl-C or SIGTERM leaves: at the plan's path, else in
-    the output folder; None (nothing written) when neither is set."""
+def interrupt_path(plan: CheckpointPlan | None, outputs: Outputs | None) -> Path | None:
+    """Where a run interrupted by Ctrl-C or SIGTERM leaves its checkpoint: at the plan's path,
+    else in the output folder; None (nothing written) when neither is set."""
     if plan is not None:
-        path = plan.path
-    elif outputs is not None:
-        path = outputs.directory / "checkpoint.npz"
-    else:
-        return None
-    return save(sim, path, outputs)
+        return plan.path
+    if outputs is not None:
+        return outputs.directory / "checkpoint.npz"
+    return None

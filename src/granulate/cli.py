@@ -12,8 +12,12 @@
     granulate info                             version, build options, threads
 
 Exit codes: 0 success, 2 invalid input, 1 failed run, 130 interrupted. User errors print one
-line (``--debug`` shows the traceback). Commands that write files refuse to start as several
-MPI ranks (granulate.parallel.launch): distributed runs are not built yet.
+line (``--debug`` shows the traceback).
+
+``mpirun -n K granulate run CASE.yaml`` runs the case on K MPI ranks (granulate.parallel; the
+``mpi`` extra installs mpi4py): the same outputs as the serial run, written by rank 0, which
+also prints; a rank's own failure is printed by that rank. The other commands that write files
+refuse to start as several ranks (granulate.parallel.launch).
 """
 
 from __future__ import annotations
@@ -31,6 +35,7 @@ from granulate._version import __version__
 from granulate.errors import InputError, InstabilityError
 from granulate.io.files import existing_file
 from granulate.io.run_folder import check_writable
+from granulate.parallel.agreement import RankFailed
 from granulate.parallel.launch import launched_ranks, serial_only_message
 from granulate.progress import ProgressReporter, duration
 
@@ -159,19 +164,24 @@ def _run_case(
 ) -> int:
     from granulate.case import load_case
 
+    comm = _world()
+    speaks = comm is None or comm.Get_rank() == 0  # rank 0 prints for every rank
     case = load_case(path, peridem_compat=compat)
-    _notes(case)
+    if speaks:
+        _notes(case)
     if out is None and case.spec.output is None:
         out = Path("out") / path.stem
-    _announce_setup(case)
-    sim = case.build(output=out, resume=resume, overwrite=overwrite)
+    if speaks:
+        _announce_setup(case)
+    sim = case.build(output=out, resume=resume, overwrite=overwrite, comm=comm)
     directory = sim.output_directory
     assert directory is not None
     if sim.checkpoint_path is None:  # a checkpoint on interrupt, at least
         sim.checkpoint_every(path=directory / "checkpoint.npz")
     if resume:
         sim.load_checkpoint(sim.checkpoint_path)
-        print(f"resuming from step {sim.step} (t = {sim.time:.6g} s)")
+        if speaks:
+            print(f"resuming from step {sim.step} (t = {sim.time:.6g} s)")
     steps = case.steps(sim)
     cut_short = False
     if limit is not None:
@@ -181,12 +191,13 @@ def _run_case(
         steps = min(steps, limit)
     stop = case.stop_criteria()
     check_every = case.spec.stop.check_every if case.spec.stop is not None else 100
-    if not quiet:
+    if not quiet and speaks:
+        ranks = "" if comm is None else f" on {comm.Get_size()} MPI ranks"
         print(
-            f"{sim.node_count} nodes, {sim.bond_count} bonds, dt {sim.dt:.4g} s, {steps} steps; "
-            f"output in {directory}"
+            f"{sim.node_count} nodes, {sim.bond_count} bonds, dt {sim.dt:.4g} s, {steps} steps"
+            f"{ranks}; output in {directory}"
         )
-    reporter = ProgressReporter(steps, quiet)
+    reporter = ProgressReporter(steps, quiet or not speaks)
     try:
         # A run cut short by --steps is continued with --resume as if never stopped, so it
         # ends like an interrupted one: no extra frame at its last step.
@@ -200,6 +211,8 @@ def _run_case(
     finally:
         reporter.close()
     sim.save_checkpoint(sim.checkpoint_path)
+    if not speaks:
+        return 0
     summary = sim.summary()
     rate = summary["nodes"] * summary["steps_run"] / max(summary["wall_seconds"], 1e-9)
     ended = f"stopped: {reason}" if reason else "finished"
@@ -208,6 +221,30 @@ def _run_case(
         f"{rate / 1e6:.2f} M node-steps/s, {sim.broken_bonds()} broken bonds"
     )
     return 0
+
+
+def _world() -> object | None:
+    """MPI's world communicator when this process was started as one of several ranks (mpirun,
+    mpiexec, srun), else None. InputError when mpi4py is missing or belongs to another MPI than
+    the launcher's (each process would see itself alone and run the whole case)."""
+    size, _rank = launched_ranks()
+    if size == 1:
+        return None
+    try:
+        from mpi4py import MPI
+    except ImportError:
+        raise InputError(
+            f"granulate run was started as {size} MPI processes, but mpi4py is not installed: "
+            "pip install 'granulate[mpi]' (or mpi4py built against your cluster's MPI)"
+        ) from None
+    if MPI.COMM_WORLD.Get_size() != size:
+        raise InputError(
+            f"the launcher started {size} processes, but mpi4py's MPI sees "
+            f"{MPI.COMM_WORLD.Get_size()}: mpi4py belongs to another MPI than this mpirun. Use "
+            "the mpirun of the MPI mpi4py was built with (python -c 'import mpi4py; "
+            "print(mpi4py.get_config())')"
+        )
+    return MPI.COMM_WORLD
 
 
 def _run_script(script: Path, args: list[str]) -> int:
@@ -320,11 +357,10 @@ def _dispatch(options: argparse.Namespace) -> int:
 
 
 def _writes_output(options: argparse.Namespace) -> bool:
-    """Whether a command writes files (so copies of it on several MPI ranks would collide); a
-    Python script is the user's own and may split its work over ranks."""
-    if options.command == "run":
-        return options.case.suffix != ".py"
-    return options.command not in ("info", "schema", "check")
+    """Whether a command writes files that copies of it on several MPI ranks would write at
+    once: not `run` (a case runs over the ranks; a Python script is the user's own, and may
+    use them itself)."""
+    return options.command not in ("info", "schema", "check", "run")
 
 
 def _main(argv: list[str] | None) -> int:
@@ -340,6 +376,18 @@ def _main(argv: list[str] | None) -> int:
             message = serial_only_message(options.command, size)
             print(f"granulate: error: {message}", file=sys.stderr)
         return 2
+    return _handled(options, rank == 0)
+
+
+def _handled(options: argparse.Namespace, first_rank: bool) -> int:
+    """The command `options` name, its errors turned into one line and an exit code. Of a
+    distributed run's errors, those every rank raises alike are printed by rank 0 alone
+    (`first_rank`), a rank's own failure by that rank."""
+
+    def shared(text: str) -> None:
+        if first_rank:
+            print(text, file=sys.stderr)
+
     try:
         if options.threads is not None:
             threads.set_num_threads(options.threads)
@@ -347,15 +395,20 @@ def _main(argv: list[str] | None) -> int:
     except InputError as error:
         if options.debug:
             raise
-        print(f"granulate: error: {error}", file=sys.stderr)
+        shared(f"granulate: error: {error}")
         return 2
     except InstabilityError as error:
         if options.debug:
             raise
         print(f"granulate: run failed: {error}", file=sys.stderr)
         return 1
+    except RankFailed as error:  # another rank's failure, which that rank prints
+        if options.debug:
+            raise
+        shared(f"granulate: run failed: {error}")
+        return 1
     except KeyboardInterrupt as error:
-        print(f"granulate: {error or 'interrupted'}", file=sys.stderr)
+        shared(f"granulate: {error or 'interrupted'}")
         return 130
     except OSError as error:  # a full disk, a file system gone read-only, a lost mount
         if options.debug:

@@ -1,6 +1,11 @@
 """The time loop of Simulation.run: chunks of steps between the places the loop must stop at
 (outputs, stop checks, checkpoints, about half a second of steps), the thread count the tuner
-picks for each chunk, progress reports, and a clean end on Ctrl-C or SIGTERM."""
+picks for each chunk, progress reports, and a clean end on Ctrl-C or SIGTERM.
+
+The loop advances the simulation through a Stepper: the simulation's own core (CoreStepper), or
+a distributed run's ranks (granulate.parallel.stepper), where rank 0 decides what every rank
+does next (chunk lengths, outputs, stops), gathers the whole state into its simulation before it
+writes or checks, and shares its errors, so that every rank takes the same steps."""
 
 from __future__ import annotations
 
@@ -9,7 +14,8 @@ import threading
 import time as wallclock
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from pathlib import Path
+from typing import TYPE_CHECKING, Protocol, TypeVar
 
 import numpy as np
 
@@ -47,6 +53,81 @@ class RunPlan:
     write_final: bool
 
 
+T = TypeVar("T")
+
+
+class Stepper(Protocol):
+    """How the loop advances a simulation and agrees with the other ranks of a distributed run
+    (every method is called on every rank together)."""
+
+    @property
+    def step(self) -> int: ...
+    @property
+    def time(self) -> float: ...
+    def advance(self, steps: int) -> None:
+        """`steps` time steps."""
+
+    def first_forces(self) -> None:
+        """The forces of the current step, before any step (for step 0's frame)."""
+
+    def collect(self) -> None:
+        """The whole state in the simulation the outputs and stop criteria read."""
+
+    def agree(self, value: T) -> T:
+        """Rank 0's `value`, on every rank."""
+
+    def on_root(self, action: Callable[[], T]) -> T:
+        """action() on rank 0, its result on every rank; its error raised on every rank."""
+
+    def any_rank(self, flag: bool) -> bool:
+        """Whether `flag` is set on any rank."""
+
+    def broken_bonds(self) -> int:
+        """The broken bonds of the whole simulation."""
+
+    def save_checkpoint(self, sim: Simulation, path: Path, outputs: Outputs | None) -> Path:
+        """The checkpoint at `path`; the path written."""
+
+
+class CoreStepper:
+    """A serial run: the simulation's own core, with nothing to agree on."""
+
+    def __init__(self, core: _core.Simulation) -> None:
+        self.core = core
+
+    @property
+    def step(self) -> int:
+        return int(self.core.step)
+
+    @property
+    def time(self) -> float:
+        return float(self.core.time)
+
+    def advance(self, steps: int) -> None:
+        self.core.run(steps)
+
+    def first_forces(self) -> None:
+        self.core.run(0)  # prescribed motion and contact of the current step
+
+    def collect(self) -> None:
+        pass
+
+    def agree(self, value: T) -> T:
+        return value
+
+    def on_root(self, action: Callable[[], T]) -> T:
+        return action()
+
+    def any_rank(self, flag: bool) -> bool:
+        return flag
+
+    def broken_bonds(self) -> int:
+        return int(self.core.broken_bonds())
+
+    def save_checkpoint(self, sim: Simulation, path: Path, outputs: Outputs | None) -> Path:
+        return checkpoints.save(sim, path, outputs)
+
+
 @dataclass(frozen=True)
 class LoopParts:
     """What the loop drives besides the simulation's public API (its core, stop criteria and
@@ -58,6 +139,7 @@ class LoopParts:
     checkpoints: CheckpointPlan | None
     tuner: threads.ThreadTuner | None  # None: the thread count stays as it is
     after_chunk: Callable[[], None]  # e.g. Interactions.warn_deep_contact
+    stepper: Stepper
 
 
 @dataclass
@@ -95,10 +177,10 @@ class SignalCatcher:
 
 
 def steps_to_run(
-    core: _core.Simulation, steps: int | None, until: float | None, check_every: int
+    time: float, dt: float, steps: int | None, until: float | None, check_every: int
 ) -> int:
-    """The number of steps a run(steps, until=...) takes from the core's time: ceil((until -
-    t) / dt) for a time; InputError for bad arguments."""
+    """The number of steps a run(steps, until=...) takes from time `time` [s] at time step
+    `dt` [s]: ceil((until - t) / dt) for a time; InputError for bad arguments."""
     if (steps is None) == (until is None):
         raise InputError("give either steps or until")
     if steps is not None:
@@ -107,7 +189,7 @@ def steps_to_run(
         check_number("run: until", until)
         if not np.isfinite(until):
             raise InputError(f"until must be a finite time, got {until}")
-        steps = max(0, int(np.ceil((until - core.time) / core.time_step - 1e-9)))
+        steps = max(0, int(np.ceil((until - time) / dt - 1e-9)))
     assert steps is not None
     if steps < 0:
         raise InputError(f"steps must be non-negative, got {steps}")
@@ -120,15 +202,9 @@ def run_in_folder(sim: Simulation, plan: RunPlan, parts: LoopParts) -> str | Non
     """The run, in its output folder when outputs are set: its space checked, its lock held
     while it writes, and run.json with its status at the end, whatever ends it."""
     out, record = parts.outputs, parts.record
+    parts.stepper.on_root(lambda: _start_writing(sim, plan, out))  # refused: every rank stops
     if out is None:
         return advance(sim, plan, parts)
-    # The frames this run writes: one every `every` steps, the last step's when it falls
-    # between, and step 0's when none is written yet; each about 8 bytes per component of its
-    # fields per node.
-    steps = plan.steps
-    frames = steps // out.every + (steps % out.every > 0) + (out.frames == 0)
-    out.folder.require_space(frames, sim.node_count * (12 + 8 * 3 * len(out.fields)))
-    out.folder.start_writing()
     record.status = "running"
     try:
         reason = advance(sim, plan, parts)
@@ -146,6 +222,19 @@ def run_in_folder(sim: Simulation, plan: RunPlan, parts: LoopParts) -> str | Non
         except OSError:
             pass  # a full disk: the error that stopped the run is the one to report
         out.folder.stop_writing()
+
+
+def _start_writing(sim: Simulation, plan: RunPlan, out: Outputs | None) -> None:
+    """The output folder checked for space and locked, when outputs are set."""
+    if out is None:
+        return
+    # The frames this run writes: one every `every` steps, the last step's when it falls
+    # between, and step 0's when none is written yet; each about 8 bytes per component of its
+    # fields per node.
+    steps = plan.steps
+    frames = steps // out.every + (steps % out.every > 0) + (out.frames == 0)
+    out.folder.require_space(frames, sim.node_count * (12 + 8 * 3 * len(out.fields)))
+    out.folder.start_writing()
 
 
 def chunk_end(step: int, plan: RunPlan, parts: LoopParts, target: int, limit: int) -> int:
@@ -166,55 +255,63 @@ def chunk_end(step: int, plan: RunPlan, parts: LoopParts, target: int, limit: in
 def advance(sim: Simulation, plan: RunPlan, parts: LoopParts) -> str | None:
     """The time loop: chunks of steps between outputs, stop checks and checkpoints, with the
     thread count the tuner picks; the reason a stop criterion gave, or None."""
-    core, out = sim.core, parts.outputs
-    if out is not None and out.frames == 0:
-        core.run(0)  # the forces of step 0 (prescribed motion, contact), for the frame
-        out.write_step(sim)
-    target = core.step + plan.steps
-    first_step = int(core.step)
+    stepper, out = parts.stepper, parts.outputs
+    if stepper.agree(out is not None and out.frames == 0):
+        stepper.first_forces()  # the forces of step 0 (prescribed motion, contact), for the frame
+        stepper.collect()
+        stepper.on_root(lambda: out.write_step(sim) if out is not None else None)
+    target = stepper.step + plan.steps
+    first_step = stepper.step
     most = threads.get_num_threads()
     start = wallclock.perf_counter()
     reason = None
     try:
         with SignalCatcher() as signals:
             chunks = _Chunks(sim, plan, parts, start)
-            while core.step < target and reason is None:
+            reports = stepper.agree(plan.progress is not None)
+            while stepper.step < target and reason is None:
                 reason = chunks.run(target)
-                if plan.progress is not None:
-                    plan.progress(chunks.progress(target))
-                if signals.caught:
-                    saved = checkpoints.save_on_interrupt(sim, parts.checkpoints, out)
+                if reports:
+                    report = chunks.progress(target)
+                    if plan.progress is not None:
+                        plan.progress(report)
+                if stepper.any_rank(signals.caught):
+                    path = stepper.agree(checkpoints.interrupt_path(parts.checkpoints, out))
+                    saved = None if path is None else stepper.save_checkpoint(sim, path, out)
                     where = f"; checkpoint written to {saved}" if saved else ""
-                    raise KeyboardInterrupt(f"interrupted at step {core.step}{where}")
+                    raise KeyboardInterrupt(f"interrupted at step {stepper.step}{where}")
     finally:
         _core.set_num_threads(most)
         parts.record.wall_seconds += wallclock.perf_counter() - start
-        parts.record.steps_run += int(core.step) - first_step
-    if out is not None:
-        out.write_final(sim, frame=plan.write_final or reason is not None)
+        parts.record.steps_run += stepper.step - first_step
+    stepper.collect()  # the end state in the simulation (rank 0's, in a distributed run)
+    frame = plan.write_final or reason is not None
+    stepper.on_root(lambda: out.write_final(sim, frame=frame) if out is not None else None)
     return reason
 
 
 class _Chunks:
-    """The chunks of one run: each up to the next stopping place, about half a second long."""
+    """The chunks of one run: each up to the next stopping place, about half a second long (as
+    rank 0 measures it, in a distributed run)."""
 
     def __init__(self, sim: Simulation, plan: RunPlan, parts: LoopParts, start: float) -> None:
         self.sim, self.plan, self.parts, self.start = sim, plan, parts, start
-        self.core = sim.core
+        self.stepper = parts.stepper
         self.limit = 10  # steps: the first chunk measures the rate
         self.rate = 0.0
 
     def run(self, target: int) -> str | None:
         """One chunk, then its outputs, stop check and checkpoint; a stop criterion's reason."""
-        sim, plan, parts, core = self.sim, self.plan, self.parts, self.core
+        sim, plan, parts, stepper = self.sim, self.plan, self.parts, self.stepper
         out, tuner = parts.outputs, parts.tuner
-        chunk = chunk_end(int(core.step), plan, parts, target, self.limit)
+        chunk = chunk_end(stepper.step, plan, parts, target, self.limit)
         if tuner is not None:
             count = tuner.threads()
             chunk = min(chunk, tuner.step_cap() or chunk)
             _core.set_num_threads(count)
+        chunk = stepper.agree(chunk)
         began = wallclock.perf_counter()
-        core.run(chunk)
+        stepper.advance(chunk)
         elapsed = wallclock.perf_counter() - began
         if tuner is not None:
             tuner.record(count, chunk, elapsed)
@@ -222,22 +319,34 @@ class _Chunks:
         # Aim at chunks of about half a second: responsive to Ctrl-C and progress.
         self.rate = chunk / max(elapsed, 1e-9)
         self.limit = int(min(10_000, max(1, 0.5 * self.rate)))
-        if out is not None and out.is_output_step(core.step):
-            out.write_step(sim)
+        step = stepper.step
+        writes = out is not None and out.is_output_step(step)
+        checks = bool(plan.stop) and step % plan.check_every == 0
+        checkpoint = parts.checkpoints
+        saves = checkpoint is not None and checkpoint.is_due(step)
+        writes, saves = stepper.agree((writes, saves))
+        if writes or checks:
+            stepper.collect()
+        if writes:
+            stepper.on_root(lambda: out.write_step(sim) if out is not None else None)
         reason = None
-        if plan.stop and core.step % plan.check_every == 0:
-            reason = next((r for c in plan.stop if (r := c.check(sim)) is not None), None)
-        if parts.checkpoints is not None:
-            parts.checkpoints.save_if_due(sim, out)
+        if checks:
+            reason = stepper.on_root(
+                lambda: next((r for c in plan.stop if (r := c.check(sim)) is not None), None)
+            )
+        if saves and checkpoint is not None:
+            stepper.save_checkpoint(sim, checkpoint.path, out)
+            checkpoint.saved()
         return reason
 
     def progress(self, target: int) -> Progress:
-        core = self.core
+        """Where the run stands (every rank computes it; rank 0 reports it)."""
+        stepper = self.stepper
         return Progress(
-            int(core.step),
+            stepper.step,
             int(target),
-            float(core.time),
-            self.sim.broken_bonds(),
+            stepper.time,
+            stepper.broken_bonds(),
             self.rate,
             self.parts.record.wall_seconds + wallclock.perf_counter() - self.start,
         )

@@ -22,7 +22,7 @@ import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import replace
 from pathlib import Path
-from typing import Literal
+from typing import TYPE_CHECKING, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -38,6 +38,7 @@ from granulate.analysis import Analysis
 from granulate.assembly import Assembly, Body
 from granulate.checkpoints import CheckpointPlan
 from granulate.errors import GranulateWarning, InputError
+from granulate.evaluation import Evaluation
 from granulate.input_errors import check_number, unknown_name
 from granulate.interactions import Interactions
 from granulate.io import checkpoint as checkpoint_file
@@ -51,6 +52,9 @@ from granulate.stopping import StopCriterion
 from granulate.writers.outputs import Outputs
 from granulate.writers.vtu_frame import FIELDS
 
+if TYPE_CHECKING:
+    from granulate.parallel import DistributedRun
+
 __all__ = ["FIELDS", "Body", "Components", "Progress", "Simulation"]
 
 
@@ -62,6 +66,15 @@ def _warn_above_stable(dt: float, stable: float, stacklevel: int) -> None:
             "become unstable",
             GranulateWarning,
             stacklevel=stacklevel,
+        )
+
+
+def _check_time_step(dt: float, stable: float, tolerance: float = 5.0) -> None:
+    """InputError if the time step dt exceeds `tolerance` times the stable estimate [s]."""
+    if dt > tolerance * stable:
+        raise InputError(
+            f"time step {dt:.4g} s is {dt / stable:.1f} times the stable estimate {stable:.4g} s; "
+            "use at most the estimate (or leave dt out: the default is 0.8 times it)"
         )
 
 
@@ -78,6 +91,12 @@ class Simulation(SimulationSetup, SimulationResults):
         gravity: body acceleration [m/s^2], e.g. (0, -9.81, 0).
         viscous_damping: background damping rate gamma [1/s] (force density -gamma rho v) for
             quasi-static settling; 0 (off) for dynamics, since it also damps rigid motion.
+        comm: an mpi4py communicator (``MPI.COMM_WORLD``) to run on its ranks: whole grains per
+            rank, the serial run's results bit for bit (granulate.parallel, docs/parallel.md).
+            Every rank sets the simulation up alike and calls ``output``, ``run``, ``dt``,
+            ``step``, ``time`` and the checkpoint methods together; rank 0 writes the outputs,
+            and its simulation holds the whole state (gathered at each output, stop check and
+            run's end) for the results: ``positions``, tables, energies. The other ranks' raise.
     """
 
     def __init__(
@@ -89,6 +108,7 @@ class Simulation(SimulationSetup, SimulationResults):
         dt_safety: float = 0.8,
         gravity: ArrayLike | None = None,
         viscous_damping: float = 0.0,
+        comm: object | None = None,
     ) -> None:
         if dimension not in (2, 3):
             raise InputError(f"dimension must be 2 or 3, got {dimension!r}")
@@ -108,6 +128,7 @@ class Simulation(SimulationSetup, SimulationResults):
         self._core: _core.Simulation | None = None
         self._model: _core.Model | None = None
         self._analysis: Analysis | None = None
+        self._gathered: Evaluation | None = None  # a distributed run's, on rank 0
         self._reference: NDArray[np.float64] | None = None
         self._record = RunRecord()
         self._precracks: list[tuple[NDArray[np.float64], NDArray[np.float64], Shape | None]] = []
@@ -116,6 +137,9 @@ class Simulation(SimulationSetup, SimulationResults):
         self._core_materials: list[Material] = []
         self._setup_digest: str | None = None
         self._checkpoint: CheckpointPlan | None = None
+        self._comm = comm
+        self._distributed: DistributedRun | None = None
+        self._output_path: Path | None = None  # output's directory, on every rank
         #: Extra text identifying the set-up (a case file's hash), checked by load_checkpoint.
         self.case_fingerprint = ""
         self.viscous_damping = viscous_damping
@@ -161,6 +185,11 @@ class Simulation(SimulationSetup, SimulationResults):
             return self._core
         if not self.bodies:
             raise InputError("the simulation has no body; add one with add_body")
+        if self._comm is not None and self._comm.Get_rank() != 0:
+            raise InputError(
+                f"this is rank {self._comm.Get_rank()} of a distributed simulation: the whole "
+                "state is on rank 0 (read results where comm.Get_rank() == 0)"
+            )
         outer_layers = self._interactions.uses_surface_law()
         model, core_materials = core_model.build_model(self._assembly, self.plane, outer_layers)
         core = _core.Simulation(model)
@@ -176,7 +205,6 @@ class Simulation(SimulationSetup, SimulationResults):
         self._assembly.set_initial_velocities(model, core)
         if self._start is not None:
             core.velocities[:] = self._start[1]
-            self._start = None
         self._model = model
         self._core = core
         self._analysis = Analysis(core, model, len(self.bodies))
@@ -249,6 +277,8 @@ class Simulation(SimulationSetup, SimulationResults):
     @property
     def dt(self) -> float:
         """Time step [s]."""
+        if self._comm is not None:
+            return self._distributed_run().dt
         return self._build().time_step
 
     @dt.setter
@@ -291,8 +321,8 @@ class Simulation(SimulationSetup, SimulationResults):
         the last step, for a run advanced in pieces; a stop criterion met always writes them),
         and run.json is brought up to date.
         """
-        self.validate_time_step()
-        steps = run_loop.steps_to_run(self.core, steps, until, check_every)
+        stepper = self._stepper()
+        steps = run_loop.steps_to_run(stepper.time, self.dt, steps, until, check_every)
         self._require_checkpoint_budget(steps)
         if not (progress is None or isinstance(progress, bool) or callable(progress)):
             raise InputError(
@@ -300,14 +330,16 @@ class Simulation(SimulationSetup, SimulationResults):
             )
         callback = None if isinstance(progress, bool) else progress
         plan = RunPlan(steps, tuple(stop), check_every, callback, write_final)
-        core = self.core
         parts = LoopParts(
             self._output,
             self._record,
             self._checkpoint,
             self._thread_tuner(threads.get_num_threads()),
-            lambda: self._interactions.warn_deep_contact(core),
+            self._after_chunk,
+            stepper,
         )
+        if progress is True and self._comm is not None and self._comm.Get_rank() != 0:
+            progress = None  # rank 0 shows it
         if progress is not True:
             return run_loop.run_in_folder(self, plan, parts)
         from granulate.progress import ProgressReporter
@@ -317,6 +349,33 @@ class Simulation(SimulationSetup, SimulationResults):
             return run_loop.run_in_folder(self, replace(plan, progress=reporter), parts)
         finally:
             reporter.close()
+
+    def _stepper(self) -> run_loop.Stepper:
+        """What advances the run: the core, or the ranks of the distributed run."""
+        if self._comm is None:
+            self.validate_time_step()
+            return run_loop.CoreStepper(self.core)
+        from granulate.parallel.stepper import DistributedStepper
+
+        return DistributedStepper(self._distributed_run())
+
+    def _distributed_run(self) -> DistributedRun:
+        """The run on the ranks of `comm` (made on first use, by every rank together; its time
+        step checked as validate_time_step checks a serial one)."""
+        if self._distributed is None:
+            from granulate.parallel import DistributedRun
+
+            self._distributed = DistributedRun(self, self._comm)
+            _check_time_step(self._distributed.dt, self._distributed.stable_dt)
+        return self._distributed
+
+    def _after_chunk(self) -> None:
+        """After each chunk of steps: the warning about bodies pressed deep into each other (in
+        a distributed run, each rank's about its own part)."""
+        if self._distributed is not None:
+            self._interactions.warn_deep_contact(self._distributed.local.core)
+        else:
+            self._interactions.warn_deep_contact(self.core)
 
     def _thread_tuner(self, most: int) -> threads.ThreadTuner | None:
         """The run's thread-count picker (kept across runs of this simulation), or None when
@@ -348,8 +407,8 @@ class Simulation(SimulationSetup, SimulationResults):
 
     @property
     def output_directory(self) -> Path | None:
-        """Where output(...) writes, or None."""
-        return None if self._output is None else self._output.directory
+        """Where output(...) writes, or None (in a distributed run: rank 0's, on every rank)."""
+        return self._output_path
 
     @property
     def checkpoint_path(self) -> Path | None:
@@ -359,13 +418,10 @@ class Simulation(SimulationSetup, SimulationResults):
     def validate_time_step(self, tolerance: float = 5.0) -> None:
         """InputError if the time step exceeds ``tolerance`` times the stable estimate (a run
         would blow up); the case runner calls it before running."""
+        if self._comm is not None:
+            return  # the distributed run checks its time step when it is made
         core = self._build()
-        if core.time_step > tolerance * core.stable_time_step:
-            raise InputError(
-                f"time step {core.time_step:.4g} s is {core.time_step / core.stable_time_step:.1f} "
-                f"times the stable estimate {core.stable_time_step:.4g} s; use at most the "
-                "estimate (or leave dt out: the default is 0.8 times it)"
-            )
+        _check_time_step(core.time_step, core.stable_time_step, tolerance)
 
     # ------------------------------------------------------------------ checkpoints
     def checkpoint_every(
@@ -378,12 +434,14 @@ class Simulation(SimulationSetup, SimulationResults):
         """Write a checkpoint every ``steps`` steps and/or every ``minutes`` of wall time, and on
         Ctrl-C/SIGTERM, to ``path`` (default: ``checkpoint.npz`` in the output directory). Each
         checkpoint replaces the last one atomically."""
-        directory = None if self._output is None else self._output.directory
-        self._checkpoint = CheckpointPlan.create(steps, minutes, path, directory)
+        self._checkpoint = CheckpointPlan.create(steps, minutes, path, self.output_directory)
 
     def _require_checkpoint_budget(self, steps: int) -> None:
         if self._checkpoint is not None:
-            self._checkpoint.require_budget(steps, self.node_count, self.bond_count)
+            bonds = (
+                self._distributed_run().bond_count if self._comm is not None else self.bond_count
+            )
+            self._checkpoint.require_budget(steps, self.node_count, bonds)
 
     def fingerprint(self) -> str:
         """Identifies the set-up a checkpoint belongs to: nodes, volumes, bonds, loading,
@@ -410,11 +468,21 @@ class Simulation(SimulationSetup, SimulationResults):
 
     def save_checkpoint(self, path: str | Path) -> Path:
         """Write the state (positions, velocities, forces, bond states, contact history, time,
-        step) and the output bookkeeping to ``path`` atomically (granulate.checkpoints)."""
+        step) and the output bookkeeping to ``path`` atomically (granulate.checkpoints). In a
+        distributed run every rank calls it; rank 0 writes the whole state, which restarts on
+        any number of ranks or serially."""
+        if self._comm is not None:
+            written = self._distributed_run().save_checkpoint(path, self._output)
+            return Path(self._comm.bcast(written, root=0))
         return checkpoints.save(self, path, self._output)
 
     def load_checkpoint(self, path: str | Path) -> None:
         """Continue from a checkpoint of this same set-up (else InputError): restores the state
         and, when outputs are set, the frame count, the PVD series and history.csv up to the
-        checkpoint's step, so that the outputs that follow are those of an uninterrupted run."""
+        checkpoint's step, so that the outputs that follow are those of an uninterrupted run.
+        In a distributed run every rank calls it; the checkpoint may come from any number of
+        ranks, or from a serial run."""
+        if self._comm is not None:
+            self._distributed_run().load_checkpoint(path, self._output)
+            return
         checkpoints.load(self, path, self._output)

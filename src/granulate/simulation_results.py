@@ -9,7 +9,7 @@ them. ``SimulationResults`` is a part of ``granulate.Simulation``, not a class t
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import Literal
+from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -19,6 +19,7 @@ from granulate._version import __version__
 from granulate.analysis import Analysis
 from granulate.assembly import Assembly, Body
 from granulate.errors import InputError
+from granulate.evaluation import Evaluation
 from granulate.interactions import Interactions
 from granulate.run_loop import RunRecord
 from granulate.shapes import Shape
@@ -50,7 +51,11 @@ class SimulationResults:
     _tuner: threads.ThreadTuner | None
     _record: RunRecord
     _output: Outputs | None
+    _gathered: Evaluation | None
+    _comm: Any
+    _distributed: Any  # granulate.parallel.DistributedRun, once a distributed run is made
     _build: Callable[[], _core.Simulation]
+    _distributed_run: Callable[[], Any]
 
     @property
     def positions(self) -> NDArray[np.float64]:
@@ -102,10 +107,16 @@ class SimulationResults:
 
     @property
     def time(self) -> float:
+        """Simulated time [s] (in a distributed run, on every rank)."""
+        if self._comm is not None:
+            return float(self._distributed_run().local.core.time)
         return self._build().time
 
     @property
     def step(self) -> int:
+        """Steps taken (in a distributed run, on every rank)."""
+        if self._comm is not None:
+            return int(self._distributed_run().local.core.step)
         return self._build().step
 
     def kinetic_energy(self) -> float:
@@ -146,6 +157,8 @@ class SimulationResults:
         crack = (vector(point, "point"), vector(normal, "normal"), region)
         if region is not None and not isinstance(region, Shape):
             raise InputError(f"precrack: region must be a shape, got {type(region).__name__}")
+        if self._distributed is not None:
+            raise InputError("precrack a distributed simulation before its first run")
         if self._core is None:
             self._precracks.append(crack)
             return None
@@ -193,7 +206,9 @@ class SimulationResults:
         ``steps_run`` and ``wall_seconds`` the steps advanced and the wall time taken by this
         process's runs (after a resume, only the resumed part)."""
         core = self._build()
-        phases = core.phase_times
+        # A distributed run's timings are rank 0's part's (its simulation steps no grain).
+        timed = core if self._distributed is None else self._distributed.local.core
+        phases = timed.phase_times
         return {
             "granulate": __version__,
             "case_fingerprint": self.case_fingerprint,
@@ -205,6 +220,7 @@ class SimulationResults:
             "stable_dt": core.stable_time_step,
             "steps": core.step,
             "time": core.time,
+            "ranks": 1 if self._comm is None else int(self._comm.Get_size()),
             "threads": threads.get_num_threads(),
             "threads_in_use": self._tuner.current if self._tuner is not None else None,
             "status": self._record.status,
@@ -214,7 +230,7 @@ class SimulationResults:
             "integration_seconds": phases.integration,
             "loading_seconds": phases.loading,
             "contact_seconds": phases.contact,
-            "neighbor_list_rebuilds": core.contact_statistics.rebuilds,
+            "neighbor_list_rebuilds": timed.contact_statistics.rebuilds,
         }
 
     @property
@@ -238,7 +254,17 @@ class SimulationResults:
         fragments, and particles on walls): the bodies, contact point [m], normal, force on
         the first body [N; N/m in 2D], normal and tangential force (granulate.network; wall
         k is ``list(sim.wall_reactions())[k]``)."""
+        if self._gathered is not None:
+            return self._gathered.contacts
         return self.analysis.contact_table()
+
+    def evaluation(self) -> Evaluation:
+        """What the last force evaluation left besides the nodes' state: contacts, contact
+        energy and counts, wall reactions (granulate.evaluation). In a distributed run, rank 0's
+        simulation holds them as gathered at the last output, stop check or end of a run."""
+        if self._gathered is not None:
+            return self._gathered
+        return Evaluation.of_core(self._build())
 
     def particle_stresses(
         self,
@@ -248,6 +274,8 @@ class SimulationResults:
         """Each particle's mean stress, (particles, D, D) [Pa; tension positive]: Love-Weber
         from its contacts (`contacts`: the current contact table, made when not given), or from
         its bond forces (granulate.network; the two agree for a particle at rest)."""
+        if method == "contacts" and contacts is None:
+            contacts = self.contact_table()
         return self.analysis.particle_stresses(method, contacts)
 
     @property

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -19,6 +20,7 @@ from granulate import _core, assembly
 from granulate.assembly import Assembly, Body
 from granulate.contact import Contact
 from granulate.errors import InputError
+from granulate.evaluation import Evaluation
 from granulate.functions import TimeFunction
 from granulate.input_errors import check_number
 from granulate.interactions import Interactions
@@ -46,8 +48,12 @@ class SimulationSetup:
     _gravity: NDArray[np.float64]
     _viscous_damping: float
     _output: Outputs | None
+    _output_path: Path | None
+    _comm: Any
+    _distributed: Any  # granulate.parallel.DistributedRun, once a distributed run is made
     _start: tuple[NDArray[np.float64], NDArray[np.float64]] | None
     _build: Callable[[], _core.Simulation]
+    evaluation: Callable[[], Evaluation]
 
     @property
     def bodies(self) -> list[Body]:
@@ -60,7 +66,7 @@ class SimulationSetup:
         return self._assembly.packings
 
     def _require_building(self, what: str) -> None:
-        if self._core is not None:
+        if self._core is not None or self._distributed is not None:
             raise InputError(
                 f"cannot {what} after the simulation has started; build everything first"
             )
@@ -287,6 +293,8 @@ class SimulationSetup:
 
     @gravity.setter
     def gravity(self, value: ArrayLike) -> None:
+        if self._distributed is not None:
+            self._require_building("change gravity in a distributed run")
         self._gravity = self._assembly.vector(value, "gravity")
         if self._core is not None:
             self._core.set_body_acceleration(tuple(self._gravity))
@@ -339,6 +347,8 @@ class SimulationSetup:
 
     def set_neighbor_skin(self, skin: float) -> None:
         """Verlet skin of the contact neighbour lists [m] (default: half the contact radius)."""
+        if self._distributed is not None:
+            self._require_building("change the skin in a distributed run")
         self._interactions.set_skin(skin)
         if self._core is not None:
             self._core.set_contact_skin(skin)
@@ -356,9 +366,8 @@ class SimulationSetup:
     def wall_reactions(self) -> dict[str, NDArray[np.float64]]:
         """Per wall: (fx, fy, fz, tx, ty, tz), the force and torque the particles exert on it
         at the last step [N, N m; per unit thickness in 2D]."""
-        core = self._build()
-        names = self._interactions.wall_names
-        return {name: np.asarray(r) for name, r in zip(names, core.wall_reactions(), strict=True)}
+        reactions = self.evaluation().wall_reactions
+        return dict(zip(self._interactions.wall_names, reactions.copy(), strict=True))
 
     def output(
         self,
@@ -393,14 +402,25 @@ class SimulationSetup:
         A file, or a directory you cannot write, is refused at once; while a run writes, the
         directory is locked (.granulate.lock) against a second run.
         """
-        self._output = Outputs.plan(
-            Path(directory),
-            every,
-            history_every,
-            fields,
-            tuple(self._assembly.body(b) for b in track),
-            track_areas or {},
-            self._interactions.wall_names,
-            overwrite=overwrite,
-            resume=resume,
-        )
+        tracked = tuple(self._assembly.body(b) for b in track)
+
+        def plan() -> Outputs:
+            return Outputs.plan(
+                Path(directory),
+                every,
+                history_every,
+                fields,
+                tracked,
+                track_areas or {},
+                self._interactions.wall_names,
+                overwrite=overwrite,
+                resume=resume,
+            )
+
+        if self._comm is None:
+            self._output = plan()
+        else:  # rank 0 writes; its folder's problems stop every rank
+            from granulate.parallel.agreement import on_root
+
+            self._output = on_root(self._comm, plan)
+        self._output_path = Path(directory)

@@ -183,6 +183,18 @@ void bind_results(nb::class_<Simulation>& cls) {
       .def("kinetic_energy", &Simulation::kinetic_energy)
       .def("strain_energy", &Simulation::strain_energy)
       .def("contact_energy", &Simulation::contact_energy)
+      .def(
+          "node_contact_terms",
+          [](const Simulation& self) {
+            const index_t n = self.model().node_count();
+            std::vector<real> energy(n);
+            std::vector<std::uint32_t> pairs(n), walls(n);
+            self.contact().node_contact_terms(self.model(), self.state(), energy.data(), pairs.data(),
+                                              walls.data());
+            return nb::make_tuple(copy_out(energy), copy_out(pairs), copy_out(walls));
+          },
+          "Per node: its contacts' spring energy, node pairs in contact (at the smaller node) and "
+          "wall contacts (ContactModel::node_contact_terms).")
       .def("broken_bonds", &Simulation::broken_bonds)
       .def("strain_energy_density",
            [](const Simulation& self) {
@@ -227,6 +239,14 @@ void bind_state(nb::class_<Simulation>& cls) {
                      return view(self.state().dilatation.data(), self.model().node_count(), 0,
                                  nb::find(self));
                    })
+      .def(
+          "broken_bond_copies",
+          [](const Simulation& self, index_t first, index_t last) {
+            if (first > last || last > self.model().node_count())
+              throw InputError("broken_bond_copies: nodes out of range");
+            return self.state().bonds.broken(self.model().bond_offsets(), first, last);
+          },
+          "first"_a, "last"_a, "The broken bond copies (two per bond) of nodes first .. last-1.")
       .def_prop_ro("bond_intact",
                    [](Simulation& self) {  // a read-only copy, 1 byte per bond (stored as bits)
                      nb::object array =

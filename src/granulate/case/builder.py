@@ -137,10 +137,12 @@ class Case:
         resume: bool = False,
         overwrite: bool = False,
         outputs: bool = True,
+        comm: object | None = None,
     ) -> Simulation:
         """The Simulation the case describes (not yet run). ``output`` overrides the output
         directory; ``resume`` keeps an existing run there for load_checkpoint; ``outputs=False``
-        sets up no output or checkpoints (``granulate check``)."""
+        sets up no output or checkpoints (``granulate check``); ``comm``: an mpi4py
+        communicator to run it on (Simulation's)."""
         spec = self.spec
         case = CaseContext(spec, self.source.parent)
         sim = Simulation(
@@ -152,6 +154,7 @@ class Case:
             if spec.gravity is None
             else _vector(spec.gravity, spec.dimension, "gravity"),
             viscous_damping=spec.viscous_damping,
+            comm=comm,
         )
         sim.case_fingerprint = self.fingerprint
         named = _add_bodies(sim, spec, case)

@@ -20,32 +20,32 @@ the state is gathered on one rank with `gather`.
 
 from __future__ import annotations
 
-import io
 import os
 import time
 import warnings
 from collections.abc import Callable
+from pathlib import Path
 from typing import TYPE_CHECKING, Any, TypeVar
 
 import numpy as np
 from numpy.typing import NDArray
 
+from granulate import checkpoints
 from granulate.errors import InputError
-from granulate.io.atomic import atomic_write
+from granulate.parallel.agreement import RankFailed, on_root, together
 from granulate.parallel.partition import Partition, bisect, ghosts, near_pairs
 from granulate.parallel.transplant import (
-    CHECKPOINT_FORMAT,
     GrainState,
     body_first_nodes,
     grain_states,
-    pack_states,
     restore_grains,
-    unpack_states,
     wall_lists,
 )
+from granulate.parallel.whole_state import install, owned_part
 
 if TYPE_CHECKING:
     from granulate.simulation import Simulation
+    from granulate.writers.outputs import Outputs
 
 _TAG = 17
 T = TypeVar("T")
@@ -67,7 +67,7 @@ class DistributedRun:
     ) -> None:
         from mpi4py import MPI
 
-        self._mpi = MPI
+        self.mpi = MPI
         self.comm = comm
         self._sim = sim
         self._slices = [body.node_slice for body in sim.bodies]  # each grain's global nodes
@@ -80,6 +80,8 @@ class DistributedRun:
         self._skin = comm.allreduce(probe.contact_skin, op=MPI.MAX)
         cutoff = comm.allreduce(probe.contact_reach - probe.contact_skin, op=MPI.MAX) + self._skin
         self._dt = comm.allreduce(probe.time_step, op=MPI.MIN)
+        #: The stable time-step estimate [s]: the least of every grain's (as the serial one).
+        self.stable_dt = comm.allreduce(probe.stable_time_step, op=MPI.MIN)
         self.margin = float(radii.max() if margin is None else margin)
         self._reach = cutoff + self.margin
         self._migrates = migrate
@@ -98,34 +100,21 @@ class DistributedRun:
         held = self._distribute(centres, radii)
         self._together(lambda: self._build(held))
         self._exchange()
-        #: Wall-clock seconds of this rank in its steps, ghost exchanges, partition checks and
-        #: migrations.
-        self.seconds = {"steps": 0.0, "exchange": 0.0, "check": 0.0, "migrate": 0.0}
+        #: Wall-clock seconds of this rank in its steps, ghost exchanges, partition checks,
+        #: migrations and collections of the whole state on rank 0 (collect).
+        self.seconds = dict.fromkeys(("steps", "exchange", "check", "migrate", "collect"), 0.0)
 
     def _build(self, held: NDArray[np.int64]) -> None:
         """This rank's part of the grains `held` at the start, with its first forces (the
         owners' values for the ghosts come with the first exchange)."""
         self.local, node_map = self._sim._subdomain(held, dt=self._dt, skin=self._skin)
+        self.held = held
         self._plan(node_map)
         self.local.core.run(0)
 
     def _together(self, action: Callable[[], T]) -> T:
-        """action() on every rank; when it raised on some rank, every rank stops: the first
-        such rank with its own error, the others with a RuntimeError naming it (one reduction;
-        no rank is left waiting in a later message)."""
-        failure, result = None, None
-        try:
-            result = action()
-        except Exception as error:  # re-raised below, once every rank knows
-            failure = error
-        size = self.comm.Get_size()
-        mine = self.comm.Get_rank() if failure is not None else size
-        first = self.comm.allreduce(mine, op=self._mpi.MIN)
-        if failure is not None:
-            raise failure
-        if first < size:
-            raise RuntimeError(f"rank {first} failed while building its part; every rank stops")
-        return result  # type: ignore[return-value]
+        """action() on every rank, ending every rank when it fails on one (agreement.py)."""
+        return together(self.comm, action)
 
     def _distribute(
         self, centres: NDArray[np.float64], radii: NDArray[np.float64]
@@ -183,6 +172,28 @@ class DistributedRun:
         return len(self._owned_nodes)
 
     @property
+    def owned(self) -> NDArray[np.int64]:
+        """The grains this rank owns, sorted."""
+        return self._owned
+
+    @property
+    def owned_nodes(self) -> NDArray[np.int64]:
+        """The local indices of the owned grains' nodes, in grain order."""
+        return self._owned_nodes
+
+    def owned_slices(self) -> list[slice]:
+        """The local node slice of each owned grain, in grain order."""
+        return [self._local_slice(g) for g in self._owned]
+
+    def is_owned_node(self, local: NDArray[np.int64]) -> NDArray[np.bool_]:
+        """Whether each of these local nodes belongs to an owned grain."""
+        return self._is_owned[local]
+
+    def global_nodes(self, local: NDArray[np.int64]) -> NDArray[np.int64]:
+        """The global indices of these local nodes."""
+        return self._to_global[local]
+
+    @property
     def ghost_node_count(self) -> int:
         """The nodes of the other ranks' grains this rank holds as ghosts."""
         return self.local._assembly.node_count - len(self._owned_nodes)
@@ -197,7 +208,7 @@ class DistributedRun:
             box = self._outbox[q]
             box[:, :3], box[:, 3:6], box[:, 6:] = x[nodes], v[nodes], f[nodes]
             requests.append(self.comm.Isend(box, dest=q, tag=_TAG))
-        self._mpi.Request.Waitall(requests)
+        self.mpi.Request.Waitall(requests)
         for q, nodes in self._receive.items():
             box = self._inbox[q]
             x[nodes], v[nodes], f[nodes] = box[:, :3], box[:, 3:6], box[:, 6:]
@@ -206,7 +217,7 @@ class DistributedRun:
         """Advance every rank `steps` time steps, migrating grains before a step once a node
         has moved a quarter of the margin. Raises InputError (on every rank) when a node has
         moved more than half the margin: the ghosts would no longer be enough. An error in one
-        rank's step ends every rank: that rank raises its own, the others a RuntimeError naming
+        rank's step ends every rank: that rank raises its own, the others RankFailed naming
         it (no rank is left waiting for a message)."""
         for _ in range(steps):
             if self._migration_due:  # before the step, so the parts hold its evaluation after
@@ -239,12 +250,12 @@ class DistributedRun:
         failed_rank = self.comm.Get_rank() if failure is not None else size
         mine = np.array([failed_rank, -farthest])  # elementwise minima: both in one reduction
         least = np.empty(2)
-        self.comm.Allreduce(mine, least, op=self._mpi.MIN)
+        self.comm.Allreduce(mine, least, op=self.mpi.MIN)
         first_failed, farthest = int(least[0]), -float(least[1])
         if failure is not None:
             raise failure
         if first_failed < size:
-            raise RuntimeError(f"step {step}: rank {first_failed} failed; every rank stops")
+            raise RankFailed(f"step {step}: rank {first_failed} failed; every rank stops")
         if farthest > 0.5 * self.margin:
             advice = (
                 "a node moved that far within one distribution of the grains; give "
@@ -337,47 +348,52 @@ class DistributedRun:
                 held, dt=self._dt, skin=self._skin, initial_motion=False
             )
             restore_grains(local.core, [states[int(g)] for g in held], node_map, moment)
-        self.local = local
+        self.local, self.held = local, held
         self._plan(node_map)
 
-    def save_checkpoint(self, path: str | os.PathLike[str]) -> None:
-        """Write every grain's whole state (transplant.py's, in global numbering) to one .npz
-        at `path`, from rank 0: a run restarts from it on any number of ranks
-        (load_checkpoint), bit for bit. Every rank calls it; a failure to write is raised on
-        every rank."""
+    def save_checkpoint(
+        self, path: str | os.PathLike[str], outputs: Outputs | None = None
+    ) -> Path | None:
+        """Write the run's checkpoint at `path`, the serial run's format (granulate.checkpoints,
+        with the bookkeeping of `outputs`): every grain's state is gathered into rank 0's
+        simulation, which writes it. It restarts on any number of ranks (load_checkpoint), or
+        serially, bit for bit. Every rank calls it; a failure to write is raised on every rank.
+        The path written, on rank 0 (None on the others)."""
         saved = dict(self.local.core.checkpoint())
         saved["contact_wall_reactions"] = self.wall_reactions().ravel()  # the whole run's
         owned = {int(g): self._local_slice(g) for g in self._owned}
         parts = self.comm.gather(grain_states(self.local, saved, self._to_global, owned), root=0)
-        problem = None
-        if parts is not None:
-            states = {grain: state for part in parts for grain, state in part.items()}
-            try:
-                buffer = io.BytesIO()
-                np.savez(buffer, **pack_states(states, saved))
-                atomic_write(path, buffer.getvalue())
-            except OSError as error:
-                problem = f"could not write the checkpoint {os.fspath(path)!r}: {error}"
-        problem = self.comm.bcast(problem, root=0)
-        if problem is not None:
-            raise InputError(problem)
 
-    def load_checkpoint(self, path: str | os.PathLike[str]) -> None:
-        """Continue from a checkpoint of save_checkpoint, written on any number of ranks (this
-        set-up's grains): the grains are cut anew where the checkpoint has them and each rank
-        builds its part from their states. Every rank calls it and reads the file."""
-        try:
-            with np.load(path) as data:
-                arrays = dict(data)
-            problem = self._checkpoint_problem(arrays)
-        except (OSError, ValueError, KeyError) as error:
-            problem = f"could not read the checkpoint {os.fspath(path)!r}: {error}"
-        problems = [p for p in self.comm.allgather(problem) if p is not None]
-        if problems:
-            raise InputError(problems[0])
+        def write() -> Path:
+            assert parts is not None
+            states = {grain: state for part in parts for grain, state in part.items()}
+            sim = self._sim
+            every = [states[g] for g in range(len(self._slices))]
+            with warnings.catch_warnings():  # the start checks were made when the run was set up
+                warnings.simplefilter("ignore")
+                restore_grains(sim._build(), every, np.arange(self._node_count), saved)
+            sim.analysis.forget_fragments()
+            return checkpoints.save(sim, path, outputs)
+
+        return on_root(self.comm, write)
+
+    def load_checkpoint(self, path: str | os.PathLike[str], outputs: Outputs | None = None) -> None:
+        """Continue from a checkpoint of this set-up written by a run on any number of ranks, or
+        by a serial run (else InputError on every rank): rank 0 reads it into its simulation
+        (with `outputs`' bookkeeping, granulate.checkpoints.load), the grains are cut anew where
+        it has them and each rank builds its part from their states. Every rank calls it."""
+
+        def read() -> tuple[dict[int, GrainState], dict[str, Any]]:
+            sim = self._sim
+            checkpoints.load(sim, path, outputs)
+            sim._gathered = None  # the evaluation gathered before is not the checkpoint's
+            saved = dict(sim.core.checkpoint())
+            every = {g: self._slices[g] for g in range(len(self._slices))}
+            return grain_states(sim, saved, np.arange(self._node_count), every), saved
+
         start = time.perf_counter()
-        every = np.arange(len(self._slices))
-        states, moment = unpack_states(arrays, every)
+        states, moment = self.comm.bcast(on_root(self.comm, read), root=0)
+        every = range(len(self._slices))
         held = self._distribute(
             *_spheres([states[g].positions for g in every], self._sim.dimension)
         )
@@ -385,20 +401,6 @@ class DistributedRun:
         self._loaded_walls = np.asarray(moment["contact_wall_reactions"]).reshape(-1, 6)
         self._migration_due = False
         self.seconds["migrate"] += time.perf_counter() - start
-
-    def _checkpoint_problem(self, arrays: dict[str, NDArray[Any]]) -> str | None:
-        """What makes a distributed checkpoint's arrays unfit for this set-up, or None."""
-        if int(arrays["format"]) != CHECKPOINT_FORMAT:
-            return f"the checkpoint's format is {int(arrays['format'])}, not {CHECKPOINT_FORMAT}"
-        nodes = [s.stop - s.start for s in self._slices]
-        if not np.array_equal(arrays["grains"], np.arange(len(nodes))) or not np.array_equal(
-            arrays["positions_rows"], nodes
-        ):
-            return (
-                "the checkpoint holds other grains than this set-up (their number or nodes "
-                "differ): load it into the simulation it was written from"
-            )
-        return None
 
     def wall_reactions(self) -> NDArray[np.float64]:
         """(walls, 6): the force and torque on each wall from the last step [N, N m; per unit
@@ -413,7 +415,7 @@ class DistributedRun:
         slots, terms = slots.reshape(-1, 2).astype(np.int64), terms.reshape(-1, 9)
         offsets, rows, keys = wall_lists(core)
         evaluated = len(terms) == len(slots) and len(reactions) == 6 * len(rows)
-        if not self.comm.allreduce(evaluated, op=self._mpi.LAND):
+        if not self.comm.allreduce(evaluated, op=self.mpi.LAND):
             raise RuntimeError(
                 "wall reactions are known once a step has evaluated them on the parts built in "
                 "the last migration: run a step first"
@@ -435,6 +437,32 @@ class DistributedRun:
         if parts is not None:
             total = _sum_wall_terms(parts, len(core.wall_reactions()))
         return self.comm.bcast(total, root=0)
+
+    def collect(self) -> None:
+        """Every rank: rank 0's simulation (the one the run was made of, built whole on the
+        first call) takes every grain's state and the last step's contacts, contact energy
+        and counts and wall reactions, in the serial order (whole_state.py): its outputs,
+        measures and stop criteria are then the serial run's at this step."""
+        start = time.perf_counter()
+        walls = self.wall_reactions()
+        parts = self.comm.gather(owned_part(self), root=0)
+        if parts is not None:
+            core = self.local.core
+            install(self._sim, parts, (float(core.time), int(core.step)), walls)
+        self.seconds["collect"] += time.perf_counter() - start
+
+    @property
+    def bond_count(self) -> int:
+        """Every grain's bonds, counted once per end (Simulation.bond_count), on every rank."""
+        offsets = np.asarray(self.local.model.bond_offsets, dtype=np.int64)
+        mine = sum(int(offsets[s.stop] - offsets[s.start]) for s in self.owned_slices())
+        return int(self.comm.allreduce(mine))
+
+    def broken_bonds(self) -> int:
+        """The broken bonds of every grain, each counted once, on every rank (one reduction)."""
+        core = self.local.core
+        copies = sum(core.broken_bond_copies(s.start, s.stop) for s in self.owned_slices())
+        return int(self.comm.allreduce(copies)) // 2
 
     @property
     def dt(self) -> float:

@@ -1,9 +1,10 @@
 """Whether this process was started as one of several MPI ranks (mpirun, mpiexec, srun), read
 from the variables the launchers set, without importing MPI.
 
-granulate does not run a case over ranks yet (issue 17), so K ranks of `granulate run case.yaml`
-would be K copies of one serial run writing the same output folder at once. The command line
-refuses that with one message from rank 0 (the other ranks exit with the same code, silently).
+`granulate run case.yaml` started as K ranks runs the case over them (granulate.parallel). The
+other commands that write files would be K copies writing the same files at once: the command
+line refuses them with one message from rank 0 (the other ranks exit with the same code,
+silently).
 """
 
 from __future__ import annotations
@@ -33,9 +34,7 @@ def launched_ranks(environ: Mapping[str, str] | None = None) -> tuple[int, int]:
 def serial_only_message(command: str, size: int) -> str:
     """What a user who started `granulate <command>` on `size` ranks is told."""
     return (
-        f"'granulate {command}' was started as {size} MPI processes (mpirun, mpiexec or srun), "
-        "but granulate does not run a case over MPI ranks yet, and the copies would write the "
-        "same output at once. Start one process and give it threads instead: "
-        f"granulate --threads N {command} ... (a Python script run with 'granulate run "
-        "script.py' may use mpi4py itself, for a parameter sweep)"
+        f"'granulate {command}' was started as {size} MPI processes (mpirun, mpiexec or srun); "
+        "only 'granulate run' runs over MPI ranks, and the copies would write the same files at "
+        f"once. Start one process: granulate --threads N {command} ..."
     )

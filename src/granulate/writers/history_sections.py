@@ -32,9 +32,9 @@ class Energies:
     def columns(self, data: StepData, outputs: Outputs) -> dict[str, float | int]:
         sim = data.simulation
         core = sim.core
+        evaluation = data.evaluation
         kinetic, strain = core.kinetic_energy(), core.strain_energy()
-        gravity, contact = sim.gravity_energy(), core.contact_energy()
-        statistics = core.contact_statistics
+        gravity, contact = sim.gravity_energy(), evaluation.contact_energy
         return {
             "step": core.step,
             "time": core.time,
@@ -44,9 +44,9 @@ class Energies:
             "contact_energy": contact,
             "total_energy": kinetic + strain + gravity + contact,
             "broken_bonds": core.broken_bonds(),
-            "node_contacts": statistics.node_contacts,
-            "wall_contacts": statistics.wall_contacts,
-            "list_rebuilds": statistics.rebuilds,
+            "node_contacts": evaluation.node_contacts,
+            "wall_contacts": evaluation.wall_contacts,
+            "list_rebuilds": evaluation.list_rebuilds,
         }
 
 
@@ -84,7 +84,7 @@ class WallLoads:
         core = sim.core
         row: dict[str, float | int] = {}
         for (name, spec), reaction, wall in zip(
-            sim.walls, core.wall_reactions(), core.walls, strict=True
+            sim.walls, data.evaluation.wall_reactions, core.walls, strict=True
         ):
             for c in _WALL_COMPONENTS[sim.dimension]:
                 row[f"{name}_{c}"] = float(reaction[_WALL_INDEX[c]])

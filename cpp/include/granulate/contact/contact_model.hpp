@@ -144,9 +144,18 @@ class ContactModel {
   /// wall it has a law with. Infinity without contact.
   real stable_time_step(const Model& model) const;
   /// Energy stored in the normal contact springs [J; J/m in 2D]: sum of k overlap^2 / 2 over
-  /// node pairs (each once) and node-wall points in contact at the state's positions, summed in
-  /// node order. The friction springs' energy is not included.
+  /// node pairs (each once) and node-wall points in contact at the state's positions, and of
+  /// P^2 / (2 k tau) over the surface probes of the last evaluation: node_contact_terms' energy
+  /// summed in node order. The friction springs' energy is not included.
   real spring_energy(const Model& model, const State& state) const;
+  /// Per node (arrays of node_count, overwritten): the normal springs' energy of its contacts
+  /// (pairs listed at it with a larger partner, its wall points, the probes it makes), the node
+  /// pairs in contact at the last evaluation counted at their smaller node (a probe at its
+  /// probing node), and its wall contacts. The counts sum to statistics().node_contacts and
+  /// wall_contacts; a node's terms depend only on its own pairs, so a distributed run sums the
+  /// owners' values in node order to the serial totals (granulate.parallel).
+  void node_contact_terms(const Model& model, const State& state, real* energy, std::uint32_t* pairs,
+                          std::uint32_t* walls) const;
   const std::vector<Wall>& walls() const { return walls_; }
 
   /// Adds contact force densities to state.forces at time t; updates wall reactions.

@@ -1,0 +1,60 @@
+"""Errors and decisions shared by every rank of a communicator, so that no rank is left waiting
+in a collective call that another rank will never make: an action that fails on one rank ends
+every rank (`together`), an action only rank 0 takes (writing a folder, reading a checkpoint)
+tells the others whether it failed (`on_root`)."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any, TypeVar
+
+from granulate.errors import InputError
+
+T = TypeVar("T")
+
+
+class RankFailed(RuntimeError):
+    """Raised on every other rank when one rank's action or step failed (that rank raises its
+    own error)."""
+
+
+def together(comm: Any, action: Callable[[], T]) -> T:
+    """action() on every rank; when it raised on some rank, every rank stops: the first such
+    rank with its own error, the others with RankFailed naming it (one reduction)."""
+    from mpi4py import MPI
+
+    failure, result = None, None
+    try:
+        result = action()
+    except Exception as error:  # re-raised below, once every rank knows
+        failure = error
+    size = comm.Get_size()
+    first = comm.allreduce(comm.Get_rank() if failure is not None else size, op=MPI.MIN)
+    if failure is not None:
+        raise failure
+    if first < size:
+        raise RankFailed(f"rank {first} failed while building its part; every rank stops")
+    return result  # type: ignore[return-value]
+
+
+def on_root(comm: Any, action: Callable[[], T]) -> T | None:
+    """action() on rank 0 alone: its result there, None on the others. An InputError or
+    OSError it raises is raised on every rank (an InputError with the same message elsewhere);
+    any other error is raised on rank 0 and ends the others with RankFailed."""
+    result, failure = None, None
+    problem: tuple[type[Exception], str] | None = None
+    if comm.Get_rank() == 0:
+        try:
+            result = action()
+        except (InputError, OSError) as error:
+            failure, problem = error, (InputError, str(error))
+        except Exception as error:  # a bug: rank 0 shows it, the others stop
+            failure = error
+            problem = (RankFailed, f"rank 0 failed: {type(error).__name__}: {error}")
+    problem = comm.bcast(problem, root=0)
+    if failure is not None:
+        raise failure
+    if problem is not None:
+        kind, message = problem
+        raise kind(message)
+    return result

@@ -1,0 +1,59 @@
+"""Simulation.run's loop on the ranks of a distributed run (granulate.run_loop.Stepper): every
+rank takes the steps of the chunks rank 0 decides, rank 0's simulation takes the whole state
+(DistributedRun.collect) before rank 0 writes outputs or checks stop criteria, and rank 0's
+decisions and errors reach every rank."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from pathlib import Path
+from typing import TYPE_CHECKING, TypeVar
+
+from granulate.parallel.agreement import on_root
+
+if TYPE_CHECKING:
+    from granulate.parallel.engine import DistributedRun
+    from granulate.simulation import Simulation
+    from granulate.writers.outputs import Outputs
+
+T = TypeVar("T")
+
+
+class DistributedStepper:
+    """The run loop's steps on the ranks of `run` (every method on every rank together)."""
+
+    def __init__(self, run: DistributedRun) -> None:
+        self.run = run
+        self.comm = run.comm
+
+    @property
+    def step(self) -> int:
+        return int(self.run.local.core.step)
+
+    @property
+    def time(self) -> float:
+        return float(self.run.local.core.time)
+
+    def advance(self, steps: int) -> None:
+        self.run.run(steps)
+
+    def first_forces(self) -> None:
+        """Nothing to do: every part evaluated its forces when it was built."""
+
+    def collect(self) -> None:
+        self.run.collect()
+
+    def agree(self, value: T) -> T:
+        return self.comm.bcast(value, root=0)  # type: ignore[no-any-return]
+
+    def on_root(self, action: Callable[[], T]) -> T:
+        return self.comm.bcast(on_root(self.comm, action), root=0)  # type: ignore[no-any-return]
+
+    def any_rank(self, flag: bool) -> bool:
+        return bool(self.comm.allreduce(bool(flag), op=self.run.mpi.LOR))
+
+    def broken_bonds(self) -> int:
+        return self.run.broken_bonds()
+
+    def save_checkpoint(self, sim: Simulation, path: Path, outputs: Outputs | None) -> Path:
+        return Path(self.comm.bcast(self.run.save_checkpoint(path, outputs), root=0))

@@ -1,0 +1,141 @@
+"""The whole state of a distributed run on rank 0, for its outputs, stop criteria and measures.
+
+Each rank sends its own grains' nodes (positions, velocities, forces, dilatation) and bonds, and
+what its last force evaluation left for them: the contacts whose first body it owns (the
+network's rows, in global numbering), its nodes' contact energy and contact counts
+(ContactModel::node_contact_terms) and its neighbour-list searches. Rank 0 puts the nodes and
+bonds into its simulation, built whole once, and the evaluation in the serial order: contact rows
+sorted as the serial core's slots (pairs of bodies by their smallest nodes, then bodies and walls),
+the energy summed node by node in node order as the serial core sums it. Every value is then the
+serial run's at that step, bit for bit, except the number of list searches, which each rank
+makes for its own part (the largest over the ranks is given).
+
+Rank 0 holds the whole model and state for this, as it holds the whole frame it writes; that
+bounds the size of a distributed run to what one process can hold (docs/parallel.md).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from granulate import network
+from granulate.evaluation import Evaluation
+
+if TYPE_CHECKING:
+    from granulate.parallel.engine import DistributedRun
+    from granulate.simulation import Simulation
+
+_NO_NODE = 2**32 - 1  # ContactNetwork's node_b of a wall contact
+_ROW_KEYS = ("particle_a", "node_a", "particle_b", "node_b", "wall")
+_VECTOR_KEYS = ("point", "normal", "force")
+
+
+@dataclass
+class OwnedPart:
+    """What one rank sends rank 0: its grains' nodes (in grain order) and bonds, and its part of
+    the last force evaluation."""
+
+    grains: NDArray[np.int64]
+    positions: NDArray[np.float64]  # (n, 3) [m]
+    velocities: NDArray[np.float64]  # (n, 3) [m/s]
+    forces: NDArray[np.float64]  # (n, 3) [N/m^3]
+    dilatation: NDArray[np.float64]  # (n,)
+    bonds: NDArray[np.uint8]  # the grains' bond copies, in the model's order
+    contacts: dict[str, NDArray[Any]]  # the network's rows whose first body is owned
+    contact_energy: NDArray[np.float64]  # (n,) per node [J; J/m in 2D]
+    node_contacts: int
+    wall_contacts: int
+    searches: int
+
+
+def owned_part(run: DistributedRun) -> OwnedPart:
+    """This rank's OwnedPart (the run's part holds the last step's evaluation)."""
+    core, nodes = run.local.core, run.owned_nodes
+    offsets = np.asarray(run.local.model.bond_offsets, dtype=np.int64)
+    intact = np.asarray(core.bond_intact)
+    bond_rows = [intact[offsets[s.start] : offsets[s.stop]] for s in run.owned_slices()]
+    energy, pairs, walls = (np.asarray(a) for a in core.node_contact_terms())
+    return OwnedPart(
+        run.owned,
+        core.positions[nodes],
+        core.velocities[nodes],
+        core.forces[nodes],
+        np.asarray(core.dilatation)[nodes],
+        np.concatenate(bond_rows) if bond_rows else np.zeros(0, np.uint8),
+        _owned_contacts(run, core.contact_network()),
+        energy[nodes],
+        int(pairs[nodes].sum()),
+        int(walls[nodes].sum()),
+        int(core.contact_statistics.rebuilds),
+    )
+
+
+def _owned_contacts(run: DistributedRun, local: dict[str, Any]) -> dict[str, NDArray[Any]]:
+    """The rows of a rank's contact network (ContactNetwork) whose first body it owns, in
+    global numbering: grains for particles, global nodes for the bodies' smallest nodes."""
+    every = {key: np.asarray(local[key]).astype(np.int64) for key in _ROW_KEYS}
+    kept = run.is_owned_node(every["node_a"])
+    rows = {key: values[kept] for key, values in every.items()}
+    wall = rows["wall"] == 1
+    other = np.where(wall, 0, rows["particle_b"])  # a wall's index is no particle
+    contacts = {
+        "particle_a": run.held[rows["particle_a"]],
+        "node_a": run.global_nodes(rows["node_a"]),
+        "particle_b": np.where(wall, rows["particle_b"], run.held[other]),
+        "node_b": np.where(wall, _NO_NODE, run.global_nodes(np.where(wall, 0, rows["node_b"]))),
+        "wall": rows["wall"],
+    }
+    for key in _VECTOR_KEYS:
+        contacts[key] = np.asarray(local[key], dtype=np.float64).reshape(-1, 3)[kept]
+    return contacts
+
+
+def install(
+    sim: Simulation,
+    parts: list[OwnedPart],
+    moment: tuple[float, int],
+    wall_reactions: NDArray[np.float64],
+) -> None:
+    """Rank 0: `parts` (every rank's) into `sim`, built whole on first use: its nodes and bonds
+    at `moment` (time [s], step), and its last evaluation (Simulation.evaluation)."""
+    core = sim._build()
+    starts = np.array([body.first_node for body in sim.bodies] + [sim.node_count])
+    bond_starts = np.asarray(sim.model.bond_offsets, dtype=np.int64)[starts]
+    state = dict(core.checkpoint())
+    x, v, f = (np.asarray(state[k]).reshape(-1, 3) for k in ("positions", "velocities", "forces"))
+    dilatation, bonds = np.asarray(state["dilatation"]), np.asarray(state["bond_intact"])
+    energy = np.zeros(sim.node_count)
+    for part in parts:
+        nodes = _ranges(starts, part.grains)
+        x[nodes], v[nodes], f[nodes] = part.positions, part.velocities, part.forces
+        dilatation[nodes], energy[nodes] = part.dilatation, part.contact_energy
+        bonds[_ranges(bond_starts, part.grains)] = part.bonds
+    state["time"], state["step"] = moment
+    core.restore(state)
+    sim._gathered = Evaluation(
+        network.contact_table(_serial_order([part.contacts for part in parts])),
+        float(np.add.accumulate(energy)[-1]) if len(energy) else 0.0,  # the core's order
+        sum(part.node_contacts for part in parts),
+        sum(part.wall_contacts for part in parts),
+        max(part.searches for part in parts),
+        wall_reactions,
+    )
+
+
+def _ranges(starts: NDArray[np.int64], grains: NDArray[np.int64]) -> NDArray[np.int64]:
+    """The indices starts[g] .. starts[g + 1] - 1 of each of `grains`, in their order."""
+    pieces = [np.arange(starts[g], starts[g + 1]) for g in grains]
+    return np.concatenate(pieces) if pieces else np.zeros(0, dtype=np.int64)
+
+
+def _serial_order(pieces: list[dict[str, NDArray[Any]]]) -> dict[str, NDArray[Any]]:
+    """The ranks' contact rows as one network in the serial core's slot order: pairs of bodies
+    sorted by their smallest nodes, then bodies and walls sorted by body and wall."""
+    rows = {key: np.concatenate([piece[key] for piece in pieces]) for key in pieces[0]}
+    wall = rows["wall"] == 1
+    order = np.lexsort((np.where(wall, rows["particle_b"], rows["node_b"]), rows["node_a"], wall))
+    return {key: values[order] for key, values in rows.items()}

@@ -1,0 +1,117 @@
+"""`mpiexec -n K granulate run case.yaml` against `granulate run case.yaml`: the same output
+folder, byte for byte, on 2 and 3 ranks (3 oversubscribe 2 cores: correctness, not speed), and
+across restarts on another number of ranks; errors reported once, every rank ending.
+
+The case (tests/cases/drum_mpi.yaml) is the checkpoint tests' drum: four grains tumbling and
+breaking in a turning drum with a lifter, the surface law, friction, a moving wall; its grains
+migrate between the ranks many times in its 3,000 steps."""
+
+from __future__ import annotations
+
+import csv
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from test_mpi import mpiexec
+
+CASE = Path(__file__).parent / "cases" / "drum_mpi.yaml"
+#: What a distributed run's folder may hold differently: its timings (run.json), and its
+#: checkpoint (the same state, with neighbour lists searched anew: it restarts bit for bit).
+DIFFERENT = {"run.json", "checkpoint.npz"}
+#: history.csv's count of neighbour-list searches, which each rank makes for its own part (the
+#: largest over the ranks is written): a diagnostic of the run, not of its physics.
+SEARCHES = "list_rebuilds"
+
+
+def granulate(
+    folder: Path, *arguments: str, ranks: int = 1, case: Path = CASE
+) -> subprocess.CompletedProcess[str]:
+    """`granulate run case` in `folder` (its outputs in folder/out/...), on `ranks` MPI ranks;
+    a hang fails the test after 5 minutes."""
+    environment = {**os.environ, "OMP_NUM_THREADS": "1"}
+    command = [sys.executable, "-m", "granulate", "run", str(case), "--quiet", *arguments]
+    if ranks > 1:
+        command = [mpiexec(), "-n", str(ranks), *command]
+    return subprocess.run(
+        command, cwd=folder, capture_output=True, text=True, timeout=300, env=environment
+    )
+
+
+def outputs(directory: Path) -> dict[str, bytes]:
+    """Every file of a run's folder but those that may differ, by relative path."""
+    return {
+        str(p.relative_to(directory)): p.read_bytes()
+        for p in sorted(directory.rglob("*"))
+        if p.is_file() and p.name not in DIFFERENT and p.name != "history.csv"
+    }
+
+
+def history(directory: Path) -> list[dict[str, str]]:
+    with open(directory / "history.csv", newline="") as table:
+        return list(csv.DictReader(table))
+
+
+def assert_same_run(serial: Path, distributed: Path) -> None:
+    """The frames, tables and PVD series byte for byte; history.csv's every column's text
+    equal, but the searches, which stay within 10 % (or 2) of the serial run's."""
+    expected, found = outputs(serial), outputs(distributed)
+    assert sorted(found) == sorted(expected)
+    assert [name for name in expected if found[name] != expected[name]] == []
+    rows, serial_rows = history(distributed), history(serial)
+    assert len(rows) == len(serial_rows) == 13  # steps 0, 250, ..., 3000
+    for row, serial_row in zip(rows, serial_rows, strict=True):
+        searches, serial_searches = int(row.pop(SEARCHES)), int(serial_row.pop(SEARCHES))
+        assert row == serial_row
+        assert abs(searches - serial_searches) <= max(2, 0.1 * serial_searches)
+
+
+@pytest.fixture(scope="module")
+def serial_run(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The case's serial run: its output folder."""
+    folder = tmp_path_factory.mktemp("serial")
+    done = granulate(folder, "--out", "out")
+    assert done.returncode == 0, done.stderr
+    return folder / "out"
+
+
+@pytest.mark.parametrize("ranks", [2, 3])
+def test_a_case_on_k_ranks_writes_the_serial_runs_outputs(
+    ranks: int, serial_run: Path, tmp_path: Path
+) -> None:
+    """Frames (.vtu), particle, fragment and contact tables, PVD series and history.csv as the
+    serial run writes them; rank 0 alone prints."""
+    done = granulate(tmp_path, "--out", "out", ranks=ranks)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.count("finished at step 3000") == 1
+    assert_same_run(serial_run, tmp_path / "out")
+
+
+def test_a_run_restarts_on_another_number_of_ranks_and_serially(
+    serial_run: Path, tmp_path: Path
+) -> None:
+    """Cut short on 3 ranks at step 1,700 and resumed on 2; cut short serially at 1,200 and
+    resumed on 3: both folders end as the uninterrupted serial run's."""
+    for first, second, steps, name in ((3, 2, "1700", "a"), (1, 3, "1200", "b")):
+        cut = granulate(tmp_path, "--out", name, "--steps", steps, ranks=first)
+        assert cut.returncode == 0, cut.stderr
+        resumed = granulate(tmp_path, "--out", name, "--resume", ranks=second)
+        assert resumed.returncode == 0, resumed.stderr
+        assert f"resuming from step {steps}" in resumed.stdout
+        assert_same_run(serial_run, tmp_path / name)
+
+
+def test_an_input_error_on_k_ranks_is_reported_once_and_ends_every_rank(tmp_path: Path) -> None:
+    """A folder that holds a run (refused on rank 0, which writes): one message, exit code 2
+    from every rank (mpiexec passes the first non-zero), no hang, the old run intact."""
+    first = granulate(tmp_path, "--out", "out", "--steps", "10")
+    assert first.returncode == 0, first.stderr
+    before = outputs(tmp_path / "out")
+    done = granulate(tmp_path, "--out", "out", ranks=3)
+    assert done.returncode == 2, done.stdout + done.stderr
+    assert done.stderr.count("already holds a run") == 1, done.stderr
+    assert "Traceback" not in done.stderr
+    assert outputs(tmp_path / "out") == before
