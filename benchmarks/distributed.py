@@ -135,6 +135,7 @@ def main() -> None:
         run.collect()  # rank 0 builds the whole simulation once
     run.seconds = dict.fromkeys(run.seconds, 0.0)
     migrations, handed = run.migrations, run.handed_over
+    comm.Barrier()  # every rank's clock starts together
     start = time.perf_counter()
     for done in range(0, arguments.steps, every):
         run.run(min(every, arguments.steps - done))
