@@ -53,7 +53,7 @@ class SimulationSetup:
     _distributed: Any  # granulate.parallel.DistributedRun, once a distributed run is made
     _start: tuple[NDArray[np.float64], NDArray[np.float64]] | None
     _build: Callable[[], _core.Simulation]
-    evaluation: Callable[[], Evaluation]
+    _gathered: Evaluation | None
 
     @property
     def bodies(self) -> list[Body]:
@@ -366,8 +366,11 @@ class SimulationSetup:
     def wall_reactions(self) -> dict[str, NDArray[np.float64]]:
         """Per wall: (fx, fy, fz, tx, ty, tz), the force and torque the particles exert on it
         at the last step [N, N m; per unit thickness in 2D]."""
-        reactions = self.evaluation().wall_reactions
-        return dict(zip(self._interactions.wall_names, reactions.copy(), strict=True))
+        names = self._interactions.wall_names
+        if self._gathered is not None:  # a distributed run's, on rank 0
+            return dict(zip(names, self._gathered.wall_reactions.copy(), strict=True))
+        reactions = self._build().wall_reactions()
+        return {name: np.asarray(r) for name, r in zip(names, reactions, strict=True)}
 
     def output(
         self,

@@ -12,10 +12,11 @@ as in the serial run, for any number of ranks (tests/test_mpi.py).
 The ghost sets hold while no node has moved more than half the margin from where it was when
 the grains were last distributed, since then no pair left out can come within the cutoff. The
 run checks that every step; past a quarter of the margin the ranks cut the grains anew where
-they are (which also rebalances) and hand grains over with their whole state (transplant.py),
-and the same states make checkpoints that restart on any number of ranks. Wall reactions are
-summed on rank 0 in the serial order. Outputs and stop criteria across ranks are not built:
-the state is gathered on one rank with `gather`.
+they are (which also rebalances) and hand grains over with their whole state (transplant.py).
+Wall reactions are summed on rank 0 in the serial order. `collect` gathers every grain's state
+and the last evaluation into rank 0's simulation (whole_state.py), whose serial writers, stop
+criteria and checkpoints then see the serial run (Simulation(comm=...) runs through
+stepper.py); checkpoints restart on any number of ranks, or serially.
 """
 
 from __future__ import annotations
