@@ -115,3 +115,16 @@ def test_an_input_error_on_k_ranks_is_reported_once_and_ends_every_rank(tmp_path
     assert done.stderr.count("already holds a run") == 1, done.stderr
     assert "Traceback" not in done.stderr
     assert outputs(tmp_path / "out") == before
+
+
+def test_a_time_step_above_the_stable_estimate_is_warned_of_once(tmp_path: Path) -> None:
+    """dt 1.2e-6 s against the drum's stable estimate 1.081e-6 s, on 3 ranks: one warning (from
+    rank 0, with the whole assembly's estimate), not one per rank and part, and the run goes
+    on."""
+    case = tmp_path / "drum_dt.yaml"
+    case.write_text(
+        CASE.read_text().replace("time: {steps: 3000}", "time: {steps: 20, dt: 1.2e-6}")
+    )
+    done = granulate(tmp_path, "--out", "out", ranks=3, case=case)
+    assert done.returncode == 0, done.stderr
+    assert done.stderr.count("exceeds the stable estimate 1.081e-06 s") == 1, done.stderr

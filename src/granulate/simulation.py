@@ -140,6 +140,7 @@ class Simulation(SimulationSetup, SimulationResults):
         self._comm = comm
         self._distributed: DistributedRun | None = None
         self._output_path: Path | None = None  # output's directory, on every rank
+        self._dt_warned = False  # a distributed run's parts: said once, by rank 0
         #: Extra text identifying the set-up (a case file's hash), checked by load_checkpoint.
         self.case_fingerprint = ""
         self.viscous_damping = viscous_damping
@@ -240,6 +241,7 @@ class Simulation(SimulationSetup, SimulationResults):
             viscous_damping=self._viscous_damping,
         )
         part._gravity = self._gravity.copy()
+        part._dt_warned = True  # the whole simulation's estimate is the one to judge dt by
         assembly, node_map = self._assembly.subset(grains)
         if not initial_motion:
             assembly.initial_velocities = []
@@ -259,7 +261,8 @@ class Simulation(SimulationSetup, SimulationResults):
         if self._dt is None:
             core.time_step = self._dt_safety * core.stable_time_step
             return
-        _warn_above_stable(self._dt, core.stable_time_step, stacklevel=5)
+        if not self._dt_warned:
+            _warn_above_stable(self._dt, core.stable_time_step, stacklevel=5)
         core.time_step = self._dt
 
     @property
@@ -365,8 +368,12 @@ class Simulation(SimulationSetup, SimulationResults):
         if self._distributed is None:
             from granulate.parallel import DistributedRun
 
-            self._distributed = DistributedRun(self, self._comm)
-            _check_time_step(self._distributed.dt, self._distributed.stable_dt)
+            run = DistributedRun(self, self._comm)
+            _check_time_step(run.dt, run.stable_dt)
+            if self._comm.Get_rank() == 0 and self._dt is not None:
+                _warn_above_stable(run.dt, run.stable_dt, stacklevel=4)
+            self._dt_warned = True  # rank 0's whole simulation, built later, is quiet
+            self._distributed = run
         return self._distributed
 
     def _after_chunk(self) -> None:
