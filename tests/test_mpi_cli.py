@@ -71,10 +71,11 @@ def assert_same_run(serial: Path, distributed: Path) -> None:
 
 @pytest.fixture(scope="module")
 def serial_run(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """The case's serial run: its output folder."""
+    """The case's serial run: its output folder (and its warnings, in warnings.txt beside)."""
     folder = tmp_path_factory.mktemp("serial")
     done = granulate(folder, "--out", "out")
     assert done.returncode == 0, done.stderr
+    (folder / "warnings.txt").write_text(done.stderr)
     return folder / "out"
 
 
@@ -83,10 +84,13 @@ def test_a_case_on_k_ranks_writes_the_serial_runs_outputs(
     ranks: int, serial_run: Path, tmp_path: Path
 ) -> None:
     """Frames (.vtu), particle, fragment and contact tables, PVD series and history.csv as the
-    serial run writes them; rank 0 alone prints."""
+    serial run writes them; rank 0 alone prints, and warns as the serial run does (of the
+    grains pressed into each other, the deepest over every rank's part)."""
     done = granulate(tmp_path, "--out", "out", ranks=ranks)
     assert done.returncode == 0, done.stderr
     assert done.stdout.count("finished at step 3000") == 1
+    assert "bodies pressed" in done.stderr
+    assert done.stderr == (serial_run.parent / "warnings.txt").read_text()
     assert_same_run(serial_run, tmp_path / "out")
 
 

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import warnings
 from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 
@@ -206,7 +207,7 @@ class Interactions:
                 "granulate.pack, which never overlaps"
             )
 
-    def warn_deep_contact(self, core: _core.Simulation) -> None:
+    def warn_deep_contact(self, statistics: Any) -> None:
         """Warn when two bodies pressed into each other by more than half their contact radius
         Rc (node spheres: a node pair's overlap; surface law: a probe's depth under the other's
         surface): the contact layer is too soft for the impact or the load, and nodes may pass
@@ -214,8 +215,9 @@ class Interactions:
         load's as 1 / stiffness_factor); and again, more strongly, past a whole Rc, where the
         contact gives way: node spheres' centres cross, and the surface law's probes reach the
         end of its points' reach (about a mesh size deep: 1.0-1.2 Rc at the default contact
-        radius), lose their push and are pulled in. Each warning is given once per run."""
-        statistics = core.contact_statistics
+        radius), lose their push and are pulled in. Each warning is given once per run.
+        `statistics`: the core's contact_statistics (deepest_overlap, half_overlap_step,
+        full_overlap_step), or a distributed run's over its ranks."""
         deepest = statistics.deepest_overlap
         level = 2 if deepest >= 1 else 1 if deepest >= 0.5 else 0
         if level <= self._deep_contact_level:

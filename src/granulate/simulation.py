@@ -378,11 +378,13 @@ class Simulation(SimulationSetup, SimulationResults):
 
     def _after_chunk(self) -> None:
         """After each chunk of steps: the warning about bodies pressed deep into each other (in
-        a distributed run, each rank's about its own part)."""
-        if self._distributed is not None:
-            self._interactions.warn_deep_contact(self._distributed.local.core)
-        else:
-            self._interactions.warn_deep_contact(self.core)
+        a distributed run, the deepest on any rank, warned of by rank 0)."""
+        if self._distributed is None:
+            self._interactions.warn_deep_contact(self.core.contact_statistics)
+            return
+        deepest = self._distributed.deepest_contact()
+        if self._comm.Get_rank() == 0:
+            self._interactions.warn_deep_contact(deepest)
 
     def _thread_tuner(self, most: int) -> threads.ThreadTuner | None:
         """The run's thread-count picker (kept across runs of this simulation), or None when

@@ -26,6 +26,7 @@ import time
 import warnings
 from collections.abc import Callable
 from pathlib import Path
+from types import SimpleNamespace
 from typing import TYPE_CHECKING, Any, TypeVar
 
 import numpy as np
@@ -451,6 +452,26 @@ class DistributedRun:
             core = self.local.core
             install(self._sim, parts, (float(core.time), int(core.step)), walls)
         self.seconds["collect"] += time.perf_counter() - start
+
+    def deepest_contact(self) -> SimpleNamespace:
+        """The deepest contact overlap (over the contact radius) of every rank so far, and the
+        first steps at which any rank's passed 0.5 and 1 (0: not yet), as the core's
+        contact_statistics name them (one reduction)."""
+        statistics = self.local.core.contact_statistics
+        never = float(2**53)
+        mine = np.array(
+            [
+                -statistics.deepest_overlap,
+                statistics.half_overlap_step or never,
+                statistics.full_overlap_step or never,
+            ]
+        )
+        least = np.empty(3)
+        self.comm.Allreduce(mine, least, op=self.mpi.MIN)
+        half, full = (int(step) if step < never else 0 for step in least[1:])
+        return SimpleNamespace(
+            deepest_overlap=-float(least[0]), half_overlap_step=half, full_overlap_step=full
+        )
 
     @property
     def bond_count(self) -> int:
