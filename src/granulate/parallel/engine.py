@@ -102,6 +102,8 @@ class DistributedRun:
         held = self._distribute(centres, radii)
         self._together(lambda: self._build(held))
         self._exchange()
+        # The deepest overlap and its steps past 0.5 and 1 Rc in the parts this rank replaced.
+        self._overlaps = (0.0, 0, 0)
         #: Wall-clock seconds of this rank in its steps, ghost exchanges, partition checks,
         #: migrations and collections of the whole state on rank 0 (collect).
         self.seconds = dict.fromkeys(("steps", "exchange", "check", "migrate", "collect"), 0.0)
@@ -350,6 +352,7 @@ class DistributedRun:
                 held, dt=self._dt, skin=self._skin, initial_motion=False
             )
             restore_grains(local.core, [states[int(g)] for g in held], node_map, moment)
+        self._overlaps = self._deepest_here()  # the part replaced kept them (not checkpointed)
         self.local, self.held = local, held
         self._plan(node_map)
 
@@ -457,20 +460,26 @@ class DistributedRun:
         """The deepest contact overlap (over the contact radius) of every rank so far, and the
         first steps at which any rank's passed 0.5 and 1 (0: not yet), as the core's
         contact_statistics name them (one reduction)."""
-        statistics = self.local.core.contact_statistics
         never = float(2**53)
-        mine = np.array(
-            [
-                -statistics.deepest_overlap,
-                statistics.half_overlap_step or never,
-                statistics.full_overlap_step or never,
-            ]
-        )
+        deepest, half, full = self._deepest_here()
+        mine = np.array([-deepest, half or never, full or never])
         least = np.empty(3)
         self.comm.Allreduce(mine, least, op=self.mpi.MIN)
         half, full = (int(step) if step < never else 0 for step in least[1:])
         return SimpleNamespace(
             deepest_overlap=-float(least[0]), half_overlap_step=half, full_overlap_step=full
+        )
+
+    def _deepest_here(self) -> tuple[float, int, int]:
+        """This rank's deepest overlap and first steps past 0.5 and 1 Rc (0: not yet), over its
+        part and the parts it replaced."""
+        statistics = self.local.core.contact_statistics
+        kept_deepest, kept_half, kept_full = self._overlaps
+        half, full = statistics.half_overlap_step, statistics.full_overlap_step
+        return (
+            max(kept_deepest, statistics.deepest_overlap),
+            min(kept_half, half) if kept_half and half else kept_half or half,
+            min(kept_full, full) if kept_full and full else kept_full or full,
         )
 
     @property
