@@ -366,6 +366,12 @@ std::uint64_t Simulation::broken_bonds() const {
   return broken_bond_copies_ / 2;
 }
 
+bool Simulation::assign_bonds(const std::vector<std::uint8_t>& states) {
+  if (!state_.bonds.assign_unpacked(model_->bond_offsets(), states)) return false;
+  broken_bond_copies_ = state_.bonds.broken(model_->bond_offsets(), 0, model_->node_count());
+  return true;
+}
+
 index_t Simulation::fragments(index_t* labels) const {
   return model_->fragments(state_.bonds, labels);
 }

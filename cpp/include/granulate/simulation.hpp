@@ -74,6 +74,10 @@ class Simulation {
   /// phi_i = 1 - (intact weighted volume)/(initial weighted volume); z_i = max_j |s_ij| / s0.
   void damage(real* phi, real* z) const;
   std::uint64_t broken_bonds() const;  ///< broken bonds, each counted once
+  /// Replaces every bond copy's state (one byte each, in the model's bond order, as checkpoints
+  /// hold them); false when the count does not match. Rank 0 of a distributed run takes the
+  /// ranks' bonds this way (granulate.parallel.whole_state).
+  bool assign_bonds(const std::vector<std::uint8_t>& states);
   /// The bonds' force densities alone at the current state [N/m^3, nodes x 3]: pass 2 of the
   /// last force evaluation again, without body forces, damping, contact and loads (zero before
   /// any evaluation). For particle stresses from internal forces.

@@ -240,6 +240,13 @@ void bind_state(nb::class_<Simulation>& cls) {
                                  nb::find(self));
                    })
       .def(
+          "assign_bonds",
+          [](Simulation& self, nb::ndarray<const std::uint8_t, nb::ndim<1>, nb::c_contig> states) {
+            if (!self.assign_bonds(std::vector<std::uint8_t>(states.data(), states.data() + states.size())))
+              throw InputError("assign_bonds: one byte per bond copy of the model is needed");
+          },
+          "states"_a, "Every bond copy's state, one byte each in the model's bond order.")
+      .def(
           "broken_bond_copies",
           [](const Simulation& self, index_t first, index_t last) {
             if (first > last || last > self.model().node_count())

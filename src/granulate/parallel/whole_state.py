@@ -105,17 +105,12 @@ def install(
     core = sim._build()
     starts = np.array([body.first_node for body in sim.bodies] + [sim.node_count])
     bond_starts = np.asarray(sim.model.bond_offsets, dtype=np.int64)[starts]
-    state = dict(core.checkpoint())
-    x, v, f = (np.asarray(state[k]).reshape(-1, 3) for k in ("positions", "velocities", "forces"))
-    dilatation, bonds = np.asarray(state["dilatation"]), np.asarray(state["bond_intact"])
+    bonds = np.empty(bond_starts[-1], dtype=np.uint8)
     energy = np.zeros(sim.node_count)
-    for part in parts:
-        nodes = _ranges(starts, part.grains)
-        x[nodes], v[nodes], f[nodes] = part.positions, part.velocities, part.forces
-        dilatation[nodes], energy[nodes] = part.dilatation, part.contact_energy
-        bonds[_ranges(bond_starts, part.grains)] = part.bonds
-    state["time"], state["step"] = moment
-    core.restore(state)
+    for part in parts:  # every grain is one rank's: every node and bond is written
+        _place(part, core, (starts, bond_starts), bonds, energy)
+    core.assign_bonds(bonds)
+    core.time, core.step = moment
     sim._gathered = Evaluation(
         network.contact_table(_serial_order([part.contacts for part in parts])),
         float(np.add.accumulate(energy)[-1]) if len(energy) else 0.0,  # the core's order
@@ -126,10 +121,28 @@ def install(
     )
 
 
-def _ranges(starts: NDArray[np.int64], grains: NDArray[np.int64]) -> NDArray[np.int64]:
-    """The indices starts[g] .. starts[g + 1] - 1 of each of `grains`, in their order."""
-    pieces = [np.arange(starts[g], starts[g + 1]) for g in grains]
-    return np.concatenate(pieces) if pieces else np.zeros(0, dtype=np.int64)
+def _place(
+    part: OwnedPart,
+    core: Any,
+    starts: tuple[NDArray[np.int64], NDArray[np.int64]],
+    bonds: NDArray[np.uint8],
+    energy: NDArray[np.float64],
+) -> None:
+    """One rank's grains into the whole `core` (its nodes), `bonds` and the nodes' contact
+    `energy`, grain by grain; `starts`: each grain's first node and first bond copy (and the
+    totals after the last)."""
+    node_starts, bond_starts = starts
+    x, v, f, dilatation = core.positions, core.velocities, core.forces, core.dilatation
+    node, bond = 0, 0  # where the grain's rows begin in the part's arrays
+    for g in part.grains:
+        nodes = slice(node_starts[g], node_starts[g + 1])
+        rows = slice(node, node + nodes.stop - nodes.start)
+        x[nodes], v[nodes] = part.positions[rows], part.velocities[rows]
+        f[nodes], dilatation[nodes] = part.forces[rows], part.dilatation[rows]
+        energy[nodes] = part.contact_energy[rows]
+        count = bond_starts[g + 1] - bond_starts[g]
+        bonds[bond_starts[g] : bond_starts[g + 1]] = part.bonds[bond : bond + count]
+        node, bond = rows.stop, bond + count
 
 
 def _serial_order(pieces: list[dict[str, NDArray[Any]]]) -> dict[str, NDArray[Any]]:
