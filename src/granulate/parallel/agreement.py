@@ -38,17 +38,17 @@ def together(comm: Any, action: Callable[[], T]) -> T:
 
 
 def on_root(comm: Any, action: Callable[[], T]) -> T | None:
-    """action() on rank 0 alone: its result there, None on the others. An InputError or
-    OSError it raises is raised on every rank (an InputError with the same message elsewhere);
-    any other error is raised on rank 0 and ends the others with RankFailed."""
+    """action() on rank 0 alone: its result there, None on the others. An InputError it
+    raises is raised on every rank (the same message: a user error every rank shares); any
+    other error (a full disk, a bug) is raised on rank 0 and ends the others with RankFailed."""
     result, failure = None, None
     problem: tuple[type[Exception], str] | None = None
     if comm.Get_rank() == 0:
         try:
             result = action()
-        except (InputError, OSError) as error:
+        except InputError as error:
             failure, problem = error, (InputError, str(error))
-        except Exception as error:  # a bug: rank 0 shows it, the others stop
+        except Exception as error:  # rank 0 reports it, the others stop
             failure = error
             problem = (RankFailed, f"rank 0 failed: {type(error).__name__}: {error}")
     problem = comm.bcast(problem, root=0)

@@ -362,8 +362,8 @@ class DistributedRun:
         """Write the run's checkpoint at `path`, the serial run's format (granulate.checkpoints,
         with the bookkeeping of `outputs`): every grain's state is gathered into rank 0's
         simulation, which writes it. It restarts on any number of ranks (load_checkpoint), or
-        serially, bit for bit. Every rank calls it; a failure to write is raised on every rank.
-        The path written, on rank 0 (None on the others)."""
+        serially, bit for bit. Every rank calls it; rank 0 raises a failure to write, the others
+        RankFailed. The path written, on rank 0 (None on the others)."""
         saved = dict(self.local.core.checkpoint())
         saved["contact_wall_reactions"] = self.wall_reactions().ravel()  # the whole run's
         owned = {int(g): self._local_slice(g) for g in self._owned}
