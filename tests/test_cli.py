@@ -163,7 +163,8 @@ def test_commands_started_as_several_mpi_ranks_say_what_is_wrong_once(
     """Under a launcher's K ranks, `granulate convert` (K copies would write one file) is
     refused, and `granulate run case.yaml` without mpi4py is told to install the mpi extra
     (tests/test_mpi_cli.py runs real ranks): rank 0 says so once, every rank exits 2, nothing is
-    written. A Python script (which may use mpi4py itself) still runs."""
+    written. `granulate schema` prints once. A Python script (which may use mpi4py itself)
+    still runs."""
     monkeypatch.chdir(tmp_path)
     monkeypatch.setitem(sys.modules, "mpi4py", None)  # import mpi4py fails
     case = Path(__file__).parent / "cases" / "base.yaml"
@@ -173,6 +174,8 @@ def test_commands_started_as_several_mpi_ranks_say_what_is_wrong_once(
         assert main(["convert", "input_0.yaml", "-o", "case.yaml"]) == 2
         assert main(["run", str(case)]) == 2
         printed = capsys.readouterr()
+        assert main(["schema"]) == 0
+        assert (capsys.readouterr().out != "") == (rank == 0)  # printed once, by rank 0
         if rank == 0:
             refused, missing = printed.err.splitlines()
             assert "'granulate convert' was started as 2 MPI processes" in refused

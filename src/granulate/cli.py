@@ -376,6 +376,8 @@ def _main(argv: list[str] | None) -> int:
             message = serial_only_message(options.command, size)
             print(f"granulate: error: {message}", file=sys.stderr)
         return 2
+    if size > 1 and rank != 0 and options.command in ("info", "schema", "check"):
+        return 0  # rank 0 prints it once
     return _handled(options, rank == 0)
 
 
