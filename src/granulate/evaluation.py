@@ -26,7 +26,7 @@ class Evaluation:
     contact_energy: float  #: the normal springs' energy [J; J/m in 2D]
     node_contacts: int  #: node pairs in contact (each once)
     wall_contacts: int  #: node-wall contacts
-    list_rebuilds: int  #: neighbour-list searches so far (in a distributed run: rank 0's)
+    list_rebuilds: int  #: neighbour-list searches so far (distributed: the most of any rank)
     wall_reactions: NDArray[np.float64]  #: (walls, 6) force and torque on each wall [N, N m]
 
     @classmethod
