@@ -149,3 +149,23 @@ def test_the_steps_contact_gave_way_are_the_serial_runs(tmp_path: Path) -> None:
         assert done.returncode == 0, done.stderr
         said.append(re.findall(r"past \d+% at step \d+", done.stderr))
     assert said[0] == said[1] == ["past 50% at step 6", "past 100% at step 23"]
+
+
+def test_a_case_restarting_from_a_frame_runs_on_ranks(serial_run: Path, tmp_path: Path) -> None:
+    """`restart:` (positions and velocities of the serial run's frame at step 1,000, bonds
+    intact) on 2 ranks writes what the same case writes serially, from step 1,000 on."""
+    frame = serial_run / "frames" / "frame_000004.vtu"
+    case = tmp_path / "drum_restart.yaml"
+    text = CASE.read_text().replace("time: {steps: 3000}", "time: {steps: 1500}")
+    case.write_text(text + f"restart: {{file: {frame}, step: 1000}}\n")
+    for ranks, name in ((1, "serial"), (2, "ranks")):
+        done = granulate(tmp_path, "--out", name, ranks=ranks, case=case)
+        assert done.returncode == 0, done.stderr
+    expected, found = outputs(tmp_path / "serial"), outputs(tmp_path / "ranks")
+    assert sorted(found) == sorted(expected) and len(expected) > 10
+    assert [name for name in expected if found[name] != expected[name]] == []
+    rows, serial_rows = history(tmp_path / "ranks"), history(tmp_path / "serial")
+    assert [row["step"] for row in serial_rows] == ["1000", "1250", "1500"]
+    for row in (*rows, *serial_rows):
+        row.pop(SEARCHES)
+    assert rows == serial_rows

@@ -133,6 +133,7 @@ class Simulation(SimulationSetup, SimulationResults):
         self._record = RunRecord()
         self._precracks: list[tuple[NDArray[np.float64], NDArray[np.float64], Shape | None]] = []
         self._start: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None  # start_from
+        self._start_step = 0  # start_from's step
         self._tuner: threads.ThreadTuner | None = None
         self._core_materials: list[Material] = []
         self._setup_digest: str | None = None
@@ -200,6 +201,7 @@ class Simulation(SimulationSetup, SimulationResults):
             core.positions[:] = self._start[0]
         self._interactions.check_start(model, core, self.dimension)
         self._set_time_step(core)
+        core.step, core.time = self._start_step, self._start_step * core.time_step
         core.set_body_acceleration(tuple(self._gravity))
         core.viscous_damping = self._viscous_damping
         self._loading.apply(core)
@@ -254,6 +256,7 @@ class Simulation(SimulationSetup, SimulationResults):
         if self._start is not None:
             kept = node_map >= 0  # kept nodes keep their order
             part._start = (self._start[0][kept], self._start[1][kept])
+            part._start_step = self._start_step
         return part, node_map
 
     def _set_time_step(self, core: _core.Simulation) -> None:

@@ -52,6 +52,7 @@ class SimulationSetup:
     _comm: Any
     _distributed: Any  # granulate.parallel.DistributedRun, once a distributed run is made
     _start: tuple[NDArray[np.float64], NDArray[np.float64]] | None
+    _start_step: int
     _build: Callable[[], _core.Simulation]
     _gathered: Evaluation | None
 
@@ -200,13 +201,17 @@ class SimulationSetup:
             return read_only(self._model.reference_positions)
         return self._assembly.reference_positions()
 
-    def start_from(self, positions: ArrayLike, velocities: ArrayLike) -> None:
+    def start_from(self, positions: ArrayLike, velocities: ArrayLike, step: int = 0) -> None:
         """Start from these node positions x [m] and velocities v [m/s] ((n, 3) each, in node
         order) instead of the reference positions at rest, as a restart from another run's
-        frame does. The start checks (a node on the wrong side of a wall, particles
-        overlapping) judge these positions; the bonds start intact (but for precracks) and
-        loaded nodes keep their prescribed motion. Call it before the first run."""
+        frame does, at `step` (time step x dt). The start checks (a node on the wrong side of a
+        wall, particles overlapping) judge these positions; the bonds start intact (but for
+        precracks) and loaded nodes keep their prescribed motion. Call it before the first
+        run."""
         self._require_building("set the start positions")
+        check_number("start_from: step", step, integer=True)
+        if step < 0:
+            raise InputError(f"start_from: step must be non-negative, got {step}")
         shape = (self._assembly.node_count, 3)
         x = np.array(positions, dtype=np.float64)
         v = np.array(velocities, dtype=np.float64)
@@ -219,6 +224,7 @@ class SimulationSetup:
             if not np.all(np.isfinite(value)):
                 raise InputError(f"start_from: {name} must be finite")
         self._start = (x, v)
+        self._start_step = int(step)
 
     def select(
         self,

@@ -418,9 +418,7 @@ def _restart(sim: Simulation, path: Path, step: int) -> None:
         )
     # Before the core is built, so that its start checks judge the frame's positions (a
     # restart may move a wall close to grains that have settled since the reference).
-    sim.start_from(sim.reference_positions + displacement, velocity)
-    sim.core.step = step
-    sim.core.time = step * sim.dt
+    sim.start_from(sim.reference_positions + displacement, velocity, step=step)
 
 
 def _named(name: str, named: dict[str, Body], what: str) -> Body:
