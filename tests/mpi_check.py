@@ -192,8 +192,8 @@ def check_api(variant: str, steps: int, comm: MPI.Comm) -> int:
     """0 when the drum set up with Simulation(comm=...) and run with outputs (every 250 steps),
     checkpoints (every 1,000) and a stop check writes the serial run's output folder (all but
     run.json, the checkpoint and history.csv's list_rebuilds, byte for byte), rank 0's
-    simulation then holds the serial state (nodes, contact table, wall reactions), the other
-    ranks' refuse to give results, and the checkpoint continues a serial run."""
+    simulation then holds the serial state (nodes, contact table, wall reactions; read-only),
+    the other ranks' refuse to give results, and the checkpoint continues a serial run."""
     folder = Path(comm.bcast(tempfile.mkdtemp() if comm.Get_rank() == 0 else None, root=0))
     stop = [gr.stopping.BrokenBonds(10**6)]  # never met: the checks gather the state
     if comm.Get_rank() == 0:
@@ -208,6 +208,11 @@ def check_api(variant: str, steps: int, comm: MPI.Comm) -> int:
             return 1
         except gr.InputError as error:
             return 0 if "whole state is on rank 0" in str(error) else 1
+    try:  # rank 0's copy of the state: writing it would change nothing in the run
+        sim.velocities[0, 0] = 1.0
+        return 1
+    except ValueError:
+        pass
     files = [p.relative_to(folder / "serial") for p in sorted((folder / "serial").rglob("*.*"))]
     differ = [
         str(f)

@@ -61,14 +61,18 @@ class SimulationResults:
     def positions(self) -> NDArray[np.float64]:
         """(n, 3) current positions x [m]: a live, writable view. Writing moves nodes before
         or between runs (bonds stretch accordingly; contact lists follow); the forces are
-        recomputed at the next step."""
-        return self._build().positions
+        recomputed at the next step. Read-only in a distributed run (rank 0's copy of the
+        gathered state: the grains live on the ranks; set the start with start_from)."""
+        positions = self._build().positions
+        return positions if self._comm is None else read_only(positions)
 
     @property
     def velocities(self) -> NDArray[np.float64]:
         """(n, 3) velocities v [m/s]: a live, writable view (set initial or changed velocities
-        before or between runs; prescribed nodes keep their prescribed motion)."""
-        return self._build().velocities
+        before or between runs; prescribed nodes keep their prescribed motion). Read-only in a
+        distributed run, as positions."""
+        velocities = self._build().velocities
+        return velocities if self._comm is None else read_only(velocities)
 
     @property
     def forces(self) -> NDArray[np.float64]:
