@@ -32,7 +32,6 @@ at the start (in a migration) and expects every rank to stop."""
 
 from __future__ import annotations
 
-import csv
 import functools
 import shutil
 import sys
@@ -49,6 +48,7 @@ sys.path.insert(0, str(Path(__file__).parent))
 import granulate as gr
 from granulate import checkpoints
 from granulate.parallel import DistributedRun
+from run_folders import SEARCHES, differing, history
 from test_checkpoint import tumbling_drum
 from test_locality import RADIUS, assembly, layout
 
@@ -213,16 +213,11 @@ def check_api(variant: str, steps: int, comm: MPI.Comm) -> int:
         return 1
     except ValueError:
         pass
-    files = [p.relative_to(folder / "serial") for p in sorted((folder / "serial").rglob("*.*"))]
-    differ = [
-        str(f)
-        for f in files
-        if f.name not in ("run.json", "checkpoint.npz", "history.csv")
-        and (folder / "serial" / f).read_bytes() != (folder / "ranks" / f).read_bytes()
-    ]
-    rows = [
-        history_without_searches(d / "history.csv") for d in (folder / "serial", folder / "ranks")
-    ]
+    files = sum(1 for p in (folder / "serial").rglob("*") if p.is_file())
+    differ = differing(folder / "serial", folder / "ranks")
+    rows = [history(folder / name) for name in ("serial", "ranks")]
+    for row in (*rows[0], *rows[1]):
+        del row[SEARCHES]  # each rank counts its own part's searches
     fields = ("positions", "velocities", "forces")
     nodes = {n: bool(np.array_equal(getattr(sim, n), getattr(serial, n))) for n in fields}
     table, expected = sim.contact_table(), serial.contact_table()
@@ -235,22 +230,13 @@ def check_api(variant: str, steps: int, comm: MPI.Comm) -> int:
     same_after = bool(np.array_equal(resumed.positions, serial.positions))
     shutil.rmtree(folder)
     print(
-        f"api {variant} on {comm.Get_size()} ranks: {len(files)} files, differing {differ}; "
+        f"api {variant} on {comm.Get_size()} ranks: {files} files, differing {differ}; "
         f"history equal but list_rebuilds {rows[0] == rows[1]} ({len(rows[0])} rows); "
         f"nodes {nodes}; contacts {contacts} ({len(expected['wall'])}); walls {walls}; "
         f"resumed serially {same_after}"
     )
     ok = not differ and rows[0] == rows[1] and all(nodes.values()) and contacts and walls
     return 0 if ok and same_after else 1
-
-
-def history_without_searches(path: Path) -> list[dict[str, str]]:
-    """history.csv's rows without list_rebuilds (each rank counts its own part's searches)."""
-    with open(path, newline="") as table:
-        rows = list(csv.DictReader(table))
-    for row in rows:
-        del row["list_rebuilds"]
-    return rows
 
 
 def stop_messages(action: Callable[[], object], comm: MPI.Comm) -> list[str] | None:

@@ -30,11 +30,11 @@ class Evaluation:
     wall_reactions: NDArray[np.float64]  #: (walls, 6) force and torque on each wall [N, N m]
 
     @classmethod
-    def of_core(cls, core: Any) -> Evaluation:
-        """A serial simulation's, read from its core."""
+    def of_core(cls, core: Any, contacts: network.Table) -> Evaluation:
+        """A serial simulation's, read from its core, with its contact table (Analysis's)."""
         statistics = core.contact_statistics
         return cls(
-            network.contact_table(core.contact_network()),
+            contacts,
             float(core.contact_energy()),
             int(statistics.node_contacts),
             int(statistics.wall_contacts),

@@ -484,8 +484,7 @@ class Simulation(SimulationSetup, SimulationResults):
         distributed run every rank calls it; rank 0 writes the whole state, which restarts on
         any number of ranks or serially."""
         if self._comm is not None:
-            written = self._distributed_run().save_checkpoint(path, self._output)
-            return Path(self._comm.bcast(written, root=0))
+            return self._distributed_run().save_checkpoint(path, self._output)
         return checkpoints.save(self, path, self._output)
 
     def load_checkpoint(self, path: str | Path) -> None:

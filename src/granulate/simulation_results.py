@@ -268,7 +268,7 @@ class SimulationResults:
         simulation holds them as gathered at the last output, stop check or end of a run."""
         if self._gathered is not None:
             return self._gathered
-        return Evaluation.of_core(self._build())
+        return Evaluation.of_core(self._build(), self.analysis.contact_table())
 
     def particle_stresses(
         self,

@@ -62,6 +62,9 @@ nb::dict checkpoint_dict(const Simulation& self) {
   d["contact_statistics"] = copy_out(
       std::vector<std::uint64_t>{c.statistics.rebuilds, c.statistics.list_entries, c.statistics.node_contacts,
                                  c.statistics.wall_contacts, c.statistics.list_updates});
+  d["contact_overlaps"] = copy_out(std::vector<real>{c.statistics.deepest_overlap,
+                                                     static_cast<real>(c.statistics.half_overlap_step),
+                                                     static_cast<real>(c.statistics.full_overlap_step)});
   d["contact_pair_offsets"] = copy_out(c.pair_offsets);
   d["contact_pair_partners"] = copy_out(c.pair_partners);
   d["contact_springs"] = copy_out(c.springs);
@@ -107,6 +110,15 @@ void restore_dict(Simulation& self, const nb::dict& d) {
   const auto statistics = entry<std::uint64_t>(d, "contact_statistics");
   if (statistics.size() != 5) throw InputError("the checkpoint's contact statistics are malformed");
   c.statistics = {statistics[0], statistics[4], statistics[1], statistics[2], statistics[3]};
+  // Written since distributed runs rebuild parts from checkpoints; a checkpoint without it
+  // starts the record anew.
+  if (d.contains("contact_overlaps")) {
+    const auto overlaps = entry<real>(d, "contact_overlaps");
+    if (overlaps.size() != 3) throw InputError("the checkpoint's contact overlaps are malformed");
+    c.statistics.deepest_overlap = overlaps[0];
+    c.statistics.half_overlap_step = static_cast<std::uint64_t>(overlaps[1]);
+    c.statistics.full_overlap_step = static_cast<std::uint64_t>(overlaps[2]);
+  }
   c.pair_offsets = entry<index_t>(d, "contact_pair_offsets");
   c.pair_partners = entry<index_t>(d, "contact_pair_partners");
   c.springs = entry<real>(d, "contact_springs");

@@ -24,10 +24,9 @@ from __future__ import annotations
 import os
 import time
 import warnings
-from collections.abc import Callable
 from pathlib import Path
 from types import SimpleNamespace
-from typing import TYPE_CHECKING, Any, TypeVar
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -50,7 +49,6 @@ if TYPE_CHECKING:
     from granulate.writers.outputs import Outputs
 
 _TAG = 17
-T = TypeVar("T")
 
 
 class DistributedRun:
@@ -78,7 +76,7 @@ class DistributedRun:
         centres, radii = _bounding_spheres(sim)
         first = bisect(centres, self._weights, comm.Get_size()).grains_of(comm.Get_rank())
         # The cutoff, skin and dt of the first grains, each met by a grain of every kind.
-        probe = self._together(lambda: sim._subdomain(np.union1d(first, _kinds(sim)))[0].core)
+        probe = together(self.comm, lambda: sim._subdomain(np.union1d(first, _kinds(sim)))[0].core)
         self._skin = comm.allreduce(probe.contact_skin, op=MPI.MAX)
         cutoff = comm.allreduce(probe.contact_reach - probe.contact_skin, op=MPI.MAX) + self._skin
         self._dt = comm.allreduce(probe.time_step, op=MPI.MIN)
@@ -100,10 +98,8 @@ class DistributedRun:
         # The wall reactions a loaded checkpoint holds, until the next step evaluates them.
         self._loaded_walls: NDArray[np.float64] | None = None
         held = self._distribute(centres, radii)
-        self._together(lambda: self._build(held))
+        together(self.comm, lambda: self._build(held))
         self._exchange()
-        # The deepest overlap and its steps past 0.5 and 1 Rc in the parts this rank replaced.
-        self._overlaps = (0.0, 0, 0)
         #: Wall-clock seconds of this rank in its steps, ghost exchanges, partition checks,
         #: migrations and collections of the whole state on rank 0 (collect).
         self.seconds = dict.fromkeys(("steps", "exchange", "check", "migrate", "collect"), 0.0)
@@ -115,10 +111,6 @@ class DistributedRun:
         self.held = held
         self._plan(node_map)
         self.local.core.run(0)
-
-    def _together(self, action: Callable[[], T]) -> T:
-        """action() on every rank, ending every rank when it fails on one (agreement.py)."""
-        return together(self.comm, action)
 
     def _distribute(
         self, centres: NDArray[np.float64], radii: NDArray[np.float64]
@@ -336,9 +328,9 @@ class DistributedRun:
         for box in self.comm.alltoall(outgoing):
             received |= box
         if not renew:
-            self._together(lambda: self._plan(self._node_map))
+            together(self.comm, lambda: self._plan(self._node_map))
             return
-        self._together(lambda: self._rebuild(held, received, saved))
+        together(self.comm, lambda: self._rebuild(held, received, saved))
         self.renewals += 1
 
     def _rebuild(
@@ -352,20 +344,22 @@ class DistributedRun:
                 held, dt=self._dt, skin=self._skin, initial_motion=False
             )
             restore_grains(local.core, [states[int(g)] for g in held], node_map, moment)
-        self._overlaps = self._deepest_here()  # the part replaced kept them (not checkpointed)
         self.local, self.held = local, held
         self._plan(node_map)
 
-    def save_checkpoint(
-        self, path: str | os.PathLike[str], outputs: Outputs | None = None
-    ) -> Path | None:
+    def save_checkpoint(self, path: str | os.PathLike[str], outputs: Outputs | None = None) -> Path:
         """Write the run's checkpoint at `path`, the serial run's format (granulate.checkpoints,
         with the bookkeeping of `outputs`): every grain's state is gathered into rank 0's
         simulation, which writes it. It restarts on any number of ranks (load_checkpoint), or
         serially, bit for bit. Every rank calls it; rank 0 raises a failure to write, the others
-        RankFailed. The path written, on rank 0 (None on the others)."""
+        RankFailed. The path written, on every rank."""
         saved = dict(self.local.core.checkpoint())
         saved["contact_wall_reactions"] = self.wall_reactions().ravel()  # the whole run's
+        deepest = self.deepest_contact()
+        saved["contact_overlaps"] = np.array(
+            [deepest.deepest_overlap, deepest.half_overlap_step, deepest.full_overlap_step],
+            dtype=float,
+        )
         owned = {int(g): self._local_slice(g) for g in self._owned}
         parts = self.comm.gather(grain_states(self.local, saved, self._to_global, owned), root=0)
 
@@ -380,7 +374,7 @@ class DistributedRun:
             sim.analysis.forget_fragments()
             return checkpoints.save(sim, path, outputs)
 
-        return on_root(self.comm, write)
+        return Path(self.comm.bcast(on_root(self.comm, write), root=0))
 
     def load_checkpoint(self, path: str | os.PathLike[str], outputs: Outputs | None = None) -> None:
         """Continue from a checkpoint of this set-up written by a run on any number of ranks, or
@@ -402,7 +396,7 @@ class DistributedRun:
         held = self._distribute(
             *_spheres([states[g].positions for g in every], self._sim.dimension)
         )
-        self._together(lambda: self._rebuild(held, states, moment))
+        together(self.comm, lambda: self._rebuild(held, states, moment))
         self._loaded_walls = np.asarray(moment["contact_wall_reactions"]).reshape(-1, 6)
         self._migration_due = False
         self.seconds["migrate"] += time.perf_counter() - start
@@ -460,26 +454,20 @@ class DistributedRun:
         """The deepest contact overlap (over the contact radius) of every rank so far, and the
         first steps at which any rank's passed 0.5 and 1 (0: not yet), as the core's
         contact_statistics name them (one reduction)."""
+        statistics = self.local.core.contact_statistics
         never = float(2**53)
-        deepest, half, full = self._deepest_here()
-        mine = np.array([-deepest, half or never, full or never])
+        mine = np.array(
+            [
+                -statistics.deepest_overlap,
+                statistics.half_overlap_step or never,
+                statistics.full_overlap_step or never,
+            ]
+        )
         least = np.empty(3)
         self.comm.Allreduce(mine, least, op=self.mpi.MIN)
         half, full = (int(step) if step < never else 0 for step in least[1:])
         return SimpleNamespace(
             deepest_overlap=-float(least[0]), half_overlap_step=half, full_overlap_step=full
-        )
-
-    def _deepest_here(self) -> tuple[float, int, int]:
-        """This rank's deepest overlap and first steps past 0.5 and 1 Rc (0: not yet), over its
-        part and the parts it replaced."""
-        statistics = self.local.core.contact_statistics
-        kept_deepest, kept_half, kept_full = self._overlaps
-        half, full = statistics.half_overlap_step, statistics.full_overlap_step
-        return (
-            max(kept_deepest, statistics.deepest_overlap),
-            min(kept_half, half) if kept_half and half else kept_half or half,
-            min(kept_full, full) if kept_full and full else kept_full or full,
         )
 
     @property

@@ -56,4 +56,4 @@ class DistributedStepper:
         return self.run.broken_bonds()
 
     def save_checkpoint(self, sim: Simulation, path: Path, outputs: Outputs | None) -> Path:
-        return Path(self.comm.bcast(self.run.save_checkpoint(path, outputs), root=0))
+        return self.run.save_checkpoint(path, outputs)

@@ -245,6 +245,7 @@ _MOMENT_KEYS = (
     "contact_last_time",
     "contact_has_last_time",
     "contact_statistics",
+    "contact_overlaps",
     "contact_wall_reactions",
 )
 

@@ -40,12 +40,13 @@ struct ContactStatistics {
   std::uint64_t node_contacts = 0;  ///< node pairs in contact at the last evaluation (once each)
   std::uint64_t wall_contacts = 0;  ///< node-wall contacts at the last evaluation
   /// Deepest overlap so far, over the pair's Rc: a node pair's, or a surface probe's depth under
-  /// the other body's surface (not checkpointed; PeriDEM's node-pair law not counted): near 1,
+  /// the other body's surface (PeriDEM's node-pair law not counted): near 1,
   /// nodes are about to pass through each other (the contact layer is too soft for the impacts).
   real deepest_overlap = 0;
   /// The steps at which deepest_overlap first reached 0.5 (the contact layer too soft for the
   /// loads) and 1 (the contact gave way: nodes pass into the other body), meaningful once it
-  /// has; not checkpointed either.
+  /// has. These three are checkpointed ("contact_overlaps"), so a distributed run's rebuilt
+  /// parts keep them.
   std::uint64_t half_overlap_step = 0, full_overlap_step = 0;
   /// Takes an overlap (over Rc) measured at `step` into deepest_overlap and the steps above.
   void add_overlap(real overlap, std::uint64_t step) {
