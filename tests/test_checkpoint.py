@@ -24,6 +24,7 @@ def tumbling_drum(
     law: str = "granulate",
     rolling: float = 0.0,
     comm: object | None = None,
+    fracture: bool = True,
 ) -> gr.Simulation:
     """Grains breaking in a rotating drum: contact, friction, damping, walls and fracture.
     ``grid``: the fourth grain is a brittle grid-meshed square instead of a lattice triangle:
@@ -32,8 +33,10 @@ def tumbling_drum(
     contact's pair_law ("surface": probes of the grains' smooth surfaces, with their groups
     and the nodes opened by cracks joining the lists). ``rolling``: mu_r, the rolling
     resistance (its springs carried through the checkpoint). ``comm``: run it on MPI ranks
-    (tests/mpi_check.py)."""
-    rock = gr.Material(density=2000, youngs_modulus=1e8, poisson_ratio=0.25, fracture_energy=0.5)
+    (tests/mpi_check.py). ``fracture``: False makes the grains unbreakable."""
+    rock = gr.Material(
+        density=2000, youngs_modulus=1e8, poisson_ratio=0.25, fracture_energy=0.5, fracture=fracture
+    )
     sim = gr.Simulation(2, gravity=(0, -9.81), comm=comm)
     sim.contact = gr.Contact(restitution=0.5, friction=0.4, pair_law=law, rolling_friction=rolling)
     for k, (x, y) in enumerate([(-3e-3, -2e-3), (0, -4e-3), (3e-3, -2e-3), (0, 0)]):

@@ -12,10 +12,13 @@ within (s + 1) x 2.1 radii of the grain's centre (the lattices' spacing is 1.9).
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
 import granulate as gr
+from test_checkpoint import tumbling_drum
 
 RADIUS = 1e-3
 ROCK = gr.Material(
@@ -82,3 +85,44 @@ def test_a_grain_moves_as_its_neighbourhood_says_bit_for_bit(dimension: int, ste
         ours = getattr(whole, field)[a.first_node : a.first_node + a.node_count]
         theirs = getattr(part, field)[b.first_node : b.first_node + b.node_count]
         np.testing.assert_array_equal(ours, theirs, err_msg=field)
+
+
+# The shattered square's fragments hit hard enough to pass half the contact radius (warned).
+@pytest.mark.filterwarnings("ignore:contact.*bodies pressed")
+@pytest.mark.parametrize("fracture", [True, False])
+def test_a_ghost_grain_needs_only_its_owners_motion(fracture: bool, tmp_path: Path) -> None:
+    """A rank skips its ghosts' bond forces (core.set_ghost_particles), which its exchange
+    overwrites. The tumbling drum run twice, once with grain 1 a ghost whose positions,
+    velocities and forces are overwritten from the whole run after every step: the other
+    grains' nodes agree bit for bit through 900 steps of contact and breaking, and so do all
+    the bonds (a ghost that can break breaks as its owner's copy does: its fragments enter its
+    partners' contact). The ghost's own forces are not computed: they differ before each
+    overwrite while it is in contact, and an unbreakable ghost's dilatation is not summed."""
+    whole = tumbling_drum(tmp_path / "whole", fracture=fracture)
+    part = tumbling_drum(tmp_path / "part", fracture=fracture)
+    whole.core.run(0)
+    part.core.set_ghost_particles([1])
+    part.core.run(0)
+    ghost = part.bodies[1].node_slice
+    others = np.ones(part.core.positions.shape[0], dtype=bool)
+    others[ghost] = False
+    differed = 0
+    for _ in range(900):
+        whole.core.run(1)
+        part.core.run(1)
+        for field in ("positions", "velocities", "forces"):
+            ours, theirs = getattr(whole.core, field), getattr(part.core, field)
+            np.testing.assert_array_equal(ours[others], theirs[others], err_msg=field)
+        differed += int(not np.array_equal(whole.core.forces[ghost], part.core.forces[ghost]))
+        for field in ("positions", "velocities", "forces"):
+            getattr(part.core, field)[ghost] = getattr(whole.core, field)[ghost]
+    assert differed == 900
+    np.testing.assert_array_equal(whole.core.bond_intact, part.core.bond_intact)
+    bonds = np.asarray(whole.model.bond_offsets)[[ghost.start, ghost.stop]]
+    broken_in_ghost = np.count_nonzero(np.asarray(whole.core.bond_intact)[slice(*bonds)] == 0)
+    assert (broken_in_ghost > 20) if fracture else (broken_in_ghost == 0)
+    ghost_dilatation = np.abs(np.asarray(part.core.dilatation)[ghost]).max()
+    assert (ghost_dilatation > 0) if fracture else (ghost_dilatation == 0)
+    assert np.abs(np.asarray(whole.core.dilatation)[ghost]).max() > 0
+    with pytest.raises(gr.InputError, match="ghost particle 4 does not exist"):
+        part.core.set_ghost_particles([4])

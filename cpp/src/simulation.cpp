@@ -53,6 +53,19 @@ void Simulation::set_time_step(real dt) {
   time_step_ = dt;
 }
 
+void Simulation::set_ghost_particles(const std::vector<index_t>& particles) {
+  std::vector<std::uint8_t> ghost(model_->particles().size(), 0);
+  for (index_t q : particles) {
+    if (q >= ghost.size()) {
+      std::ostringstream msg;
+      msg << "ghost particle " << q << " does not exist: the model has " << ghost.size() << " particles";
+      throw InputError(msg.str());
+    }
+    ghost[q] = 1;
+  }
+  ghost_ = particles.empty() ? std::vector<std::uint8_t>{} : std::move(ghost);  // empty: none
+}
+
 void Simulation::set_body_acceleration(const std::array<real, 3>& g) {
   for (real c : g) {
     if (!std::isfinite(c)) throw InputError("body acceleration must be finite");

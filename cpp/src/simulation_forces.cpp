@@ -125,13 +125,15 @@ void add_pair_forces(index_t i, const NodeBonds& bonds, const std::uint8_t* bond
 
 void Simulation::add_bond_forces(real* forces) const {
   // Pass 2: pair forces, w_ij s y/|y| on i and -w_ji s y/|y| on j (w_ij = J beta V_j), from the
-  // pressures of pass 1.
+  // pressures of pass 1. Ghost particles are skipped (set_ghost_particles).
   const Model& m = *model_;
   const BondSchedule& schedule = m.bond_schedule();
   const PairForceArrays arrays{state_.positions.data(),     m.volumes().data(),       pressure_.data(),
                                m.lps_coefficients().data(), m.pmb_stiffness().data(), forces};
+  const std::uint8_t* const ghost = ghost_.empty() ? nullptr : ghost_.data();
 #pragma omp parallel
   for_each_node_in_colours(schedule, [&](index_t i) {
+    if (ghost && ghost[m.node_particle()[i]]) return;  // another process's forces
     const NodeBonds bonds = m.node_bonds(i);
     const bool lps = m.materials()[m.node_material()[i]].params.model == ForceModel::lps;
     const bool gathers = schedule.particle_gathers[m.node_particle()[i]];
@@ -168,7 +170,8 @@ void Simulation::compute_forces() {
 std::uint64_t Simulation::sum_dilatation_and_break_bonds() {
   // Pass 1: stretch, irreversible breaking, sum_j w r e at both ends. A bond breaks at the end
   // that evaluates it; its other copy is cleared below, before any loop reads it (when both
-  // ends gather, both see bitwise the same stretch and each clears its own).
+  // ends gather, both see bitwise the same stretch and each clears its own). Ghost particles
+  // that cannot break are skipped (set_ghost_particles).
   const Model& m = *model_;
   const auto& materials = m.materials();
   const auto& node_material = m.node_material();
@@ -178,6 +181,7 @@ std::uint64_t Simulation::sum_dilatation_and_break_bonds() {
   const real* const positions = state_.positions.data();
   const real* const volumes = m.volumes().data();
   real* const dilatation_sums = state_.dilatation.data();
+  const std::uint8_t* const ghost = ghost_.empty() ? nullptr : ghost_.data();
   std::vector<std::array<index_t, 2>> broken;  // (evaluating node, neighbour)
 #pragma omp parallel
   {
@@ -190,6 +194,7 @@ std::uint64_t Simulation::sum_dilatation_and_break_bonds() {
       const CriticalStretch criterion{m.particles()[m.node_particle()[i]].critical_stretch,
                                       material.params.break_in_compression};
       const bool breaks = material.params.fracture, gathers = schedule.particle_gathers[m.node_particle()[i]];
+      if (ghost && !breaks && ghost[m.node_particle()[i]]) return;  // another process's dilatation
       std::uint8_t* const bits = intact.node(i);
       if (breaks && !gathers) {
         add_dilatation_terms<true, false>(i, bonds, bits, criterion, positions, volumes, dilatation_sums,

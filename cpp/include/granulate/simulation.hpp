@@ -80,7 +80,8 @@ class Simulation {
   bool assign_bonds(const std::vector<std::uint8_t>& states);
   /// The bonds' force densities alone at the current state [N/m^3, nodes x 3]: pass 2 of the
   /// last force evaluation again, without body forces, damping, contact and loads (zero before
-  /// any evaluation). For particle stresses from internal forces.
+  /// any evaluation; zero on ghost particles, see set_ghost_particles). For particle stresses
+  /// from internal forces.
   std::vector<real> bond_force_densities() const;
   /// Breaks the bonds between the given node pairs (both copies; pre-cracks, notches). Pairs
   /// that are not bonded are an InputError; already broken ones are left as they are.
@@ -102,6 +103,13 @@ class Simulation {
   /// Lists every node's contact partners again now (ContactModel::search); the forces of the
   /// last step stay. For a distributed run, whose ranks re-list the grains they receive.
   void search_contacts() { contact_.search(*model_, state_, broken_bond_copies_); }
+  /// Marks the particles whose forces another process evaluates (a distributed run's ghosts;
+  /// the rest are not). Their bonds' pair forces (pass 2) are skipped, and pass 1 too unless
+  /// their material breaks: breaking decides their fragments, which their partners' contact
+  /// needs. Their forces and dilatation are then not their own until the caller overwrites them
+  /// (granulate.parallel's exchange); their positions, velocities and bonds stay exact as long
+  /// as it does. InputError for an index out of range.
+  void set_ghost_particles(const std::vector<index_t>& particles);
 
  private:
   // The phases of compute_forces, in order.
@@ -128,6 +136,8 @@ class Simulation {
   std::vector<PrescribedMotion> motions_;
   std::vector<NodalForce> nodal_forces_;
   std::vector<real> pressure_;            // A_i theta_i of LPS nodes
+  std::vector<std::uint8_t> ghost_;       // per particle: 1 if another process evaluates it;
+                                          // empty when none is
   std::uint64_t broken_bond_copies_ = 0;  // both copies of a broken bond count
   ContactModel contact_;
   contact::PeridemDamping peridem_damping_;

@@ -123,6 +123,8 @@ void bind_loading(nb::class_<Simulation>& cls) {
           "The neighbour lists' skin [m]: as set, or half the largest contact radius.")
       .def(
           "set_contact_skin", [](Simulation& self, real skin) { self.contact().set_skin(skin); }, "skin"_a)
+      .def("set_ghost_particles", &Simulation::set_ghost_particles, "particles"_a,
+           "Mark the particles whose forces another process evaluates (Simulation::set_ghost_particles).")
       .def("search_contacts", &Simulation::search_contacts,
            "List every node's contact partners again now, carrying collisions and friction springs over.")
       .def(

@@ -125,12 +125,15 @@ class DistributedRun:
     def _plan(self, node_map: NDArray[np.int64]) -> None:
         """Which local nodes go to which rank and come from which, in grain order, with the
         message buffers (9 numbers a node: x, v, f), made once per partition; the positions
-        the nodes' travel is measured from."""
+        the nodes' travel is measured from. The core skips the ghosts' bond forces, which the
+        exchange overwrites (Simulation::set_ghost_particles)."""
         rank = self.comm.Get_rank()
         owner = self.partition.owner
         self._node_map = node_map
         self._to_global = np.flatnonzero(node_map >= 0)  # subsets keep the serial order
         self._owned = self.partition.grains_of(rank)
+        ghost_particles = np.flatnonzero(owner[self.held] != rank)  # the part's particle order
+        self.local.core.set_ghost_particles(ghost_particles.tolist())
         self._owned_nodes = self._nodes_of(self._owned, node_map)
         self._is_owned = np.zeros(len(self._to_global), dtype=bool)
         self._is_owned[self._owned_nodes] = True
