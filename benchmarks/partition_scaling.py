@@ -46,9 +46,10 @@ import granulate as gr
 from granulate.parallel import bisect, ghosts, near_pairs
 
 RADIUS = 1e-3
-#: The check after each step (a pass over the positions), as a share of a step: 4.4 % on one
-#: rank of benchmarks/distributed.py's pile3d (1,000 grains, 258,624 nodes; measured).
-CHECK_SHARE = 0.044
+#: The check after each step (one reduction of the travel the core measures in its last half
+#: kick, and the Python around it), as a share of a step: 0.2 % on one rank of `granulate bench
+#: --ranks`' pile3d (1,000 grains, 258,624 nodes; measured; 4.4 % when it was a NumPy pass).
+CHECK_SHARE = 0.002
 MATERIAL = gr.Material(density=1200, bulk_modulus=2.16e7, shear_modulus=1.296e7, fracture_energy=50)
 
 
@@ -204,10 +205,9 @@ def as_built(
     largest bounding radius; `pairs`: near_pairs at that distance), stepped and then
     overwritten, less their bonds' pair forces (`pair_share` of a step, which the core skips
     for ghosts); it receives 72 bytes (x, v, f) of every ghost node, one message per
-    neighbouring rank, passes over its positions after each step (CHECK_SHARE of a step,
-    measured) and reduces once. Efficiency: its own nodes' compute over its step; the same
-    with ghosts stepped in full (the engine before the core skipped their pair forces), and if
-    ghosts were not stepped at all (not built)."""
+    neighbouring rank, checks after each step (CHECK_SHARE of a step, measured) and reduces
+    once. Efficiency: its own nodes' compute over its step; the same with the ghosts stepped in
+    full, and if ghosts were not stepped at all (not built)."""
     partition = bisect(centres, np.ones(len(centres)), ranks)
     needed = ghosts(partition, pairs)
     owned = np.bincount(partition.owner, minlength=ranks)
@@ -262,7 +262,7 @@ def engine_as_built(
     print(
         f"\nthe engine as built: whole ghost grains within {1e3 * (args.reach + margin):.2f} mm "
         f"(reach + margin) stepped but for their pair forces ({100 * pair_share:.0f} % of a "
-        "step, measured), x, v, f of every ghost node exchanged, a positions pass "
+        "step, measured), x, v, f of every ghost node exchanged, the check "
         f"({100 * CHECK_SHARE:.1f} % of a step) and one reduction"
     )
     print(

@@ -126,3 +126,20 @@ def test_a_ghost_grain_needs_only_its_owners_motion(fracture: bool, tmp_path: Pa
     assert np.abs(np.asarray(whole.core.dilatation)[ghost]).max() > 0
     with pytest.raises(gr.InputError, match="ghost particle 4 does not exist"):
         part.core.set_ghost_particles([4])
+
+
+def test_the_core_measures_how_far_the_nodes_travelled(tmp_path: Path) -> None:
+    """core.largest_travel (a rank's check that its ghosts still hold): after each step, the
+    largest distance of a node from where it was at set_travel_origin [m], as NumPy finds it;
+    0 before the first step and with no origin set."""
+    sim = tumbling_drum(tmp_path)
+    sim.core.run(100)
+    assert sim.core.largest_travel == 0.0
+    origin = sim.core.positions.copy()
+    sim.core.set_travel_origin()
+    assert sim.core.largest_travel == 0.0
+    for _ in range(5):
+        sim.core.run(40)
+        moved = np.linalg.norm(sim.core.positions - origin, axis=1).max()
+        assert sim.core.largest_travel == pytest.approx(moved, rel=1e-14)
+    assert sim.core.largest_travel > 1e-4  # the grains fall and tumble

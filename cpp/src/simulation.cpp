@@ -204,8 +204,11 @@ void Simulation::run(std::uint64_t steps) {
     start = clock_type::now();
     // The second half kick, and the first node (if any) that moved more than its mesh size in
     // the step or became non-finite: checked every step, at the cost of one comparison per node.
+    // With a travel origin, also the largest squared distance of a node from it.
     std::int64_t first_unstable = n3;
-#pragma omp parallel for schedule(static) reduction(min : first_unstable)
+    real travel2 = 0;
+    const real* const origin = travel_origin_.empty() ? nullptr : travel_origin_.data();
+#pragma omp parallel for schedule(static) reduction(min : first_unstable) reduction(max : travel2)
     for (std::int64_t i = 0; i < n3 / 3; ++i) {
       real speed2 = 0;
       const real density = m.density(static_cast<index_t>(i));
@@ -215,7 +218,13 @@ void Simulation::run(std::uint64_t steps) {
       }
       const real limit = particles[node_particle[i]].mesh_size / dt;
       if (!(speed2 <= limit * limit)) first_unstable = std::min(first_unstable, i);
+      if (origin) {
+        const real dx = x[3 * i] - origin[3 * i], dy = x[3 * i + 1] - origin[3 * i + 1],
+                   dz = x[3 * i + 2] - origin[3 * i + 2];
+        travel2 = std::max(travel2, dx * dx + dy * dy + dz * dz);
+      }
     }
+    if (origin) largest_travel_ = std::sqrt(travel2);
     apply_prescribed_motion(false);
     ++state_.step;
     if (first_unstable < n3) check_stability();  // names the node (a prescribed one is fine)
@@ -231,9 +240,9 @@ std::array<std::size_t, 2> Simulation::memory_bytes() const {
     bonds += bytes(f.neighbors) + bytes(f.weights) + bytes(f.lengths);
   std::size_t other = state_.bonds.offset_bytes() + bytes(state_.positions) + bytes(state_.velocities) +
                       bytes(state_.forces) + bytes(state_.dilatation) + bytes(pressure_) +
-                      bytes(m.reference_positions()) + bytes(m.volumes()) + bytes(m.node_particle()) +
-                      bytes(m.node_material()) + bytes(m.bond_offsets()) + bytes(m.lps_coefficients()) +
-                      bytes(m.pmb_stiffness()) + contact_.memory_bytes();
+                      bytes(travel_origin_) + bytes(m.reference_positions()) + bytes(m.volumes()) +
+                      bytes(m.node_particle()) + bytes(m.node_material()) + bytes(m.bond_offsets()) +
+                      bytes(m.lps_coefficients()) + bytes(m.pmb_stiffness()) + contact_.memory_bytes();
   for (const BondFamilies& f : m.families()) other += bytes(f.offsets) + bytes(f.forward);
   other += m.bond_schedule().memory_bytes();
   for (const Shape& s : m.shapes()) other += s.anchors.memory_bytes();  // nodes and volumes released

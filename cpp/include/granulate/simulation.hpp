@@ -110,6 +110,16 @@ class Simulation {
   /// (granulate.parallel's exchange); their positions, velocities and bonds stay exact as long
   /// as it does. InputError for an index out of range.
   void set_ghost_particles(const std::vector<index_t>& particles);
+  /// From now on each step measures how far the farthest node is from where it is now [m]
+  /// (largest_travel), in its last half kick: a distributed run's check that its ghosts still
+  /// hold. Off until called (a serial run measures nothing).
+  void set_travel_origin() {
+    travel_origin_ = state_.positions;
+    largest_travel_ = 0;
+  }
+  /// The largest distance of a node from the travel origin after the last step [m] (0 before
+  /// a step, or with no origin set).
+  real largest_travel() const { return largest_travel_; }
 
  private:
   // The phases of compute_forces, in order.
@@ -135,9 +145,11 @@ class Simulation {
   real viscous_damping_ = 0;
   std::vector<PrescribedMotion> motions_;
   std::vector<NodalForce> nodal_forces_;
-  std::vector<real> pressure_;            // A_i theta_i of LPS nodes
-  std::vector<std::uint8_t> ghost_;       // per particle: 1 if another process evaluates it;
-                                          // empty when none is
+  std::vector<real> pressure_;       // A_i theta_i of LPS nodes
+  std::vector<std::uint8_t> ghost_;  // per particle: 1 if another process evaluates it;
+                                     // empty when none is
+  std::vector<real> travel_origin_;  // positions largest_travel is measured from; or empty
+  real largest_travel_ = 0;
   std::uint64_t broken_bond_copies_ = 0;  // both copies of a broken bond count
   ContactModel contact_;
   contact::PeridemDamping peridem_damping_;

@@ -125,6 +125,10 @@ void bind_loading(nb::class_<Simulation>& cls) {
           "set_contact_skin", [](Simulation& self, real skin) { self.contact().set_skin(skin); }, "skin"_a)
       .def("set_ghost_particles", &Simulation::set_ghost_particles, "particles"_a,
            "Mark the particles whose forces another process evaluates (Simulation::set_ghost_particles).")
+      .def("set_travel_origin", &Simulation::set_travel_origin,
+           "Measure each step how far the farthest node is from where it is now (largest_travel).")
+      .def_prop_ro("largest_travel", &Simulation::largest_travel,
+                   "The largest distance of a node from the travel origin after the last step [m].")
       .def("search_contacts", &Simulation::search_contacts,
            "List every node's contact partners again now, carrying collisions and friction springs over.")
       .def(

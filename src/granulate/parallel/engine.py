@@ -125,8 +125,8 @@ class DistributedRun:
     def _plan(self, node_map: NDArray[np.int64]) -> None:
         """Which local nodes go to which rank and come from which, in grain order, with the
         message buffers (9 numbers a node: x, v, f), made once per partition; the positions
-        the nodes' travel is measured from. The core skips the ghosts' bond forces, which the
-        exchange overwrites (Simulation::set_ghost_particles)."""
+        the nodes' travel is measured from (the core measures it in each step). The core skips
+        the ghosts' bond forces, which the exchange overwrites (Simulation::set_ghost_particles)."""
         rank = self.comm.Get_rank()
         owner = self.partition.owner
         self._node_map = node_map
@@ -148,8 +148,7 @@ class DistributedRun:
         }
         self._outbox = {q: np.empty((len(n), 9)) for q, n in self._send.items()}
         self._inbox = {q: np.empty((len(n), 9)) for q, n in self._receive.items()}
-        self._start = self.local.core.positions.copy()
-        self._moved = np.empty_like(self._start)
+        self.local.core.set_travel_origin()
 
     def _local_slice(self, grain: int) -> slice:
         """The local nodes of a held grain."""
@@ -241,10 +240,10 @@ class DistributedRun:
     def _check_step(self, step: int, failure: Exception | None) -> float:
         """One reduction after each step, before the exchange: the first rank whose step
         failed, and the largest distance of a node from where it was when the grains were
-        distributed (the ghosts' positions are already exact here: they drifted from exact
-        values). Stops every rank on either; returns that distance [m]."""
-        moved = np.subtract(self.local.core.positions, self._start, out=self._moved)
-        farthest = float(np.sqrt(np.einsum("ij,ij->i", moved, moved).max(initial=0.0)))
+        distributed (core.largest_travel, measured in the step: the ghosts' positions are
+        exact there, they drifted from exact values). Stops every rank on either; returns that
+        distance [m]."""
+        farthest = float(self.local.core.largest_travel)
         size = self.comm.Get_size()
         failed_rank = self.comm.Get_rank() if failure is not None else size
         mine = np.array([failed_rank, -farthest])  # elementwise minima: both in one reduction
