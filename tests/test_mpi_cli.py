@@ -8,6 +8,7 @@ migrate between the ranks many times in its 3,000 steps."""
 
 from __future__ import annotations
 
+import json
 import os
 import re
 import subprocess
@@ -143,3 +144,53 @@ def test_a_case_restarting_from_a_frame_runs_on_ranks(serial_run: Path, tmp_path
         assert done.returncode == 0, done.stderr
     assert [row["step"] for row in history(tmp_path / "serial")] == ["1000", "1250", "1500"]
     assert_same_run(tmp_path / "serial", tmp_path / "ranks", row_count=3)
+
+
+def bench_ranks(*arguments: str, ranks: int = 2) -> subprocess.CompletedProcess[str]:
+    """`granulate bench --ranks ...` on `ranks` MPI ranks; a hang fails after 5 minutes."""
+    command = [mpiexec(), "-n", str(ranks), sys.executable, "-m", "granulate", "bench"]
+    return subprocess.run(
+        [*command, "--ranks", *arguments], capture_output=True, text=True, timeout=300
+    )
+
+
+def test_bench_ranks_prints_each_ranks_speed_and_communication() -> None:
+    """`mpiexec -n 2 granulate bench --ranks --quick --json` (the 3D pile, 200 grains): one JSON
+    object, from rank 0: a row per rank, whose grains and nodes add up to the case's, each
+    rank holding the other's nearby grains as ghosts, with its speed and time shares; one
+    thread per rank by default."""
+    done = bench_ranks("--quick", "--json")
+    assert done.returncode == 0, done.stderr
+    (line,) = done.stdout.splitlines()
+    result = json.loads(line)
+    assert (result["case"], result["ranks"], result["threads"], result["steps"]) == (
+        "pile3d",
+        2,
+        1,
+        20,
+    )
+    rows = result["rows"]
+    assert len(rows) == 2
+    assert sum(row["grains"] for row in rows) == result["grains"] == 200
+    assert sum(row["nodes"] for row in rows) == 51_712
+    for row in rows:
+        assert 0 < row["ghost_nodes"] < row["nodes"]
+        assert row["node_steps_per_s"] > 0
+        assert all(0 <= row[f"{name}_share"] < 1 for name in ("exchange", "check", "migrate"))
+        assert row["collect_share"] == 0
+
+
+def test_bench_ranks_refuses_what_it_cannot_run_once() -> None:
+    """A case it does not have, or --collect-every without --ranks: one message, exit 2 from
+    every rank."""
+    done = bench_ranks("--case", "lps3d_lattice")
+    assert done.returncode == 2
+    assert done.stderr.count("unknown distributed benchmark case 'lps3d_lattice'") == 1
+    done = subprocess.run(
+        [sys.executable, "-m", "granulate", "bench", "--collect-every", "5"],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert done.returncode == 2
+    assert "go with --ranks" in done.stderr

@@ -9,6 +9,7 @@
     granulate render DIR [--frame N] [--gif]   PNG images (and a GIF) of the particles
     granulate schema [--json]                  the case-file reference (or its JSON Schema)
     granulate bench [--quick] [--case NAME ...] [--threads N] [--json] [--contended]
+    mpirun -n K granulate bench --ranks [--case NAME] [--steps S] [--grains N] [--collect-every N]
     granulate info                             version, build options, threads
 
 Exit codes: 0 success, 2 invalid input, 1 failed run, 130 interrupted. User errors print one
@@ -16,8 +17,9 @@ line (``--debug`` shows the traceback).
 
 ``mpirun -n K granulate run CASE.yaml`` runs the case on K MPI ranks (granulate.parallel; the
 ``mpi`` extra installs mpi4py): the same outputs as the serial run, written by rank 0, which
-also prints; a rank's own failure is printed by that rank. The other commands that write files
-refuse to start as several ranks (granulate.parallel.launch).
+also prints; a rank's own failure is printed by that rank. ``bench --ranks`` measures a
+distributed run (granulate.bench_ranks). The other commands that write files refuse to start as
+several ranks (granulate.parallel.launch).
 """
 
 from __future__ import annotations
@@ -223,7 +225,7 @@ def _run_case(
     return 0
 
 
-def _world() -> object | None:
+def _world(command: str = "run") -> object | None:
     """MPI's world communicator when this process was started as one of several ranks (mpirun,
     mpiexec, srun), else None. InputError when mpi4py is missing or belongs to another MPI than
     the launcher's (each process would see itself alone and run the whole case)."""
@@ -234,7 +236,8 @@ def _world() -> object | None:
         from mpi4py import MPI
     except ImportError:
         raise InputError(
-            f"granulate run was started as {size} MPI processes, but mpi4py is not installed: "
+            f"granulate {command} was started as {size} MPI processes, but mpi4py is not "
+            "installed: "
             "pip install 'granulate[mpi]' (or mpi4py built against your cluster's MPI)"
         ) from None
     if MPI.COMM_WORLD.Get_size() != size:
@@ -306,6 +309,20 @@ def _parser() -> argparse.ArgumentParser:
         help="next to one busy process: 1 thread, all fixed, all adaptive",
     )
     bench.add_argument("--out", type=Path, default=Path("out") / "bench", help="scratch output")
+    bench.add_argument(
+        "--ranks",
+        action="store_true",
+        help="a distributed run on the MPI ranks this is launched on (mpirun -n K): per rank "
+        "node-steps/s and communication shares; cases pile3d (default), pile, drum",
+    )
+    bench.add_argument("--steps", type=int, help="with --ranks: timed steps (default 300)")
+    bench.add_argument("--grains", type=int, help="with --ranks: grains (default: the case's)")
+    bench.add_argument(
+        "--collect-every",
+        type=int,
+        default=0,
+        help="with --ranks: gather the whole state on rank 0 every N steps (0: never)",
+    )
     plot = commands.add_parser("plot", help="PNG plots of a run's history.csv and fragment tables")
     plot.add_argument("directory", type=Path)
     render = commands.add_parser("render", help="PNG images of the particles coloured by damage")
@@ -342,6 +359,10 @@ def _dispatch(options: argparse.Namespace) -> int:
     if options.command == "bench":
         from granulate import bench as benchmarks
 
+        if options.ranks:
+            return _bench_ranks(options)
+        if options.steps is not None or options.grains is not None or options.collect_every:
+            raise InputError("bench: --steps, --grains and --collect-every go with --ranks")
         if options.contended:
             return benchmarks.contended(options.case, options.quick, options.json, options.out)
         return benchmarks.main(options.case, options.quick, None, options.json, options.out)
@@ -356,10 +377,44 @@ def _dispatch(options: argparse.Namespace) -> int:
     return 0
 
 
+def _bench_ranks(options: argparse.Namespace) -> int:
+    """`granulate bench --ranks`: the distributed benchmark on the ranks this process was
+    launched among (one, without a launcher), one thread each unless --threads."""
+    from granulate import bench_ranks
+
+    cases = options.case or []
+    if options.contended or len(cases) > 1:
+        raise InputError("bench --ranks runs one case, and not --contended")
+    comm = _world("bench --ranks")
+    if comm is None:
+        try:
+            from mpi4py import MPI
+        except ImportError:
+            raise InputError(
+                "bench --ranks needs mpi4py: pip install 'granulate[mpi]' (or mpi4py built "
+                "against your cluster's MPI)"
+            ) from None
+        comm = MPI.COMM_WORLD
+    if options.threads is None:
+        threads.set_num_threads(1, adaptive=False)
+    case = cases[0] if cases else None
+    return bench_ranks.main(
+        comm,
+        case,
+        options.grains,
+        options.steps,
+        options.collect_every,
+        options.quick,
+        options.json,
+    )
+
+
 def _writes_output(options: argparse.Namespace) -> bool:
     """Whether a command writes files that copies of it on several MPI ranks would write at
     once: not `run` (a case runs over the ranks; a Python script is the user's own, and may
-    use them itself)."""
+    use them itself) nor `bench --ranks` (which measures the ranks, writing nothing)."""
+    if options.command == "bench" and options.ranks:
+        return False
     return options.command not in ("info", "schema", "check", "run")
 
 

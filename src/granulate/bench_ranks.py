@@ -1,0 +1,230 @@
+"""The distributed benchmark: ``mpiexec -n K granulate bench --ranks [--case NAME] [--grains N]
+[--steps S] [--collect-every N] [--json]``, per rank its speed and the shares of its time spent
+communicating (granulate.parallel; benchmarks/distributed.py runs the same).
+
+Cases:
+
+======  ======================================================================================
+pile3d  (default; 1,000 grains, 258,624 nodes) spheres and cubes of radius 0.98-1 mm (R/h = 4)
+        on a cubic lattice 2 mm apart, 10 x 10 columns, on a floor, under gravity
+pile    (400 grains) compression-like, at rest: discs and hexagons of radius 0.98-1 mm (R/h = 5)
+        on a hexagonal lattice 2 mm apart, touching their neighbours, under gravity on a floor
+        between two side walls
+drum    (300 grains) drum-like, flowing: the same grains on a hexagonal lattice inside a drum
+        turning at 20 rad/s, each thrown at 2 m/s in a random direction, so that the ranks
+        migrate grains every few dozen steps
+======  ======================================================================================
+
+Each rank runs one thread unless ``granulate --threads N`` says otherwise. After 20 untimed
+steps (lists built, caches warm) the ranks' clocks start together and run the steps. Rank 0
+prints a table: per rank the grains and nodes it owns at the end, the ghost nodes it holds
+besides, its owned node-steps per second, and the shares of its wall-clock time spent in the
+ghost exchange, in the partition check (a reduction), in migrations and, with
+``--collect-every N``, in gathering the whole state into rank 0's simulation every N steps (as a
+run with outputs or stop criteria every N steps does, DistributedRun.collect; nothing is
+written); then the migrations and grains handed over. With ``--json``, one JSON object instead.
+On fewer cores than ranks (oversubscribed) the shares include waiting for the other ranks and
+are an upper bound.
+"""
+
+from __future__ import annotations
+
+import json
+import time
+import warnings
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+
+import granulate as gr
+from granulate.errors import InputError
+
+RADIUS = 1e-3
+ROCK = gr.Material(
+    density=1200, bulk_modulus=2.16e7, shear_modulus=1.296e7, fracture_energy=50, horizon=0.6e-3
+)
+SHARES = ("exchange", "check", "migrate", "collect")
+
+
+def pile(grains: int) -> gr.Simulation:
+    """`grains` grains in rows of 20 on a hexagonal lattice, in a box open at the top."""
+    rng = np.random.default_rng(3)
+    spacing, columns = 2.0 * RADIUS, 20
+    sim = gr.Simulation(2, gravity=(0, -9.81, 0))
+    sim.contact = gr.Contact(restitution=0.5, friction=0.5)
+    for k in range(grains):
+        row, column = divmod(k, columns)
+        centre = (spacing * (column + 0.5 * (row % 2)), spacing * np.sqrt(3) / 2 * row)
+        radius = RADIUS * rng.uniform(0.98, 1.0)
+        shape = (
+            gr.RegularPolygon(centre, radius, 6, angle=0.3 * k)
+            if k % 3 == 0
+            else gr.Disc(centre, radius)
+        )
+        sim.add_body(shape, ROCK, RADIUS / 5)
+    width = spacing * (columns + 0.5)
+    sim.add_wall(gr.Wall(gr.Plane((0, -0.99 * RADIUS, 0), (0, 1, 0))), name="floor")
+    sim.add_wall(gr.Wall(gr.Plane((-0.99 * RADIUS, 0, 0), (1, 0, 0))), name="left")
+    sim.add_wall(gr.Wall(gr.Plane((width - RADIUS, 0, 0), (-1, 0, 0))), name="right")
+    return sim
+
+
+def drum(grains: int) -> gr.Simulation:
+    """`grains` grains on a hexagonal lattice inside a turning drum, thrown at 2 m/s."""
+    rng = np.random.default_rng(5)
+    spacing = 2.0 * RADIUS
+    size = int(np.ceil(np.sqrt(grains / 0.9 * 2 / np.sqrt(3)))) + 2
+    sites = [
+        (
+            spacing * (column + 0.5 * (row % 2) - size / 2),
+            spacing * np.sqrt(3) / 2 * (row - size / 2),
+        )
+        for row in range(size)
+        for column in range(size)
+    ]
+    sites.sort(key=lambda site: (np.hypot(*site), site))
+    sim = gr.Simulation(2, gravity=(0, -9.81, 0))
+    sim.contact = gr.Contact(restitution=0.5, friction=0.5)
+    for k, centre in enumerate(sites[:grains]):
+        radius = RADIUS * rng.uniform(0.98, 1.0)
+        shape = (
+            gr.RegularPolygon(centre, radius, 6, angle=0.3 * k)
+            if k % 3 == 0
+            else gr.Disc(centre, radius)
+        )
+        angle = rng.uniform(0, 2 * np.pi)
+        velocity = (2.0 * np.cos(angle), 2.0 * np.sin(angle))
+        sim.add_body(shape, ROCK, RADIUS / 5, velocity=velocity)
+    reach = max(np.hypot(*site) for site in sites[:grains]) + 2 * RADIUS
+    rotation = gr.Rotation.steady(20.0)
+    sim.add_wall(gr.Wall(gr.CircleContainer((0, 0), reach), motion=rotation), name="drum")
+    return sim
+
+
+def pile3d(grains: int) -> gr.Simulation:
+    """`grains` grains in 10 x 10 columns on a cubic lattice, on a floor."""
+    rng = np.random.default_rng(3)
+    sim = gr.Simulation(3, gravity=(0, -9.81, 0))
+    sim.contact = gr.Contact(restitution=0.5, friction=0.5)
+    for k in range(grains):
+        layer, rest = divmod(k, 100)
+        row, column = divmod(rest, 10)
+        centre = (2 * RADIUS * column, 2 * RADIUS * layer, 2 * RADIUS * row)
+        radius = RADIUS * rng.uniform(0.98, 1.0)
+        if k % 3 == 0:
+            half = 0.8 * radius
+            shape = gr.Box(tuple(c - half for c in centre), tuple(c + half for c in centre))
+        else:
+            shape = gr.Sphere(centre, radius)
+        sim.add_body(shape, ROCK, RADIUS / 4)
+    sim.add_wall(gr.Wall(gr.Plane((0, -0.99 * RADIUS, 0), (0, 1, 0))), name="floor")
+    return sim
+
+
+#: name: (set-up, default grains, grains with --quick)
+CASES: dict[str, tuple[Callable[[int], gr.Simulation], int, int]] = {
+    "pile3d": (pile3d, 1000, 200),
+    "pile": (pile, 400, 40),
+    "drum": (drum, 300, 40),
+}
+
+
+def measure(
+    case: str, grains: int | None, steps: int, collect_every: int, comm: Any, quick: bool = False
+) -> dict[str, Any] | None:
+    """Run `case` with `grains` grains (None: its default, or its quick size) for `steps` timed
+    steps on the ranks of `comm`, gathering the whole state every `collect_every` steps (0:
+    never). On rank 0 the result (a dict, rows per rank); None on the others. Every rank calls
+    it."""
+    from granulate.parallel import DistributedRun
+
+    if case not in CASES:
+        raise InputError(f"unknown distributed benchmark case {case!r}; choose from {_names()}")
+    if steps < 1 or collect_every < 0 or (grains is not None and grains < 1):
+        raise InputError(
+            "bench --ranks: --steps and --grains must be positive and --collect-every at least 0"
+        )
+    make, default, small = CASES[case]
+    grains = grains or (small if quick else default)
+    with warnings.catch_warnings():
+        warnings.filterwarnings("ignore", message="contact.*bodies pressed")  # placed pressed
+        run = DistributedRun(make(grains), comm)
+        run.run(20)  # lists built, caches warm
+    every = collect_every or steps
+    if collect_every:
+        run.collect()  # rank 0 builds the whole simulation once
+    run.seconds = dict.fromkeys(run.seconds, 0.0)
+    migrations, handed = run.migrations, run.handed_over
+    comm.Barrier()  # every rank's clock starts together
+    start = time.perf_counter()
+    for done in range(0, steps, every):
+        run.run(min(every, steps - done))
+        if collect_every:
+            run.collect()
+    wall = time.perf_counter() - start
+    row = {
+        "grains": len(run.owned),
+        "nodes": run.owned_node_count,
+        "ghost_nodes": run.ghost_node_count,
+        "seconds": wall,
+        "node_steps_per_s": run.owned_node_count * steps / wall,
+    } | {f"{name}_share": run.seconds[name] / wall for name in SHARES}
+    rows = comm.gather(row, root=0)
+    if rows is None:
+        return None
+    return {
+        "case": case,
+        "grains": grains,
+        "steps": steps,
+        "collect_every": collect_every,
+        "ranks": comm.Get_size(),
+        "threads": gr.get_num_threads(),
+        "rows": rows,
+        "migrations": run.migrations - migrations,
+        "handed_over": run.handed_over - handed,
+    }
+
+
+def table(result: dict[str, Any]) -> str:
+    """The result of `measure` as a Markdown table with a heading and a closing line."""
+    lines = [
+        f"{result['case']}: {result['grains']} grains, {result['steps']} steps, "
+        f"{result['ranks']} ranks, {result['threads']} thread(s) each",
+        "| rank | grains | nodes | ghost nodes | node-steps/s | exchange % | check % | migrate % "
+        "| collect % |",
+        "|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
+    ]
+    for rank, row in enumerate(result["rows"]):
+        shares = " | ".join(f"{100 * row[f'{name}_share']:.1f}" for name in SHARES)
+        lines.append(
+            f"| {rank} | {row['grains']} | {row['nodes']:,} | {row['ghost_nodes']:,} | "
+            f"{row['node_steps_per_s'] / 1e6:.2f} M | {shares} |"
+        )
+    lines.append(
+        f"{result['migrations']} migrations, {result['handed_over']} grains handed over in the "
+        "timed steps"
+    )
+    return "\n".join(lines)
+
+
+def main(
+    comm: Any,
+    case: str | None,
+    grains: int | None,
+    steps: int | None,
+    collect_every: int,
+    quick: bool,
+    as_json: bool,
+) -> int:
+    """`granulate bench --ranks`: measure and print on rank 0 (`steps` None: 300, or 20 with
+    `quick`)."""
+    steps = steps if steps is not None else (20 if quick else 300)
+    result = measure(case or "pile3d", grains, steps, collect_every, comm, quick)
+    if result is not None:
+        print(json.dumps(result) if as_json else table(result), flush=True)
+    return 0
+
+
+def _names() -> str:
+    return ", ".join(CASES)
