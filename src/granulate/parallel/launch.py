@@ -1,10 +1,10 @@
 """Whether this process was started as one of several MPI ranks (mpirun, mpiexec, srun), read
 from the variables the launchers set, without importing MPI.
 
-`granulate run case.yaml` started as K ranks runs the case over them (granulate.parallel). The
-other commands that write files would be K copies writing the same files at once: the command
-line refuses them with one message from rank 0 (the other ranks exit with the same code,
-silently).
+`granulate run case.yaml` started as K ranks runs the case over them (granulate.parallel), and
+`granulate bench --ranks` measures them. The other commands that write files would be K copies
+writing the same files at once: the command line refuses them with one message from rank 0 (the
+other ranks exit with the same code, silently).
 """
 
 from __future__ import annotations
@@ -35,6 +35,7 @@ def serial_only_message(command: str, size: int) -> str:
     """What a user who started `granulate <command>` on `size` ranks is told."""
     return (
         f"'granulate {command}' was started as {size} MPI processes (mpirun, mpiexec or srun); "
-        "only 'granulate run' runs over MPI ranks, and the copies would write the same files at "
-        f"once. Start one process: granulate --threads N {command} ..."
+        "only 'granulate run' (and 'granulate bench --ranks') runs over MPI ranks, and the copies "
+        f"would write the same files at once. Start one process: granulate --threads N {command} "
+        "..."
     )
