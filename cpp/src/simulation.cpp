@@ -167,69 +167,111 @@ void Simulation::update_kinematic_nodes() {
 }
 
 void Simulation::run(std::uint64_t steps) {
-  const Model& m = *model_;
-  const auto& particles = m.particles();
-  const auto& node_particle = m.node_particle();
-  const std::int64_t n3 = 3 * static_cast<std::int64_t>(m.node_count());
-  auto& x = state_.positions;
-  auto& v = state_.velocities;
-  auto& f = state_.forces;
-  const real dt = time_step_;
+  if (step_begun_) throw InputError("run: the step begin_step began is not finished (finish_step)");
   if (!forces_current_) {
     apply_prescribed_motion(true);
     compute_forces();
   }
   for (std::uint64_t s = 0; s < steps; ++s) {
-    auto start = clock_type::now();
-#pragma omp parallel for schedule(static)
-    for (std::int64_t i = 0; i < n3 / 3; ++i) {
-      const real density = m.density(static_cast<index_t>(i));
-      for (std::int64_t k = 3 * i; k < 3 * i + 3; ++k) {
-        v[k] += 0.5 * dt * f[k] / density;
-        x[k] += dt * v[k];
-      }
-    }
-    state_.time += dt;
-    phase_times_.integration += seconds_since(start);
-
-    start = clock_type::now();
-    apply_prescribed_motion(true);
-    phase_times_.loading += seconds_since(start);
-
-    start = clock_type::now();
-    const double contact_before = phase_times_.contact;
-    compute_forces();
-    phase_times_.peridynamics += seconds_since(start) - (phase_times_.contact - contact_before);
-
-    start = clock_type::now();
-    // The second half kick, and the first node (if any) that moved more than its mesh size in
-    // the step or became non-finite: checked every step, at the cost of one comparison per node.
-    // With a travel origin, also the largest squared distance of a node from it.
-    std::int64_t first_unstable = n3;
-    real travel2 = 0;
-    const real* const origin = travel_origin_.empty() ? nullptr : travel_origin_.data();
-#pragma omp parallel for schedule(static) reduction(min : first_unstable) reduction(max : travel2)
-    for (std::int64_t i = 0; i < n3 / 3; ++i) {
-      real speed2 = 0;
-      const real density = m.density(static_cast<index_t>(i));
-      for (std::int64_t k = 3 * i; k < 3 * i + 3; ++k) {
-        v[k] += 0.5 * dt * f[k] / density;
-        speed2 += v[k] * v[k];
-      }
-      const real limit = particles[node_particle[i]].mesh_size / dt;
-      if (!(speed2 <= limit * limit)) first_unstable = std::min(first_unstable, i);
-      if (origin) {
-        const real dx = x[3 * i] - origin[3 * i], dy = x[3 * i + 1] - origin[3 * i + 1],
-                   dz = x[3 * i + 2] - origin[3 * i + 2];
-        travel2 = std::max(travel2, dx * dx + dy * dy + dz * dz);
-      }
-    }
-    if (origin) largest_travel_ = std::sqrt(travel2);
-    apply_prescribed_motion(false);
-    ++state_.step;
-    if (first_unstable < n3) check_stability();  // names the node (a prescribed one is fine)
-    phase_times_.integration += seconds_since(start);
+    move_and_break_bonds();
+    finish_step_after_breaks({});
   }
+}
+
+std::vector<std::array<index_t, 2>> Simulation::begin_step() {
+  if (step_begun_) throw InputError("begin_step: the step begun before is not finished (finish_step)");
+  if (!forces_current_) {
+    if (!ghost_.empty()) {
+      throw InputError(
+          "begin_step: evaluate the forces (run(0)) before marking ghost particles, "
+          "whose bonds the first evaluation breaks too");
+    }
+    apply_prescribed_motion(true);
+    compute_forces();
+  }
+  move_and_break_bonds();
+  step_begun_ = true;
+  return breaks_;
+}
+
+void Simulation::finish_step(std::span<const std::array<index_t, 2>> ghost_breaks) {
+  if (!step_begun_) throw InputError("finish_step without begin_step");
+  check_ghost_breaks(ghost_breaks);  // before anything changes: the step can be finished again
+  step_begun_ = false;
+  finish_step_after_breaks(ghost_breaks);
+}
+
+void Simulation::move_and_break_bonds() {
+  const Model& m = *model_;
+  const std::int64_t n = m.node_count();
+  auto& x = state_.positions;
+  auto& v = state_.velocities;
+  const auto& f = state_.forces;
+  const real dt = time_step_;
+  auto start = clock_type::now();
+#pragma omp parallel for schedule(static)
+  for (std::int64_t i = 0; i < n; ++i) {
+    const real density = m.density(static_cast<index_t>(i));
+    for (std::int64_t k = 3 * i; k < 3 * i + 3; ++k) {
+      v[k] += 0.5 * dt * f[k] / density;
+      x[k] += dt * v[k];
+    }
+  }
+  state_.time += dt;
+  phase_times_.integration += seconds_since(start);
+
+  start = clock_type::now();
+  apply_prescribed_motion(true);
+  phase_times_.loading += seconds_since(start);
+
+  start = clock_type::now();
+  update_kinematic_nodes();
+  sum_dilatation_and_break_bonds();  // pass 1
+  phase_times_.peridynamics += seconds_since(start);
+}
+
+void Simulation::finish_step_after_breaks(std::span<const std::array<index_t, 2>> ghost_breaks) {
+  const Model& m = *model_;
+  const auto& particles = m.particles();
+  const auto& node_particle = m.node_particle();
+  const std::int64_t n = m.node_count();
+  const auto& x = state_.positions;
+  auto& v = state_.velocities;
+  const auto& f = state_.forces;
+  const real dt = time_step_;
+  auto start = clock_type::now();
+  const double contact_before = phase_times_.contact;
+  finish_forces(ghost_breaks);
+  phase_times_.peridynamics += seconds_since(start) - (phase_times_.contact - contact_before);
+
+  start = clock_type::now();
+  // The second half kick, and the first node (if any) that moved more than its mesh size in
+  // the step or became non-finite: checked every step, at the cost of one comparison per node.
+  // With a travel origin, also the largest squared distance of a node from it.
+  std::int64_t first_unstable = n;
+  real travel2 = 0;
+  const real* const origin = travel_origin_.empty() ? nullptr : travel_origin_.data();
+#pragma omp parallel for schedule(static) reduction(min : first_unstable) reduction(max : travel2)
+  for (std::int64_t i = 0; i < n; ++i) {
+    real speed2 = 0;
+    const real density = m.density(static_cast<index_t>(i));
+    for (std::int64_t k = 3 * i; k < 3 * i + 3; ++k) {
+      v[k] += 0.5 * dt * f[k] / density;
+      speed2 += v[k] * v[k];
+    }
+    const real limit = particles[node_particle[i]].mesh_size / dt;
+    if (!(speed2 <= limit * limit)) first_unstable = std::min(first_unstable, i);
+    if (origin) {
+      const real dx = x[3 * i] - origin[3 * i], dy = x[3 * i + 1] - origin[3 * i + 1],
+                 dz = x[3 * i + 2] - origin[3 * i + 2];
+      travel2 = std::max(travel2, dx * dx + dy * dy + dz * dz);
+    }
+  }
+  if (origin) largest_travel_ = std::sqrt(travel2);
+  apply_prescribed_motion(false);
+  ++state_.step;
+  if (first_unstable < n) check_stability();  // names the node (a prescribed one is fine)
+  phase_times_.integration += seconds_since(start);
 }
 
 std::array<std::size_t, 2> Simulation::memory_bytes() const {

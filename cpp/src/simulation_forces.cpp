@@ -158,20 +158,49 @@ std::vector<real> Simulation::bond_force_densities() const {
 
 void Simulation::compute_forces() {
   update_kinematic_nodes();
-  const std::uint64_t newly_broken = sum_dilatation_and_break_bonds();  // pass 1
+  sum_dilatation_and_break_bonds();  // pass 1
+  finish_forces({});
+}
+
+void Simulation::finish_forces(std::span<const std::array<index_t, 2>> ghost_breaks) {
+  break_ghost_bonds(ghost_breaks);
+  contact_.bonds_broke(*model_, state_, breaks_);
   start_node_forces();
   add_bond_forces(state_.forces.data());  // pass 2
-  broken_bond_copies_ += newly_broken;
+  broken_bond_copies_ += 2 * breaks_.size();
   add_contact_forces();
   add_nodal_forces();
   forces_current_ = true;
 }
 
-std::uint64_t Simulation::sum_dilatation_and_break_bonds() {
+void Simulation::check_ghost_breaks(std::span<const std::array<index_t, 2>> pairs) const {
+  const Model& m = *model_;
+  for (const auto& [i, j] : pairs) {
+    const bool ghosts = i < m.node_count() && j < m.node_count() && !ghost_.empty() &&
+                        ghost_[m.node_particle()[i]] && m.node_particle()[j] == m.node_particle()[i];
+    const index_t b = ghosts ? m.node_bonds(i).find(j) : 0;
+    if (!ghosts || b == m.node_bonds(i).count || !state_.bonds.intact(i, b)) {
+      throw InputError("ghost bond " + std::to_string(i) + "-" + std::to_string(j) +
+                       " is not an intact bond of a ghost particle");
+    }
+  }
+}
+
+void Simulation::break_ghost_bonds(std::span<const std::array<index_t, 2>> pairs) {
+  const Model& m = *model_;
+  for (const auto& [i, j] : pairs) {
+    BondStates::clear(state_.bonds.node(i), m.node_bonds(i).find(j));
+    BondStates::clear(state_.bonds.node(j), m.node_bonds(j).find(i));
+    breaks_.push_back({i, j});
+  }
+}
+
+void Simulation::sum_dilatation_and_break_bonds() {
   // Pass 1: stretch, irreversible breaking, sum_j w r e at both ends. A bond breaks at the end
   // that evaluates it; its other copy is cleared below, before any loop reads it (when both
-  // ends gather, both see bitwise the same stretch and each clears its own). Ghost particles
-  // that cannot break are skipped (set_ghost_particles).
+  // ends gather, both see bitwise the same stretch and each clears its own). The bonds broken
+  // are left in breaks_ for finish_forces. Ghost particles are skipped (set_ghost_particles):
+  // their breaks come from their owners.
   const Model& m = *model_;
   const auto& materials = m.materials();
   const auto& node_material = m.node_material();
@@ -194,7 +223,7 @@ std::uint64_t Simulation::sum_dilatation_and_break_bonds() {
       const CriticalStretch criterion{m.particles()[m.node_particle()[i]].critical_stretch,
                                       material.params.break_in_compression};
       const bool breaks = material.params.fracture, gathers = schedule.particle_gathers[m.node_particle()[i]];
-      if (ghost && !breaks && ghost[m.node_particle()[i]]) return;  // another process's dilatation
+      if (ghost && ghost[m.node_particle()[i]]) return;  // another process's bonds
       std::uint8_t* const bits = intact.node(i);
       if (breaks && !gathers) {
         add_dilatation_terms<true, false>(i, bonds, bits, criterion, positions, volumes, dilatation_sums,
@@ -219,8 +248,7 @@ std::uint64_t Simulation::sum_dilatation_and_break_bonds() {
     const NodeBonds bonds = m.node_bonds(j);
     BondStates::clear(intact.node(j), bonds.find(i));
   }
-  contact_.bonds_broke(m, state_, broken);
-  return 2 * broken.size();
+  breaks_ = std::move(broken);
 }
 
 void Simulation::start_node_forces() {

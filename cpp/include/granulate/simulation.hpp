@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <memory>
+#include <span>
 #include <vector>
 
 #include "granulate/contact/contact_model.hpp"
@@ -61,6 +62,16 @@ class Simulation {
   /// Throws InstabilityError if positions become non-finite or a node moves more than its
   /// mesh size in one step.
   void run(std::uint64_t steps);
+  /// One step of run in two halves, for a distributed run whose ghosts' bonds other processes
+  /// evaluate. begin_step: the first half kick, the drift, prescribed motion and pass 1 of the
+  /// bonds (stretch and breaking; ghost particles skipped); returns the bonds it broke, (i, j)
+  /// node pairs, which the owners send to the processes holding their particles as ghosts.
+  /// finish_step(ghost_breaks): breaks the ghosts' bonds their owners broke in this step, then
+  /// the rest of the step as run takes it (InputError, with nothing changed, for a pair that is
+  /// not an intact bond of a ghost particle; each bond once). The forces must be evaluated
+  /// before ghosts are marked; run and begin_step refuse to start while a step is begun.
+  std::vector<std::array<index_t, 2>> begin_step();
+  void finish_step(std::span<const std::array<index_t, 2>> ghost_breaks);
 
   /// Recomputes forces (and breaks bonds) at the current positions.
   void compute_forces();
@@ -103,12 +114,12 @@ class Simulation {
   /// Lists every node's contact partners again now (ContactModel::search); the forces of the
   /// last step stay. For a distributed run, whose ranks re-list the grains they receive.
   void search_contacts() { contact_.search(*model_, state_, broken_bond_copies_); }
-  /// Marks the particles whose forces another process evaluates (a distributed run's ghosts;
-  /// the rest are not). Their bonds' pair forces (pass 2) are skipped, and pass 1 too unless
-  /// their material breaks: breaking decides their fragments, which their partners' contact
-  /// needs. Their forces and dilatation are then not their own until the caller overwrites them
-  /// (granulate.parallel's exchange); their positions, velocities and bonds stay exact as long
-  /// as it does. InputError for an index out of range.
+  /// Marks the particles whose bonds and forces another process evaluates (a distributed run's
+  /// ghosts; the rest are not): both bond passes skip them, and their bonds break only through
+  /// finish_step's ghost_breaks (their fragments enter their partners' contact). Their forces
+  /// and dilatation are then not their own until the caller overwrites them (granulate.
+  /// parallel's exchange); their positions, velocities and bonds stay exact as long as it does
+  /// and the breaks arrive. InputError for an index out of range.
   void set_ghost_particles(const std::vector<index_t>& particles);
   /// From now on each step measures how far the farthest node is from where it is now [m]
   /// (largest_travel), in its last half kick: a distributed run's check that its ghosts still
@@ -124,8 +135,18 @@ class Simulation {
  private:
   // The phases of compute_forces, in order.
   /// Pass 1 of the bonds: each node's dilatation sum; bonds past their critical stretch break
-  /// (both copies) and contact is told. Returns the bond copies broken.
-  std::uint64_t sum_dilatation_and_break_bonds();
+  /// (both copies), left in breaks_.
+  void sum_dilatation_and_break_bonds();
+  /// InputError unless every pair is an intact bond of a ghost particle.
+  void check_ghost_breaks(std::span<const std::array<index_t, 2>> pairs) const;
+  /// The ghosts' bonds their owners broke (both copies), appended to breaks_.
+  void break_ghost_bonds(std::span<const std::array<index_t, 2>> pairs);
+  /// After pass 1 and the ghosts' breaks: contact told of breaks_, then the LPS pressures and
+  /// body forces, pass 2, contact forces and nodal loads.
+  void finish_forces(std::span<const std::array<index_t, 2>> ghost_breaks);
+  /// The halves of a step (begin_step and finish_step without their checks).
+  void move_and_break_bonds();
+  void finish_step_after_breaks(std::span<const std::array<index_t, 2>> ghost_breaks);
   /// LPS dilatation theta_i and pressure A_i theta_i; each node's force density started with
   /// rho (g - gamma v).
   void start_node_forces();
@@ -150,7 +171,9 @@ class Simulation {
                                      // empty when none is
   std::vector<real> travel_origin_;  // positions largest_travel is measured from; or empty
   real largest_travel_ = 0;
-  std::uint64_t broken_bond_copies_ = 0;  // both copies of a broken bond count
+  std::vector<std::array<index_t, 2>> breaks_;  // the bonds pass 1 (and the owners) broke
+  bool step_begun_ = false;                     // begin_step called, finish_step not yet
+  std::uint64_t broken_bond_copies_ = 0;        // both copies of a broken bond count
   ContactModel contact_;
   contact::PeridemDamping peridem_damping_;
   bool forces_current_ = false;

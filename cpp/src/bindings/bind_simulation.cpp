@@ -185,6 +185,31 @@ void bind_results(nb::class_<Simulation>& cls) {
       .def_prop_ro("walls", [](const Simulation& self) { return self.contact().walls(); })
       .def_prop_ro("contact_statistics", [](const Simulation& self) { return self.contact().statistics(); })
       .def("run", &Simulation::run, "steps"_a, nb::call_guard<nb::gil_scoped_release>())
+      .def(
+          "begin_step",
+          [](Simulation& self) {
+            std::vector<std::array<index_t, 2>> broken;
+            {
+              nb::gil_scoped_release released;
+              broken = self.begin_step();
+            }
+            std::vector<index_t> flat;
+            flat.reserve(2 * broken.size());
+            for (const auto& [i, j] : broken) flat.insert(flat.end(), {i, j});
+            return copy_out(flat);
+          },
+          "The first half of a step (Simulation::begin_step); the bonds it broke, (i, j) flat.")
+      .def(
+          "finish_step",
+          [](Simulation& self,
+             nb::ndarray<const std::uint32_t, nb::shape<-1, 2>, nb::c_contig> ghost_breaks) {
+            std::vector<std::array<index_t, 2>> list(ghost_breaks.shape(0));
+            for (std::size_t k = 0; k < list.size(); ++k) list[k] = {ghost_breaks(k, 0), ghost_breaks(k, 1)};
+            nb::gil_scoped_release released;
+            self.finish_step(list);
+          },
+          "ghost_breaks"_a,
+          "The rest of the step, after breaking the ghosts' bonds their owners broke, (k, 2) node pairs.")
       .def("compute_forces", &Simulation::compute_forces, nb::call_guard<nb::gil_scoped_release>())
       .def("kinetic_energy", &Simulation::kinetic_energy)
       .def("strain_energy", &Simulation::strain_energy)

@@ -3,11 +3,13 @@
 
 Each rank holds the grains it owns and, as ghosts, the grains of other ranks whose bounding
 spheres come within the contact lists' cutoff plus a margin of its own (partition.py), in the
-serial order, at the serial run's time step and neighbour skin. It steps them all; after each
-step the owners send their grains' positions, velocities and forces to the ranks that hold them
-as ghosts, which overwrite their own copies. An owned grain's next step then needs only its
-partners' exact state, which it has (tests/test_locality.py): the owned grains move bit for bit
-as in the serial run, for any number of ranks (tests/test_mpi.py).
+serial order, at the serial run's time step and neighbour skin. It moves them all but
+evaluates only its own grains' bonds (core.set_ghost_particles): within each step the owners
+send the bonds that broke in their grains to the ranks holding them as ghosts, before the
+contact forces (a ghost's fragments enter its partners' contact), and after each step their
+grains' positions, velocities and forces, which overwrite the ghosts' copies. An owned grain's
+next step then needs only its partners' exact state, which it has (tests/test_locality.py): the
+owned grains move bit for bit as in the serial run, for any number of ranks (tests/test_mpi.py).
 
 The ghost sets hold while no node has moved more than half the margin from where it was when
 the grains were last distributed, since then no pair left out can come within the cutoff. The
@@ -49,6 +51,8 @@ if TYPE_CHECKING:
     from granulate.writers.outputs import Outputs
 
 _TAG = 17
+_BREAK_TAG = 18
+_NONE = np.zeros((0, 2), dtype=np.int64)  # no bonds broke
 
 
 class DistributedRun:
@@ -109,8 +113,8 @@ class DistributedRun:
         owners' values for the ghosts come with the first exchange)."""
         self.local, node_map = self._sim._subdomain(held, dt=self._dt, skin=self._skin)
         self.held = held
+        self.local.core.run(0)  # before the ghosts are marked: they break bonds here too
         self._plan(node_map)
-        self.local.core.run(0)
 
     def _distribute(
         self, centres: NDArray[np.float64], radii: NDArray[np.float64]
@@ -126,7 +130,8 @@ class DistributedRun:
         """Which local nodes go to which rank and come from which, in grain order, with the
         message buffers (9 numbers a node: x, v, f), made once per partition; the positions
         the nodes' travel is measured from (the core measures it in each step). The core skips
-        the ghosts' bond forces, which the exchange overwrites (Simulation::set_ghost_particles)."""
+        the ghosts' bonds (Simulation::set_ghost_particles): the exchange overwrites their
+        forces, and their breaks come from their owners (_exchange_breaks)."""
         rank = self.comm.Get_rank()
         owner = self.partition.owner
         self._node_map = node_map
@@ -146,9 +151,16 @@ class DistributedRun:
         self._receive = {
             int(q): self._nodes_of(mine[owner[mine] == q], node_map) for q in np.unique(owner[mine])
         }
+        self._sent_to = {q: self._marked(n) for q, n in self._send.items()}
         self._outbox = {q: np.empty((len(n), 9)) for q, n in self._send.items()}
         self._inbox = {q: np.empty((len(n), 9)) for q, n in self._receive.items()}
         self.local.core.set_travel_origin()
+
+    def _marked(self, local: NDArray[np.int64]) -> NDArray[np.bool_]:
+        """Over this rank's nodes, whether each is one of `local`."""
+        mask = np.zeros(len(self._to_global), dtype=bool)
+        mask[local] = True
+        return mask
 
     def _local_slice(self, grain: int) -> slice:
         """The local nodes of a held grain."""
@@ -211,6 +223,28 @@ class DistributedRun:
             box = self._inbox[q]
             x[nodes], v[nodes], f[nodes] = box[:, :3], box[:, 3:6], box[:, 6:]
 
+    def _exchange_breaks(self, broken: NDArray[np.uint32]) -> NDArray[np.uint32]:
+        """The bonds this step broke in the owned grains (flat (i, j) local node pairs) to the
+        ranks holding those grains as ghosts, in global numbering; the ghosts' bonds the other
+        ranks broke, as (k, 2) local node pairs. One small message per pair of neighbouring
+        ranks, every step (most are empty)."""
+        pairs = np.asarray(broken, dtype=np.int64).reshape(-1, 2)
+        outgoing = {
+            q: self._to_global[pairs[sent[pairs[:, 0]]]] if len(pairs) else _NONE
+            for q, sent in self._sent_to.items()
+        }  # fancy indexing: new, contiguous arrays
+        requests = [self.comm.Isend(out, dest=q, tag=_BREAK_TAG) for q, out in outgoing.items()]
+        received, status = [], self.mpi.Status()
+        for q in self._receive:  # sizes unknown: probed
+            self.comm.Probe(source=q, tag=_BREAK_TAG, status=status)
+            box = np.empty((status.Get_count(self.mpi.INT64_T) // 2, 2), dtype=np.int64)
+            self.comm.Recv(box, source=q, tag=_BREAK_TAG)
+            received.append(box)
+        self.mpi.Request.Waitall(requests)
+        if not any(len(box) for box in received):
+            return np.zeros((0, 2), np.uint32)
+        return self._node_map[np.concatenate(received)].astype(np.uint32)
+
     def run(self, steps: int) -> None:
         """Advance every rank `steps` time steps, migrating grains before a step once a node
         has moved a quarter of the margin. Raises InputError (on every rank) when a node has
@@ -222,20 +256,28 @@ class DistributedRun:
                 self.migrate()
             core = self.local.core
             start = time.perf_counter()
-            failure = None
+            failure, broken = None, np.zeros(0, np.uint32)
             try:
-                core.run(1)
+                broken = core.begin_step()
             except Exception as error:  # re-raised below, after the ranks agree to stop
                 failure = error
+            began = time.perf_counter()
+            ghost_breaks = self._exchange_breaks(broken)  # every rank, failed or not
+            told = time.perf_counter()
+            if failure is None:
+                try:
+                    core.finish_step(ghost_breaks)
+                except Exception as error:
+                    failure = error
             stepped = time.perf_counter()
             farthest = self._check_step(int(core.step), failure)
             checked = time.perf_counter()
             self._exchange()
             self._loaded_walls = None
             self._migration_due = self._migrates and farthest > 0.25 * self.margin
-            self.seconds["steps"] += stepped - start
+            self.seconds["steps"] += (began - start) + (stepped - told)
             self.seconds["check"] += checked - stepped
-            self.seconds["exchange"] += time.perf_counter() - checked
+            self.seconds["exchange"] += (told - began) + (time.perf_counter() - checked)
 
     def _check_step(self, step: int, failure: Exception | None) -> float:
         """One reduction after each step, before the exchange: the first rank whose step
