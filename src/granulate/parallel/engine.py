@@ -254,30 +254,36 @@ class DistributedRun:
         for _ in range(steps):
             if self._migration_due:  # before the step, so the parts hold its evaluation after
                 self.migrate()
-            core = self.local.core
-            start = time.perf_counter()
-            failure, broken = None, np.zeros(0, np.uint32)
+            self._step()
+
+    def _step(self) -> None:
+        """One step: its first half (core.begin_step), the bonds broken exchanged, its second
+        half (core.finish_step), the check and the ghosts' exchange. Every rank goes through
+        both exchanges and the check whatever failed, so that none waits for another."""
+        core = self.local.core
+        start = time.perf_counter()
+        failure, broken = None, np.zeros(0, np.uint32)
+        try:
+            broken = core.begin_step()
+        except Exception as error:  # re-raised by the check, after the ranks agree to stop
+            failure = error
+        began = time.perf_counter()
+        ghost_breaks = self._exchange_breaks(broken)
+        told = time.perf_counter()
+        if failure is None:
             try:
-                broken = core.begin_step()
-            except Exception as error:  # re-raised below, after the ranks agree to stop
+                core.finish_step(ghost_breaks)
+            except Exception as error:
                 failure = error
-            began = time.perf_counter()
-            ghost_breaks = self._exchange_breaks(broken)  # every rank, failed or not
-            told = time.perf_counter()
-            if failure is None:
-                try:
-                    core.finish_step(ghost_breaks)
-                except Exception as error:
-                    failure = error
-            stepped = time.perf_counter()
-            farthest = self._check_step(int(core.step), failure)
-            checked = time.perf_counter()
-            self._exchange()
-            self._loaded_walls = None
-            self._migration_due = self._migrates and farthest > 0.25 * self.margin
-            self.seconds["steps"] += (began - start) + (stepped - told)
-            self.seconds["check"] += checked - stepped
-            self.seconds["exchange"] += (told - began) + (time.perf_counter() - checked)
+        stepped = time.perf_counter()
+        farthest = self._check_step(int(core.step), failure)
+        checked = time.perf_counter()
+        self._exchange()
+        self._loaded_walls = None
+        self._migration_due = self._migrates and farthest > 0.25 * self.margin
+        self.seconds["steps"] += (began - start) + (stepped - told)
+        self.seconds["check"] += checked - stepped
+        self.seconds["exchange"] += (told - began) + (time.perf_counter() - checked)
 
     def _check_step(self, step: int, failure: Exception | None) -> float:
         """One reduction after each step, before the exchange: the first rank whose step
