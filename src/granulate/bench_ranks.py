@@ -151,18 +151,8 @@ def measure(
         warnings.filterwarnings("ignore", message="contact.*bodies pressed")  # placed pressed
         run = DistributedRun(make(grains), comm)
         run.run(20)  # lists built, caches warm
-    every = collect_every or steps
-    if collect_every:
-        run.collect()  # rank 0 builds the whole simulation once
-    run.seconds = dict.fromkeys(run.seconds, 0.0)
     migrations, handed = run.migrations, run.handed_over
-    comm.Barrier()  # every rank's clock starts together
-    start = time.perf_counter()
-    for done in range(0, steps, every):
-        run.run(min(every, steps - done))
-        if collect_every:
-            run.collect()
-    wall = time.perf_counter() - start
+    wall = _timed(run, steps, collect_every, comm)
     row = {
         "grains": len(run.owned),
         "nodes": run.owned_node_count,
@@ -184,6 +174,22 @@ def measure(
         "migrations": run.migrations - migrations,
         "handed_over": run.handed_over - handed,
     }
+
+
+def _timed(run: Any, steps: int, collect_every: int, comm: Any) -> float:
+    """The wall-clock seconds of `steps` steps of the DistributedRun `run`, gathering the whole
+    state every `collect_every` (0: never); its `seconds` count these steps alone."""
+    every = collect_every or steps
+    if collect_every:
+        run.collect()  # rank 0 builds the whole simulation once, untimed
+    run.seconds = dict.fromkeys(run.seconds, 0.0)
+    comm.Barrier()  # every rank's clock starts together
+    start = time.perf_counter()
+    for done in range(0, steps, every):
+        run.run(min(every, steps - done))
+        if collect_every:
+            run.collect()
+    return time.perf_counter() - start
 
 
 def table(result: dict[str, Any]) -> str:

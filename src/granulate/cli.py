@@ -237,8 +237,7 @@ def _world(command: str = "run") -> object | None:
     except ImportError:
         raise InputError(
             f"granulate {command} was started as {size} MPI processes, but mpi4py is not "
-            "installed: "
-            "pip install 'granulate[mpi]' (or mpi4py built against your cluster's MPI)"
+            "installed: pip install 'granulate[mpi]' (or mpi4py built against your cluster's MPI)"
         ) from None
     if MPI.COMM_WORLD.Get_size() != size:
         raise InputError(
