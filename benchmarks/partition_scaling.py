@@ -30,7 +30,7 @@ pass; compute is one core's node-steps per second on a 20^3 block of that lattic
 A third table models the engine as built (granulate.parallel.DistributedRun): whole ghost
 grains within the reach plus its margin, stepped but for their bonds (which the core skips for
 ghosts; the share of a step a ghost saves is measured on the same 27 spheres), all their
-nodes' x, v and f exchanged, and the bonds broken in a step sent mid-step (see as_built).
+nodes' x and v and the bonds broken exchanged within each step (see as_built).
 """
 
 from __future__ import annotations
@@ -202,21 +202,21 @@ def as_built(
 ) -> dict[str, float]:
     """The engine as built (granulate.parallel.DistributedRun), for the rank with the most ghost
     grains per owned grain: its ghosts are whole grains within the reach plus the margin (the
-    largest bounding radius; `pairs`: near_pairs at that distance), stepped and then
-    overwritten, less their bonds (`ghost_saving` of a step, which the core skips for
-    ghosts); it receives the bonds broken in the step (one message per neighbouring rank,
-    mostly empty: its latency) and 72 bytes (x, v, f) of every ghost node, one message per
-    neighbouring rank, checks after each step (CHECK_SHARE of a step, measured) and reduces
-    once. Efficiency: its own nodes' compute over its step; the same with the ghosts stepped in
-    full, and if ghosts were not stepped at all (not built)."""
+    largest bounding radius; `pairs`: near_pairs at that distance), stepped but for their
+    bonds (`ghost_saving` of a step, which the core skips for ghosts); within the step it
+    receives 48 bytes (x, v) of every ghost node and the bonds broken (two messages per
+    neighbouring rank, the second mostly empty: its latency), checks after each step
+    (CHECK_SHARE of a step, measured) and reduces once. Efficiency: its own nodes' compute over
+    its step; the same with the ghosts stepped in full, and if ghosts were not stepped at all
+    (not built)."""
     partition = bisect(centres, np.ones(len(centres)), ranks)
     needed = ghosts(partition, pairs)
     owned = np.bincount(partition.owner, minlength=ranks)
     worst = int(np.argmax([len(g) / o for g, o in zip(needed, owned, strict=True)]))
     own, ghost = owned[worst] * nodes_per_grain, len(needed[worst]) * nodes_per_grain
     neighbours = len(np.unique(partition.owner[needed[worst]]))
-    # two messages per neighbour a step: the bonds broken (mostly none), then x, v, f
-    exchange, reduction = communication_seconds(2, neighbours, 72.0 * ghost, ranks, args)
+    # two messages per neighbour within a step: x and v of the ghost nodes, the bonds broken
+    exchange, reduction = communication_seconds(2, neighbours, 48.0 * ghost, ranks, args)
     useful = own / rate
     stepped = (own + (1.0 - ghost_saving) * ghost) / rate * (1 + CHECK_SHARE)
     in_full = (own + ghost) / rate * (1 + CHECK_SHARE)
@@ -225,7 +225,7 @@ def as_built(
         "ranks": ranks,
         "ghost_grains_over_owned": len(needed[worst]) / owned[worst],
         "neighbours": neighbours,
-        "exchange_bytes": 72.0 * ghost,
+        "exchange_bytes": 48.0 * ghost,
         "communication_share": (exchange + reduction) / (stepped + exchange + reduction),
         "efficiency": useful / (stepped + exchange + reduction),
         "efficiency_ghosts_in_full": useful / (in_full + exchange + reduction),
@@ -264,7 +264,7 @@ def engine_as_built(
     print(
         f"\nthe engine as built: whole ghost grains within {1e3 * (args.reach + margin):.2f} mm "
         f"(reach + margin) stepped but for their bonds ({100 * ghost_saving:.0f} % of a "
-        "step, measured), the step's broken bonds and x, v, f of every ghost node exchanged, "
+        "step, measured), x, v of every ghost node and the step's broken bonds exchanged, "
         "the check "
         f"({100 * CHECK_SHARE:.1f} % of a step) and one reduction"
     )

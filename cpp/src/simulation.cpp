@@ -246,7 +246,8 @@ void Simulation::finish_step_after_breaks(std::span<const std::array<index_t, 2>
 
   start = clock_type::now();
   // The second half kick, and the first node (if any) that moved more than its mesh size in
-  // the step or became non-finite: checked every step, at the cost of one comparison per node.
+  // the step or became non-finite: checked every step, at the cost of one comparison per node
+  // (not on ghosts, whose velocities are their owners' to check).
   // With a travel origin, also the largest squared distance of a node from it.
   std::int64_t first_unstable = n;
   real travel2 = 0;
@@ -260,7 +261,7 @@ void Simulation::finish_step_after_breaks(std::span<const std::array<index_t, 2>
       speed2 += v[k] * v[k];
     }
     const real limit = particles[node_particle[i]].mesh_size / dt;
-    if (!(speed2 <= limit * limit)) first_unstable = std::min(first_unstable, i);
+    if (!(speed2 <= limit * limit) && !ghost_node(i)) first_unstable = std::min(first_unstable, i);
     if (origin) {
       const real dx = x[3 * i] - origin[3 * i], dy = x[3 * i + 1] - origin[3 * i + 1],
                  dz = x[3 * i + 2] - origin[3 * i + 2];
@@ -317,6 +318,7 @@ void Simulation::check_stability() const {
   const auto& x = state_.positions;
   const index_t n = model_->node_count();
   for (index_t i = 0; i < n; ++i) {
+    if (ghost_node(i)) continue;  // its owner checks it
     const real speed2 = v[3 * i] * v[3 * i] + v[3 * i + 1] * v[3 * i + 1] + v[3 * i + 2] * v[3 * i + 2];
     const bool finite = std::isfinite(speed2) && std::isfinite(x[3 * i]) && std::isfinite(x[3 * i + 1]) &&
                         std::isfinite(x[3 * i + 2]);

@@ -116,10 +116,11 @@ class Simulation {
   void search_contacts() { contact_.search(*model_, state_, broken_bond_copies_); }
   /// Marks the particles whose bonds and forces another process evaluates (a distributed run's
   /// ghosts; the rest are not): both bond passes skip them, and their bonds break only through
-  /// finish_step's ghost_breaks (their fragments enter their partners' contact). Their forces
-  /// and dilatation are then not their own until the caller overwrites them (granulate.
-  /// parallel's exchange); their positions, velocities and bonds stay exact as long as it does
-  /// and the breaks arrive. InputError for an index out of range.
+  /// finish_step's ghost_breaks (their fragments enter their partners' contact), and the
+  /// stability check passes them over. Their forces, velocities and dilatation are then not
+  /// their own: the caller gives them their owners' positions and velocities between
+  /// begin_step and finish_step (granulate.parallel's exchange), which is all the contact
+  /// reads of them. InputError for an index out of range.
   void set_ghost_particles(const std::vector<index_t>& particles);
   /// From now on each step measures how far the farthest node is from where it is now [m]
   /// (largest_travel), in its last half kick: a distributed run's check that its ghosts still
@@ -157,6 +158,8 @@ class Simulation {
   /// The nodal force densities f(t) b.
   void add_nodal_forces();
   void apply_prescribed_motion(bool positions_too);
+  /// Whether node i belongs to a ghost particle (set_ghost_particles).
+  bool ghost_node(index_t i) const { return !ghost_.empty() && ghost_[model_->node_particle()[i]]; }
   void check_stability() const;
   std::shared_ptr<Model> model_;
   State state_;

@@ -3,13 +3,14 @@
 
 Each rank holds the grains it owns and, as ghosts, the grains of other ranks whose bounding
 spheres come within the contact lists' cutoff plus a margin of its own (partition.py), in the
-serial order, at the serial run's time step and neighbour skin. It moves them all but
-evaluates only its own grains' bonds (core.set_ghost_particles): within each step the owners
-send the bonds that broke in their grains to the ranks holding them as ghosts, before the
-contact forces (a ghost's fragments enter its partners' contact), and after each step their
-grains' positions, velocities and forces, which overwrite the ghosts' copies. An owned grain's
-next step then needs only its partners' exact state, which it has (tests/test_locality.py): the
-owned grains move bit for bit as in the serial run, for any number of ranks (tests/test_mpi.py).
+serial order, at the serial run's time step and neighbour skin, but evaluates only its own
+grains' bonds (core.set_ghost_particles). Each step runs in two halves (core.begin_step: the
+drift and the bonds' stretch and breaking; core.finish_step: the contact and the rest), and
+between them the owners send the ranks that hold their grains as ghosts the grains' positions
+and velocities and the bonds that broke in them, which overwrite the ghosts' copies before the
+contact reads them (a ghost's fragments enter its partners' contact too). An owned grain's step
+needs only its partners' exact state then, which it has (tests/test_locality.py): the owned
+grains move bit for bit as in the serial run, for any number of ranks (tests/test_mpi.py).
 
 The ghost sets hold while no node has moved more than half the margin from where it was when
 the grains were last distributed, since then no pair left out can come within the cutoff. The
@@ -103,7 +104,7 @@ class DistributedRun:
         self._loaded_walls: NDArray[np.float64] | None = None
         held = self._distribute(centres, radii)
         together(self.comm, lambda: self._build(held))
-        self._exchange()
+        self._exchange_state()
         #: Wall-clock seconds of this rank in its steps, ghost exchanges, partition checks,
         #: migrations and collections of the whole state on rank 0 (collect).
         self.seconds = dict.fromkeys(("steps", "exchange", "check", "migrate", "collect"), 0.0)
@@ -128,7 +129,8 @@ class DistributedRun:
 
     def _plan(self, node_map: NDArray[np.int64]) -> None:
         """Which local nodes go to which rank and come from which, in grain order, with the
-        message buffers (9 numbers a node: x, v, f), made once per partition; the positions
+        message buffers of the steps' exchange (6 numbers a node: x, v), made once per
+        partition; the positions
         the nodes' travel is measured from (the core measures it in each step). The core skips
         the ghosts' bonds (Simulation::set_ghost_particles): the exchange overwrites their
         forces, and their breaks come from their owners (_exchange_breaks)."""
@@ -152,8 +154,8 @@ class DistributedRun:
             int(q): self._nodes_of(mine[owner[mine] == q], node_map) for q in np.unique(owner[mine])
         }
         self._sent_to = {q: self._marked(n) for q, n in self._send.items()}
-        self._outbox = {q: np.empty((len(n), 9)) for q, n in self._send.items()}
-        self._inbox = {q: np.empty((len(n), 9)) for q, n in self._receive.items()}
+        self._outbox = {q: np.empty((len(n), 6)) for q, n in self._send.items()}
+        self._inbox = {q: np.empty((len(n), 6)) for q, n in self._receive.items()}
         self.local.core.set_travel_origin()
 
     def _marked(self, local: NDArray[np.int64]) -> NDArray[np.bool_]:
@@ -208,42 +210,72 @@ class DistributedRun:
         """The nodes of the other ranks' grains this rank holds as ghosts."""
         return self.local._assembly.node_count - len(self._owned_nodes)
 
-    def _exchange(self) -> None:
+    def _exchange_state(self) -> None:
         """Owners' positions, velocities and forces to the ranks that hold their grains as
-        ghosts (one message per pair of neighbouring ranks)."""
+        ghosts (one message per pair of neighbouring ranks): every ghost exact, as its owner's
+        grain, at the start and before a migration (between them the steps' exchange keeps only
+        what the next step needs)."""
         core = self.local.core
-        x, v, f = core.positions, core.velocities, core.forces
-        requests = [self.comm.Irecv(box, source=q, tag=_TAG) for q, box in self._inbox.items()]
+        fields = (core.positions, core.velocities, core.forces)
+        outbox = {q: np.empty((len(n), 9)) for q, n in self._send.items()}
+        inbox = {q: np.empty((len(n), 9)) for q, n in self._receive.items()}
+        self._swap(fields, outbox, inbox, None)
+
+    def _exchange_within_step(self, broken: NDArray[np.uint32]) -> NDArray[np.uint32]:
+        """After the first half of a step (the drift and pass 1): each rank sends the ranks that
+        hold its grains as ghosts their nodes' positions and velocities now (the half-step
+        velocities, which the contact uses) and the bonds that broke in them this step
+        (`broken`: flat (i, j) local node pairs; sent in global numbering, sizes probed), and
+        takes the same for its ghosts, overwriting their copies. The ghosts' breaks, as (k, 2)
+        local node pairs. A ghost's own drift and forces are never used: what the contact and
+        the check read of it comes from here."""
+        core = self.local.core
+        pairs = np.asarray(broken, dtype=np.int64).reshape(-1, 2)
+        breaks = [
+            (q, self._to_global[pairs[sent[pairs[:, 0]]]] if len(pairs) else _NONE)
+            for q, sent in self._sent_to.items()
+        ]  # fancy indexing: new, contiguous arrays, alive until sent
+        fields = (core.positions, core.velocities)
+        received = self._swap(fields, self._outbox, self._inbox, breaks)
+        if not any(len(box) for box in received):
+            return np.zeros((0, 2), np.uint32)
+        return self._node_map[np.concatenate(received)].astype(np.uint32)
+
+    def _swap(
+        self,
+        fields: tuple[NDArray[np.float64], ...],
+        outbox: dict[int, NDArray[np.float64]],
+        inbox: dict[int, NDArray[np.float64]],
+        breaks: list[tuple[int, NDArray[np.int64]]] | None,
+    ) -> list[NDArray[np.int64]]:
+        """Send each neighbouring rank the owned nodes' `fields` (3 columns each, through
+        `outbox`) and, unless `breaks` is None, its breaks; overwrite the ghosts' fields with
+        what comes back (through `inbox`). The breaks received, one array per rank the ghosts
+        come from."""
+        requests = [self.comm.Irecv(box, source=q, tag=_TAG) for q, box in inbox.items()]
         for q, nodes in self._send.items():
-            box = self._outbox[q]
-            box[:, :3], box[:, 3:6], box[:, 6:] = x[nodes], v[nodes], f[nodes]
+            box = outbox[q]
+            for k, field in enumerate(fields):
+                box[:, 3 * k : 3 * k + 3] = field[nodes]
             requests.append(self.comm.Isend(box, dest=q, tag=_TAG))
+        requests += [self.comm.Isend(out, dest=q, tag=_BREAK_TAG) for q, out in breaks or []]
+        received = self._receive_breaks() if breaks is not None else []
         self.mpi.Request.Waitall(requests)
         for q, nodes in self._receive.items():
-            box = self._inbox[q]
-            x[nodes], v[nodes], f[nodes] = box[:, :3], box[:, 3:6], box[:, 6:]
+            for k, field in enumerate(fields):
+                field[nodes] = inbox[q][:, 3 * k : 3 * k + 3]
+        return received
 
-    def _exchange_breaks(self, broken: NDArray[np.uint32]) -> NDArray[np.uint32]:
-        """The bonds this step broke in the owned grains (flat (i, j) local node pairs) to the
-        ranks holding those grains as ghosts, in global numbering; the ghosts' bonds the other
-        ranks broke, as (k, 2) local node pairs. One small message per pair of neighbouring
-        ranks, every step (most are empty)."""
-        pairs = np.asarray(broken, dtype=np.int64).reshape(-1, 2)
-        outgoing = {
-            q: self._to_global[pairs[sent[pairs[:, 0]]]] if len(pairs) else _NONE
-            for q, sent in self._sent_to.items()
-        }  # fancy indexing: new, contiguous arrays
-        requests = [self.comm.Isend(out, dest=q, tag=_BREAK_TAG) for q, out in outgoing.items()]
+    def _receive_breaks(self) -> list[NDArray[np.int64]]:
+        """The bonds broken in the ghosts, (k, 2) global node pairs from each rank they come
+        from (sizes probed)."""
         received, status = [], self.mpi.Status()
-        for q in self._receive:  # sizes unknown: probed
+        for q in self._receive:
             self.comm.Probe(source=q, tag=_BREAK_TAG, status=status)
             box = np.empty((status.Get_count(self.mpi.INT64_T) // 2, 2), dtype=np.int64)
             self.comm.Recv(box, source=q, tag=_BREAK_TAG)
             received.append(box)
-        self.mpi.Request.Waitall(requests)
-        if not any(len(box) for box in received):
-            return np.zeros((0, 2), np.uint32)
-        return self._node_map[np.concatenate(received)].astype(np.uint32)
+        return received
 
     def run(self, steps: int) -> None:
         """Advance every rank `steps` time steps, migrating grains before a step once a node
@@ -257,9 +289,9 @@ class DistributedRun:
             self._step()
 
     def _step(self) -> None:
-        """One step: its first half (core.begin_step), the bonds broken exchanged, its second
-        half (core.finish_step), the check and the ghosts' exchange. Every rank goes through
-        both exchanges and the check whatever failed, so that none waits for another."""
+        """One step: its first half (core.begin_step), the exchange of the ghosts' motion and
+        breaks, its second half (core.finish_step) and the check. Every rank goes through the
+        exchange and the check whatever failed, so that none waits for another."""
         core = self.local.core
         start = time.perf_counter()
         failure, broken = None, np.zeros(0, np.uint32)
@@ -268,7 +300,7 @@ class DistributedRun:
         except Exception as error:  # re-raised by the check, after the ranks agree to stop
             failure = error
         began = time.perf_counter()
-        ghost_breaks = self._exchange_breaks(broken)
+        ghost_breaks = self._exchange_within_step(broken)
         told = time.perf_counter()
         if failure is None:
             try:
@@ -277,13 +309,11 @@ class DistributedRun:
                 failure = error
         stepped = time.perf_counter()
         farthest = self._check_step(int(core.step), failure)
-        checked = time.perf_counter()
-        self._exchange()
         self._loaded_walls = None
         self._migration_due = self._migrates and farthest > 0.25 * self.margin
         self.seconds["steps"] += (began - start) + (stepped - told)
-        self.seconds["check"] += checked - stepped
-        self.seconds["exchange"] += (told - began) + (time.perf_counter() - checked)
+        self.seconds["check"] += time.perf_counter() - stepped
+        self.seconds["exchange"] += told - began
 
     def _check_step(self, step: int, failure: Exception | None) -> float:
         """One reduction after each step, before the exchange: the first rank whose step
@@ -322,10 +352,12 @@ class DistributedRun:
         holds other grains than before builds its part anew from the owners' states of them
         (transplant.py); a rank that holds the same grains keeps its part, whose every grain
         is exact (the ghosts' own bonds, collisions and springs among the grains it holds
-        follow from their exact motion). Either way the run goes on as the serial run, bit
-        for bit."""
+        follow from their exact motion; their velocities and forces are made their owners'
+        first, as a ghost that becomes owned needs them). Either way the run goes on as the
+        serial run, bit for bit."""
         start = time.perf_counter()
         self._migration_due = False
+        self._exchange_state()
         before, owners_before = self._held_by_rank(), self.partition.owner
         held = self._distribute(*self._current_spheres())
         self.handed_over += int(np.count_nonzero(self.partition.owner != owners_before))
