@@ -204,19 +204,18 @@ def as_built(
     grains per owned grain: its ghosts are whole grains within the reach plus the margin (the
     largest bounding radius; `pairs`: near_pairs at that distance), stepped but for their
     bonds (`ghost_saving` of a step, which the core skips for ghosts); within the step it
-    receives 48 bytes (x, v) of every ghost node and the bonds broken (two messages per
-    neighbouring rank, the second mostly empty: its latency), checks after each step
-    (CHECK_SHARE of a step, measured) and reduces once. Efficiency: its own nodes' compute over
-    its step; the same with the ghosts stepped in full, and if ghosts were not stepped at all
-    (not built)."""
+    receives 48 bytes (x, v) of every ghost node and the bonds broken (one message per
+    neighbouring rank), checks after each step (CHECK_SHARE of a step, measured) and reduces
+    once. Efficiency: its own nodes' compute over its step; the same with the ghosts stepped in
+    full, and if ghosts were not stepped at all (not built)."""
     partition = bisect(centres, np.ones(len(centres)), ranks)
     needed = ghosts(partition, pairs)
     owned = np.bincount(partition.owner, minlength=ranks)
     worst = int(np.argmax([len(g) / o for g, o in zip(needed, owned, strict=True)]))
     own, ghost = owned[worst] * nodes_per_grain, len(needed[worst]) * nodes_per_grain
     neighbours = len(np.unique(partition.owner[needed[worst]]))
-    # two messages per neighbour within a step: x and v of the ghost nodes, the bonds broken
-    exchange, reduction = communication_seconds(2, neighbours, 48.0 * ghost, ranks, args)
+    # one message per neighbour within a step: x and v of the ghost nodes, the bonds broken
+    exchange, reduction = communication_seconds(1, neighbours, 48.0 * ghost, ranks, args)
     useful = own / rate
     stepped = (own + (1.0 - ghost_saving) * ghost) / rate * (1 + CHECK_SHARE)
     in_full = (own + ghost) / rate * (1 + CHECK_SHARE)

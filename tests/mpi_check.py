@@ -105,6 +105,13 @@ def main() -> int:
     return compare(lambda: set_up(dimension), f"{dimension}D", steps, comm)
 
 
+class OneBreakPerMessage(DistributedRun):
+    """A distributed run whose steps' messages carry one bond break each, the rest sent in a
+    second message (DistributedRun.break_slots)."""
+
+    break_slots = 1
+
+
 def compare(
     make: Callable[[], gr.Simulation],
     name: str,
@@ -115,11 +122,12 @@ def compare(
 ) -> int:
     """0 when `steps` steps of make() distributed over the ranks end with every node's
     position, velocity and force equal to the serial run's, at the same dt. `renew`: every
-    rank builds its part anew from the owners' states at every migration; `margin`: the
-    ghost margin [m] (default DistributedRun's)."""
+    rank builds its part anew from the owners' states at every migration, and a step's message
+    carries one break at most (the others go in a second message); `margin`: the ghost margin
+    [m] (default DistributedRun's)."""
     serial = make()
     serial.core.run(steps)
-    distributed = DistributedRun(make(), comm, margin=margin)
+    distributed = (OneBreakPerMessage if renew else DistributedRun)(make(), comm, margin=margin)
     distributed.always_renew = renew
     distributed.run(steps)
     fields = {name: distributed.gather(name) for name in ("positions", "velocities", "forces")}

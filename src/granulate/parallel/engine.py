@@ -67,6 +67,11 @@ class DistributedRun:
     constructor and each method together.
     """
 
+    #: Breaks a step's message to a neighbouring rank carries after its nodes' x and v (their
+    #: count, then node pairs as float64, exact below 2^53); more go in a second message
+    #: (tests lower it to exercise that path).
+    break_slots = 64
+
     def __init__(
         self, sim: Simulation, comm: Any, margin: float | None = None, migrate: bool = True
     ) -> None:
@@ -129,8 +134,8 @@ class DistributedRun:
 
     def _plan(self, node_map: NDArray[np.int64]) -> None:
         """Which local nodes go to which rank and come from which, in grain order, with the
-        message buffers of the steps' exchange (6 numbers a node: x, v), made once per
-        partition; the positions
+        message buffers of the steps' exchange (6 numbers a node: x, v; then the breaks),
+        made once per partition; the positions
         the nodes' travel is measured from (the core measures it in each step). The core skips
         the ghosts' bonds (Simulation::set_ghost_particles): the exchange overwrites their
         forces, and their breaks come from their owners (_exchange_breaks)."""
@@ -154,8 +159,9 @@ class DistributedRun:
             int(q): self._nodes_of(mine[owner[mine] == q], node_map) for q in np.unique(owner[mine])
         }
         self._sent_to = {q: self._marked(n) for q, n in self._send.items()}
-        self._outbox = {q: np.empty((len(n), 6)) for q, n in self._send.items()}
-        self._inbox = {q: np.empty((len(n), 6)) for q, n in self._receive.items()}
+        size = 1 + 2 * self.break_slots
+        self._outbox = {q: np.empty(6 * len(n) + size) for q, n in self._send.items()}
+        self._inbox = {q: np.empty(6 * len(n) + size) for q, n in self._receive.items()}
         self.local.core.set_travel_origin()
 
     def _marked(self, local: NDArray[np.int64]) -> NDArray[np.bool_]:
@@ -216,66 +222,60 @@ class DistributedRun:
         grain, at the start and before a migration (between them the steps' exchange keeps only
         what the next step needs)."""
         core = self.local.core
-        fields = (core.positions, core.velocities, core.forces)
-        outbox = {q: np.empty((len(n), 9)) for q, n in self._send.items()}
+        x, v, f = core.positions, core.velocities, core.forces
         inbox = {q: np.empty((len(n), 9)) for q, n in self._receive.items()}
-        self._swap(fields, outbox, inbox, None)
+        outbox = {q: np.hstack([x[n], v[n], f[n]]) for q, n in self._send.items()}
+        requests = [self.comm.Irecv(box, source=q, tag=_TAG) for q, box in inbox.items()]
+        requests += [self.comm.Isend(box, dest=q, tag=_TAG) for q, box in outbox.items()]
+        self.mpi.Request.Waitall(requests)
+        for q, nodes in self._receive.items():
+            x[nodes], v[nodes], f[nodes] = inbox[q][:, :3], inbox[q][:, 3:6], inbox[q][:, 6:]
 
     def _exchange_within_step(self, broken: NDArray[np.uint32]) -> NDArray[np.uint32]:
         """After the first half of a step (the drift and pass 1): each rank sends the ranks that
         hold its grains as ghosts their nodes' positions and velocities now (the half-step
         velocities, which the contact uses) and the bonds that broke in them this step
-        (`broken`: flat (i, j) local node pairs; sent in global numbering, sizes probed), and
-        takes the same for its ghosts, overwriting their copies. The ghosts' breaks, as (k, 2)
-        local node pairs. A ghost's own drift and forces are never used: what the contact and
-        the check read of it comes from here."""
+        (`broken`: flat (i, j) local node pairs; sent in global numbering), and takes the same
+        for its ghosts, overwriting their copies. One message per pair of neighbouring ranks,
+        its last numbers the breaks (_pack); more breaks than it holds go in a second.
+        The ghosts' breaks, as (k, 2) local node pairs. A ghost's own drift and forces are
+        never used: what the contact and the check read of it comes from here."""
         core = self.local.core
+        x, v = core.positions, core.velocities
         pairs = np.asarray(broken, dtype=np.int64).reshape(-1, 2)
-        breaks = [
-            (q, self._to_global[pairs[sent[pairs[:, 0]]]] if len(pairs) else _NONE)
-            for q, sent in self._sent_to.items()
-        ]  # fancy indexing: new, contiguous arrays, alive until sent
-        fields = (core.positions, core.velocities)
-        received = self._swap(fields, self._outbox, self._inbox, breaks)
+        requests = [self.comm.Irecv(box, source=q, tag=_TAG) for q, box in self._inbox.items()]
+        overflow = []
+        for q, nodes in self._send.items():
+            theirs = self._to_global[pairs[self._sent_to[q][pairs[:, 0]]]] if len(pairs) else _NONE
+            box = self._outbox[q]
+            _pack(box, len(nodes), (x[nodes], v[nodes]), theirs[: self.break_slots], len(theirs))
+            requests.append(self.comm.Isend(box, dest=q, tag=_TAG))
+            if len(theirs) > self.break_slots:
+                rest = theirs[self.break_slots :].copy()
+                overflow.append(self.comm.Isend(rest, dest=q, tag=_BREAK_TAG))
+        self.mpi.Request.Waitall(requests)
+        received = [self._unpack(q, nodes, (x, v)) for q, nodes in self._receive.items()]
+        self.mpi.Request.Waitall(overflow)
         if not any(len(box) for box in received):
             return np.zeros((0, 2), np.uint32)
         return self._node_map[np.concatenate(received)].astype(np.uint32)
 
-    def _swap(
-        self,
-        fields: tuple[NDArray[np.float64], ...],
-        outbox: dict[int, NDArray[np.float64]],
-        inbox: dict[int, NDArray[np.float64]],
-        breaks: list[tuple[int, NDArray[np.int64]]] | None,
-    ) -> list[NDArray[np.int64]]:
-        """Send each neighbouring rank the owned nodes' `fields` (3 columns each, through
-        `outbox`) and, unless `breaks` is None, its breaks; overwrite the ghosts' fields with
-        what comes back (through `inbox`). The breaks received, one array per rank the ghosts
-        come from."""
-        requests = [self.comm.Irecv(box, source=q, tag=_TAG) for q, box in inbox.items()]
-        for q, nodes in self._send.items():
-            box = outbox[q]
-            for k, field in enumerate(fields):
-                box[:, 3 * k : 3 * k + 3] = field[nodes]
-            requests.append(self.comm.Isend(box, dest=q, tag=_TAG))
-        requests += [self.comm.Isend(out, dest=q, tag=_BREAK_TAG) for q, out in breaks or []]
-        received = self._receive_breaks() if breaks is not None else []
-        self.mpi.Request.Waitall(requests)
-        for q, nodes in self._receive.items():
-            for k, field in enumerate(fields):
-                field[nodes] = inbox[q][:, 3 * k : 3 * k + 3]
-        return received
-
-    def _receive_breaks(self) -> list[NDArray[np.int64]]:
-        """The bonds broken in the ghosts, (k, 2) global node pairs from each rank they come
-        from (sizes probed)."""
-        received, status = [], self.mpi.Status()
-        for q in self._receive:
-            self.comm.Probe(source=q, tag=_BREAK_TAG, status=status)
-            box = np.empty((status.Get_count(self.mpi.INT64_T) // 2, 2), dtype=np.int64)
-            self.comm.Recv(box, source=q, tag=_BREAK_TAG)
-            received.append(box)
-        return received
+    def _unpack(
+        self, q: int, nodes: NDArray[np.int64], fields: tuple[NDArray[np.float64], ...]
+    ) -> NDArray[np.int64]:
+        """Rank q's message of this step into the ghosts' `fields`; its breaks, (k, 2) global
+        node pairs (those past break_slots received now, from their own message)."""
+        box = self._inbox[q]
+        motion = box[: 6 * len(nodes)].reshape(-1, 6)
+        for k, field in enumerate(fields):
+            field[nodes] = motion[:, 3 * k : 3 * k + 3]
+        count, slots = int(box[6 * len(nodes)]), self.break_slots
+        kept = box[6 * len(nodes) + 1 :][: 2 * min(count, slots)].astype(np.int64).reshape(-1, 2)
+        if count <= slots:
+            return kept
+        rest = np.empty((count - slots, 2), dtype=np.int64)
+        self.comm.Recv(rest, source=q, tag=_BREAK_TAG)
+        return np.concatenate([kept, rest])
 
     def run(self, steps: int) -> None:
         """Advance every rank `steps` time steps, migrating grains before a step once a node
@@ -583,6 +583,22 @@ class DistributedRun:
         for grains, values in parts:
             whole[self._nodes_of(grains)] = values
         return whole
+
+
+def _pack(
+    box: NDArray[np.float64],
+    count: int,
+    fields: tuple[NDArray[np.float64], ...],
+    breaks: NDArray[np.int64],
+    total: int,
+) -> None:
+    """A step's message: the `count` nodes' `fields` (x, v: 6 numbers a node), the number of
+    breaks in all (`total`) and those it carries (`breaks`)."""
+    motion = box[: 6 * count].reshape(-1, 6)
+    for k, field in enumerate(fields):
+        motion[:, 3 * k : 3 * k + 3] = field
+    box[6 * count] = total
+    box[6 * count + 1 : 6 * count + 1 + breaks.size] = breaks.ravel()
 
 
 def _sum_wall_terms(parts: list[tuple[NDArray[Any], ...]], walls: int) -> NDArray[np.float64]:
