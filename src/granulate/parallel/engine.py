@@ -135,10 +135,10 @@ class DistributedRun:
     def _plan(self, node_map: NDArray[np.int64]) -> None:
         """Which local nodes go to which rank and come from which, in grain order, with the
         message buffers of the steps' exchange (6 numbers a node: x, v; then the breaks),
-        made once per partition; the positions
-        the nodes' travel is measured from (the core measures it in each step). The core skips
-        the ghosts' bonds (Simulation::set_ghost_particles): the exchange overwrites their
-        forces, and their breaks come from their owners (_exchange_breaks)."""
+        made once per partition; the positions the nodes' travel is measured from (the core
+        measures it in each step). The core skips the ghosts' bonds
+        (Simulation::set_ghost_particles): their positions, velocities and breaks come from
+        their owners within each step (_exchange_within_step)."""
         rank = self.comm.Get_rank()
         owner = self.partition.owner
         self._node_map = node_map
@@ -318,9 +318,8 @@ class DistributedRun:
     def _check_step(self, step: int, failure: Exception | None) -> float:
         """One reduction after each step, before the exchange: the first rank whose step
         failed, and the largest distance of a node from where it was when the grains were
-        distributed (core.largest_travel, measured in the step: the ghosts' positions are
-        exact there, they drifted from exact values). Stops every rank on either; returns that
-        distance [m]."""
+        distributed (core.largest_travel, measured in the step's second half, when the ghosts'
+        positions are their owners'). Stops every rank on either; returns that distance [m]."""
         farthest = float(self.local.core.largest_travel)
         size = self.comm.Get_size()
         failed_rank = self.comm.Get_rank() if failure is not None else size
