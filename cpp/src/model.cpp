@@ -431,6 +431,13 @@ void Model::colour_bond_blocks() {
   for (index_t k = 0; k < blocks; ++k) s.blocks[next[colour[k]]++] = k;
 }
 
+std::optional<index_t> Model::bond_between(index_t i, index_t j) const {
+  if (i >= node_count() || j >= node_count() || node_particle_[i] != node_particle_[j]) return std::nullopt;
+  const NodeBonds bonds = node_bonds(i);
+  const index_t b = bonds.find(j);
+  return b == bonds.count ? std::nullopt : std::optional<index_t>{b};
+}
+
 index_t NodeBonds::find(index_t j) const {
   const index_t local = j - first_node;
   const index_t* found = std::lower_bound(neighbors, neighbors + count, local);

@@ -166,12 +166,15 @@ void Simulation::update_kinematic_nodes() {
   kinematic_stale_ = false;
 }
 
+void Simulation::evaluate_if_stale() {
+  if (forces_current_) return;
+  apply_prescribed_motion(true);
+  compute_forces();
+}
+
 void Simulation::run(std::uint64_t steps) {
   if (step_begun_) throw InputError("run: the step begin_step began is not finished (finish_step)");
-  if (!forces_current_) {
-    apply_prescribed_motion(true);
-    compute_forces();
-  }
+  evaluate_if_stale();
   for (std::uint64_t s = 0; s < steps; ++s) {
     move_and_break_bonds();
     finish_step_after_breaks({});
@@ -180,15 +183,12 @@ void Simulation::run(std::uint64_t steps) {
 
 std::vector<std::array<index_t, 2>> Simulation::begin_step() {
   if (step_begun_) throw InputError("begin_step: the step begun before is not finished (finish_step)");
-  if (!forces_current_) {
-    if (!ghost_.empty()) {
-      throw InputError(
-          "begin_step: evaluate the forces (run(0)) before marking ghost particles, "
-          "whose bonds the first evaluation breaks too");
-    }
-    apply_prescribed_motion(true);
-    compute_forces();
+  if (!forces_current_ && !ghost_.empty()) {
+    throw InputError(
+        "begin_step: evaluate the forces (run(0)) before marking ghost particles, "
+        "whose bonds the first evaluation breaks too");
   }
+  evaluate_if_stale();
   move_and_break_bonds();
   step_begun_ = true;
   return breaks_;
@@ -407,13 +407,9 @@ void Simulation::damage(real* phi, real* z) const {
 void Simulation::break_bonds(const std::vector<std::array<index_t, 2>>& pairs) {
   const Model& m = *model_;
   auto copy_of = [&](index_t i, index_t j) -> std::array<index_t, 2> {  // (node, its bond)
-    const bool same_particle =
-        i < m.node_count() && j < m.node_count() && m.node_particle()[i] == m.node_particle()[j];
-    const index_t b = same_particle ? m.node_bonds(i).find(j) : 0;
-    if (!same_particle || b == m.node_bonds(i).count) {
-      throw InputError("nodes " + std::to_string(i) + " and " + std::to_string(j) + " are not bonded");
-    }
-    return {i, b};
+    const auto b = m.bond_between(i, j);
+    if (!b) throw InputError("nodes " + std::to_string(i) + " and " + std::to_string(j) + " are not bonded");
+    return {i, *b};
   };
   for (const auto& [i, j] : pairs) {
     const auto forward = copy_of(i, j), backward = copy_of(j, i);

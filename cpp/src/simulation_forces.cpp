@@ -174,12 +174,9 @@ void Simulation::finish_forces(std::span<const std::array<index_t, 2>> ghost_bre
 }
 
 void Simulation::check_ghost_breaks(std::span<const std::array<index_t, 2>> pairs) const {
-  const Model& m = *model_;
   for (const auto& [i, j] : pairs) {
-    const bool ghosts = i < m.node_count() && j < m.node_count() && !ghost_.empty() &&
-                        ghost_[m.node_particle()[i]] && m.node_particle()[j] == m.node_particle()[i];
-    const index_t b = ghosts ? m.node_bonds(i).find(j) : 0;
-    if (!ghosts || b == m.node_bonds(i).count || !state_.bonds.intact(i, b)) {
+    const auto b = model_->bond_between(i, j);
+    if (!b || !ghost_node(i) || !state_.bonds.intact(i, *b)) {
       throw InputError("ghost bond " + std::to_string(i) + "-" + std::to_string(j) +
                        " is not an intact bond of a ghost particle");
     }

@@ -140,7 +140,8 @@ def measure(
     from granulate.parallel import DistributedRun
 
     if case not in CASES:
-        raise InputError(f"unknown distributed benchmark case {case!r}; choose from {_names()}")
+        names = ", ".join(CASES)
+        raise InputError(f"unknown distributed benchmark case {case!r}; choose from {names}")
     if steps < 1 or collect_every < 0 or (grains is not None and grains < 1):
         raise InputError(
             "bench --ranks: --steps and --grains must be positive and --collect-every at least 0"
@@ -230,7 +231,3 @@ def main(
     if result is not None:
         print(json.dumps(result) if as_json else table(result), flush=True)
     return 0
-
-
-def _names() -> str:
-    return ", ".join(CASES)

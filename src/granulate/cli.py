@@ -225,21 +225,27 @@ def _run_case(
     return 0
 
 
-def _world(command: str = "run") -> object | None:
+def _world(command: str = "run", required: bool = False) -> object | None:
     """MPI's world communicator when this process was started as one of several ranks (mpirun,
-    mpiexec, srun), else None. InputError when mpi4py is missing or belongs to another MPI than
-    the launcher's (each process would see itself alone and run the whole case)."""
+    mpiexec, srun) or the command is `required` to have one, else None. InputError when mpi4py
+    is missing or belongs to another MPI than the launcher's (each process would see itself
+    alone and run the whole case)."""
     size, _rank = launched_ranks()
-    if size == 1:
+    if size == 1 and not required:
         return None
     try:
         from mpi4py import MPI
     except ImportError:
+        problem = (
+            f"was started as {size} MPI processes, but mpi4py is not installed"
+            if size > 1
+            else "needs mpi4py, which is not installed"
+        )
         raise InputError(
-            f"granulate {command} was started as {size} MPI processes, but mpi4py is not "
-            "installed: pip install 'granulate[mpi]' (or mpi4py built against your cluster's MPI)"
+            f"granulate {command} {problem}: pip install 'granulate[mpi]' (or mpi4py built "
+            "against your cluster's MPI)"
         ) from None
-    if MPI.COMM_WORLD.Get_size() != size:
+    if size > 1 and MPI.COMM_WORLD.Get_size() != size:  # else the one world mpi4py sees
         raise InputError(
             f"the launcher started {size} processes, but mpi4py's MPI sees "
             f"{MPI.COMM_WORLD.Get_size()}: mpi4py belongs to another MPI than this mpirun. Use "
@@ -384,16 +390,7 @@ def _bench_ranks(options: argparse.Namespace) -> int:
     cases = options.case or []
     if options.contended or len(cases) > 1:
         raise InputError("bench --ranks runs one case, and not --contended")
-    comm = _world("bench --ranks")
-    if comm is None:
-        try:
-            from mpi4py import MPI
-        except ImportError:
-            raise InputError(
-                "bench --ranks needs mpi4py: pip install 'granulate[mpi]' (or mpi4py built "
-                "against your cluster's MPI)"
-            ) from None
-        comm = MPI.COMM_WORLD
+    comm = _world("bench --ranks", required=True)
     if options.threads is None:
         threads.set_num_threads(1, adaptive=False)
     case = cases[0] if cases else None

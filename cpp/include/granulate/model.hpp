@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -195,6 +196,9 @@ class Model {
   /// the smallest node index of its fragment, and returns the number of fragments.
   /// Deterministic (sequential union-find).
   index_t fragments(const BondStates& intact, index_t* labels) const;
+  /// Node i's bond to node j (its index among i's bonds), or nothing when they are not bonded
+  /// (out of range, of different particles, or beyond the horizon).
+  std::optional<index_t> bond_between(index_t i, index_t j) const;
 
   /// Per-node stable time step sqrt(2 rho / sum_j C_ij w_ij), minimised (Silling & Askari
   /// 2005, with the LPS dilatation coupling bounded by Gershgorin) [s].

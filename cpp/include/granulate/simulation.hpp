@@ -145,6 +145,8 @@ class Simulation {
   /// After pass 1 and the ghosts' breaks: contact told of breaks_, then the LPS pressures and
   /// body forces, pass 2, contact forces and nodal loads.
   void finish_forces(std::span<const std::array<index_t, 2>> ghost_breaks);
+  /// The forces at the current state unless they are current (prescribed motion first).
+  void evaluate_if_stale();
   /// The halves of a step (begin_step and finish_step without their checks).
   void move_and_break_bonds();
   void finish_step_after_breaks(std::span<const std::array<index_t, 2>> ghost_breaks);

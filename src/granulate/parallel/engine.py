@@ -147,8 +147,7 @@ class DistributedRun:
         ghost_particles = np.flatnonzero(owner[self.held] != rank)  # the part's particle order
         self.local.core.set_ghost_particles(ghost_particles.tolist())
         self._owned_nodes = self._nodes_of(self._owned, node_map)
-        self._is_owned = np.zeros(len(self._to_global), dtype=bool)
-        self._is_owned[self._owned_nodes] = True
+        self._is_owned = self._marked(self._owned_nodes)
         self._send = {
             q: self._nodes_of(held[owner[held] == rank], node_map)
             for q, held in enumerate(self.ghosts)
