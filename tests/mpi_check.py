@@ -20,6 +20,9 @@ with the serial run's, and continuing serially from the distributed checkpoint.
 checkpoint, and continues from it on K - 1 ranks (one rank fewer: a checkpoint restarts on
 another number of ranks) and serially, comparing both ends with the serial run's bit for bit.
 
+`... fine STEPS MARGIN CAP_MARGIN` compares finely meshed brittle discs (fine_discs) thrown at
+each other, whose ghosts' caps are a small part of them, with those margins [m].
+
 `... DIMENSION STEPS MARGIN compare` compares as the first form does, with that ghost margin
 [m] and every rank building its part anew at every migration (a small margin: many).
 
@@ -63,6 +66,29 @@ def set_up(dimension: int) -> gr.Simulation:
     return sim
 
 
+def fine_discs() -> gr.Simulation:
+    """The 2D locality layout's grains as discs meshed finely (R/h = 12, horizon 3h: a ghost's
+    caps are a small part of it), brittle, thrown at each other under gravity on a floor,
+    placed 2.02 mm apart (the layout's pressed grains would overlap at this mesh)."""
+    centres, rows = layout(2)
+    centres = centres * (2.02 / 1.9)
+    h = RADIUS / 12
+    rock = gr.Material(
+        density=1200,
+        bulk_modulus=2.16e7,
+        shear_modulus=1.296e7,
+        fracture_energy=0.01,
+        horizon=3 * h,
+    )
+    sim = gr.Simulation(2, gravity=(0.0, -9.81, 0.0))
+    sim.contact = gr.Contact(restitution=0.6, friction=0.5)
+    for centre, row in zip(centres, rows, strict=True):
+        sim.add_body(gr.Disc(tuple(centre), row[0]), rock, h, velocity=row[1:])
+    floor = centres[:, 1].min() - 0.99 * RADIUS
+    sim.add_wall(gr.Wall(gr.Plane((0.0, floor, 0.0), (0.0, 1.0, 0.0))), name="floor")
+    return sim
+
+
 DRUMS: dict[str, dict[str, Any]] = {
     "lattice": {},
     "grid": {"grid": True},
@@ -86,6 +112,11 @@ def main() -> int:
             return check_restart(functools.partial(drum, variant, Path(folder)), steps, comm)
     if sys.argv[1] == "api":
         return check_api(sys.argv[2], int(sys.argv[3]), comm)
+    if sys.argv[1] == "fine":
+        steps, margin, cap_margin = int(sys.argv[2]), float(sys.argv[3]), float(sys.argv[4])
+        return compare(
+            fine_discs, "fine", steps, comm, margin=margin, cap_margin=cap_margin, narrow=True
+        )
     if sys.argv[1] == "drum":
         variant, steps, renew = sys.argv[2], int(sys.argv[3]), sys.argv[4:] == ["renew"]
         with tempfile.TemporaryDirectory() as folder:
@@ -105,11 +136,13 @@ def main() -> int:
     return compare(lambda: set_up(dimension), f"{dimension}D", steps, comm)
 
 
-class OneBreakPerMessage(DistributedRun):
-    """A distributed run whose steps' messages carry one bond break each, the rest sent in a
-    second message (DistributedRun.break_slots)."""
+class NarrowMessages(DistributedRun):
+    """A distributed run whose steps' messages carry one bond break each and one body's motion
+    per grain sent, the rest sent in a second message (DistributedRun.break_slots and
+    body_slots)."""
 
     break_slots = 1
+    body_slots = 0
 
 
 def compare(
@@ -119,20 +152,26 @@ def compare(
     comm: MPI.Comm,
     renew: bool = False,
     margin: float | None = None,
+    cap_margin: float | None = None,
+    narrow: bool = False,
 ) -> int:
     """0 when `steps` steps of make() distributed over the ranks end with every node's
     position, velocity and force equal to the serial run's, at the same dt. `renew`: every
-    rank builds its part anew from the owners' states at every migration, and a step's message
-    carries one break at most (the others go in a second message); `margin`: the ghost margin
-    [m] (default DistributedRun's)."""
+    rank builds its part anew from the owners' states at every migration, and narrow messages;
+    `margin`, `cap_margin`: the ghost and cap margins [m] (default DistributedRun's);
+    `narrow`: a step's message carries one break and one body per grain at most (the others go
+    in a second message, NarrowMessages)."""
     serial = make()
     serial.core.run(steps)
-    distributed = (OneBreakPerMessage if renew else DistributedRun)(make(), comm, margin=margin)
+    kind = NarrowMessages if renew or narrow else DistributedRun
+    distributed = kind(make(), comm, margin=margin, cap_margin=cap_margin)
     distributed.always_renew = renew
     distributed.run(steps)
     fields = {name: distributed.gather(name) for name in ("positions", "velocities", "forces")}
     walls = distributed.wall_reactions()
     renewals = comm.gather(distributed.renewals, root=0)
+    held = comm.gather((distributed.ghost_node_count, distributed.exchanged_node_count), root=0)
+    seconds = comm.allreduce(distributed.second_messages)
     if comm.Get_rank() != 0:
         return 0
     worst = {name: float(np.abs(fields[name] - getattr(serial, name)).max()) for name in fields}
@@ -142,7 +181,10 @@ def compare(
     print(
         f"ranks {comm.Get_size()}, {name}, {steps} steps, dt equal {same_dt}, ghosts per "
         f"rank {ghosts}, migrations {distributed.migrations}, grains handed over "
-        f"{distributed.handed_over}, parts built anew per rank {renewals}, bonds broken "
+        f"{distributed.handed_over}, parts built anew per rank {renewals}, caps picked anew "
+        f"{distributed.cap_refreshes}, ghost nodes held and sent a step per rank {held}, "
+        f"second messages {seconds}, "
+        "bonds broken "
         f"{serial.broken_bonds()}, largest differences {worst}"
     )
     return 0 if same_dt and not any(worst.values()) else 1

@@ -281,6 +281,19 @@ void ContactModel::label_bodies(const Model& model, const State& state, std::uin
   for (index_t i = 0; i < n; ++i) body_nodes_[fill[node_body_[i]]++] = i;
 }
 
+std::vector<std::span<const index_t>> ContactModel::bodies_in(index_t first, index_t end) const {
+  // Bodies are numbered in the order of their smallest node, so those starting in [first, end)
+  // follow the body of `first` (when `first` is the smallest node of a particle).
+  std::vector<std::span<const index_t>> bodies;
+  const index_t count = static_cast<index_t>(body_node_offsets_.size()) - 1;
+  for (index_t b = first < end ? node_body_[first] : count; b < count; ++b) {
+    const index_t* nodes = body_nodes_.data() + body_node_offsets_[b];
+    if (nodes[0] >= end) break;
+    bodies.emplace_back(nodes, body_node_offsets_[b + 1] - body_node_offsets_[b]);
+  }
+  return bodies;
+}
+
 std::vector<index_t> ContactModel::body_first_nodes() const {
   std::vector<index_t> first(body_node_offsets_.size() - 1);
   for (std::size_t b = 0; b < first.size(); ++b) first[b] = body_nodes_[body_node_offsets_[b]];

@@ -5,6 +5,8 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
+#include <string>
 
 #include "contact_vectors.hpp"
 #include "granulate/contact/contact_model.hpp"
@@ -28,9 +30,8 @@ std::array<real, 6> inverse_inertia(const std::array<real, 6>& m, int dimension)
   return {cxx / det, cyy / det, czz / det, cxy / det, cxz / det, cyz / det};
 }
 
-/// Rigid-body motion of a body from its nodes (one pass, moments about its first node, so far
-/// from the origin nothing cancels): centre c, velocity V = sum m v / M, inertia
-/// I = sum m (|r|^2 1 - r r^T) and angular momentum L = sum m r x (v - V) about c, omega = I^-1 L.
+}  // namespace
+
 BodyMotion measure_body(const Model& model, const State& state, const index_t* nodes, index_t count,
                         int dimension) {
   const auto& x = state.positions;
@@ -75,6 +76,8 @@ BodyMotion measure_body(const Model& model, const State& state, const index_t* n
   motion.angular_velocity = symmetric_times(motion.inverse_inertia, angular_momentum);
   return motion;
 }
+
+namespace {
 
 /// Outward unit normal of the surface at node i, in the current configuration: the opposite of
 /// the influence-weighted sum of its intact bonds, sum_j w_ij (y_j - y_i), which points into
@@ -272,6 +275,7 @@ void ContactModel::add_forces(const Model& model, State& state, std::uint64_t br
   probe_couples(state);                                 //    the probes' friction couples, as loads
   body_loads(model, state);  // E: dashpots and friction couples as rigid-body loads
   sum_wall_reactions();      // D: wall reactions
+  ghosts_.forget();          // the ghosts' motions were this state's
 }
 
 namespace {
@@ -381,6 +385,7 @@ void ContactModel::measure_contacts(const Model& model, const State& state) {
         return xi;
       };
       bool touching = false;
+      const bool counted = !ghosts_.ghost(model.node_particle()[i]);  // a ghost's owner counts it
       real pair_overlap = 0;     // the deepest of its sphere pairs under the surface law
       bool sphere_pair = false;  // whether one of them touches, before their rests
       for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
@@ -398,13 +403,14 @@ void ContactModel::measure_contacts(const Model& model, const State& state) {
                                  ? static_cast<float>(contact::pair_stiffness(law, volume[i], volume[j]))
                                  : 0.0f;
         touching = touching || (pair_stiffness_[e] > 0 && !law.node_pair && node_body_[i] != node_body_[j]);
-        if (pair_stiffness_[e] > 0 && !law.node_pair && !law.surface)
+        if (pair_stiffness_[e] > 0 && !law.node_pair && !law.surface && counted)
           deepest = std::max(deepest, 1 - distance / law.contact_radius);
         if (law.surface) pair_overlap = std::max(pair_overlap, law.contact_radius - distance);
         if (law.surface && pair_stiffness_[e] > 0) sphere_pair = true;
       }
       if (touching) touching_nodes.push_back(i);
-      deepest = std::max(deepest, measure_probes(model, state, i, probe_scratch, pair_overlap));
+      const real probed = measure_probes(model, state, i, probe_scratch, pair_overlap);
+      if (counted) deepest = std::max(deepest, probed);
       if (sphere_pair) sphere_pairs.push_back(i);
       for (index_t e = wall_offsets_[i]; e < wall_offsets_[i + 1]; ++e)
         measure_wall_points(model, state, i, e, centre(), found);
@@ -702,13 +708,41 @@ void ContactModel::sum_slot_stiffness() {
 }
 
 void ContactModel::measure_bodies(const Model& model, const State& state) {
+  // A ghost body takes the motion its owner gave (give_ghost_motions): this process may hold
+  // only the ghost's nodes within reach of its own, the rest left where they were.
   const std::int64_t count = static_cast<std::int64_t>(touching_bodies_.size());
+  std::vector<std::uint8_t> measured(ghosts_.any() ? count : 0, 1);
 #pragma omp parallel for schedule(dynamic, 16)
   for (std::int64_t k = 0; k < count; ++k) {
     const index_t b = touching_bodies_[k];
+    const index_t* nodes = body_nodes_.data() + body_node_offsets_[b];
     body_load_[k] = {0, 0, 0, 0, 0, 0};
-    body_motion_[k] = measure_body(model, state, body_nodes_.data() + body_node_offsets_[b],
-                                   body_node_offsets_[b + 1] - body_node_offsets_[b], dimension_);
+    const BodyMotion* given = ghosts_.ghost(body_particle_[b]) ? ghosts_.given(nodes[0]) : nullptr;
+    if (given) {
+      body_motion_[k] = *given;
+      measured[k] = 0;
+    } else {
+      body_motion_[k] =
+          measure_body(model, state, nodes, body_node_offsets_[b + 1] - body_node_offsets_[b], dimension_);
+    }
+  }
+  if (ghosts_.any()) check_ghost_motions(measured);
+}
+
+void ContactModel::check_ghost_motions(const std::vector<std::uint8_t>& measured) const {
+  auto unknown = [&](index_t body) {
+    return ghosts_.ghost(body_particle_[body]) && measured[body_touch_[body]];
+  };
+  for (std::size_t slot = 0; slot < particle_slot_count_; ++slot) {
+    const index_t p = slots_[slot][0], q = slots_[slot][1];
+    if (body_touch_[p] == not_touching || body_touch_[q] == not_touching) continue;
+    if (ghosts_.ghost(body_particle_[p]) && ghosts_.ghost(body_particle_[q])) continue;
+    if (unknown(p) || unknown(q)) {
+      const index_t ghost = unknown(p) ? p : q;
+      throw std::runtime_error("contact: the motion of ghost body " + std::to_string(ghost) +
+                               " (first node " + std::to_string(body_nodes_[body_node_offsets_[ghost]]) +
+                               ") was not given, and it touches a body of this process");
+    }
   }
 }
 
@@ -736,7 +770,8 @@ void ContactModel::release_rested_pairs(const Model& model, const State& state,
       if (pair_stiffness_[e] == 0 || surface_entry(model, i, e) || !slot_law(pair_slot_[e]).surface) continue;
       const real overlap = pair_geometry(model, state, i, e).overlap;
       if (overlap > 0) {
-        statistics_.add_overlap(overlap / slot_law(pair_slot_[e]).contact_radius, state.step);
+        if (!ghosts_.ghost(model.node_particle()[i]))  // its owner counts it
+          statistics_.add_overlap(overlap / slot_law(pair_slot_[e]).contact_radius, state.step);
       } else {
         pair_stiffness_[e] = 0;
       }

@@ -445,32 +445,35 @@ index_t NodeBonds::find(index_t j) const {
 }
 
 index_t Model::fragments(const BondStates& intact, index_t* labels) const {
+  return fragments_in(intact, 0, node_count(), labels);
+}
+
+index_t Model::fragments_in(const BondStates& intact, index_t first, index_t count, index_t* labels) const {
   // Union-find; the root of a set is always its smallest node, so labels are deterministic.
-  const index_t n = node_count();
-  std::vector<index_t> parent(n);
-  for (index_t i = 0; i < n; ++i) parent[i] = i;
-  auto root = [&](index_t i) {
-    while (parent[i] != i) {
-      parent[i] = parent[parent[i]];
-      i = parent[i];
+  std::vector<index_t> parent(count);
+  for (index_t k = 0; k < count; ++k) parent[k] = k;
+  auto root = [&](index_t k) {
+    while (parent[k] != k) {
+      parent[k] = parent[parent[k]];
+      k = parent[k];
     }
-    return i;
+    return k;
   };
-  for (index_t i = 0; i < n; ++i) {
-    const NodeBonds bonds = node_bonds(i);
-    for (index_t k = 0; k < bonds.count; ++k) {
-      if (!intact.intact(i, k)) continue;
-      const index_t a = root(i), b = root(bonds.neighbor(k));
-      if (a < b) parent[b] = a;
-      if (b < a) parent[a] = b;
+  for (index_t k = 0; k < count; ++k) {
+    const NodeBonds bonds = node_bonds(first + k);
+    for (index_t b = 0; b < bonds.count; ++b) {
+      if (!intact.intact(first + k, b)) continue;
+      const index_t a = root(k), c = root(bonds.neighbor(b) - first);
+      if (a < c) parent[c] = a;
+      if (c < a) parent[a] = c;
     }
   }
-  index_t count = 0;
-  for (index_t i = 0; i < n; ++i) {
-    labels[i] = root(i);
-    if (labels[i] == i) ++count;
+  index_t fragments = 0;
+  for (index_t k = 0; k < count; ++k) {
+    labels[k] = first + root(k);
+    if (labels[k] == first + k) ++fragments;
   }
-  return count;
+  return fragments;
 }
 
 real Model::stable_time_step() const {

@@ -53,19 +53,6 @@ void Simulation::set_time_step(real dt) {
   time_step_ = dt;
 }
 
-void Simulation::set_ghost_particles(const std::vector<index_t>& particles) {
-  std::vector<std::uint8_t> ghost(model_->particles().size(), 0);
-  for (index_t q : particles) {
-    if (q >= ghost.size()) {
-      std::ostringstream msg;
-      msg << "ghost particle " << q << " does not exist: the model has " << ghost.size() << " particles";
-      throw InputError(msg.str());
-    }
-    ghost[q] = 1;
-  }
-  ghost_ = particles.empty() ? std::vector<std::uint8_t>{} : std::move(ghost);  // empty: none
-}
-
 void Simulation::set_body_acceleration(const std::array<real, 3>& g) {
   for (real c : g) {
     if (!std::isfinite(c)) throw InputError("body acceleration must be finite");
@@ -208,9 +195,12 @@ void Simulation::move_and_break_bonds() {
   auto& v = state_.velocities;
   const auto& f = state_.forces;
   const real dt = time_step_;
+  const std::uint8_t* const ghost = ghost_.empty() ? nullptr : ghost_.data();
+  const auto& node_particle = m.node_particle();
   auto start = clock_type::now();
 #pragma omp parallel for schedule(static)
   for (std::int64_t i = 0; i < n; ++i) {
+    if (ghost && ghost[node_particle[i]]) continue;  // moved by its owner (set_ghost_particles)
     const real density = m.density(static_cast<index_t>(i));
     for (std::int64_t k = 3 * i; k < 3 * i + 3; ++k) {
       v[k] += 0.5 * dt * f[k] / density;
@@ -239,6 +229,7 @@ void Simulation::finish_step_after_breaks(std::span<const std::array<index_t, 2>
   auto& v = state_.velocities;
   const auto& f = state_.forces;
   const real dt = time_step_;
+  const std::uint8_t* const ghost = ghost_.empty() ? nullptr : ghost_.data();
   auto start = clock_type::now();
   const double contact_before = phase_times_.contact;
   finish_forces(ghost_breaks);
@@ -247,13 +238,14 @@ void Simulation::finish_step_after_breaks(std::span<const std::array<index_t, 2>
   start = clock_type::now();
   // The second half kick, and the first node (if any) that moved more than its mesh size in
   // the step or became non-finite: checked every step, at the cost of one comparison per node
-  // (not on ghosts, whose velocities are their owners' to check).
+  // (not on ghosts, which their owners move and check).
   // With a travel origin, also the largest squared distance of a node from it.
   std::int64_t first_unstable = n;
   real travel2 = 0;
   const real* const origin = travel_origin_.empty() ? nullptr : travel_origin_.data();
 #pragma omp parallel for schedule(static) reduction(min : first_unstable) reduction(max : travel2)
   for (std::int64_t i = 0; i < n; ++i) {
+    if (ghost && ghost[node_particle[i]]) continue;  // moved and checked by its owner
     real speed2 = 0;
     const real density = m.density(static_cast<index_t>(i));
     for (std::int64_t k = 3 * i; k < 3 * i + 3; ++k) {
@@ -261,7 +253,7 @@ void Simulation::finish_step_after_breaks(std::span<const std::array<index_t, 2>
       speed2 += v[k] * v[k];
     }
     const real limit = particles[node_particle[i]].mesh_size / dt;
-    if (!(speed2 <= limit * limit) && !ghost_node(i)) first_unstable = std::min(first_unstable, i);
+    if (!(speed2 <= limit * limit)) first_unstable = std::min(first_unstable, i);
     if (origin) {
       const real dx = x[3 * i] - origin[3 * i], dy = x[3 * i + 1] - origin[3 * i + 1],
                  dz = x[3 * i + 2] - origin[3 * i + 2];

@@ -173,25 +173,6 @@ void Simulation::finish_forces(std::span<const std::array<index_t, 2>> ghost_bre
   forces_current_ = true;
 }
 
-void Simulation::check_ghost_breaks(std::span<const std::array<index_t, 2>> pairs) const {
-  for (const auto& [i, j] : pairs) {
-    const auto b = model_->bond_between(i, j);
-    if (!b || !ghost_node(i) || !state_.bonds.intact(i, *b)) {
-      throw InputError("ghost bond " + std::to_string(i) + "-" + std::to_string(j) +
-                       " is not an intact bond of a ghost particle");
-    }
-  }
-}
-
-void Simulation::break_ghost_bonds(std::span<const std::array<index_t, 2>> pairs) {
-  const Model& m = *model_;
-  for (const auto& [i, j] : pairs) {
-    BondStates::clear(state_.bonds.node(i), m.node_bonds(i).find(j));
-    BondStates::clear(state_.bonds.node(j), m.node_bonds(j).find(i));
-    breaks_.push_back({i, j});
-  }
-}
-
 void Simulation::sum_dilatation_and_break_bonds() {
   // Pass 1: stretch, irreversible breaking, sum_j w r e at both ends. A bond breaks at the end
   // that evaluates it; its other copy is cleared below, before any loop reads it (when both

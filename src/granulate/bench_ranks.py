@@ -158,6 +158,7 @@ def measure(
         "grains": len(run.owned),
         "nodes": run.owned_node_count,
         "ghost_nodes": run.ghost_node_count,
+        "exchanged_nodes": run.exchanged_node_count,
         "seconds": wall,
         "node_steps_per_s": run.owned_node_count * steps / wall,
     } | {f"{name}_share": run.seconds[name] / wall for name in SHARES}
@@ -198,15 +199,15 @@ def table(result: dict[str, Any]) -> str:
     lines = [
         f"{result['case']}: {result['grains']} grains, {result['steps']} steps, "
         f"{result['ranks']} ranks, {result['threads']} thread(s) each",
-        "| rank | grains | nodes | ghost nodes | node-steps/s | exchange % | check % | migrate % "
-        "| collect % |",
-        "|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
+        "| rank | grains | nodes | ghost nodes | received a step | node-steps/s | exchange % "
+        "| check % | migrate % | collect % |",
+        "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
     ]
     for rank, row in enumerate(result["rows"]):
         shares = " | ".join(f"{100 * row[f'{name}_share']:.1f}" for name in SHARES)
         lines.append(
             f"| {rank} | {row['grains']} | {row['nodes']:,} | {row['ghost_nodes']:,} | "
-            f"{row['node_steps_per_s'] / 1e6:.2f} M | {shares} |"
+            f"{row['exchanged_nodes']:,} | {row['node_steps_per_s'] / 1e6:.2f} M | {shares} |"
         )
     lines.append(
         f"{result['migrations']} migrations, {result['handed_over']} grains handed over in the "

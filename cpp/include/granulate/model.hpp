@@ -196,6 +196,9 @@ class Model {
   /// the smallest node index of its fragment, and returns the number of fragments.
   /// Deterministic (sequential union-find).
   index_t fragments(const BondStates& intact, index_t* labels) const;
+  /// The same over the `count` nodes from `first`, whole particles (bonds never leave a
+  /// particle): labels[k] for node first + k.
+  index_t fragments_in(const BondStates& intact, index_t first, index_t count, index_t* labels) const;
   /// Node i's bond to node j (its index among i's bonds), or nothing when they are not bonded
   /// (out of range, of different particles, or beyond the horizon).
   std::optional<index_t> bond_between(index_t i, index_t j) const;

@@ -117,11 +117,22 @@ class Simulation {
   /// Marks the particles whose bonds and forces another process evaluates (a distributed run's
   /// ghosts; the rest are not): both bond passes skip them, and their bonds break only through
   /// finish_step's ghost_breaks (their fragments enter their partners' contact), and the
-  /// stability check passes them over. Their forces, velocities and dilatation are then not
-  /// their own: the caller gives them their owners' positions and velocities between
-  /// begin_step and finish_step (granulate.parallel's exchange), which is all the contact
-  /// reads of them. InputError for an index out of range.
+  /// steps neither move them nor check their stability. Their forces, velocities and
+  /// dilatation are then not their own: between begin_step and finish_step the caller gives
+  /// the ghost nodes within the contact's reach their owners' positions and velocities and the
+  /// ghost bodies their owners' motion (give_ghost_motions), which is all the contact reads of
+  /// them; the other ghost nodes stay where they were. InputError for an index out of range.
   void set_ghost_particles(const std::vector<index_t>& particles);
+  /// Between begin_step and finish_step, on the owner: the rigid-body motion (measure_body) of
+  /// every fragment of each of `particles` (this process's own) at the state the contact will
+  /// see, named by the fragment's smallest node: what a process holding them as ghosts needs of
+  /// their bodies (give_ghost_motions). The fragments are those after this step's breaks.
+  std::vector<std::pair<index_t, BodyMotion>> fragment_motions(const std::vector<index_t>& particles) const;
+  /// Before finish_step, where ghosts are held: their bodies' motions, from fragment_motions
+  /// on their owners (node numbers this process's), for the contact of this step, which would
+  /// otherwise measure them from the ghost nodes held (ContactModel::give_ghost_motions).
+  /// InputError for a node that is not a ghost's.
+  void give_ghost_motions(std::vector<std::pair<index_t, BodyMotion>> motions);
   /// From now on each step measures how far the farthest node is from where it is now [m]
   /// (largest_travel), in its last half kick: a distributed run's check that its ghosts still
   /// hold. Off until called (a serial run measures nothing).

@@ -1,5 +1,6 @@
 // granulate._core's contact laws, damping ratios and contact statistics.
 #include "bindings.hpp"
+#include "granulate/cell_grid.hpp"
 
 namespace granulate::bindings {
 
@@ -24,6 +25,27 @@ void bind_contact(nb::module_& m) {
   m.def("power_law_restitution", &contact::power_law_restitution, "damping_ratio"_a, "exponent"_a);
   m.def("power_law_damping_ratio", &contact::power_law_damping_ratio, "restitution"_a, "exponent"_a,
         "low"_a = 0.0, "high"_a = 50.0);
+
+  m.def(
+      "points_within",
+      [](Points points, Points targets, real distance) {
+        if (!(distance >= 0) || !std::isfinite(distance))
+          throw InputError("points_within: the distance must be a non-negative length in m");
+        const index_t n = static_cast<index_t>(points.shape(0)), m = static_cast<index_t>(targets.shape(0));
+        std::vector<real> x(3 * static_cast<std::size_t>(m + n));  // the targets, then the points
+        std::copy(targets.data(), targets.data() + 3 * static_cast<std::size_t>(m), x.begin());
+        std::copy(points.data(), points.data() + 3 * static_cast<std::size_t>(n), x.begin() + 3 * m);
+        std::vector<std::uint8_t> near(n, 0);
+        {
+          nb::gil_scoped_release released;
+          const CellGrid grid = CellGrid::build(x, 0, m, std::max(distance, 1e-300));
+          for (index_t k = 0; k < n; ++k)
+            grid.for_each_within(x, m + k, distance, 3, [&](index_t, real) { near[k] = 1; });
+        }
+        return copy_out(near);
+      },
+      "points"_a, "targets"_a, "distance"_a,
+      "Per point (n, 3), 1 where one of `targets` (m, 3) lies within `distance` [m] of it (a cell grid).");
 
   nb::class_<ContactStatistics>(m, "ContactStatistics")
       .def_ro("rebuilds", &ContactStatistics::rebuilds)

@@ -1,4 +1,6 @@
 // granulate._core's Model: particles, shared shapes and bond families, zero-copy views.
+#include <algorithm>
+
 #include "bindings.hpp"
 
 namespace granulate::bindings {
@@ -93,6 +95,21 @@ void bind_contents(nb::class_<Model>& model) {
                      return view(const_cast<std::size_t*>(self.bond_offsets().data()),
                                  self.bond_offsets().size(), 0, nb::find(self));
                    })
+      .def(
+          "bond_partners",
+          [](const Model& self, const std::vector<index_t>& nodes) {
+            std::vector<index_t> partners;
+            for (const index_t i : nodes) {
+              if (i >= self.node_count())
+                throw InputError("bond_partners: node " + std::to_string(i) + " does not exist");
+              const NodeBonds bonds = self.node_bonds(i);
+              for (index_t b = 0; b < bonds.count; ++b) partners.push_back(bonds.neighbor(b));
+            }
+            std::sort(partners.begin(), partners.end());
+            partners.erase(std::unique(partners.begin(), partners.end()), partners.end());
+            return copy_out(partners);
+          },
+          "nodes"_a, "The nodes bonded to any of `nodes` (broken bonds too), sorted, each once.")
       .def("bond_neighbors", [](const Model& self) {
         std::vector<index_t> neighbors(self.bond_count());
         for (index_t i = 0; i < self.node_count(); ++i) {

@@ -7,6 +7,24 @@ using namespace nb::literals;
 
 namespace {
 
+/// A BodyMotion's numbers (body_motion_size: centre, velocity, angular velocity, inverse
+/// inertia) appended to `out`, and read back.
+void append_motion(std::vector<real>& out, const BodyMotion& motion) {
+  for (const auto* part : {&motion.centre, &motion.velocity, &motion.angular_velocity})
+    out.insert(out.end(), part->begin(), part->end());
+  out.insert(out.end(), motion.inverse_inertia.begin(), motion.inverse_inertia.end());
+}
+
+BodyMotion motion_from(const double* numbers) {
+  BodyMotion motion;
+  for (auto* part : {&motion.centre, &motion.velocity, &motion.angular_velocity}) {
+    std::copy(numbers, numbers + 3, part->begin());
+    numbers += 3;
+  }
+  std::copy(numbers, numbers + 6, motion.inverse_inertia.begin());
+  return motion;
+}
+
 // The time step, PeriDEM's damping, time and step, checkpoints, body forces.
 void bind_run_setup(nb::class_<Simulation>& cls) {
   cls.def(nb::init<std::shared_ptr<Model>>(), "model"_a, nb::call_guard<nb::gil_scoped_release>())
@@ -210,6 +228,36 @@ void bind_results(nb::class_<Simulation>& cls) {
           },
           "ghost_breaks"_a,
           "The rest of the step, after breaking the ghosts' bonds their owners broke, (k, 2) node pairs.")
+      .def(
+          "fragment_motions",
+          [](const Simulation& self, const std::vector<index_t>& particles) {
+            std::vector<index_t> nodes;
+            std::vector<real> numbers;
+            for (const auto& [node, motion] : self.fragment_motions(particles)) {
+              nodes.push_back(node);
+              append_motion(numbers, motion);
+            }
+            return nb::make_tuple(copy_out(nodes), copy_out(numbers));
+          },
+          "particles"_a,
+          "Between begin_step and finish_step: every fragment of these own particles, its smallest "
+          "node and its rigid-body motion (Simulation::fragment_motions), as (nodes, flat motions: "
+          "centre, velocity, angular velocity, inverse inertia; 15 a fragment).")
+      .def(
+          "give_ghost_motions",
+          [](Simulation& self, nb::ndarray<const std::uint32_t, nb::ndim<1>, nb::c_contig> nodes,
+             nb::ndarray<const double, nb::shape<-1, body_motion_size>, nb::c_contig> motions) {
+            if (nodes.shape(0) != motions.shape(0))
+              throw InputError("give_ghost_motions: one node per motion, got " +
+                               std::to_string(nodes.shape(0)) + " nodes and " +
+                               std::to_string(motions.shape(0)) + " motions");
+            std::vector<std::pair<index_t, BodyMotion>> given(nodes.shape(0));
+            for (std::size_t k = 0; k < given.size(); ++k) given[k] = {nodes(k), motion_from(&motions(k, 0))};
+            self.give_ghost_motions(std::move(given));
+          },
+          "nodes"_a, "motions"_a,
+          "Before finish_step: the ghost bodies' motions from their owners' fragment_motions "
+          "(Simulation::give_ghost_motions), each named by its smallest node here; (k, 15).")
       .def("compute_forces", &Simulation::compute_forces, nb::call_guard<nb::gil_scoped_release>())
       .def("kinetic_energy", &Simulation::kinetic_energy)
       .def("strain_energy", &Simulation::strain_energy)

@@ -4,18 +4,21 @@
 Each rank holds the grains it owns and, as ghosts, the grains of other ranks whose bounding
 spheres come within the contact lists' cutoff plus a margin of its own (partition.py), in the
 serial order, at the serial run's time step and neighbour skin, but evaluates only its own
-grains' bonds (core.set_ghost_particles). Each step runs in two halves (core.begin_step: the
-drift and the bonds' stretch and breaking; core.finish_step: the contact and the rest), and
-between them the owners send the ranks that hold their grains as ghosts the grains' positions
-and velocities and the bonds that broke in them, which overwrite the ghosts' copies before the
-contact reads them (a ghost's fragments enter its partners' contact too). An owned grain's step
-needs only its partners' exact state then, which it has (tests/test_locality.py): the owned
+grains' bonds and moves only its own nodes (core.set_ghost_particles). Each step runs in two
+halves (core.begin_step: the drift and the bonds' stretch and breaking; core.finish_step: the
+contact and the rest), and between them the owners send the ranks that hold their grains as
+ghosts the positions and velocities of the nodes within their reach (the caps), the bonds that
+broke in those grains and the rigid-body motion of each of their fragments, which the contact
+takes in place of what the ghost copies would give (a ghost's fragments enter its partners'
+contact too). An owned grain's step needs nothing else (tests/test_locality.py): the owned
 grains move bit for bit as in the serial run, for any number of ranks (tests/test_mpi.py).
 
 The ghost sets hold while no node has moved more than half the margin from where it was when
-the grains were last distributed, since then no pair left out can come within the cutoff. The
-run checks that every step; past a quarter of the margin the ranks cut the grains anew where
-they are (which also rebalances) and hand grains over with their whole state (transplant.py).
+the grains were last distributed, since then no pair left out can come within the cutoff; the
+caps, while none has moved half the cap margin since they were picked. The run checks both
+every step: past a quarter of the cap margin the ranks pick the caps anew, past a quarter of
+the margin they cut the grains anew where they are (which also rebalances) and hand grains over
+with their whole state (transplant.py).
 Wall reactions are summed on rank 0 in the serial order. `collect` gathers every grain's state
 and the last evaluation into rank 0's simulation (whole_state.py), whose serial writers, stop
 criteria and checkpoints then see the serial run (Simulation(comm=...) runs through
@@ -35,6 +38,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from granulate import checkpoints
+from granulate._core import points_within
 from granulate.errors import InputError
 from granulate.parallel.agreement import RankFailed, on_root, together
 from granulate.parallel.partition import Partition, bisect, ghosts, near_pairs
@@ -52,8 +56,9 @@ if TYPE_CHECKING:
     from granulate.writers.outputs import Outputs
 
 _TAG = 17
-_BREAK_TAG = 18
-_NONE = np.zeros((0, 2), dtype=np.int64)  # no bonds broke
+_REST_TAG = 18  # what a step's message has no room for
+_CAP_TAG = 19
+_BODY = 16  # numbers a body's motion takes in a message: its first node, then 15
 
 
 class DistributedRun:
@@ -61,19 +66,37 @@ class DistributedRun:
 
     ``margin`` [m]: how much farther than the contact lists' cutoff a ghost is taken; default
     the largest grain's bounding radius. The ghosts hold while every node stays within margin/2
-    of where it was when the grains were last distributed; once one has moved margin/4, the
-    ranks ``migrate`` (cut the assembly anew and hand grains over with their whole state), or
-    with ``migrate=False`` stop with an InputError past margin/2. Every rank calls the
-    constructor and each method together.
+    of where it was when the grains were last distributed; once one may have moved margin/4,
+    the ranks ``migrate`` (cut the assembly anew and hand grains over with their whole state),
+    or with ``migrate=False`` stop with an InputError past margin/2.
+
+    ``cap_margin`` [m]: the same for the caps, the ghost nodes whose positions and velocities
+    travel in each step (_exchange_caps); default margin/4, but at least four times the
+    largest mesh size (a node that moves more than its mesh size in a step is unstable, so the
+    caps are always picked anew in time) and at most the margin. Once a node has moved
+    cap_margin/4 since they were picked, the ranks pick them anew (refresh_caps: the ghosts
+    made their owners' grains whole, no grain changes hands); past cap_margin/2 they stop
+    with an InputError. A smaller cap margin sends fewer nodes each step and refreshes more
+    often. Caps that hold every ghost node (coarse grains) are never picked anew.
+
+    Every rank calls the constructor and each method together.
     """
 
     #: Breaks a step's message to a neighbouring rank carries after its nodes' x and v (their
     #: count, then node pairs as float64, exact below 2^53); more go in a second message
     #: (tests lower it to exercise that path).
     break_slots = 64
+    #: Bodies' motions it carries beyond one per grain sent (a grain's fragments, each its
+    #: first node and 15 numbers); more go in the second message too.
+    body_slots = 64
 
     def __init__(
-        self, sim: Simulation, comm: Any, margin: float | None = None, migrate: bool = True
+        self,
+        sim: Simulation,
+        comm: Any,
+        margin: float | None = None,
+        migrate: bool = True,
+        cap_margin: float | None = None,
     ) -> None:
         from mpi4py import MPI
 
@@ -94,6 +117,21 @@ class DistributedRun:
         self.stable_dt = comm.allreduce(probe.stable_time_step, op=MPI.MIN)
         self.margin = float(radii.max() if margin is None else margin)
         self._reach = cutoff + self.margin
+        largest_mesh = max(body.mesh_size for body in sim.bodies)
+        default = min(self.margin, max(0.25 * self.margin, 4 * largest_mesh))
+        self.cap_margin = float(default if cap_margin is None else cap_margin)
+        if not 0 < self.cap_margin <= self.margin:
+            raise InputError(
+                f"cap_margin must be a length in m above 0 and at most the margin "
+                f"({self.margin:.3g} m), got {cap_margin!r}"
+            )
+        self._cap_reach = cutoff + self.cap_margin + 2 * largest_mesh
+        #: How many times the caps were picked anew between distributions (refresh_caps).
+        self.cap_refreshes = 0
+        #: How many of this rank's step messages had a second one for the breaks and bodies'
+        #: motions they had no room for.
+        self.second_messages = 0
+        self._caps_due = False
         self._migrates = migrate
         #: How many times the grains were distributed anew (migrate()), and how many grains
         #: changed owner then, in all.
@@ -110,9 +148,12 @@ class DistributedRun:
         held = self._distribute(centres, radii)
         together(self.comm, lambda: self._build(held))
         self._exchange_state()
+        self._exchange_caps()
         #: Wall-clock seconds of this rank in its steps, ghost exchanges, partition checks,
         #: migrations and collections of the whole state on rank 0 (collect).
-        self.seconds = dict.fromkeys(("steps", "exchange", "check", "migrate", "collect"), 0.0)
+        self.seconds = dict.fromkeys(
+            ("steps", "exchange", "check", "caps", "migrate", "collect"), 0.0
+        )
 
     def _build(self, held: NDArray[np.int64]) -> None:
         """This rank's part of the grains `held` at the start, with its first forces (the
@@ -133,12 +174,11 @@ class DistributedRun:
         return np.union1d(self.partition.grains_of(rank), self.ghosts[rank])
 
     def _plan(self, node_map: NDArray[np.int64]) -> None:
-        """Which local nodes go to which rank and come from which, in grain order, with the
-        message buffers of the steps' exchange (6 numbers a node: x, v; then the breaks),
-        made once per partition; the positions the nodes' travel is measured from (the core
-        measures it in each step). The core skips the ghosts' bonds
-        (Simulation::set_ghost_particles): their positions, velocities and breaks come from
-        their owners within each step (_exchange_within_step)."""
+        """Which grains go to which rank and come from which, and the positions the nodes'
+        travel is measured from (the core measures it in each step). The core skips the
+        ghosts' bonds and moves (Simulation::set_ghost_particles): their positions,
+        velocities, breaks and bodies' motions come from their owners within each step
+        (_exchange_within_step), of the nodes _exchange_caps picks. Local work only."""
         rank = self.comm.Get_rank()
         owner = self.partition.owner
         self._node_map = node_map
@@ -148,20 +188,68 @@ class DistributedRun:
         self.local.core.set_ghost_particles(ghost_particles.tolist())
         self._owned_nodes = self._nodes_of(self._owned, node_map)
         self._is_owned = self._marked(self._owned_nodes)
-        self._send = {
-            q: self._nodes_of(held[owner[held] == rank], node_map)
+        self._send_grains = {
+            q: held[owner[held] == rank]
             for q, held in enumerate(self.ghosts)
             if q != rank and np.any(owner[held] == rank)
         }
         mine = self.ghosts[rank]
-        self._receive = {
-            int(q): self._nodes_of(mine[owner[mine] == q], node_map) for q in np.unique(owner[mine])
+        self._receive_grains = {int(q): mine[owner[mine] == q] for q in np.unique(owner[mine])}
+        self._send_whole = {q: self._nodes_of(g, node_map) for q, g in self._send_grains.items()}
+        self._receive_whole = {
+            q: self._nodes_of(g, node_map) for q, g in self._receive_grains.items()
         }
-        self._sent_to = {q: self._marked(n) for q, n in self._send.items()}
-        size = 1 + 2 * self.break_slots
-        self._outbox = {q: np.empty(6 * len(n) + size) for q, n in self._send.items()}
-        self._inbox = {q: np.empty(6 * len(n) + size) for q, n in self._receive.items()}
+        self._sent_to = {q: self._marked(n) for q, n in self._send_whole.items()}
+        particles = {q: np.searchsorted(self.held, g) for q, g in self._send_grains.items()}
+        self._motion_particles = np.unique(
+            np.concatenate([np.zeros(0, np.int64), *particles.values()])
+        )
+        self._particle_to = {q: _mask(len(self.held), p) for q, p in particles.items()}
+        self._node_particle = np.asarray(self.local.model.node_particle, dtype=np.int64)
         self.local.core.set_travel_origin()
+        self._travelled = 0.0  # the farthest travel of each cap period since, summed
+        self._caps_due = False  # _exchange_caps picks them where the nodes are
+
+    def _exchange_caps(self) -> None:
+        """Which of the ghosts' nodes each step sends (the caps): of each ghost grain, the
+        nodes within the cutoff plus the cap margin (and twice the largest mesh size, by which
+        a contact centre may lie off its node) of one of this rank's own nodes, and the nodes
+        bonded to those (a node's surface normal and anchors are its bonded neighbours). No
+        other ghost node can come within the cutoff of an own node, or of where one of them
+        is, before the caps are picked again (each moves less than cap_margin/2), so a ghost
+        node outside the cap stays where it was, out of every own node's contact. Each rank
+        picks its caps from the ghosts' positions now, which are their owners' (after
+        _exchange_state or a rebuild), and tells the owners; one message per neighbour."""
+        x = self.local.core.positions
+        own = x[self._owned_nodes]
+        caps = {}
+        for q, nodes in self._receive_whole.items():
+            near = nodes[points_within(x[nodes], own, self._cap_reach).astype(bool)]
+            caps[q] = np.union1d(near, np.asarray(self.local.model.bond_partners(near.tolist())))
+        requests = [
+            self.comm.isend(self._to_global[cap], dest=q, tag=_CAP_TAG) for q, cap in caps.items()
+        ]
+        self._send = {
+            q: self._node_map[self.comm.recv(source=q, tag=_CAP_TAG)] for q in self._send_whole
+        }
+        self.mpi.Request.waitall(requests)
+        self._receive = caps
+        whole = all(len(caps[q]) == len(nodes) for q, nodes in self._receive_whole.items())
+        #: Whether some rank's caps leave ghost nodes out (else no need to pick them anew).
+        self.caps_partial = not self.comm.allreduce(whole, op=self.mpi.LAND)
+        self._outbox = {
+            q: np.empty(self._message_size(len(n), len(self._send_grains[q])))
+            for q, n in self._send.items()
+        }
+        self._inbox = {
+            q: np.empty(self._message_size(len(n), len(self._receive_grains[q])))
+            for q, n in self._receive.items()
+        }
+
+    def _message_size(self, nodes: int, grains: int) -> int:
+        """The numbers a step's message between two ranks holds at most (_pack): x and v of
+        `nodes` nodes, the counts, break_slots breaks and one body per grain plus body_slots."""
+        return 6 * nodes + 2 + 2 * self.break_slots + _BODY * (grains + self.body_slots)
 
     def _marked(self, local: NDArray[np.int64]) -> NDArray[np.bool_]:
         """Over this rank's nodes, whether each is one of `local`."""
@@ -215,6 +303,12 @@ class DistributedRun:
         """The nodes of the other ranks' grains this rank holds as ghosts."""
         return self.local._assembly.node_count - len(self._owned_nodes)
 
+    @property
+    def exchanged_node_count(self) -> int:
+        """The ghost nodes whose positions and velocities this rank receives each step (the
+        caps, _exchange_caps)."""
+        return sum(len(nodes) for nodes in self._receive.values())
+
     def _exchange_state(self) -> None:
         """Owners' positions, velocities and forces to the ranks that hold their grains as
         ghosts (one message per pair of neighbouring ranks): every ghost exact, as its owner's
@@ -222,59 +316,103 @@ class DistributedRun:
         what the next step needs)."""
         core = self.local.core
         x, v, f = core.positions, core.velocities, core.forces
-        inbox = {q: np.empty((len(n), 9)) for q, n in self._receive.items()}
-        outbox = {q: np.hstack([x[n], v[n], f[n]]) for q, n in self._send.items()}
+        inbox = {q: np.empty((len(n), 9)) for q, n in self._receive_whole.items()}
+        outbox = {q: np.hstack([x[n], v[n], f[n]]) for q, n in self._send_whole.items()}
         requests = [self.comm.Irecv(box, source=q, tag=_TAG) for q, box in inbox.items()]
         requests += [self.comm.Isend(box, dest=q, tag=_TAG) for q, box in outbox.items()]
         self.mpi.Request.Waitall(requests)
-        for q, nodes in self._receive.items():
+        for q, nodes in self._receive_whole.items():
             x[nodes], v[nodes], f[nodes] = inbox[q][:, :3], inbox[q][:, 3:6], inbox[q][:, 6:]
 
-    def _exchange_within_step(self, broken: NDArray[np.uint32]) -> NDArray[np.uint32]:
+    def _exchange_within_step(
+        self, broken: NDArray[np.uint32] | None
+    ) -> tuple[NDArray[np.uint32], tuple[NDArray[np.uint32], NDArray[np.float64]]]:
         """After the first half of a step (the drift and pass 1): each rank sends the ranks that
-        hold its grains as ghosts their nodes' positions and velocities now (the half-step
-        velocities, which the contact uses) and the bonds that broke in them this step
-        (`broken`: flat (i, j) local node pairs; sent in global numbering), and takes the same
-        for its ghosts, overwriting their copies. One message per pair of neighbouring ranks,
-        its last numbers the breaks (_pack); more breaks than it holds go in a second.
-        The ghosts' breaks, as (k, 2) local node pairs. A ghost's own drift and forces are
-        never used: what the contact and the check read of it comes from here."""
+        hold its grains as ghosts the positions and velocities now (the half-step velocities,
+        which the contact uses) of the nodes in their caps (_exchange_caps), the bonds that
+        broke in those grains this step (`broken`: flat (i, j) local node pairs; None when
+        the step failed, and then no bodies either) and the motion of each of their fragments
+        (core.fragment_motions), all in global numbering; it takes the same for its ghosts,
+        overwriting their copies and giving the core their bodies' motions. One message per
+        pair of neighbouring ranks (_pack); what it has no room for goes in a second. The
+        ghosts' breaks, as (k, 2) local node pairs, and their bodies' motions (first nodes,
+        local; (k, 15) motions) for core.give_ghost_motions."""
         core = self.local.core
         x, v = core.positions, core.velocities
-        pairs = np.asarray(broken, dtype=np.int64).reshape(-1, 2)
+        pairs = np.asarray([] if broken is None else broken, dtype=np.int64).reshape(-1, 2)
+        bodies, rows = self._own_motions(broken is not None)
         requests = [self.comm.Irecv(box, source=q, tag=_TAG) for q, box in self._inbox.items()]
         overflow = []
         for q, nodes in self._send.items():
-            theirs = self._to_global[pairs[self._sent_to[q][pairs[:, 0]]]] if len(pairs) else _NONE
+            theirs = self._to_global[pairs[self._sent_to[q][pairs[:, 0]]]]
+            sections = [(theirs, self.break_slots), (bodies[rows[q]], self._body_room(q))]
             box = self._outbox[q]
-            _pack(box, len(nodes), (x[nodes], v[nodes]), theirs[: self.break_slots], len(theirs))
-            requests.append(self.comm.Isend(box, dest=q, tag=_TAG))
-            if len(theirs) > self.break_slots:
-                rest = theirs[self.break_slots :].copy()
-                overflow.append(self.comm.Isend(rest, dest=q, tag=_BREAK_TAG))
+            used, rest = _pack(box, (x[nodes], v[nodes]), sections)
+            requests.append(self.comm.Isend(box[:used], dest=q, tag=_TAG))
+            if len(rest):
+                overflow.append(self.comm.Isend(rest, dest=q, tag=_REST_TAG))
+                self.second_messages += 1
         self.mpi.Request.Waitall(requests)
         received = [self._unpack(q, nodes, (x, v)) for q, nodes in self._receive.items()]
         self.mpi.Request.Waitall(overflow)
-        if not any(len(box) for box in received):
-            return np.zeros((0, 2), np.uint32)
-        return self._node_map[np.concatenate(received)].astype(np.uint32)
+        motions = np.concatenate([np.zeros((0, _BODY)), *(m for _, m in received)])
+        first = self._node_map[motions[:, 0].astype(np.int64)].astype(np.uint32)
+        ghost_breaks = np.concatenate([np.zeros((0, 2), np.int64), *(b for b, _ in received)])
+        return self._node_map[ghost_breaks].astype(np.uint32), (
+            first,
+            np.ascontiguousarray(motions[:, 1:]),
+        )
+
+    def _own_motions(
+        self, measured: bool
+    ) -> tuple[NDArray[np.float64], dict[int, NDArray[np.bool_]]]:
+        """(bodies, 16): every fragment of the grains this rank sends, its first node (global)
+        and its motion now (core.fragment_motions), with per receiving rank the rows of its
+        grains; none unless `measured` (the step failed before)."""
+        if not measured:
+            return np.zeros((0, _BODY)), {q: np.zeros(0, bool) for q in self._send}
+        nodes, numbers = self.local.core.fragment_motions(self._motion_particles.tolist())
+        nodes = np.asarray(nodes, dtype=np.int64)
+        particle = self._node_particle[nodes]
+        motions = np.empty((len(nodes), _BODY))
+        motions[:, 0] = self._to_global[nodes]
+        motions[:, 1:] = np.asarray(numbers).reshape(-1, _BODY - 1)
+        return motions, {q: mask[particle] for q, mask in self._particle_to.items()}
+
+    def _body_room(self, q: int) -> int:
+        """The bodies' motions a step's message to or from rank q carries."""
+        grains = self._send_grains.get(q, self._receive_grains.get(q))
+        return len(grains) + self.body_slots
 
     def _unpack(
         self, q: int, nodes: NDArray[np.int64], fields: tuple[NDArray[np.float64], ...]
-    ) -> NDArray[np.int64]:
+    ) -> tuple[NDArray[np.int64], NDArray[np.float64]]:
         """Rank q's message of this step into the ghosts' `fields`; its breaks, (k, 2) global
-        node pairs (those past break_slots received now, from their own message)."""
+        node pairs, and bodies' motions, (k, 16) (with what the message had no room for,
+        received now from the second message)."""
         box = self._inbox[q]
-        motion = box[: 6 * len(nodes)].reshape(-1, 6)
+        count = 6 * len(nodes)
+        motion = box[:count].reshape(-1, 6)
         for k, field in enumerate(fields):
             field[nodes] = motion[:, 3 * k : 3 * k + 3]
-        count, slots = int(box[6 * len(nodes)]), self.break_slots
-        kept = box[6 * len(nodes) + 1 :][: 2 * min(count, slots)].astype(np.int64).reshape(-1, 2)
-        if count <= slots:
-            return kept
-        rest = np.empty((count - slots, 2), dtype=np.int64)
-        self.comm.Recv(rest, source=q, tag=_BREAK_TAG)
-        return np.concatenate([kept, rest])
+        totals = box[count : count + 2].astype(np.int64)
+        rooms = (self.break_slots, len(self._receive_grains[q]) + self.body_slots)
+        widths = (2, _BODY)
+        kept = [min(int(t), room) for t, room in zip(totals, rooms, strict=True)]
+        start, parts = count + 2, []
+        for n, width in zip(kept, widths, strict=True):
+            parts.append(box[start : start + n * width].reshape(-1, width))
+            start += n * width
+        missing = [int(t) - n for t, n in zip(totals, kept, strict=True)]
+        if any(missing):
+            rest = np.empty(sum(m * w for m, w in zip(missing, widths, strict=True)))
+            self.comm.Recv(rest, source=q, tag=_REST_TAG)
+            split = missing[0] * widths[0]
+            parts = [
+                np.concatenate([parts[0], rest[:split].reshape(-1, widths[0])]),
+                np.concatenate([parts[1], rest[split:].reshape(-1, widths[1])]),
+            ]
+        return parts[0].astype(np.int64), parts[1]
 
     def run(self, steps: int) -> None:
         """Advance every rank `steps` time steps, migrating grains before a step once a node
@@ -285,7 +423,22 @@ class DistributedRun:
         for _ in range(steps):
             if self._migration_due:  # before the step, so the parts hold its evaluation after
                 self.migrate()
+            elif self._caps_due:
+                self.refresh_caps()
             self._step()
+
+    def refresh_caps(self) -> None:
+        """Pick the caps anew (_exchange_caps) where the nodes are now, after making every
+        ghost its owner's grain (_exchange_state); the travel since is measured afresh, the
+        travel before counted towards the next migration."""
+        start = time.perf_counter()
+        self._caps_due = False
+        self._exchange_state()
+        self._travelled += self._cap_travel
+        self.local.core.set_travel_origin()
+        self._exchange_caps()
+        self.cap_refreshes += 1
+        self.seconds["caps"] += time.perf_counter() - start
 
     def _step(self) -> None:
         """One step: its first half (core.begin_step), the exchange of the ghosts' motion and
@@ -293,32 +446,37 @@ class DistributedRun:
         exchange and the check whatever failed, so that none waits for another."""
         core = self.local.core
         start = time.perf_counter()
-        failure, broken = None, np.zeros(0, np.uint32)
+        failure, broken = None, None
         try:
             broken = core.begin_step()
         except Exception as error:  # re-raised by the check, after the ranks agree to stop
             failure = error
         began = time.perf_counter()
-        ghost_breaks = self._exchange_within_step(broken)
+        ghost_breaks, motions = self._exchange_within_step(broken)
         told = time.perf_counter()
         if failure is None:
             try:
+                core.give_ghost_motions(*motions)
                 core.finish_step(ghost_breaks)
             except Exception as error:
                 failure = error
         stepped = time.perf_counter()
         farthest = self._check_step(int(core.step), failure)
         self._loaded_walls = None
-        self._migration_due = self._migrates and farthest > 0.25 * self.margin
+        self._cap_travel = farthest
+        self._migration_due = self._migrates and self._travelled + farthest > 0.25 * self.margin
+        self._caps_due = self.caps_partial and farthest > 0.25 * self.cap_margin
         self.seconds["steps"] += (began - start) + (stepped - told)
         self.seconds["check"] += time.perf_counter() - stepped
         self.seconds["exchange"] += told - began
 
     def _check_step(self, step: int, failure: Exception | None) -> float:
-        """One reduction after each step, before the exchange: the first rank whose step
-        failed, and the largest distance of a node from where it was when the grains were
-        distributed (core.largest_travel, measured in the step's second half, when the ghosts'
-        positions are their owners'). Stops every rank on either; returns that distance [m]."""
+        """One reduction after each step: the first rank whose step failed, and the largest
+        distance of an own node from where it was when the caps were picked
+        (core.largest_travel, measured in the step's second half). Stops every rank on either,
+        and when a node may have moved more than half the margin since the grains were
+        distributed (the travels of the caps' periods summed) or half the cap margin since the
+        caps were picked; returns that distance [m]."""
         farthest = float(self.local.core.largest_travel)
         size = self.comm.Get_size()
         failed_rank = self.comm.Get_rank() if failure is not None else size
@@ -330,7 +488,8 @@ class DistributedRun:
             raise failure
         if first_failed < size:
             raise RankFailed(f"step {step}: rank {first_failed} failed; every rank stops")
-        if farthest > 0.5 * self.margin:
+        travelled = self._travelled + farthest  # since the grains were distributed, at most
+        if travelled > 0.5 * self.margin:
             advice = (
                 "a node moved that far within one distribution of the grains; give "
                 "DistributedRun a larger margin"
@@ -339,20 +498,27 @@ class DistributedRun:
                 "margin, or let it migrate"
             )
             raise InputError(
-                f"step {step}: a node moved {farthest:.3g} m from where the grains were "
-                f"distributed, more than half the ghost margin ({self.margin:.3g} m): {advice}"
+                f"step {step}: a node may have moved {travelled:.3g} m from where the grains "
+                f"were distributed, more than half the ghost margin ({self.margin:.3g} m): "
+                f"{advice}"
+            )
+        if self.caps_partial and farthest > 0.5 * self.cap_margin:
+            raise InputError(
+                f"step {step}: a node moved {farthest:.3g} m from where it was when the caps "
+                f"were picked, more than half the cap margin ({self.cap_margin:.3g} m): give "
+                "DistributedRun a larger cap_margin"
             )
         return farthest
 
     def migrate(self) -> None:
         """Cut the assembly anew where the grains are now (recursive coordinate bisection of
         their current bounding spheres, which also rebalances the ranks). A rank that now
-        holds other grains than before builds its part anew from the owners' states of them
-        (transplant.py); a rank that holds the same grains keeps its part, whose every grain
-        is exact (the ghosts' own bonds, collisions and springs among the grains it holds
-        follow from their exact motion; their velocities and forces are made their owners'
-        first, as a ghost that becomes owned needs them). Either way the run goes on as the
-        serial run, bit for bit."""
+        holds other grains than before, or owns one it held as a ghost, builds its part anew
+        from the owners' states of them (transplant.py): of a ghost only the caps move with
+        its owner (_exchange_caps), so its contacts with the other ghosts are not the serial
+        run's. A rank that holds the same grains and owns no new one keeps its part; every
+        ghost's positions, velocities and forces are made their owners' first, and the caps
+        are picked anew. Either way the run goes on as the serial run, bit for bit."""
         start = time.perf_counter()
         self._migration_due = False
         self._exchange_state()
@@ -360,9 +526,12 @@ class DistributedRun:
         held = self._distribute(*self._current_spheres())
         self.handed_over += int(np.count_nonzero(self.partition.owner != owners_before))
         after = self._held_by_rank()
-        renewed = [
-            self.always_renew or not np.array_equal(old, new)
-            for old, new in zip(before, after, strict=True)
+        owner = self.partition.owner
+        renewed = [  # a ghost that becomes owned needs its contacts with the other ghosts
+            self.always_renew
+            or not np.array_equal(old, new)
+            or bool(np.any((owner[new] == q) & (owners_before[new] != q)))
+            for q, (old, new) in enumerate(zip(before, after, strict=True))
         ]
         rank = self.comm.Get_rank()
         wanted = [
@@ -373,6 +542,7 @@ class DistributedRun:
             self._hand_over(held, wanted, renewed[rank])
         else:
             self._plan(self._node_map)
+        self._exchange_caps()
         self.migrations += 1
         self.seconds["migrate"] += time.perf_counter() - start
 
@@ -477,6 +647,7 @@ class DistributedRun:
             *_spheres([states[g].positions for g in every], self._sim.dimension)
         )
         together(self.comm, lambda: self._rebuild(held, states, moment))
+        self._exchange_caps()
         self._loaded_walls = np.asarray(moment["contact_wall_reactions"]).reshape(-1, 6)
         self._migration_due = False
         self.seconds["migrate"] += time.perf_counter() - start
@@ -585,18 +756,32 @@ class DistributedRun:
 
 def _pack(
     box: NDArray[np.float64],
-    count: int,
     fields: tuple[NDArray[np.float64], ...],
-    breaks: NDArray[np.int64],
-    total: int,
-) -> None:
-    """A step's message: the `count` nodes' `fields` (x, v: 6 numbers a node), the number of
-    breaks in all (`total`) and those it carries (`breaks`)."""
-    motion = box[: 6 * count].reshape(-1, 6)
+    sections: list[tuple[NDArray[Any], int]],
+) -> tuple[int, NDArray[np.float64]]:
+    """A step's message: the nodes' `fields` (x, v: 6 numbers a node), then each section's row
+    count, then each section's rows (breaks, (k, 2); bodies, (k, 16)), up to its room; the
+    numbers written, and the rows with no room (every section's, flat, in order) for a
+    second message."""
+    count = 6 * len(fields[0])
+    motion = box[:count].reshape(-1, 6)
     for k, field in enumerate(fields):
         motion[:, 3 * k : 3 * k + 3] = field
-    box[6 * count] = total
-    box[6 * count + 1 : 6 * count + 1 + breaks.size] = breaks.ravel()
+    box[count : count + len(sections)] = [len(rows) for rows, _ in sections]
+    start, rest = count + len(sections), []
+    for rows, room in sections:
+        kept = rows[:room].ravel()
+        box[start : start + kept.size] = kept
+        start += kept.size
+        rest.append(rows[room:].ravel().astype(float))
+    return start, np.concatenate(rest)
+
+
+def _mask(size: int, indices: NDArray[np.int64]) -> NDArray[np.bool_]:
+    """(size,) True at `indices`."""
+    mask = np.zeros(size, dtype=bool)
+    mask[indices] = True
+    return mask
 
 
 def _sum_wall_terms(parts: list[tuple[NDArray[Any], ...]], walls: int) -> NDArray[np.float64]:

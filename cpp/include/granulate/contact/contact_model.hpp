@@ -9,9 +9,11 @@
 #include <span>
 #include <vector>
 
+#include "granulate/contact/body_motion.hpp"
 #include "granulate/contact/body_rotation.hpp"
 #include "granulate/contact/collisions.hpp"
 #include "granulate/contact/contact_law.hpp"
+#include "granulate/contact/ghost_bodies.hpp"
 #include "granulate/contact/power_law_damping.hpp"
 #include "granulate/contact/surface_centres.hpp"
 #include "granulate/contact/surface_law.hpp"
@@ -20,18 +22,6 @@
 #include "granulate/walls.hpp"
 
 namespace granulate {
-
-using vec3 = std::array<real, 3>;
-
-/// Rigid-body motion of a body in contact: centre of mass, mean velocity, angular velocity
-/// omega = I^-1 L, and the inverse inertia tensor about the centre (symmetric: xx, yy, zz, xy,
-/// xz, yz; zero for a body without rotational inertia, such as a one-node fragment).
-struct BodyMotion {
-  vec3 centre{0, 0, 0};
-  vec3 velocity{0, 0, 0};
-  vec3 angular_velocity{0, 0, 0};
-  std::array<real, 6> inverse_inertia{0, 0, 0, 0, 0, 0};
-};
 
 struct ContactStatistics {
   std::uint64_t rebuilds = 0;       ///< neighbour-list builds so far (grid searches)
@@ -176,6 +166,25 @@ class ContactModel {
   /// that lose it count their overlaps from a rest measured anew (opened_rest_) and make the next
   /// contact phase list them again, since their reach grows.
   void bonds_broke(const Model& model, const State& state, std::span<const std::array<index_t, 2>> pairs);
+
+  /// Ghost particles (per particle 1 or 0; empty: none), whose nodes another process moves:
+  /// their bodies' motion must be given (give_ghost_motions) wherever they touch a body of this
+  /// process, their overlaps are left out of statistics() (their owners count them).
+  void set_ghost_particles(std::vector<std::uint8_t> ghost) { ghosts_.set_particles(std::move(ghost)); }
+  /// The rigid-body motions of ghost bodies, each named by its smallest node, measured by their
+  /// owners at the state of the next evaluation, which uses them in place of its own measure
+  /// (the owner holds every node of the body) and drops them. That evaluation raises
+  /// std::runtime_error if a ghost body touches a body of this process with no motion given.
+  void give_ghost_motions(std::vector<std::pair<index_t, BodyMotion>> motions) {
+    ghosts_.give(std::move(motions));
+  }
+  /// Whether the bodies were labelled with `broken_bonds` bonds broken (and are then current).
+  bool bodies_labelled_at(std::uint64_t broken_bonds) const {
+    return bodies_labelled_ && broken_at_labelling_ == broken_bonds;
+  }
+  /// The nodes (in node order) of each body whose smallest node is in [first, end): a particle's
+  /// bodies when those are its nodes. Meaningful while bodies_labelled_at the current count.
+  std::vector<std::span<const index_t>> bodies_in(index_t first, index_t end) const;
 
   /// Per wall: force (x, y, z) and torque about its centre (x, y, z) exerted by the particles
   /// [N, N m; per unit thickness in 2D], from the last evaluation.
@@ -492,6 +501,9 @@ class ContactModel {
   void measure_contacts(const Model& model, const State& state);
   void sum_slot_stiffness();
   void measure_bodies(const Model& model, const State& state);
+  /// std::runtime_error if a ghost body whose motion was not given touches one of this
+  /// process's bodies (`measured`: per touching body, 1 where its motion was measured here).
+  void check_ghost_motions(const std::vector<std::uint8_t>& measured) const;
   void sum_slot_springs(const Model& model, const State& state);
   void sum_probe_springs();
   void slot_dashpots(const State& state, real dt);
@@ -717,6 +729,7 @@ class ContactModel {
   std::vector<index_t> body_touch_;  // per body: its index among the touching bodies, or none
   std::vector<index_t> touching_bodies_;
   std::vector<BodyMotion> body_motion_;         // per touching body
+  GhostBodies ghosts_;                          // ghost particles and their bodies' motions
   std::vector<std::array<real, 6>> body_load_;  // per touching body: force, torque about the centre
   std::vector<index_t> slot_touch_;             // per slot: its index among the slots in contact
   std::vector<real> slot_force_;                // per slot in contact: spring force, and the

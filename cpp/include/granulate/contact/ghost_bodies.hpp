@@ -1,0 +1,45 @@
+// The bodies of ghost particles in a distributed run (granulate.parallel): a process holds
+// another process's particle as a ghost for the contact of its own bodies with it, but only the
+// ghost's nodes within reach of its own are kept current. A ghost body's rigid-body motion,
+// which needs all its nodes, comes from the owner instead, named by the body's smallest node.
+#pragma once
+
+#include <algorithm>
+#include <cstdint>
+#include <utility>
+#include <vector>
+
+#include "granulate/contact/body_motion.hpp"
+
+namespace granulate {
+
+class GhostBodies {
+ public:
+  /// Per particle: 1 for a ghost; empty when there are none (a serial run).
+  void set_particles(std::vector<std::uint8_t> ghost) {
+    ghost_ = std::move(ghost);
+    forget();
+  }
+  bool any() const { return !ghost_.empty(); }
+  bool ghost(index_t particle) const { return !ghost_.empty() && ghost_[particle]; }
+  /// The motions of ghost bodies for the next evaluation, each named by its smallest node
+  /// (sorted here; each node once).
+  void give(std::vector<std::pair<index_t, BodyMotion>> motions) {
+    std::sort(motions.begin(), motions.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    given_ = std::move(motions);
+  }
+  /// The motion given for the body whose smallest node is `first`, or null.
+  const BodyMotion* given(index_t first) const {
+    const auto it = std::lower_bound(given_.begin(), given_.end(), first,
+                                     [](const auto& entry, index_t node) { return entry.first < node; });
+    return it != given_.end() && it->first == first ? &it->second : nullptr;
+  }
+  /// Drops the motions given (after the evaluation that used them: they hold for one state).
+  void forget() { given_.clear(); }
+
+ private:
+  std::vector<std::uint8_t> ghost_;
+  std::vector<std::pair<index_t, BodyMotion>> given_;  // by smallest node
+};
+
+}  // namespace granulate

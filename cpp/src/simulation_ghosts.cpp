@@ -1,0 +1,91 @@
+// A distributed run's ghosts in the core (granulate.parallel): the particles another process
+// owns, which this one holds for its own particles' contact. Their bonds break where their
+// owner breaks them; their bodies move as their owner measures them.
+#include <algorithm>
+#include <sstream>
+
+#include "granulate/simulation.hpp"
+
+namespace granulate {
+
+void Simulation::set_ghost_particles(const std::vector<index_t>& particles) {
+  std::vector<std::uint8_t> ghost(model_->particles().size(), 0);
+  for (index_t q : particles) {
+    if (q >= ghost.size()) {
+      std::ostringstream msg;
+      msg << "ghost particle " << q << " does not exist: the model has " << ghost.size() << " particles";
+      throw InputError(msg.str());
+    }
+    ghost[q] = 1;
+  }
+  ghost_ = particles.empty() ? std::vector<std::uint8_t>{} : std::move(ghost);  // empty: none
+  contact_.set_ghost_particles(ghost_);
+}
+
+void Simulation::check_ghost_breaks(std::span<const std::array<index_t, 2>> pairs) const {
+  for (const auto& [i, j] : pairs) {
+    const auto b = model_->bond_between(i, j);
+    if (!b || !ghost_node(i) || !state_.bonds.intact(i, *b)) {
+      throw InputError("ghost bond " + std::to_string(i) + "-" + std::to_string(j) +
+                       " is not an intact bond of a ghost particle");
+    }
+  }
+}
+
+void Simulation::break_ghost_bonds(std::span<const std::array<index_t, 2>> pairs) {
+  const Model& m = *model_;
+  for (const auto& [i, j] : pairs) {
+    BondStates::clear(state_.bonds.node(i), m.node_bonds(i).find(j));
+    BondStates::clear(state_.bonds.node(j), m.node_bonds(j).find(i));
+    breaks_.push_back({i, j});
+  }
+}
+
+std::vector<std::pair<index_t, BodyMotion>> Simulation::fragment_motions(
+    const std::vector<index_t>& particles) const {
+  if (!step_begun_) throw InputError("fragment_motions: call it between begin_step and finish_step");
+  const Model& m = *model_;
+  std::vector<std::uint8_t> broke(m.particles().size(), 0);  // in this step's pass 1
+  for (const auto& pair : breaks_) broke[m.node_particle()[pair[0]]] = 1;
+  const bool labelled = contact_.bodies_labelled_at(broken_bond_copies_);  // before this step
+  std::vector<std::pair<index_t, BodyMotion>> motions;
+  std::vector<index_t> labels, nodes, offsets, fill;
+  for (const index_t p : particles) {
+    if (p >= broke.size() || (!ghost_.empty() && ghost_[p])) {
+      throw InputError("fragment_motions: particle " + std::to_string(p) + " is not one of this process's");
+    }
+    const index_t first = m.particles()[p].first_node, count = m.particles()[p].node_count;
+    if (labelled && !broke[p]) {
+      for (const auto body : contact_.bodies_in(first, first + count)) {
+        motions.emplace_back(
+            body[0], measure_body(m, state_, body.data(), static_cast<index_t>(body.size()), m.dimension()));
+      }
+      continue;
+    }
+    labels.resize(count);  // the particle's fragments now, named by their smallest node
+    m.fragments_in(state_.bonds, first, count, labels.data());
+    offsets.assign(static_cast<std::size_t>(count) + 1, 0);  // each fragment's nodes, in order
+    for (index_t k = 0; k < count; ++k) ++offsets[labels[k] - first + 1];
+    for (index_t k = 0; k < count; ++k) offsets[k + 1] += offsets[k];
+    nodes.resize(count);
+    fill.assign(offsets.begin(), offsets.end() - 1);
+    for (index_t k = 0; k < count; ++k) nodes[fill[labels[k] - first]++] = first + k;
+    for (index_t k = 0; k < count; ++k) {
+      if (offsets[k + 1] == offsets[k]) continue;  // not a fragment's smallest node
+      motions.emplace_back(first + k, measure_body(m, state_, nodes.data() + offsets[k],
+                                                   offsets[k + 1] - offsets[k], m.dimension()));
+    }
+  }
+  return motions;
+}
+
+void Simulation::give_ghost_motions(std::vector<std::pair<index_t, BodyMotion>> motions) {
+  for (const auto& [node, motion] : motions) {
+    if (node >= model_->node_count() || !ghost_node(node)) {
+      throw InputError("ghost motion: node " + std::to_string(node) + " is not a node of a ghost particle");
+    }
+  }
+  contact_.give_ghost_motions(std::move(motions));
+}
+
+}  // namespace granulate
