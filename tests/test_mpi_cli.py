@@ -177,9 +177,20 @@ def test_bench_ranks_prints_each_ranks_speed_and_communication() -> None:
     assert sum(row["nodes"] for row in rows) == 51_712
     for row in rows:
         assert 0 < row["ghost_nodes"] < row["nodes"]
+        assert row["exchanged_nodes"] == row["ghost_nodes"]  # coarse grains: whole caps
         assert row["node_steps_per_s"] > 0
-        assert all(0 <= row[f"{name}_share"] < 1 for name in ("exchange", "check", "migrate"))
+        shares = ("exchange", "check", "caps", "migrate")
+        assert all(0 <= row[f"{name}_share"] < 1 for name in shares)
         assert row["collect_share"] == 0
+
+
+def test_bench_ranks_fine_grains_send_caps() -> None:
+    """`--case fine2d --quick` (40 discs and hexagons at 16 nodes per radius): each step sends
+    each rank less than half the ghost nodes it holds."""
+    done = bench_ranks("--case", "fine2d", "--quick", "--json")
+    assert done.returncode == 0, done.stderr
+    rows = json.loads(done.stdout)["rows"]
+    assert all(0 < row["exchanged_nodes"] < 0.5 * row["ghost_nodes"] for row in rows)
 
 
 def test_bench_ranks_refuses_what_it_cannot_run_once() -> None:

@@ -312,8 +312,8 @@ class DistributedRun:
     def _exchange_state(self) -> None:
         """Owners' positions, velocities and forces to the ranks that hold their grains as
         ghosts (one message per pair of neighbouring ranks): every ghost exact, as its owner's
-        grain, at the start and before a migration (between them the steps' exchange keeps only
-        what the next step needs)."""
+        grain, at the start, before the caps are picked anew and before a migration (between
+        them the steps' exchange keeps only what the next step needs)."""
         core = self.local.core
         x, v, f = core.positions, core.velocities, core.forces
         inbox = {q: np.empty((len(n), 9)) for q, n in self._receive_whole.items()}
@@ -345,7 +345,8 @@ class DistributedRun:
         overflow = []
         for q, nodes in self._send.items():
             theirs = self._to_global[pairs[self._sent_to[q][pairs[:, 0]]]]
-            sections = [(theirs, self.break_slots), (bodies[rows[q]], self._body_room(q))]
+            room = len(self._send_grains[q]) + self.body_slots  # as q's _unpack has it
+            sections = [(theirs, self.break_slots), (bodies[rows[q]], room)]
             box = self._outbox[q]
             used, rest = _pack(box, (x[nodes], v[nodes]), sections)
             requests.append(self.comm.Isend(box[:used], dest=q, tag=_TAG))
@@ -379,11 +380,6 @@ class DistributedRun:
         motions[:, 1:] = np.asarray(numbers).reshape(-1, _BODY - 1)
         return motions, {q: mask[particle] for q, mask in self._particle_to.items()}
 
-    def _body_room(self, q: int) -> int:
-        """The bodies' motions a step's message to or from rank q carries."""
-        grains = self._send_grains.get(q, self._receive_grains.get(q))
-        return len(grains) + self.body_slots
-
     def _unpack(
         self, q: int, nodes: NDArray[np.int64], fields: tuple[NDArray[np.float64], ...]
     ) -> tuple[NDArray[np.int64], NDArray[np.float64]]:
@@ -416,8 +412,10 @@ class DistributedRun:
 
     def run(self, steps: int) -> None:
         """Advance every rank `steps` time steps, migrating grains before a step once a node
-        has moved a quarter of the margin. Raises InputError (on every rank) when a node has
-        moved more than half the margin: the ghosts would no longer be enough. An error in one
+        may have moved a quarter of the margin, or picking the caps anew once one has moved a
+        quarter of the cap margin. Raises InputError (on every rank) when a node may have
+        moved more than half the margin, or half the cap margin since the caps were picked:
+        the ghosts, or the caps, would no longer be enough. An error in one
         rank's step ends every rank: that rank raises its own, the others RankFailed naming
         it (no rank is left waiting for a message)."""
         for _ in range(steps):
