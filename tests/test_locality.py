@@ -186,7 +186,9 @@ def test_ghost_breaks_are_checked(tmp_path: Path) -> None:
     """What begin_step and finish_step refuse: ghosts marked before the first evaluation (its
     breaks would be lost), a finish without a begin, a step begun twice or run over, a ghost
     break that is no intact bond of a ghost particle (the step can still be finished), a ghost
-    index out of range."""
+    index out of range; and around them: the fragments' motions outside a step or of a ghost,
+    a motion given to a node that is no ghost's or without its 15 numbers, reported numbers
+    of the wrong count."""
     sim = tumbling_drum(tmp_path)
     sim.core.set_ghost_particles([1])
     with pytest.raises(gr.InputError, match="before marking ghost particles"):
@@ -197,7 +199,15 @@ def test_ghost_breaks_are_checked(tmp_path: Path) -> None:
     with pytest.raises(gr.InputError, match="finish_step without begin_step"):
         sim.core.finish_step(np.zeros((0, 2), np.uint32))
     owned, ghost = sim.bodies[0].first_node, sim.bodies[1].first_node
+    with pytest.raises(gr.InputError, match="between begin_step and finish_step"):
+        sim.core.fragment_motions([0])
     sim.core.begin_step()
+    with pytest.raises(gr.InputError, match="particle 1 is not one of this process's"):
+        sim.core.fragment_motions([0, 1])
+    with pytest.raises(gr.InputError, match=f"node {owned} is not a node of a ghost particle"):
+        sim.core.give_ghost_motions(np.array([owned], np.uint32), np.zeros((1, 15)))
+    with pytest.raises(TypeError):
+        sim.core.give_ghost_motions(np.array([ghost], np.uint32), np.zeros((1, 14)))
     for start in (lambda: sim.core.run(1), sim.core.begin_step):
         with pytest.raises(gr.InputError, match="not finished"):
             start()
@@ -208,6 +218,8 @@ def test_ghost_breaks_are_checked(tmp_path: Path) -> None:
     assert sim.core.step == 1
     with pytest.raises(gr.InputError, match="ghost particle 4 does not exist"):
         sim.core.set_ghost_particles([4])
+    with pytest.raises(gr.InputError, match=r"one per node .* and one per particle"):
+        sim.core.set_reported_numbers([0, 1], [0])
 
 
 def test_the_core_measures_how_far_the_nodes_travelled(tmp_path: Path) -> None:

@@ -143,6 +143,8 @@ def test_grains_moving_past_the_ghost_margin_stop_every_rank_with_the_reason(
 
 
 def test_a_blow_up_on_one_rank_ends_every_rank_without_a_hang() -> None:
+    """The last of 3 ranks blows up one of its nodes: it raises the InstabilityError, naming
+    the node and grain as the serial run numbers them, the others RankFailed naming it."""
     done = run_ranks(3, "2", "20", "fail")
     assert done.returncode == 0, done.stdout + done.stderr
     assert "rank 2 failed" in done.stdout and "InstabilityError" in done.stdout

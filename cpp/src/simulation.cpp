@@ -318,7 +318,9 @@ void Simulation::check_stability() const {
     if (!finite || std::sqrt(speed2) * time_step_ > mesh_size) {
       std::ostringstream msg;
       msg << "the simulation became unstable at step " << state_.step << " (t = " << state_.time
-          << " s): node " << i << " of particle " << model_->node_particle()[i];
+          << " s): node " << (reported_node_.empty() ? i : reported_node_[i]) << " of particle "
+          << (reported_particle_.empty() ? model_->node_particle()[i]
+                                         : reported_particle_[model_->node_particle()[i]]);
       if (finite)
         msg << " moves at " << std::sqrt(speed2) << " m/s, more than its mesh size " << mesh_size
             << " m per step";

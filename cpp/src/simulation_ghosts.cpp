@@ -1,6 +1,7 @@
-// A distributed run's ghosts in the core (granulate.parallel): the particles another process
-// owns, which this one holds for its own particles' contact. Their bonds break where their
-// owner breaks them; their bodies move as their owner measures them.
+// A distributed run's part in the core (granulate.parallel): the ghosts, the particles another
+// process owns, which this one holds for its own particles' contact (their bonds break where
+// their owner breaks them; their bodies move as their owner measures them), and the numbers
+// its messages give its nodes and particles.
 #include <algorithm>
 #include <sstream>
 
@@ -20,6 +21,17 @@ void Simulation::set_ghost_particles(const std::vector<index_t>& particles) {
   }
   ghost_ = particles.empty() ? std::vector<std::uint8_t>{} : std::move(ghost);  // empty: none
   contact_.set_ghost_particles(ghost_);
+}
+
+void Simulation::set_reported_numbers(std::vector<index_t> nodes, std::vector<index_t> particles) {
+  const bool none = nodes.empty() && particles.empty();
+  if (!none && (nodes.size() != model_->node_count() || particles.size() != model_->particles().size())) {
+    throw InputError("reported numbers: one per node (" + std::to_string(model_->node_count()) +
+                     ") and one per particle (" + std::to_string(model_->particles().size()) + "), got " +
+                     std::to_string(nodes.size()) + " and " + std::to_string(particles.size()));
+  }
+  reported_node_ = std::move(nodes);
+  reported_particle_ = std::move(particles);
 }
 
 void Simulation::check_ghost_breaks(std::span<const std::array<index_t, 2>> pairs) const {

@@ -133,6 +133,10 @@ class Simulation {
   /// otherwise measure them from the ghost nodes held (ContactModel::give_ghost_motions).
   /// InputError for a node that is not a ghost's.
   void give_ghost_motions(std::vector<std::pair<index_t, BodyMotion>> motions);
+  /// The numbers error messages give this process's nodes and particles (a distributed run's
+  /// part names them as the whole run does): one per node and one per particle; empty, their
+  /// own indices. InputError for the wrong sizes.
+  void set_reported_numbers(std::vector<index_t> nodes, std::vector<index_t> particles);
   /// From now on each step measures how far the farthest node is from where it is now [m]
   /// (largest_travel), in its last half kick: a distributed run's check that its ghosts still
   /// hold. Off until called (a serial run measures nothing).
@@ -185,6 +189,7 @@ class Simulation {
   std::vector<real> pressure_;       // A_i theta_i of LPS nodes
   std::vector<std::uint8_t> ghost_;  // per particle: 1 if another process evaluates it;
                                      // empty when none is
+  std::vector<index_t> reported_node_, reported_particle_;  // set_reported_numbers; or empty
   std::vector<real> travel_origin_;  // positions largest_travel is measured from; or empty
   real largest_travel_ = 0;
   std::vector<std::array<index_t, 2>> breaks_;  // the bonds pass 1 (and the owners) broke

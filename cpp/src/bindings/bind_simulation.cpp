@@ -143,6 +143,8 @@ void bind_loading(nb::class_<Simulation>& cls) {
           "set_contact_skin", [](Simulation& self, real skin) { self.contact().set_skin(skin); }, "skin"_a)
       .def("set_ghost_particles", &Simulation::set_ghost_particles, "particles"_a,
            "Mark the particles whose forces another process evaluates (Simulation::set_ghost_particles).")
+      .def("set_reported_numbers", &Simulation::set_reported_numbers, "nodes"_a, "particles"_a,
+           "The node and particle numbers error messages give (Simulation::set_reported_numbers).")
       .def("set_travel_origin", &Simulation::set_travel_origin,
            "Measure each step how far the farthest node is from where it is now (largest_travel).")
       .def_prop_ro("largest_travel", &Simulation::largest_travel,

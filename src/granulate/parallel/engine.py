@@ -186,6 +186,7 @@ class DistributedRun:
         self._owned = self.partition.grains_of(rank)
         ghost_particles = np.flatnonzero(owner[self.held] != rank)  # the part's particle order
         self.local.core.set_ghost_particles(ghost_particles.tolist())
+        self.local.core.set_reported_numbers(self._to_global.tolist(), self.held.tolist())
         self._owned_nodes = self._nodes_of(self._owned, node_map)
         self._is_owned = self._marked(self._owned_nodes)
         self._send_grains = {
