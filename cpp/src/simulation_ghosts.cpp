@@ -3,6 +3,7 @@
 // their owner breaks them; their bodies move as their owner measures them), and the numbers
 // its messages give its nodes and particles.
 #include <algorithm>
+#include <span>
 #include <sstream>
 
 #include "granulate/simulation.hpp"
@@ -53,6 +54,28 @@ void Simulation::break_ghost_bonds(std::span<const std::array<index_t, 2>> pairs
   }
 }
 
+namespace {
+
+/// The fragments of the `count` nodes from `first` (whole particles) under `intact`: each
+/// fragment's nodes in node order, the fragments in the order of their smallest node.
+std::vector<std::vector<index_t>> fragments_of(const Model& model, const BondStates& intact, index_t first,
+                                               index_t count) {
+  std::vector<index_t> labels(count);  // each node's fragment, named by its smallest node
+  model.fragments_in(intact, first, count, labels.data());
+  std::vector<index_t> place(count, 0);  // a fragment's place among them, by its smallest node
+  std::vector<std::vector<index_t>> fragments;
+  for (index_t k = 0; k < count; ++k) {
+    if (labels[k] == first + k) {
+      place[k] = static_cast<index_t>(fragments.size());
+      fragments.emplace_back();
+    }
+    fragments[place[labels[k] - first]].push_back(first + k);
+  }
+  return fragments;
+}
+
+}  // namespace
+
 std::vector<std::pair<index_t, BodyMotion>> Simulation::fragment_motions(
     const std::vector<index_t>& particles) const {
   if (!step_begun_) throw InputError("fragment_motions: call it between begin_step and finish_step");
@@ -61,31 +84,19 @@ std::vector<std::pair<index_t, BodyMotion>> Simulation::fragment_motions(
   for (const auto& pair : breaks_) broke[m.node_particle()[pair[0]]] = 1;
   const bool labelled = contact_.bodies_labelled_at(broken_bond_copies_);  // before this step
   std::vector<std::pair<index_t, BodyMotion>> motions;
-  std::vector<index_t> labels, nodes, offsets, fill;
+  auto add = [&](std::span<const index_t> body) {
+    motions.emplace_back(
+        body[0], measure_body(m, state_, body.data(), static_cast<index_t>(body.size()), m.dimension()));
+  };
   for (const index_t p : particles) {
     if (p >= broke.size() || (!ghost_.empty() && ghost_[p])) {
       throw InputError("fragment_motions: particle " + std::to_string(p) + " is not one of this process's");
     }
     const index_t first = m.particles()[p].first_node, count = m.particles()[p].node_count;
-    if (labelled && !broke[p]) {
-      for (const auto body : contact_.bodies_in(first, first + count)) {
-        motions.emplace_back(
-            body[0], measure_body(m, state_, body.data(), static_cast<index_t>(body.size()), m.dimension()));
-      }
-      continue;
-    }
-    labels.resize(count);  // the particle's fragments now, named by their smallest node
-    m.fragments_in(state_.bonds, first, count, labels.data());
-    offsets.assign(static_cast<std::size_t>(count) + 1, 0);  // each fragment's nodes, in order
-    for (index_t k = 0; k < count; ++k) ++offsets[labels[k] - first + 1];
-    for (index_t k = 0; k < count; ++k) offsets[k + 1] += offsets[k];
-    nodes.resize(count);
-    fill.assign(offsets.begin(), offsets.end() - 1);
-    for (index_t k = 0; k < count; ++k) nodes[fill[labels[k] - first]++] = first + k;
-    for (index_t k = 0; k < count; ++k) {
-      if (offsets[k + 1] == offsets[k]) continue;  // not a fragment's smallest node
-      motions.emplace_back(first + k, measure_body(m, state_, nodes.data() + offsets[k],
-                                                   offsets[k + 1] - offsets[k], m.dimension()));
+    if (labelled && !broke[p]) {  // the contact's bodies are the particle's fragments now
+      for (const auto body : contact_.bodies_in(first, first + count)) add(body);
+    } else {
+      for (const auto& body : fragments_of(m, state_.bonds, first, count)) add(body);
     }
   }
   return motions;
