@@ -222,10 +222,12 @@ class DistributedRun:
         picks its caps from the ghosts' positions now, which are their owners' (after
         _exchange_state or a rebuild), and tells the owners; one message per neighbour."""
         x = self.local.core.positions
-        own = x[self._owned_nodes]
+        ghosts = np.concatenate([np.zeros(0, np.int64), *self._receive_whole.values()])
+        close = np.zeros(len(x), dtype=bool)  # one grid over the own nodes for every ghost
+        close[ghosts] = points_within(x[ghosts], x[self._owned_nodes], self._cap_reach)
         caps = {}
         for q, nodes in self._receive_whole.items():
-            near = nodes[points_within(x[nodes], own, self._cap_reach).astype(bool)]
+            near = nodes[close[nodes]]
             caps[q] = np.union1d(near, np.asarray(self.local.model.bond_partners(near.tolist())))
         requests = [
             self.comm.isend(self._to_global[cap], dest=q, tag=_CAP_TAG) for q, cap in caps.items()
