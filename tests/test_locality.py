@@ -112,8 +112,9 @@ def test_a_ghost_grain_needs_only_its_owners_cap_motion_and_breaks(
     nodes bonded to those), the breaks, and the motion of each of their bodies
     (core.fragment_motions, core.give_ghost_motions). The tumbling drum run twice, once with
     grain 1 a ghost given that within each step (node spheres, and the surface law with rolling
-    resistance), its other nodes a little off (1e-9 of their
-    positions and velocities, so that any use of them would show): the other grains' nodes
+    resistance), its other nodes a little off (1e-9 of their positions and velocities, so that
+    any use of them would show) and out of the contact lists (core.set_inert_contact_nodes,
+    the cap picked anew each step): the other grains' nodes
     agree bit for bit through 900 steps of contact and breaking, the part breaks the other
     grains' bonds as the whole run does, and every bond ends the same. The ghost's own forces
     and dilatation are not computed."""
@@ -140,6 +141,7 @@ def test_a_ghost_grain_needs_only_its_owners_cap_motion_and_breaks(
         for field in ("positions", "velocities"):  # as the ranks' exchange within the step
             getattr(part.core, field)[cap] = getattr(whole.core, field)[cap]
             getattr(part.core, field)[rest] = getattr(whole.core, field)[rest] * (1 + 1e-9)
+        part.core.set_inert_contact_nodes(rest.tolist())  # out of the lists, as on the ranks
         nodes, motions = whole.core.fragment_motions([1])
         part.core.give_ghost_motions(
             np.asarray(nodes, np.uint32), np.asarray(motions).reshape(-1, 15)
@@ -180,6 +182,38 @@ def test_a_ghost_body_in_contact_needs_its_owners_motion(tmp_path: Path) -> None
                 getattr(part.core, field)[ghost] = getattr(whole.core, field)[ghost]
             whole.core.finish_step(np.zeros((0, 2), np.uint32))
             part.core.finish_step(np.zeros((0, 2), np.uint32))
+
+
+def pushed(sim: gr.Simulation, nodes: slice) -> bool:
+    """Whether anything but their bonds and gravity acts on `nodes` (gravity: the same force
+    density on each, to 1e-9 of the largest force density)."""
+    rest = sim.core.forces[nodes] - sim.bond_forces()[nodes]
+    return not np.allclose(rest, rest[0], rtol=0, atol=1e-9 * np.abs(sim.core.forces[nodes]).max())
+
+
+def test_inert_nodes_leave_the_lists_and_come_back(tmp_path: Path) -> None:
+    """core.set_inert_contact_nodes (a rank's ghost nodes outside its caps): the next
+    evaluation drops their list entries, so the grain they make up is pushed by nothing; set
+    back, the one after lists them again where they are, though they have not moved, and the
+    contact acts on them again. An index out of range is refused. (Whether the engine's use
+    changes no force is tests/test_mpi.py's and the cap test's above.)"""
+    sim = tumbling_drum(tmp_path)
+    sim.core.run(300)  # grains in contact with each other and the drum
+    grain = sim.bodies[1].node_slice
+    entries = sim.core.contact_statistics.list_entries
+    walls = len(sim.core.contact_wall_entries()[1])
+    sim.core.set_inert_contact_nodes(list(range(grain.start, grain.stop)))
+    sim.core.compute_forces()
+    inert = sim.core.contact_statistics.list_entries
+    assert inert < entries
+    assert len(sim.core.contact_wall_entries()[1]) < walls
+    assert not pushed(sim, grain)
+    sim.core.set_inert_contact_nodes([])
+    sim.core.compute_forces()
+    assert sim.core.contact_statistics.list_entries > inert  # those in reach now: 66 of 70
+    assert pushed(sim, grain)
+    with pytest.raises(gr.InputError, match="inert contact node 99999 does not exist"):
+        sim.core.set_inert_contact_nodes([99999])
 
 
 def test_ghost_breaks_are_checked(tmp_path: Path) -> None:

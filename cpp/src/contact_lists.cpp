@@ -30,6 +30,7 @@ real ContactModel::largest_displacement(const Model& model, const State& state) 
 #pragma omp parallel for schedule(static) reduction(max : worst)
   for (std::int64_t i = 0; i < n; ++i) {
     const index_t node = static_cast<index_t>(i);
+    if (inert(node)) continue;  // listed nowhere
     const real* y = &state.positions[3 * node];
     const vec3 x = centres_.moved(node) ? centres_.at_list(model, state, node) : vec3{y[0], y[1], y[2]};
     real d2 = 0;
@@ -46,6 +47,7 @@ std::vector<index_t> ContactModel::nodes_moved_past(const Model& model, const St
                                                     real limit) const {
   std::vector<index_t> moved;
   for (index_t i = 0; i < model.node_count(); ++i) {
+    if (inert(i)) continue;
     const vec3 x = centres_.at_list(model, state, i);
     real d2 = 0;
     for (int k = 0; k < 3; ++k) {
@@ -73,12 +75,13 @@ bool ContactModel::needs_search(const Model& model, const State& state, bool bro
     // every list change costs a pass over all entries (finish_lists).
     relist = nodes_moved_past(model, state, 0.25 * skin_);
   }
-  if (broke) {
+  if (broke || !changed_inert_.empty()) {
     // A node a crack opened, or that lost its surface point (its list position and reach
     // change), has not moved half the skin (or it is relisted already): it can reach only the
-    // particles near its own.
-    std::vector<index_t> changed = opened_nodes(model);
-    changed.insert(changed.end(), detached_nodes_.begin(), detached_nodes_.end());
+    // particles near its own. So can a node made inert or woken (set_inert_nodes).
+    std::vector<index_t> changed = broke ? opened_nodes(model) : std::vector<index_t>{};
+    if (broke) changed.insert(changed.end(), detached_nodes_.begin(), detached_nodes_.end());
+    changed.insert(changed.end(), changed_inert_.begin(), changed_inert_.end());
     for (const index_t k : changed) {
       if (!near_particle_[model.node_particle()[k]] || !relisting_) return true;
       relist.push_back(k);
@@ -141,7 +144,7 @@ std::vector<std::array<index_t, 2>> ContactModel::broken_pairs(const Model& mode
   std::vector<std::array<index_t, 2>> added;
   for (const auto& [i, j] : newly_broken_) {
     const index_t m = node_material[i];  // a bond joins two nodes of one particle
-    if (!law_set_[m * material_count_ + m]) continue;
+    if (!law_set_[m * material_count_ + m] || inert(i) || inert(j)) continue;
     const real limit = std::max(pair_reach(model, i, j, true), pair_reach(model, i, j, false)) + extra;
     const vec3 xi = centres_.at_list(model, state, i);
     const vec3 xj = centres_.at_list(model, state, j);
@@ -165,7 +168,8 @@ std::vector<std::array<index_t, 2>> ContactModel::relisted_pairs(const Model& mo
   }
   auto part = [&](index_t i) {
     const index_t p = node_particle[i];
-    return near_particle_[p] && (taking_part_.empty() || !surface_particle(p) || taking_part_[i]);
+    return near_particle_[p] && !inert(i) &&
+           (taking_part_.empty() || !surface_particle(p) || taking_part_[i]);
   };
   std::vector<index_t> searched;
   for (index_t i = 0; i < model.node_count(); ++i) {
@@ -228,7 +232,7 @@ void ContactModel::update_lists(const Model& model, const State& state, std::uin
       std::set_union(old.begin(), old.end(), fresh.begin(), fresh.end(), std::back_inserter(pair_partner_));
       pair_offsets_[i + 1] = static_cast<index_t>(pair_partner_.size());
       if (is_relisted(i)) {
-        list_node_walls(model, time_at_build_, i, wall_entry_);
+        if (!inert(i)) list_node_walls(model, time_at_build_, i, wall_entry_);
       } else {
         wall_entry_.insert(wall_entry_.end(), kept.wall_entry.begin() + kept.wall_offsets[i],
                            kept.wall_entry.begin() + kept.wall_offsets[i + 1]);
@@ -240,6 +244,7 @@ void ContactModel::update_lists(const Model& model, const State& state, std::uin
   }
   broken_at_build_ = broken_bonds;
   detached_nodes_.clear();
+  changed_inert_.clear();
   ++statistics_.list_updates;
   statistics_.list_entries = pair_partner_.size();
 }
@@ -279,6 +284,15 @@ void ContactModel::label_bodies(const Model& model, const State& state, std::uin
   body_nodes_.resize(n);
   std::vector<index_t> fill(body_node_offsets_.begin(), body_node_offsets_.end() - 1);
   for (index_t i = 0; i < n; ++i) body_nodes_[fill[node_body_[i]]++] = i;
+}
+
+void ContactModel::set_inert_nodes(std::vector<std::uint8_t> inert) {
+  const std::size_t n = std::max(inert.size(), inert_.size());
+  for (std::size_t i = 0; i < n; ++i) {
+    const bool was = i < inert_.size() && inert_[i], now = i < inert.size() && inert[i];
+    if (was != now) changed_inert_.push_back(static_cast<index_t>(i));
+  }
+  inert_ = std::move(inert);
 }
 
 std::vector<std::span<const index_t>> ContactModel::bodies_in(index_t first, index_t end) const {

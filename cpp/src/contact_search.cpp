@@ -28,6 +28,7 @@ void ContactModel::rebuild(const Model& model, const State& state, std::uint64_t
   const real reach = largest_pair_reach(model) + skin_;
   newly_broken_.clear();  // the search finds every unbonded pair
   detached_nodes_.clear();
+  changed_inert_.clear();  // the search lists every node as it is now
   label_bodies(model, state, broken_bonds);
   const NearParticles near = near_particles(model, state, broken_bonds, reach);
   near_particle_ = near.particle;
@@ -119,7 +120,7 @@ void ContactModel::search_node_pairs(const Model& model, const State& state,
   for (std::size_t p = 0; p < particle_count; ++p) {
     if (!near_particle[p]) continue;
     for (index_t i = particles[p].first_node; i < particles[p].first_node + particles[p].node_count; ++i) {
-      if (surface[p] && !takes_part(model, state, i)) continue;
+      if (inert(i) || (surface[p] && !takes_part(model, state, i))) continue;
       if (surface[p]) taking_part_[i] = 1;
       searched.push_back(i);
     }
@@ -179,7 +180,7 @@ void ContactModel::search_node_walls(const Model& model, const State& state,
   for (std::size_t p = 0; p < particle_count; ++p) {
     if (!near_wall[p]) continue;
     for (index_t i = particles[p].first_node; i < particles[p].first_node + particles[p].node_count; ++i) {
-      wall_nodes.push_back(i);
+      if (!inert(i)) wall_nodes.push_back(i);
     }
   }
   const std::int64_t wall_node_count = static_cast<std::int64_t>(wall_nodes.size());

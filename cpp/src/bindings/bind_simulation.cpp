@@ -143,6 +143,19 @@ void bind_loading(nb::class_<Simulation>& cls) {
           "set_contact_skin", [](Simulation& self, real skin) { self.contact().set_skin(skin); }, "skin"_a)
       .def("set_ghost_particles", &Simulation::set_ghost_particles, "particles"_a,
            "Mark the particles whose forces another process evaluates (Simulation::set_ghost_particles).")
+      .def(
+          "set_inert_contact_nodes",
+          [](Simulation& self, const std::vector<index_t>& nodes) {
+            std::vector<std::uint8_t> inert(nodes.empty() ? 0 : self.model().node_count(), 0);
+            for (const index_t i : nodes) {
+              if (i >= inert.size())
+                throw InputError("inert contact node " + std::to_string(i) + " does not exist");
+              inert[i] = 1;
+            }
+            self.contact().set_inert_nodes(std::move(inert));
+          },
+          "nodes"_a,
+          "Leave these nodes out of the contact lists (ContactModel::set_inert_nodes); [] for none.")
       .def("set_reported_numbers", &Simulation::set_reported_numbers, "nodes"_a, "particles"_a,
            "The node and particle numbers error messages give (Simulation::set_reported_numbers).")
       .def("set_travel_origin", &Simulation::set_travel_origin,

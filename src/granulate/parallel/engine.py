@@ -218,9 +218,10 @@ class DistributedRun:
         bonded to those (a node's surface normal and anchors are its bonded neighbours). No
         other ghost node can come within the cutoff of an own node, or of where one of them
         is, before the caps are picked again (each moves less than cap_margin/2), so a ghost
-        node outside the cap stays where it was, out of every own node's contact. Each rank
-        picks its caps from the ghosts' positions now, which are their owners' (after
-        _exchange_state or a rebuild), and tells the owners; one message per neighbour."""
+        node outside the cap stays where it was, out of every own node's contact, and out of
+        the contact lists (core.set_inert_contact_nodes). Each rank picks its caps from the
+        ghosts' positions now, which are their owners' (after _exchange_state or a rebuild),
+        and tells the owners; one message per neighbour."""
         x = self.local.core.positions
         ghosts = np.concatenate([np.zeros(0, np.int64), *self._receive_whole.values()])
         close = np.zeros(len(x), dtype=bool)  # one grid over the own nodes for every ghost
@@ -237,6 +238,8 @@ class DistributedRun:
         }
         self.mpi.Request.waitall(requests)
         self._receive = caps
+        outside = [np.setdiff1d(self._receive_whole[q], cap) for q, cap in caps.items()]
+        self.local.core.set_inert_contact_nodes(np.concatenate([[], *outside]).astype(int).tolist())
         whole = all(len(caps[q]) == len(nodes) for q, nodes in self._receive_whole.items())
         #: Whether some rank's caps leave ghost nodes out (else no need to pick them anew).
         self.caps_partial = not self.comm.allreduce(whole, op=self.mpi.LAND)

@@ -178,6 +178,12 @@ class ContactModel {
   void give_ghost_motions(std::vector<std::pair<index_t, BodyMotion>> motions) {
     ghosts_.give(std::move(motions));
   }
+  /// Nodes left out of the lists (per node 1 or 0; empty: none): a distributed run's ghost nodes
+  /// outside its caps, which stay where they were and can reach none of its own nodes. Takes
+  /// effect at the next evaluation: the nodes whose flag changed are listed again (an inert
+  /// node has no entries, a node woken finds its partners), and an inert node's displacement
+  /// asks for no search.
+  void set_inert_nodes(std::vector<std::uint8_t> inert);
   /// Whether the bodies were labelled with `broken_bonds` bonds broken (and are then current).
   bool bodies_labelled_at(std::uint64_t broken_bonds) const {
     return bodies_labelled_ && broken_at_labelling_ == broken_bonds;
@@ -340,7 +346,10 @@ class ContactModel {
   /// the surface law, else the surface points and the nodes on crack faces (with a broken
   /// bond): the nodes inside an intact surface never touch another body.
   bool takes_part(const Model& model, const State& state, index_t i) const;
-  std::vector<index_t> detached_nodes_;      // surface nodes that lost their point since the last list change
+  std::vector<index_t> detached_nodes_;  // surface nodes that lost their point since the last list change
+  std::vector<std::uint8_t> inert_;      // per node: left out of the lists (set_inert_nodes); or empty
+  std::vector<index_t> changed_inert_;   // nodes whose inert flag changed since the last list change
+  bool inert(index_t i) const { return !inert_.empty() && inert_[i]; }
   std::vector<std::uint8_t> taking_part_;    // per node, since the last search or list update
   std::vector<std::uint8_t> near_particle_;  // per particle, searched at the last search
   bool relisting_ = true;                    // set_relisting
