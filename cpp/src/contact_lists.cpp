@@ -26,11 +26,11 @@ void fit(std::vector<T>& v) {
 
 real ContactModel::largest_displacement(const Model& model, const State& state) const {
   const std::int64_t n = model.node_count();
+  const std::uint8_t* const inert = inert_.empty() ? nullptr : inert_.data();  // listed nowhere
   real worst = 0;
 #pragma omp parallel for schedule(static) reduction(max : worst)
   for (std::int64_t i = 0; i < n; ++i) {
     const index_t node = static_cast<index_t>(i);
-    if (inert(node)) continue;  // listed nowhere
     const real* y = &state.positions[3 * node];
     const vec3 x = centres_.moved(node) ? centres_.at_list(model, state, node) : vec3{y[0], y[1], y[2]};
     real d2 = 0;
@@ -38,7 +38,7 @@ real ContactModel::largest_displacement(const Model& model, const State& state) 
       const real d = x[k] - positions_at_build_[3 * i + k];
       d2 += d * d;
     }
-    worst = std::max(worst, d2);
+    if (!inert || !inert[i]) worst = std::max(worst, d2);
   }
   return std::sqrt(worst);
 }
@@ -166,9 +166,10 @@ std::vector<std::array<index_t, 2>> ContactModel::relisted_pairs(const Model& mo
     if (!taking_part_.empty() && surface_particle(node_particle[k]) && takes_part(model, state, k))
       taking_part_[k] = 1;
   }
+  const std::uint8_t* const inert = inert_.empty() ? nullptr : inert_.data();
   auto part = [&](index_t i) {
     const index_t p = node_particle[i];
-    return near_particle_[p] && !inert(i) &&
+    return near_particle_[p] && !(inert && inert[i]) &&
            (taking_part_.empty() || !surface_particle(p) || taking_part_[i]);
   };
   std::vector<index_t> searched;
