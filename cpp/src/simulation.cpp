@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <sstream>
+#include <utility>
 
 #include "bond_extension.hpp"
 #include "granulate/peridynamics/critical_stretch.hpp"
@@ -18,6 +19,65 @@ using clock_type = std::chrono::steady_clock;
 
 double seconds_since(clock_type::time_point start) {
   return std::chrono::duration<double>(clock_type::now() - start).count();
+}
+
+/// The first half kick and the drift, v += dt/2 f/rho, x += dt v, of every node (with
+/// SkipGhosts, but those of the particles `ghost` flags, which their owners move). A template so
+/// that a serial run's loop has no test per node.
+template <bool SkipGhosts>
+void kick_and_drift(const Model& m, State& state, real dt, const std::uint8_t* ghost) {
+  const std::int64_t n = m.node_count();
+  auto& x = state.positions;
+  auto& v = state.velocities;
+  const auto& f = state.forces;
+  const auto& node_particle = m.node_particle();
+#pragma omp parallel for schedule(static)
+  for (std::int64_t i = 0; i < n; ++i) {
+    if constexpr (SkipGhosts) {
+      if (ghost[node_particle[i]]) continue;
+    }
+    const real density = m.density(static_cast<index_t>(i));
+    for (std::int64_t k = 3 * i; k < 3 * i + 3; ++k) {
+      v[k] += 0.5 * dt * f[k] / density;
+      x[k] += dt * v[k];
+    }
+  }
+}
+
+/// The second half kick of every node (with SkipGhosts, but the ghosts'), and the first node
+/// that moves more than its mesh size in a step or is not finite (n if none) and, with an
+/// `origin`, the largest squared distance of a node from it.
+template <bool SkipGhosts>
+std::pair<std::int64_t, real> second_half_kick(const Model& m, State& state, real dt, const real* origin,
+                                               const std::uint8_t* ghost) {
+  const std::int64_t n = m.node_count();
+  const auto& particles = m.particles();
+  const auto& node_particle = m.node_particle();
+  const auto& x = state.positions;
+  auto& v = state.velocities;
+  const auto& f = state.forces;
+  std::int64_t first_unstable = n;
+  real travel2 = 0;
+#pragma omp parallel for schedule(static) reduction(min : first_unstable) reduction(max : travel2)
+  for (std::int64_t i = 0; i < n; ++i) {
+    if constexpr (SkipGhosts) {
+      if (ghost[node_particle[i]]) continue;
+    }
+    real speed2 = 0;
+    const real density = m.density(static_cast<index_t>(i));
+    for (std::int64_t k = 3 * i; k < 3 * i + 3; ++k) {
+      v[k] += 0.5 * dt * f[k] / density;
+      speed2 += v[k] * v[k];
+    }
+    const real limit = particles[node_particle[i]].mesh_size / dt;
+    if (!(speed2 <= limit * limit)) first_unstable = std::min(first_unstable, i);
+    if (origin) {
+      const real dx = x[3 * i] - origin[3 * i], dy = x[3 * i + 1] - origin[3 * i + 1],
+                 dz = x[3 * i + 2] - origin[3 * i + 2];
+      travel2 = std::max(travel2, dx * dx + dy * dy + dz * dz);
+    }
+  }
+  return {first_unstable, travel2};
 }
 
 }  // namespace
@@ -189,23 +249,12 @@ void Simulation::finish_step(std::span<const std::array<index_t, 2>> ghost_break
 }
 
 void Simulation::move_and_break_bonds() {
-  const Model& m = *model_;
-  const std::int64_t n = m.node_count();
-  auto& x = state_.positions;
-  auto& v = state_.velocities;
-  const auto& f = state_.forces;
   const real dt = time_step_;
-  const std::uint8_t* const ghost = ghost_.empty() ? nullptr : ghost_.data();
-  const auto& node_particle = m.node_particle();
   auto start = clock_type::now();
-#pragma omp parallel for schedule(static)
-  for (std::int64_t i = 0; i < n; ++i) {
-    if (ghost && ghost[node_particle[i]]) continue;  // moved by its owner (set_ghost_particles)
-    const real density = m.density(static_cast<index_t>(i));
-    for (std::int64_t k = 3 * i; k < 3 * i + 3; ++k) {
-      v[k] += 0.5 * dt * f[k] / density;
-      x[k] += dt * v[k];
-    }
+  if (ghost_.empty()) {
+    kick_and_drift<false>(*model_, state_, dt, nullptr);
+  } else {
+    kick_and_drift<true>(*model_, state_, dt, ghost_.data());
   }
   state_.time += dt;
   phase_times_.integration += seconds_since(start);
@@ -221,15 +270,7 @@ void Simulation::move_and_break_bonds() {
 }
 
 void Simulation::finish_step_after_breaks(std::span<const std::array<index_t, 2>> ghost_breaks) {
-  const Model& m = *model_;
-  const auto& particles = m.particles();
-  const auto& node_particle = m.node_particle();
-  const std::int64_t n = m.node_count();
-  const auto& x = state_.positions;
-  auto& v = state_.velocities;
-  const auto& f = state_.forces;
-  const real dt = time_step_;
-  const std::uint8_t* const ghost = ghost_.empty() ? nullptr : ghost_.data();
+  const std::int64_t n = model_->node_count();
   auto start = clock_type::now();
   const double contact_before = phase_times_.contact;
   finish_forces(ghost_breaks);
@@ -238,28 +279,12 @@ void Simulation::finish_step_after_breaks(std::span<const std::array<index_t, 2>
   start = clock_type::now();
   // The second half kick, and the first node (if any) that moved more than its mesh size in
   // the step or became non-finite: checked every step, at the cost of one comparison per node
-  // (not on ghosts, which their owners move and check).
-  // With a travel origin, also the largest squared distance of a node from it.
-  std::int64_t first_unstable = n;
-  real travel2 = 0;
+  // (not on ghosts, which their owners move and check). With a travel origin, also the largest
+  // squared distance of a node from it.
   const real* const origin = travel_origin_.empty() ? nullptr : travel_origin_.data();
-#pragma omp parallel for schedule(static) reduction(min : first_unstable) reduction(max : travel2)
-  for (std::int64_t i = 0; i < n; ++i) {
-    if (ghost && ghost[node_particle[i]]) continue;  // moved and checked by its owner
-    real speed2 = 0;
-    const real density = m.density(static_cast<index_t>(i));
-    for (std::int64_t k = 3 * i; k < 3 * i + 3; ++k) {
-      v[k] += 0.5 * dt * f[k] / density;
-      speed2 += v[k] * v[k];
-    }
-    const real limit = particles[node_particle[i]].mesh_size / dt;
-    if (!(speed2 <= limit * limit)) first_unstable = std::min(first_unstable, i);
-    if (origin) {
-      const real dx = x[3 * i] - origin[3 * i], dy = x[3 * i + 1] - origin[3 * i + 1],
-                 dz = x[3 * i + 2] - origin[3 * i + 2];
-      travel2 = std::max(travel2, dx * dx + dy * dy + dz * dz);
-    }
-  }
+  const auto [first_unstable, travel2] =
+      ghost_.empty() ? second_half_kick<false>(*model_, state_, time_step_, origin, nullptr)
+                     : second_half_kick<true>(*model_, state_, time_step_, origin, ghost_.data());
   if (origin) largest_travel_ = std::sqrt(travel2);
   apply_prescribed_motion(false);
   ++state_.step;
