@@ -53,7 +53,7 @@ from granulate import checkpoints
 from granulate.parallel import DistributedRun
 from run_folders import SEARCHES, differing, history
 from test_checkpoint import tumbling_drum
-from test_locality import RADIUS, assembly, layout
+from test_locality import RADIUS, assembly, layout, rock
 
 
 def set_up(dimension: int) -> gr.Simulation:
@@ -73,17 +73,11 @@ def fine_discs() -> gr.Simulation:
     centres, rows = layout(2)
     centres = centres * (2.02 / 1.9)
     h = RADIUS / 12
-    rock = gr.Material(
-        density=1200,
-        bulk_modulus=2.16e7,
-        shear_modulus=1.296e7,
-        fracture_energy=0.01,
-        horizon=3 * h,
-    )
+    brittle = rock(3 * h, fracture_energy=0.01)
     sim = gr.Simulation(2, gravity=(0.0, -9.81, 0.0))
     sim.contact = gr.Contact(restitution=0.6, friction=0.5)
     for centre, row in zip(centres, rows, strict=True):
-        sim.add_body(gr.Disc(tuple(centre), row[0]), rock, h, velocity=row[1:])
+        sim.add_body(gr.Disc(tuple(centre), row[0]), brittle, h, velocity=row[1:])
     floor = centres[:, 1].min() - 0.99 * RADIUS
     sim.add_wall(gr.Wall(gr.Plane((0.0, floor, 0.0), (0.0, 1.0, 0.0))), name="floor")
     return sim

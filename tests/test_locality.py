@@ -21,9 +21,20 @@ import granulate as gr
 from test_checkpoint import tumbling_drum
 
 RADIUS = 1e-3
-ROCK = gr.Material(
-    density=1200, bulk_modulus=2.16e7, shear_modulus=1.296e7, fracture_energy=50, horizon=0.6e-3
-)
+
+
+def rock(horizon: float, fracture_energy: float = 50) -> gr.Material:
+    """The grains' material (a soft rock), with this horizon [m] and fracture energy [J/m^2]."""
+    return gr.Material(
+        density=1200,
+        bulk_modulus=2.16e7,
+        shear_modulus=1.296e7,
+        fracture_energy=fracture_energy,
+        horizon=horizon,
+    )
+
+
+ROCK = rock(0.6e-3)
 
 
 def layout(dimension: int) -> tuple[np.ndarray, np.ndarray]:

@@ -79,9 +79,12 @@ bool ContactModel::needs_search(const Model& model, const State& state, bool bro
     // A node a crack opened, or that lost its surface point (its list position and reach
     // change), has not moved half the skin (or it is relisted already): it can reach only the
     // particles near its own. So can a node made inert or woken (set_inert_nodes).
-    std::vector<index_t> changed = broke ? opened_nodes(model) : std::vector<index_t>{};
-    if (broke) changed.insert(changed.end(), detached_nodes_.begin(), detached_nodes_.end());
-    changed.insert(changed.end(), changed_inert_.begin(), changed_inert_.end());
+    std::vector<index_t> changed = changed_inert_;
+    if (broke) {
+      const std::vector<index_t> opened = opened_nodes(model);
+      changed.insert(changed.end(), opened.begin(), opened.end());
+      changed.insert(changed.end(), detached_nodes_.begin(), detached_nodes_.end());
+    }
     for (const index_t k : changed) {
       if (!near_particle_[model.node_particle()[k]] || !relisting_) return true;
       relist.push_back(k);

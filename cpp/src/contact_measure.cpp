@@ -733,6 +733,7 @@ void ContactModel::check_ghost_motions(const std::vector<std::uint8_t>& measured
   auto unknown = [&](index_t body) {
     return ghosts_.ghost(body_particle_[body]) && measured[body_touch_[body]];
   };
+  if (std::none_of(touching_bodies_.begin(), touching_bodies_.end(), unknown)) return;  // all given
   for (std::size_t slot = 0; slot < particle_slot_count_; ++slot) {
     const index_t p = slots_[slot][0], q = slots_[slot][1];
     if (body_touch_[p] == not_touching || body_touch_[q] == not_touching) continue;

@@ -59,6 +59,7 @@ _TAG = 17
 _REST_TAG = 18  # what a step's message has no room for
 _CAP_TAG = 19
 _BODY = 16  # numbers a body's motion takes in a message: its first node, then 15
+_WIDTHS = np.array([2, _BODY])  # a step message's sections: breaks (node pairs), bodies
 
 
 class DistributedRun:
@@ -131,7 +132,6 @@ class DistributedRun:
         #: How many of this rank's step messages had a second one for the breaks and bodies'
         #: motions they had no room for.
         self.second_messages = 0
-        self._caps_due = False
         self._migrates = migrate
         #: How many times the grains were distributed anew (migrate()), and how many grains
         #: changed owner then, in all.
@@ -188,7 +188,7 @@ class DistributedRun:
         self.local.core.set_ghost_particles(ghost_particles.tolist())
         self.local.core.set_reported_numbers(self._to_global.tolist(), self.held.tolist())
         self._owned_nodes = self._nodes_of(self._owned, node_map)
-        self._is_owned = self._marked(self._owned_nodes)
+        self._is_owned = _mask(len(self._to_global), self._owned_nodes)
         self._send_grains = {
             q: held[owner[held] == rank]
             for q, held in enumerate(self.ghosts)
@@ -200,11 +200,15 @@ class DistributedRun:
         self._receive_whole = {
             q: self._nodes_of(g, node_map) for q, g in self._receive_grains.items()
         }
-        self._sent_to = {q: self._marked(n) for q, n in self._send_whole.items()}
+        self._sent_to = {q: _mask(len(self._to_global), n) for q, n in self._send_whole.items()}
         particles = {q: np.searchsorted(self.held, g) for q, g in self._send_grains.items()}
         self._motion_particles = np.unique(
             np.concatenate([np.zeros(0, np.int64), *particles.values()])
-        )
+        ).tolist()
+        # Rows of breaks and of bodies' motions a step's message carries, each way (_pack):
+        # the sender's grains for q are q's grains from it, so both ends count alike.
+        self._rooms_out = {q: self._rooms(len(g)) for q, g in self._send_grains.items()}
+        self._rooms_in = {q: self._rooms(len(g)) for q, g in self._receive_grains.items()}
         self._particle_to = {q: _mask(len(self.held), p) for q, p in particles.items()}
         self._node_particle = np.asarray(self.local.model.node_particle, dtype=np.int64)
         self.local.core.set_travel_origin()
@@ -240,28 +244,15 @@ class DistributedRun:
         self._receive = caps
         outside = [np.setdiff1d(self._receive_whole[q], cap) for q, cap in caps.items()]
         self.local.core.set_inert_contact_nodes(np.concatenate([[], *outside]).astype(int).tolist())
-        whole = all(len(caps[q]) == len(nodes) for q, nodes in self._receive_whole.items())
         #: Whether some rank's caps leave ghost nodes out (else no need to pick them anew).
-        self.caps_partial = not self.comm.allreduce(whole, op=self.mpi.LAND)
-        self._outbox = {
-            q: np.empty(self._message_size(len(n), len(self._send_grains[q])))
-            for q, n in self._send.items()
-        }
-        self._inbox = {
-            q: np.empty(self._message_size(len(n), len(self._receive_grains[q])))
-            for q, n in self._receive.items()
-        }
+        self.caps_partial = self.comm.allreduce(any(len(o) for o in outside), op=self.mpi.LOR)
+        self._outbox = {q: _message(len(n), self._rooms_out[q]) for q, n in self._send.items()}
+        self._inbox = {q: _message(len(n), self._rooms_in[q]) for q, n in self._receive.items()}
 
-    def _message_size(self, nodes: int, grains: int) -> int:
-        """The numbers a step's message between two ranks holds at most (_pack): x and v of
-        `nodes` nodes, the counts, break_slots breaks and one body per grain plus body_slots."""
-        return 6 * nodes + 2 + 2 * self.break_slots + _BODY * (grains + self.body_slots)
-
-    def _marked(self, local: NDArray[np.int64]) -> NDArray[np.bool_]:
-        """Over this rank's nodes, whether each is one of `local`."""
-        mask = np.zeros(len(self._to_global), dtype=bool)
-        mask[local] = True
-        return mask
+    def _rooms(self, grains: int) -> NDArray[np.int64]:
+        """The rows a step's message about `grains` grains carries of each section: break_slots
+        breaks, and one body per grain plus body_slots."""
+        return np.array([self.break_slots, grains + self.body_slots])
 
     def _local_slice(self, grain: int) -> slice:
         """The local nodes of a held grain."""
@@ -351,10 +342,10 @@ class DistributedRun:
         overflow = []
         for q, nodes in self._send.items():
             theirs = self._to_global[pairs[self._sent_to[q][pairs[:, 0]]]]
-            room = len(self._send_grains[q]) + self.body_slots  # as q's _unpack has it
-            sections = [(theirs, self.break_slots), (bodies[rows[q]], room)]
             box = self._outbox[q]
-            used, rest = _pack(box, (x[nodes], v[nodes]), sections)
+            used, rest = _pack(
+                box, (x[nodes], v[nodes]), [theirs, bodies[rows[q]]], self._rooms_out[q]
+            )
             requests.append(self.comm.Isend(box[:used], dest=q, tag=_TAG))
             if len(rest):
                 overflow.append(self.comm.Isend(rest, dest=q, tag=_REST_TAG))
@@ -378,7 +369,7 @@ class DistributedRun:
         grains; none unless `measured` (the step failed before)."""
         if not measured:
             return np.zeros((0, _BODY)), {q: np.zeros(0, bool) for q in self._send}
-        nodes, numbers = self.local.core.fragment_motions(self._motion_particles.tolist())
+        nodes, numbers = self.local.core.fragment_motions(self._motion_particles)
         nodes = np.asarray(nodes, dtype=np.int64)
         particle = self._node_particle[nodes]
         motions = np.empty((len(nodes), _BODY))
@@ -397,24 +388,13 @@ class DistributedRun:
         motion = box[:count].reshape(-1, 6)
         for k, field in enumerate(fields):
             field[nodes] = motion[:, 3 * k : 3 * k + 3]
-        totals = box[count : count + 2].astype(np.int64)
-        rooms = (self.break_slots, len(self._receive_grains[q]) + self.body_slots)
-        widths = (2, _BODY)
-        kept = [min(int(t), room) for t, room in zip(totals, rooms, strict=True)]
-        start, parts = count + 2, []
-        for n, width in zip(kept, widths, strict=True):
-            parts.append(box[start : start + n * width].reshape(-1, width))
-            start += n * width
-        missing = [int(t) - n for t, n in zip(totals, kept, strict=True)]
-        if any(missing):
-            rest = np.empty(sum(m * w for m, w in zip(missing, widths, strict=True)))
+        totals = box[count : count + len(_WIDTHS)].astype(np.int64)
+        kept = np.minimum(totals, self._rooms_in[q])
+        rest = np.empty(int(((totals - kept) * _WIDTHS).sum()))
+        if len(rest):
             self.comm.Recv(rest, source=q, tag=_REST_TAG)
-            split = missing[0] * widths[0]
-            parts = [
-                np.concatenate([parts[0], rest[:split].reshape(-1, widths[0])]),
-                np.concatenate([parts[1], rest[split:].reshape(-1, widths[1])]),
-            ]
-        return parts[0].astype(np.int64), parts[1]
+        breaks, bodies = _sections(box[count + len(_WIDTHS) :], kept, rest, totals - kept)
+        return breaks.astype(np.int64), bodies
 
     def run(self, steps: int) -> None:
         """Advance every rank `steps` time steps, migrating grains before a step once a node
@@ -758,10 +738,17 @@ class DistributedRun:
         return whole
 
 
+def _message(nodes: int, rooms: NDArray[np.int64]) -> NDArray[np.float64]:
+    """A buffer for the largest step message about `nodes` nodes (_pack): their x and v, the
+    sections' counts, and each section's `rooms` rows."""
+    return np.empty(6 * nodes + len(_WIDTHS) + int((rooms * _WIDTHS).sum()))
+
+
 def _pack(
     box: NDArray[np.float64],
     fields: tuple[NDArray[np.float64], ...],
-    sections: list[tuple[NDArray[Any], int]],
+    sections: list[NDArray[Any]],
+    rooms: NDArray[np.int64],
 ) -> tuple[int, NDArray[np.float64]]:
     """A step's message: the nodes' `fields` (x, v: 6 numbers a node), then each section's row
     count, then each section's rows (breaks, (k, 2); bodies, (k, 16)), up to its room; the
@@ -771,14 +758,31 @@ def _pack(
     motion = box[:count].reshape(-1, 6)
     for k, field in enumerate(fields):
         motion[:, 3 * k : 3 * k + 3] = field
-    box[count : count + len(sections)] = [len(rows) for rows, _ in sections]
+    box[count : count + len(sections)] = [len(rows) for rows in sections]
     start, rest = count + len(sections), []
-    for rows, room in sections:
+    for rows, room in zip(sections, rooms, strict=True):
         kept = rows[:room].ravel()
         box[start : start + kept.size] = kept
         start += kept.size
         rest.append(rows[room:].ravel().astype(float))
     return start, np.concatenate(rest)
+
+
+def _sections(
+    carried: NDArray[np.float64],
+    kept: NDArray[np.int64],
+    rest: NDArray[np.float64],
+    missing: NDArray[np.int64],
+) -> list[NDArray[np.float64]]:
+    """The sections of a step's message as _pack wrote them: `kept` rows of each from the
+    message (`carried`, after the counts), then `missing` rows of each from the second
+    message (`rest`); each (rows, width)."""
+    parts, here, there = [], 0, 0
+    for n, m, width in zip(kept, missing, _WIDTHS, strict=True):
+        rows = [carried[here : here + n * width], rest[there : there + m * width]]
+        parts.append(np.concatenate(rows).reshape(-1, width))
+        here, there = here + n * width, there + m * width
+    return parts
 
 
 def _mask(size: int, indices: NDArray[np.int64]) -> NDArray[np.bool_]:
