@@ -53,11 +53,26 @@ def test_a_subdomain_takes_increasing_grains_that_exist(grains: list[int]) -> No
         row_of_discs()._subdomain(np.array(grains, dtype=np.int64))
 
 
-def test_peridem_damping_is_refused_for_distributed_runs() -> None:
-    sim = row_of_discs()
-    sim.set_peridem_damping(ROCK, ROCK, epsilon=0.9)
-    with pytest.raises(gr.InputError, match="one process"):
-        sim._subdomain(np.array([0]))
+def test_a_subdomain_keeps_peridem_damping_as_the_whole_sets_it() -> None:
+    """PeriDEM's damping (--peridem-compat) on a part: its contact radius is the whole
+    assembly's (the law's factor times the smallest mesh size of the bodies of the pair's
+    materials: here a finer slab, which one part leaves out) and its walls are the part's
+    bodies of the same names."""
+    whole = row_of_discs()
+    slab = whole.add_body(gr.Rectangle((-1e-3, 1.5e-3), (8e-3, 2e-3)), ROCK, 1.25e-4, name="slab")
+    whole.set_peridem_damping(ROCK, ROCK, epsilon=0.9)
+    whole.set_peridem_walls([slab])
+    reach = whole._interactions.peridem_reach()
+    assert reach == pytest.approx(1.01 * gr.Contact().contact_radius_factor * 1.25e-4)
+    discs, _ = whole._subdomain(np.array([0, 3]))
+    with_slab, _ = whole._subdomain(np.array([3, 4]))
+    assert discs._interactions.peridem_reach() == with_slab._interactions.peridem_reach() == reach
+    assert discs._interactions.peridem_walls == []
+    assert with_slab._interactions.peridem_walls == ["slab"]
+    alone = gr.Simulation(2)  # the discs' own smallest mesh size would give another radius
+    alone.add_body(gr.Disc((0.0, 0.0), 1e-3), ROCK, 2.5e-4)
+    alone.set_peridem_damping(ROCK, ROCK, epsilon=0.9)
+    assert alone._interactions.peridem_reach() == pytest.approx(2 * reach)
 
 
 def test_translated_copies_in_a_subdomain_keep_the_whole_assemblys_bonds() -> None:

@@ -63,11 +63,12 @@ void PeridemDamping::add_forces(const Model& model, State& state) const {
 
 #pragma omp parallel
   {
+    std::vector<index_t> near;      // particles whose centres are within reach (scratch)
     std::vector<index_t> touching;  // wall nodes within Rc of this particle (scratch)
 #pragma omp for schedule(dynamic, 4)
     for (std::int64_t pp = 0; pp < static_cast<std::int64_t>(count); ++pp) {
       const PeridemParticle& me = particles_[pp];
-      if (me.wall) continue;
+      if (me.wall || (!ghost_.empty() && ghost_[pp])) continue;
       const Particle& particle = model.particles()[pp];
       const index_t c = me.center;
       const real area = std::numbers::pi * me.radius * me.radius;
@@ -85,20 +86,25 @@ void PeridemDamping::add_forces(const Model& model, State& state) const {
         closing = std::min(0.0, closing);
         for (int d = 0; d < 3; ++d) force[d] += beta * closing * n[d] / area;
       };
+      near.clear();
       center_grid.for_each_within(
           x, c, me.radius + max_radius_ + 1.01 * max_contact_radius_, dimension,
           [&](index_t other_center, real r2) {
             const index_t q = center_particle_[other_center];
-            const PeridemParticle& other = particles_[q];
             const PeridemPair& pair =
                 pairs_[particle.material * material_count_ + model.particles()[q].material];
-            if (pair.betan == 0 || !(std::sqrt(r2) < me.radius + other.radius + 1.01 * pair.contact_radius))
-              return;
-            const real other_mass =
-                model.density(other_center) * std::numbers::pi * other.radius * other.radius;
-            const real reduced = 2 * mass * other_mass / (mass + other_mass);  // harmonic mean
-            damp(other_center, pair.betan * std::sqrt(pair.kappa * pair.contact_radius * reduced));
+            if (pair.betan > 0 &&
+                std::sqrt(r2) < me.radius + particles_[q].radius + 1.01 * pair.contact_radius)
+              near.push_back(q);
           });
+      std::sort(near.begin(), near.end());
+      for (index_t q : near) {
+        const PeridemParticle& other = particles_[q];
+        const PeridemPair& pair = pairs_[particle.material * material_count_ + model.particles()[q].material];
+        const real other_mass = model.density(other.center) * std::numbers::pi * other.radius * other.radius;
+        const real reduced = 2 * mass * other_mass / (mass + other_mass);  // harmonic mean
+        damp(other.center, pair.betan * std::sqrt(pair.kappa * pair.contact_radius * reduced));
+      }
       touching.clear();
       for (index_t a = 0; a < particle.node_count; ++a) {
         const index_t i = particle.first_node + a;

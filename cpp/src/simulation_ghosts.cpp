@@ -22,6 +22,7 @@ void Simulation::set_ghost_particles(const std::vector<index_t>& particles) {
   }
   ghost_ = particles.empty() ? std::vector<std::uint8_t>{} : std::move(ghost);  // empty: none
   contact_.set_ghost_particles(ghost_);
+  peridem_damping_.set_ghost_particles(ghost_);
 }
 
 void Simulation::set_reported_numbers(std::vector<index_t> nodes, std::vector<index_t> particles) {

@@ -39,6 +39,11 @@ def core_law(contact: Contact) -> _core.ContactLaw:
     return law
 
 
+#: PeriDEM's damping acts between two particles whose centres are closer than the sum of
+#: their radii and this factor times the pair's contact radius (contact/peridem_damping.hpp).
+PERIDEM_CENTRE_REACH = 1.01
+
+
 def _checked_contact(contact: Contact | None) -> Contact | None:
     if contact is not None and not isinstance(contact, Contact):
         raise InputError(
@@ -60,14 +65,29 @@ class Interactions:
         self.walls: list[tuple[str, Wall]] = []
         self.skin: float | None = None
         self._deep_contact_level = 0  # 1: warned past half of Rc, 2: past Rc
+        # PeriDEM damping's contact radius per pair of materials, fixed by the whole assembly
+        # for a subset of it (on()); else found from this assembly's bodies (_peridem_radius).
+        self._peridem_radii: dict[tuple[int, int], float] = {}
 
     def on(self, assembly: Assembly) -> Interactions:
-        """The same laws, walls and skin for another assembly (a subset of this one's)."""
+        """The same laws, walls, skin and PeriDEM damping for another assembly (a subset of
+        this one's, holding the same materials): the damping's contact radii stay the ones
+        this assembly gives, its wall bodies the subset's bodies of the same names."""
         other = Interactions(assembly)
         other.contact = self.contact
         other.pair_contacts = dict(self.pair_contacts)
         other.walls = list(self.walls)
         other.skin = self.skin
+        other.peridem_damping = dict(self.peridem_damping)
+        materials = {id(body.material): body.material for body in self._assembly.bodies}
+        other._peridem_radii = {
+            (a, b): self._peridem_radius(materials[a], materials[b])
+            for a, b in self.peridem_damping
+            if a in materials and b in materials
+        }
+        held = {body.name for body in assembly.bodies}
+        walls = (self._assembly.body(b).name for b in self.peridem_walls)
+        other.peridem_walls = [name for name in walls if name in held]
         return other
 
     @property
@@ -170,9 +190,24 @@ class Interactions:
             radius.ravel(),
         )
 
+    def peridem_reach(self) -> float:
+        """How far apart PeriDEM's damping acts at most [m], beyond the particles' radii
+        between their centre nodes, and between a node and a wall node: 1.01 times the
+        largest of its contact radii (contact/peridem_damping.hpp); 0 without it."""
+        materials = {id(body.material): body.material for body in self._assembly.bodies}
+        radii = [
+            self._peridem_radius(materials[a], materials[b])
+            for a, b in self.peridem_damping
+            if a in materials and b in materials
+        ]
+        return PERIDEM_CENTRE_REACH * max(radii, default=0.0)
+
     def _peridem_radius(self, a: Material, b: Material) -> float:
         """The contact radius PeriDEM's damping uses between materials a and b: the law's, or
         its factor times the smallest mesh size among particles of the two materials."""
+        fixed = self._peridem_radii.get((id(a), id(b)))
+        if fixed is not None:
+            return fixed
         contact = self.law_between(a, b)
         if contact is None:
             raise InputError("PeriDEM damping is set for a pair of materials without contact")

@@ -230,11 +230,6 @@ class Simulation(SimulationSetup, SimulationResults):
         of this simulation's node indices to its own (-1: left out). For granulate.parallel,
         whose ranks each hold their grains and ghosts; this simulation is not built."""
         interactions = self._interactions
-        if interactions.peridem_damping or interactions.peridem_walls:
-            raise InputError(
-                "PeriDEM's damping (--peridem-compat decks) is not supported in distributed "
-                "runs; run the deck on one process"
-            )
         part = Simulation(
             self.dimension,
             self.plane,

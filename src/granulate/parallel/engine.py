@@ -107,12 +107,19 @@ class DistributedRun:
         self._slices = [body.node_slice for body in sim.bodies]  # each grain's global nodes
         self._node_count = sim._assembly.node_count
         self._weights = np.array([body.node_count for body in sim.bodies], dtype=float)
-        centres, radii = _bounding_spheres(sim)
+        start = _start_positions(sim)
+        centres, radii = _spheres([start[body.node_slice] for body in sim.bodies], sim.dimension)
+        # PeriDEM's damping (--peridem-compat): between particles whose centre nodes come within
+        # their radii plus this reach, and from wall nodes within it of a node (0: none).
+        self._damping_reach = sim._interactions.peridem_reach()
+        damped, self._damping_radii = sim._assembly.centres_and_radii()
+        self._damped_centres = np.asarray(damped, dtype=np.int64)  # global nodes
         first = bisect(centres, self._weights, comm.Get_size()).grains_of(comm.Get_rank())
         # The cutoff, skin and dt of the first grains, each met by a grain of every kind.
         probe = together(self.comm, lambda: sim._subdomain(np.union1d(first, _kinds(sim)))[0].core)
         self._skin = comm.allreduce(probe.contact_skin, op=MPI.MAX)
         cutoff = comm.allreduce(probe.contact_reach - probe.contact_skin, op=MPI.MAX) + self._skin
+        cutoff = max(cutoff, self._damping_reach)
         self._dt = comm.allreduce(probe.time_step, op=MPI.MIN)
         #: The stable time-step estimate [s]: the least of every grain's (as the serial one).
         self.stable_dt = comm.allreduce(probe.stable_time_step, op=MPI.MIN)
@@ -145,7 +152,7 @@ class DistributedRun:
         self._migration_due = False
         # The wall reactions a loaded checkpoint holds, until the next step evaluates them.
         self._loaded_walls: NDArray[np.float64] | None = None
-        held = self._distribute(centres, radii)
+        held = self._distribute(centres, radii, start[self._damped_centres, : sim.dimension])
         together(self.comm, lambda: self._build(held))
         self._exchange_state()
         self._exchange_caps()
@@ -164,13 +171,22 @@ class DistributedRun:
         self._plan(node_map)
 
     def _distribute(
-        self, centres: NDArray[np.float64], radii: NDArray[np.float64]
+        self,
+        centres: NDArray[np.float64],
+        radii: NDArray[np.float64],
+        damped_centres: NDArray[np.float64],
     ) -> NDArray[np.int64]:
         """Owners by recursive coordinate bisection of the grains' `centres` and the ghosts of
-        every rank from their bounding spheres; the grains this rank holds (sorted)."""
+        every rank from their bounding spheres (`radii`), and with PeriDEM's damping also from
+        where their centre nodes are (`damped_centres`); the grains this rank holds (sorted)."""
         rank = self.comm.Get_rank()
         self.partition: Partition = bisect(centres, self._weights, self.comm.Get_size())
-        self.ghosts = ghosts(self.partition, near_pairs(centres, radii, self._reach))
+        first, last = near_pairs(centres, radii, self._reach)
+        if self._damping_reach > 0:  # centres within radii + reach, each moving < margin/2
+            reach = self._damping_reach + self.margin
+            more = near_pairs(damped_centres, self._damping_radii, reach)
+            first, last = np.concatenate([first, more[0]]), np.concatenate([last, more[1]])
+        self.ghosts = ghosts(self.partition, (first, last))
         return np.union1d(self.partition.grains_of(rank), self.ghosts[rank])
 
     def _plan(self, node_map: NDArray[np.int64]) -> None:
@@ -219,7 +235,8 @@ class DistributedRun:
         """Which of the ghosts' nodes each step sends (the caps): of each ghost grain, the
         nodes within the cutoff plus the cap margin (and twice the largest mesh size, by which
         a contact centre may lie off its node) of one of this rank's own nodes, and the nodes
-        bonded to those (a node's surface normal and anchors are its bonded neighbours). No
+        bonded to those (a node's surface normal and anchors are its bonded neighbours), and
+        under PeriDEM's damping every ghost's centre node (the damping reads it). No
         other ghost node can come within the cutoff of an own node, or of where one of them
         is, before the caps are picked again (each moves less than cap_margin/2), so a ghost
         node outside the cap stays where it was, out of every own node's contact, and out of
@@ -234,6 +251,9 @@ class DistributedRun:
         for q, nodes in self._receive_whole.items():
             near = nodes[close[nodes]]
             caps[q] = np.union1d(near, np.asarray(self.local.model.bond_partners(near.tolist())))
+            if self._damping_reach > 0:  # PeriDEM's damping reads every ghost's centre node
+                centres = self._node_map[self._damped_centres[self._receive_grains[q]]]
+                caps[q] = np.union1d(caps[q], centres)
         requests = [
             self.comm.isend(self._to_global[cap], dest=q, tag=_CAP_TAG) for q, cap in caps.items()
         ]
@@ -537,15 +557,21 @@ class DistributedRun:
             for q in range(self.comm.Get_size())
         ]
 
-    def _current_spheres(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        """Every grain's bounding sphere now, from its owner (one allgather)."""
+    def _current_spheres(
+        self,
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+        """Every grain's bounding sphere now and where its centre node is (PeriDEM's damping),
+        from its owner (one allgather)."""
         positions = self.local.core.positions
-        mine = _spheres([positions[self._local_slice(g)] for g in self._owned], self._sim.dimension)
-        centres = np.empty((len(self._slices), self._sim.dimension))
+        dimension = self._sim.dimension
+        mine = _spheres([positions[self._local_slice(g)] for g in self._owned], dimension)
+        points = positions[self._node_map[self._damped_centres[self._owned]], :dimension]
+        centres = np.empty((len(self._slices), dimension))
         radii = np.empty(len(self._slices))
-        for grains, (their_centres, their_radii) in self.comm.allgather((self._owned, mine)):
-            centres[grains], radii[grains] = their_centres, their_radii
-        return centres, radii
+        damped = np.empty((len(self._slices), dimension))
+        for grains, spheres, their_points in self.comm.allgather((self._owned, mine, points)):
+            centres[grains], radii[grains], damped[grains] = *spheres, their_points
+        return centres, radii, damped
 
     def _hand_over(
         self, held: NDArray[np.int64], wanted: list[NDArray[np.int64]], renew: bool
@@ -626,10 +652,13 @@ class DistributedRun:
 
         start = time.perf_counter()
         states, moment = self.comm.bcast(on_root(self.comm, read), root=0)
-        every = range(len(self._slices))
-        held = self._distribute(
-            *_spheres([states[g].positions for g in every], self._sim.dimension)
-        )
+        dimension = self._sim.dimension
+        grains = [states[g].positions for g in range(len(self._slices))]
+        damped = [
+            nodes[centre - where.start, :dimension]
+            for nodes, centre, where in zip(grains, self._damped_centres, self._slices, strict=True)
+        ]
+        held = self._distribute(*_spheres(grains, dimension), np.array(damped))
         together(self.comm, lambda: self._rebuild(held, states, moment))
         self._exchange_caps()
         self._loaded_walls = np.asarray(moment["contact_wall_reactions"]).reshape(-1, 6)
@@ -820,11 +849,9 @@ def _kinds(sim: Simulation) -> NDArray[np.int64]:
     return np.array(sorted(first.values()), dtype=np.int64)
 
 
-def _bounding_spheres(sim: Simulation) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """Every grain's bounding sphere (_spheres) at the start (its start state when one is
-    set)."""
-    start = sim._start[0] if sim._start is not None else sim._assembly.reference_positions()
-    return _spheres([start[body.node_slice] for body in sim.bodies], sim.dimension)
+def _start_positions(sim: Simulation) -> NDArray[np.float64]:
+    """Every node's position at the start: its start state when one is set."""
+    return sim._start[0] if sim._start is not None else sim._assembly.reference_positions()
 
 
 def _spheres(

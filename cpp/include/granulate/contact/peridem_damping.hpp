@@ -16,8 +16,12 @@
 //   each node k of a wall within Rc of a node of P (counted once):
 //     m_eq = rho_P A_P;  n = (x_k - x_P) / |x_k - x_P|;  f_P += beta min(0, (v_k - v_P).n) n / A_P
 //   f_P, a force density [N/m^3], is added to every node of P.
+// The particles Q are summed in particle order and the wall nodes in node order, so a
+// distributed run's part, which holds a subset of the particles in the same order, sums its
+// own particles' terms as the whole run does (PeriDEM sums in its search's order).
 #pragma once
 
+#include <cstdint>
 #include <vector>
 
 #include "granulate/model.hpp"
@@ -42,6 +46,9 @@ class PeridemDamping {
   /// One entry per particle of the model; pairs: material x material (row-major).
   void configure(const Model& model, std::vector<PeridemParticle> particles, std::vector<PeridemPair> pairs);
   bool active() const { return !particles_.empty(); }
+  /// The particles whose damping is not computed (a distributed run's ghosts: their owners
+  /// compute it); they still damp the others. Flags per particle, or empty for none.
+  void set_ghost_particles(std::vector<std::uint8_t> ghost) { ghost_ = std::move(ghost); }
   /// Adds the damping force densities to state.forces (deterministic for any thread count).
   void add_forces(const Model& model, State& state) const;
 
@@ -54,6 +61,7 @@ class PeridemDamping {
   std::vector<index_t> wall_nodes_;
   std::vector<index_t> centers_;          // centre nodes of the particles that are not walls
   std::vector<index_t> center_particle_;  // node -> particle, read at centre nodes only
+  std::vector<std::uint8_t> ghost_;       // per particle, or empty: none
 };
 
 }  // namespace granulate::contact
