@@ -15,8 +15,10 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
+from granulate.io.vtu import read_vtu_point_data
 from peridem_decks import broken_deck
 from run_folders import SEARCHES, differing, history, outputs
 from test_mpi import mpiexec
@@ -149,6 +151,41 @@ def test_a_case_restarting_from_a_frame_runs_on_ranks(serial_run: Path, tmp_path
         assert done.returncode == 0, done.stderr
     assert [row["step"] for row in history(tmp_path / "serial")] == ["1000", "1250", "1500"]
     assert_same_run(tmp_path / "serial", tmp_path / "ranks", row_count=3)
+
+
+def test_frames_in_pieces_join_to_the_serial_runs_frames(serial_run: Path, tmp_path: Path) -> None:
+    """`output: {pieces: true}` on 3 ranks: each frame a .pvtu over one piece per rank, each of
+    the nodes that rank owns (every node in one piece, its number the serial run's), which
+    joined (read_vtu_point_data, as Results reads them) are the serial run's one-file frames
+    bit for bit; the other files are the serial run's. Cut short at step 1,700 and resumed
+    on 2 ranks (whose frames have two pieces): the same."""
+    case = tmp_path / "drum_pieces.yaml"
+    case.write_text(
+        CASE.read_text().replace("output: {every: 250}", "output: {every: 250, pieces: true}")
+    )
+    done = granulate(tmp_path, "--out", "whole", ranks=3, case=case)
+    assert done.returncode == 0, done.stderr
+    cut = granulate(tmp_path, "--out", "cut", "--steps", "1700", ranks=3, case=case)
+    assert cut.returncode == 0, cut.stderr
+    resumed = granulate(tmp_path, "--out", "cut", "--resume", ranks=2, case=case)
+    assert resumed.returncode == 0, resumed.stderr
+    for name, last_pieces in (("whole", 3), ("cut", 2)):
+        frames = tmp_path / name / "frames"
+        for k in range(13):
+            expected = read_vtu_point_data(serial_run / "frames" / f"frame_{k:06d}.vtu")
+            joined = read_vtu_point_data(frames / f"frame_{k:06d}.pvtu")
+            np.testing.assert_array_equal(joined[0], expected[0])
+            assert joined[1].keys() == expected[1].keys()
+            for field, values in expected[1].items():
+                np.testing.assert_array_equal(joined[1][field], values)
+        pieces = sorted((frames / "frame_000012").iterdir())
+        assert [p.name for p in pieces] == [f"piece_{r}.vtu" for r in range(last_pieces)]
+        numbers = [read_vtu_point_data(p)[1]["Node_ID"] for p in pieces]
+        assert all(len(n) > 0 for n in numbers)
+        assert sorted(np.concatenate(numbers)) == list(range(len(expected[0])))
+        assert [p for p in differing(serial_run, tmp_path / name) if "frame_" not in p] == [
+            "simulation.pvd"
+        ]
 
 
 def test_a_peridem_deck_with_peridems_damping_runs_on_ranks(tmp_path: Path) -> None:

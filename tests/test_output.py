@@ -86,6 +86,49 @@ def test_bad_output_requests(tmp_path: Path) -> None:
         sim.output(tmp_path, every=0)
 
 
+def test_frames_in_pieces_are_the_one_file_frames(tmp_path: Path) -> None:
+    """Simulation.output(pieces=True) in a serial run: each frame a .pvtu over one piece
+    (frame_NNNNNN/piece_0.vtu) of every node with its number (Node_ID), listed in the PVD
+    series; read back (Results, restart's reader) it is the one-file frame bit for bit, and
+    the contact network's series keeps its .vtu names. --overwrite removes the pieces."""
+    pulled_plate(tmp_path / "one")
+    pulled_plate(tmp_path / "pieces", pieces=True)
+    frames = tmp_path / "pieces" / "frames"
+    assert sorted(f.name for f in frames.glob("frame_*.pvtu")) == [
+        f"frame_{k:06d}.pvtu" for k in range(5)
+    ]
+    assert [p.name for p in (frames / "frame_000004").iterdir()] == ["piece_0.vtu"]
+    piece = meshio.read(frames / "frame_000004" / "piece_0.vtu")
+    np.testing.assert_array_equal(piece.point_data["Node_ID"], np.arange(len(piece.points)))
+    one, pieces = gr.Results(tmp_path / "one"), gr.Results(tmp_path / "pieces")
+    for k in range(5):
+        a, b = one.frame(k), pieces.frame(k)
+        np.testing.assert_array_equal(a.positions, b.positions)
+        assert a.fields.keys() == b.fields.keys() == set(gr.FIELDS)
+        for name, values in a.fields.items():
+            assert values.dtype == b.fields[name].dtype
+            np.testing.assert_array_equal(values, b.fields[name])
+    chains = ET.parse(tmp_path / "pieces" / "contacts.pvd").getroot().iter("DataSet")
+    assert [d.get("file") for d in chains][-1] == "frames/contacts_000004.vtu"
+    pulled_plate(tmp_path / "pieces", overwrite=True)
+    assert not [p for p in frames.iterdir() if p.is_dir()]
+
+
+def test_a_parallel_frame_with_bad_pieces_is_refused(tmp_path: Path) -> None:
+    """A .pvtu whose piece is missing, or whose pieces number a node twice: one InputError
+    naming the file."""
+    pulled_plate(tmp_path, pieces=True)
+    frame = tmp_path / "frames" / "frame_000001.pvtu"
+    text = frame.read_text()
+    frame.write_text(text.replace("piece_0.vtu", "piece_9.vtu"))
+    with pytest.raises(gr.InputError, match=r"piece_9\.vtu"):
+        gr.Results(tmp_path).frame(1)
+    piece = '<Piece Source="frame_000001/piece_0.vtu"/>'
+    frame.write_text(text.replace(piece, 2 * piece))
+    with pytest.raises(gr.InputError, match=r"frame_000001\.pvtu: its pieces' Node_IDs"):
+        gr.Results(tmp_path).frame(1)
+
+
 def test_no_temporary_files_left(tmp_path: Path) -> None:
     pulled_plate(tmp_path)
     assert not list(tmp_path.rglob("*.tmp"))

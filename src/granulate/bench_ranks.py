@@ -116,10 +116,11 @@ def drum(grains: int) -> gr.Simulation:
     return sim
 
 
-def pile3d(grains: int) -> gr.Simulation:
-    """`grains` grains in 10 x 10 columns on a cubic lattice, on a floor."""
+def pile3d(grains: int, comm: Any = None) -> gr.Simulation:
+    """`grains` grains in 10 x 10 columns on a cubic lattice, on a floor (run on the ranks of
+    `comm`, given one: Simulation's)."""
     rng = np.random.default_rng(3)
-    sim = gr.Simulation(3, gravity=(0, -9.81, 0))
+    sim = gr.Simulation(3, gravity=(0, -9.81, 0), comm=comm)
     sim.contact = gr.Contact(restitution=0.5, friction=0.5)
     for k in range(grains):
         layer, rest = divmod(k, 100)

@@ -37,6 +37,7 @@ import numpy as np
 from granulate import fragments, network
 from granulate.errors import InputError
 from granulate.io.history import read_history
+from granulate.io.vtu import read_vtu_point_data
 from granulate.results import Results
 
 
@@ -225,18 +226,18 @@ def plot_breakage(results: Results) -> list[Path]:
 
 
 def _frames(directory: Path) -> list[Path]:
-    frames = sorted((directory / "frames").glob("frame_*.vtu"))
+    """A run's frames in order: frame_NNNNNN.vtu, or .pvtu when written in pieces."""
+    folder = directory / "frames"
+    frames = sorted([*folder.glob("frame_*.vtu"), *folder.glob("frame_*.pvtu")])
     if not frames:
         raise InputError(
-            f"{directory / 'frames'} holds no frame_*.vtu; give the output directory of a run"
+            f"{folder} holds no frame_*.vtu or .pvtu; give the output directory of a run"
         )
     return frames
 
 
 def render(directory: str | Path, *, frame: int | None = None, gif: bool = False) -> list[Path]:
     """Write PNG images of the frames (one, or all) and optionally an animated GIF."""
-    import meshio
-
     folder = Path(directory)
     frames = _frames(folder)
     if frame is not None:
@@ -248,17 +249,17 @@ def render(directory: str | Path, *, frame: int | None = None, gif: bool = False
     plt = _pyplot()
     out = folder / "renders"
     out.mkdir(exist_ok=True)
-    meshes = [meshio.read(f) for f in frames]
-    points = np.concatenate([m.points for m in meshes])
+    meshes = [read_vtu_point_data(f) for f in frames]
+    points = np.concatenate([positions for positions, _ in meshes])
     is_3d = bool(np.ptp(points[:, 2]) > 0)
     columns = (0, 2) if is_3d else (0, 1)
     lower, upper = points[:, columns].min(axis=0), points[:, columns].max(axis=0)
     margin = 0.05 * float(np.max(upper - lower) or 1.0)
     written = []
     images = []
-    for path, mesh in zip(frames, meshes, strict=True):
-        damage = mesh.point_data.get("Damage", np.zeros(len(mesh.points)))
-        volume = mesh.point_data.get("Nodal_Volume")
+    for path, (positions, point_data) in zip(frames, meshes, strict=True):
+        damage = point_data.get("Damage", np.zeros(len(positions)))
+        volume = point_data.get("Nodal_Volume")
         figure, axes = plt.subplots(
             figsize=(
                 6,
@@ -271,8 +272,8 @@ def render(directory: str | Path, *, frame: int | None = None, gif: bool = False
             4.0 if volume is None else np.clip(2e4 * (np.asarray(volume) / np.max(volume)), 1, 20)
         )
         dots = axes.scatter(
-            mesh.points[:, columns[0]],
-            mesh.points[:, columns[1]],
+            positions[:, columns[0]],
+            positions[:, columns[1]],
             c=damage,
             s=size,
             cmap="inferno_r",

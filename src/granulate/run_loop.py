@@ -88,6 +88,10 @@ class Stepper(Protocol):
     def save_checkpoint(self, sim: Simulation, path: Path, outputs: Outputs | None) -> Path:
         """The checkpoint at `path`; the path written."""
 
+    def write_pieces(self, folder: Path, fields: tuple[str, ...]) -> None:
+        """Each rank's piece of the frame about to be written, with `fields`, into
+        `folder`."""
+
 
 class CoreStepper:
     """A serial run: the simulation's own core, with nothing to agree on."""
@@ -126,6 +130,9 @@ class CoreStepper:
 
     def save_checkpoint(self, sim: Simulation, path: Path, outputs: Outputs | None) -> Path:
         return checkpoints.save(sim, path, outputs)
+
+    def write_pieces(self, folder: Path, fields: tuple[str, ...]) -> None:
+        pass  # a serial run's frame writer writes its one piece
 
 
 @dataclass(frozen=True)
@@ -259,7 +266,7 @@ def advance(sim: Simulation, plan: RunPlan, parts: LoopParts) -> str | None:
     if stepper.agree(out is not None and out.frames == 0):
         stepper.first_forces()  # the forces of step 0 (prescribed motion, contact), for the frame
         stepper.collect()
-        stepper.on_root(lambda: out.write_step(sim) if out is not None else None)
+        write_outputs(stepper, sim, out)
     target = stepper.step + plan.steps
     first_step = stepper.step
     most = threads.get_num_threads()
@@ -285,9 +292,24 @@ def advance(sim: Simulation, plan: RunPlan, parts: LoopParts) -> str | None:
         parts.record.wall_seconds += wallclock.perf_counter() - start
         parts.record.steps_run += stepper.step - first_step
     stepper.collect()  # the end state in the simulation (rank 0's, in a distributed run)
-    frame = plan.write_final or reason is not None
-    stepper.on_root(lambda: out.write_final(sim, frame=frame) if out is not None else None)
+    write_outputs(stepper, sim, out, final=plan.write_final or reason is not None)
     return reason
+
+
+def write_outputs(
+    stepper: Stepper, sim: Simulation, out: Outputs | None, final: bool | None = None
+) -> None:
+    """The current step's outputs, written by rank 0 (Outputs.write_step; with `final`,
+    write_final with that frame flag) once every rank has written its piece of the frame
+    they write, when the frames go in pieces written by the ranks."""
+    folder = out.piece_folder(stepper.step, final) if out is not None else None
+    pieces = stepper.agree(None if folder is None or out is None else (folder, out.fields))
+    if pieces is not None:
+        stepper.write_pieces(*pieces)
+    if final is None:
+        stepper.on_root(lambda: out.write_step(sim) if out is not None else None)
+    else:
+        stepper.on_root(lambda: out.write_final(sim, frame=final) if out is not None else None)
 
 
 class _Chunks:
@@ -328,7 +350,7 @@ class _Chunks:
         if writes or checks:
             stepper.collect()
         if writes:
-            stepper.on_root(lambda: out.write_step(sim) if out is not None else None)
+            write_outputs(stepper, sim, out)
         reason = None
         if checks:
             reason = stepper.on_root(

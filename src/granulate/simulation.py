@@ -358,6 +358,8 @@ class Simulation(SimulationSetup, SimulationResults):
             return run_loop.CoreStepper(self.core)
         from granulate.parallel.stepper import DistributedStepper
 
+        if self._output is not None:  # rank 0's: each rank writes its piece of a frame
+            self._output.piece_ranks = self._comm.Get_size()
         return DistributedStepper(self._distributed_run())
 
     def _distributed_run(self) -> DistributedRun:

@@ -389,6 +389,7 @@ class SimulationSetup:
         history_every: int | None = None,
         track: Sequence[Body | str] = (),
         track_areas: Mapping[str, float] | None = None,
+        pieces: bool = False,
     ) -> None:
         """Write VTU frames (``frames/``), ``simulation.pvd`` and particle snapshots
         (``frames/particles_*.csv``) every ``every`` steps, and a row of ``history.csv`` every
@@ -403,6 +404,13 @@ class SimulationSetup:
         names to a nominal area [m^2; m in 2D, per unit thickness], for which history.csv also
         records ``<name>_stress``, the magnitude of that resultant over the area [Pa] (a loading
         platen's stress, as ``Wall(area=)`` gives a wall's).
+
+        ``pieces``: each frame is ``frames/frame_NNNNNN.pvtu`` over pieces
+        ``frames/frame_NNNNNN/piece_R.vtu``, one written by each rank of a distributed run (of
+        the nodes of the grains it owns, with their numbers in the whole run, ``Node_ID``), one
+        in a serial run, rather than one ``.vtu`` written by rank 0 from the whole state.
+        ParaView opens the series as before; granulate.Results and ``restart:`` join the
+        pieces in the nodes' order.
 
         A directory that already holds a run (simulation.pvd or frames) is refused unless
         ``overwrite`` is true (the old run is deleted when the new one starts writing, so an
@@ -424,6 +432,7 @@ class SimulationSetup:
                 self._interactions.wall_names,
                 overwrite=overwrite,
                 resume=resume,
+                pieces=pieces,
             )
 
         if self._comm is None:

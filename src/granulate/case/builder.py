@@ -351,6 +351,7 @@ def _set_outputs(
             history_every=o.history_every,
             track=[_named(t, named, "output.track") for t in o.track],
             track_areas=o.track_areas,
+            pieces=o.pieces,
         )
     if spec.checkpoint is not None:
         sim.checkpoint_every(spec.checkpoint.every_steps, minutes=spec.checkpoint.every_minutes)

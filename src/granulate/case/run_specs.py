@@ -253,6 +253,10 @@ class OutputSpec(Spec):
         description="nominal areas of tracked bodies, for <name>_stress in history.csv "
         "[m^2; m in 2D]",
     )
+    pieces: bool = Field(
+        False,
+        description="frames as .pvtu over pieces, one written by each MPI rank (one serially)",
+    )
 
     @model_validator(mode="after")
     def _areas_of_tracked(self) -> OutputSpec:

@@ -16,7 +16,7 @@ from granulate.resources import size_text
 LOCK = ".granulate.lock"
 #: What a run writes (replaced together with --overwrite).
 RUN_FILES = ("simulation.pvd", "contacts.pvd", "history.csv", "run.json", "checkpoint.npz")
-FRAME_PATTERNS = ("frame_*.vtu", "particles_*.csv")
+FRAME_PATTERNS = ("frame_*.vtu", "frame_*.pvtu", "particles_*.csv")
 
 
 def _holds_run(path: Path) -> bool:
@@ -125,6 +125,9 @@ class RunFolder:
             for pattern in FRAME_PATTERNS:
                 for old in (self.path / "frames").glob(pattern):
                     old.unlink()
+            for pieces in (self.path / "frames").glob("frame_*"):  # frames written in pieces
+                if pieces.is_dir():
+                    shutil.rmtree(pieces)
             self.clean_temporaries()
 
     def stop_writing(self) -> None:
@@ -135,7 +138,8 @@ class RunFolder:
 
     def clean_temporaries(self) -> None:
         """Remove the temporary files of atomic writes that were interrupted (.<name>.*.tmp)."""
-        for folder in (self.path, self.path / "frames"):
+        pieces = [p for p in self.path.glob("frames/frame_*") if p.is_dir()]
+        for folder in (self.path, self.path / "frames", *pieces):
             if folder.is_dir():
                 for temporary in folder.glob(".*.tmp"):
                     temporary.unlink(missing_ok=True)

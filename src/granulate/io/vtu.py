@@ -1,8 +1,11 @@
-"""VTK XML unstructured grids (.vtu) of nodes, and .pvd time series, for ParaView.
+"""VTK XML unstructured grids (.vtu) of nodes, parallel ones (.pvtu: pieces written by several
+processes) and .pvd time series, for ParaView.
 
 Binary appended data, zlib-compressed in blocks (header_type UInt64), as VTK writes it:
 each array is [number of blocks, block size, size of the last block, compressed sizes...]
-followed by the compressed blocks. Nodes are written as VTK_VERTEX cells.
+followed by the compressed blocks. Nodes are written as VTK_VERTEX cells. A .pvtu lists its
+pieces' files and the arrays each holds; granulate's pieces carry each node's number in the
+whole run (NODE_ID), by which read_vtu_point_data puts their nodes back in order.
 """
 
 from __future__ import annotations
@@ -10,7 +13,7 @@ from __future__ import annotations
 import os
 import zlib
 from base64 import b64decode
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
@@ -165,6 +168,43 @@ def write_vtu(
     head = "\n".join(xml).encode() + b"\n_"
     tail = b"\n</AppendedData>\n</VTKFile>\n"
     atomic_write(path, [head, *(chunk for payload in payloads for chunk in payload), tail])
+
+
+#: The point array of a frame's piece that numbers its nodes as the whole run does.
+NODE_ID = "Node_ID"
+
+
+def write_pvtu(
+    path: str | os.PathLike[str],
+    pieces: Sequence[str],
+    point_arrays: Sequence[tuple[str, np.dtype[np.generic], int]],
+) -> None:
+    """Write a parallel VTU (.pvtu, atomically) listing `pieces` (.vtu files of points as
+    write_vtu writes them, paths relative to the .pvtu's folder) whose point data holds
+    `point_arrays` (name, dtype, components) each."""
+    arrays = [
+        f'<PDataArray type="{_VTK_TYPES[np.dtype(dtype)]}" Name={quoteattr(name)}'
+        + (f' NumberOfComponents="{components}"' if components > 1 else "")
+        + "/>"
+        for name, dtype, components in point_arrays
+    ]
+    xml = [
+        '<?xml version="1.0"?>',
+        '<VTKFile type="PUnstructuredGrid" version="1.0" byte_order="LittleEndian" '
+        'header_type="UInt64">',
+        '<PUnstructuredGrid GhostLevel="0">',
+        "<PPointData>",
+        *arrays,
+        "</PPointData>",
+        "<PPoints>",
+        '<PDataArray type="Float64" NumberOfComponents="3"/>',
+        "</PPoints>",
+        *(f"<Piece Source={quoteattr(Path(piece).as_posix())}/>" for piece in pieces),
+        "</PUnstructuredGrid>",
+        "</VTKFile>",
+        "",
+    ]
+    atomic_write(path, "\n".join(xml).encode())
 
 
 class PvdSeries:
@@ -325,8 +365,12 @@ def read_vtu_point_data(
 ) -> tuple[NDArray[np.float64], dict[str, NDArray[np.generic]]]:
     """Points and point data of a .vtu file: appended data (raw or base64, plain or with VTK's
     zlib blocks, UInt32 or UInt64 headers) or inline ASCII arrays; this writer's frames and
-    PeriDEM's output files. Raises InputError naming the problem otherwise."""
+    PeriDEM's output files. A .pvtu's pieces are read and joined, in the whole run's node order
+    when every piece numbers its nodes (NODE_ID, then left out), else in piece order. Raises
+    InputError naming the problem otherwise."""
     source = Path(path)
+    if source.suffix == ".pvtu":
+        return _read_pvtu(source)
     try:
         data = source.read_bytes()
     except OSError as error:
@@ -360,3 +404,31 @@ def read_vtu_point_data(
     except (ValueError, IndexError, zlib.error) as error:
         raise InputError(f"{source}: damaged data ({error})") from None
     return points, point_data
+
+
+def _read_pvtu(
+    source: Path,
+) -> tuple[NDArray[np.float64], dict[str, NDArray[np.generic]]]:
+    """A .pvtu's pieces joined (read_vtu_point_data)."""
+    try:
+        root = ElementTree.parse(source).getroot()
+    except OSError as error:
+        raise InputError(f"cannot read {source}: {error.strerror or error}") from None
+    except ElementTree.ParseError as error:
+        raise InputError(f"{source} is not a parallel VTU file: {error}") from None
+    names = [piece.get("Source", "") for piece in root.iter("Piece")]
+    if root.get("type") != "PUnstructuredGrid" or not names:
+        raise InputError(f"{source} is not a parallel VTU file with pieces")
+    pieces = [read_vtu_point_data(source.parent / name) for name in names]
+    fields = set(pieces[0][1])
+    if any(set(data) != fields for _, data in pieces):
+        raise InputError(f"{source}: its pieces hold different point arrays")
+    points = np.concatenate([points for points, _ in pieces])
+    data = {name: np.concatenate([d[name] for _, d in pieces]) for name in pieces[0][1]}
+    numbers = data.pop(NODE_ID, None)
+    if numbers is None:
+        return points, data
+    order = np.argsort(numbers, kind="stable")
+    if not np.array_equal(numbers[order], np.arange(len(numbers))):
+        raise InputError(f"{source}: its pieces' {NODE_ID}s are not the nodes 0 .. n-1 once each")
+    return points[order], {name: values[order] for name, values in data.items()}

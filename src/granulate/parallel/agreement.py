@@ -18,9 +18,10 @@ class RankFailed(RuntimeError):
     own error)."""
 
 
-def together(comm: Any, action: Callable[[], T]) -> T:
+def together(comm: Any, action: Callable[[], T], doing: str = "building its part") -> T:
     """action() on every rank; when it raised on some rank, every rank stops: the first such
-    rank with its own error, the others with RankFailed naming it (one reduction)."""
+    rank with its own error, the others with RankFailed naming it and what it was `doing`
+    (one reduction)."""
     from mpi4py import MPI
 
     failure, result = None, None
@@ -33,7 +34,7 @@ def together(comm: Any, action: Callable[[], T]) -> T:
     if failure is not None:
         raise failure
     if first < size:
-        raise RankFailed(f"rank {first} failed while building its part; every rank stops")
+        raise RankFailed(f"rank {first} failed while {doing}; every rank stops")
     return result  # type: ignore[return-value]
 
 

@@ -50,6 +50,7 @@ from granulate.parallel.transplant import (
     wall_lists,
 )
 from granulate.parallel.whole_state import install, owned_part
+from granulate.writers.vtu_frame import write_piece
 
 if TYPE_CHECKING:
     from granulate.simulation import Simulation
@@ -664,6 +665,13 @@ class DistributedRun:
         self._loaded_walls = np.asarray(moment["contact_wall_reactions"]).reshape(-1, 6)
         self._migration_due = False
         self.seconds["migrate"] += time.perf_counter() - start
+
+    def write_piece(self, folder: Path, fields: tuple[str, ...]) -> None:
+        """This rank's piece of a frame in pieces (writers/vtu_frame.py): its own nodes now,
+        with `fields`, numbered as the whole run numbers them, as folder/piece_<rank>.vtu."""
+        numbering = (self._to_global, self.held)
+        path = Path(folder) / f"piece_{self.comm.Get_rank()}.vtu"
+        write_piece(path, self.local, fields, self._owned_nodes, numbering)
 
     def wall_reactions(self) -> NDArray[np.float64]:
         """(walls, 6): the force and torque on each wall from the last step [N, N m; per unit

@@ -9,7 +9,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING, TypeVar
 
-from granulate.parallel.agreement import on_root
+from granulate.parallel.agreement import on_root, together
 
 if TYPE_CHECKING:
     from granulate.parallel.engine import DistributedRun
@@ -57,3 +57,6 @@ class DistributedStepper:
 
     def save_checkpoint(self, sim: Simulation, path: Path, outputs: Outputs | None) -> Path:
         return self.run.save_checkpoint(path, outputs)
+
+    def write_pieces(self, folder: Path, fields: tuple[str, ...]) -> None:
+        together(self.comm, lambda: self.run.write_piece(folder, fields), "writing its piece")

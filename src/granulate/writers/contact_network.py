@@ -4,6 +4,7 @@ contact point on a wall) and contacts.pvd, whose entries follow simulation.pvd's
 
 from __future__ import annotations
 
+from pathlib import PurePosixPath
 from typing import TYPE_CHECKING
 
 from granulate import network
@@ -27,6 +28,7 @@ class ContactNetwork:
             cell_data=network.chain_fields(data.contacts),
         )
         chains = PvdSeries(outputs.directory / "contacts.pvd")
-        for t, name in outputs.pvd.entries:
-            chains.entries.append((t, name.replace("/frame_", "/contacts_")))
+        for t, name in outputs.pvd.entries:  # frames/frame_NNNNNN.vtu, or .pvtu (pieces)
+            chain = PurePosixPath(name.replace("/frame_", "/contacts_")).with_suffix(".vtu")
+            chains.entries.append((t, str(chain)))
         chains.write()

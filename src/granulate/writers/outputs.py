@@ -42,6 +42,11 @@ class Outputs:
     frame_step: int = -1  # the step of the last frame written (-1: none in this process)
     history_step: int = -1  # likewise for the last history row
     seconds: float = 0.0  # wall-clock seconds spent writing frames and rows
+    #: Frames as a .pvtu over pieces (vtu_frame.py) rather than one .vtu each.
+    pieces: bool = False
+    #: The ranks that write a frame's pieces (a distributed run's), or 0: the frame writer
+    #: writes the one piece of a serial run itself.
+    piece_ranks: int = 0
 
     @classmethod
     def plan(
@@ -56,6 +61,7 @@ class Outputs:
         *,
         overwrite: bool,
         resume: bool,
+        pieces: bool = False,
     ) -> Outputs:
         """The outputs Simulation.output asks for, checked (InputError), in their folder
         (RunFolder: a run already there is refused unless `overwrite` or `resume`)."""
@@ -78,7 +84,11 @@ class Outputs:
             raise InputError(f"unknown output fields {unknown}; choose from {', '.join(FIELDS)}")
         folder = RunFolder(directory, overwrite=overwrite, resume=resume)
         pvd = PvdSeries(directory / "simulation.pvd")
-        return cls(directory, every, tuple(fields), pvd, history_every, folder, tracked, areas)
+        if not isinstance(pieces, bool):
+            raise InputError(f"pieces must be true or false, got {pieces!r}")
+        outputs = cls(directory, every, tuple(fields), pvd, history_every, folder, tracked, areas)
+        outputs.pieces = pieces
+        return outputs
 
     def is_output_step(self, step: int) -> bool:
         """Whether `step` writes a frame or a history row."""
@@ -88,13 +98,27 @@ class Outputs:
         """Steps from `step` to the next frame or history row."""
         return min(self.every - step % self.every, self.history_every - step % self.history_every)
 
+    def frame_due(self, step: int, final: bool | None = None) -> bool:
+        """Whether the outputs of `step` write a frame: write_step's (final None), or
+        write_final's with its `frame` flag (`final`)."""
+        if final is None:
+            return step % self.every == 0 or self.frames == 0
+        return final and self.frame_step != step
+
+    def piece_folder(self, step: int, final: bool | None = None) -> Path | None:
+        """The folder of the pieces the ranks write of the frame `step`'s outputs write
+        (frame_due), or None when there is none or it is not written by ranks."""
+        if not (self.pieces and self.piece_ranks and self.frame_due(step, final)):
+            return None
+        return self.directory / "frames" / f"frame_{self.frames:06d}"
+
     def write_step(self, sim: Simulation) -> None:
         """The frame (at a frame step, or the first) and the history row (at a history step,
         or the first) of the current step."""
-        step = sim.core.step
+        step = int(sim.core.step)
         self.write(
             sim,
-            step % self.every == 0 or self.frames == 0,
+            self.frame_due(step),
             step % self.history_every == 0 or self.history is None,
         )
 
@@ -102,7 +126,7 @@ class Outputs:
         """The end of a run: with ``frame``, the frame and history row of the last step when
         it was not an output step."""
         step = int(sim.core.step)
-        self.write(sim, frame and self.frame_step != step, frame and self.history_step != step)
+        self.write(sim, self.frame_due(step, frame), frame and self.history_step != step)
 
     def write(self, sim: Simulation, frame: bool, history: bool) -> None:
         """The frame and the history row of the current step, as asked, from one StepData."""

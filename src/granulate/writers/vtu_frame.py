@@ -1,13 +1,26 @@
-"""frames/frame_NNNNNN.vtu, the nodes with the chosen point fields, listed in simulation.pvd."""
+"""frames/frame_NNNNNN.vtu, the nodes with the chosen point fields, listed in simulation.pvd.
+
+With Simulation.output(pieces=True) a frame is frames/frame_NNNNNN.pvtu instead, over pieces
+frames/frame_NNNNNN/piece_R.vtu: one per rank of a distributed run, written by that rank, of
+the nodes of the grains it owns (one piece of every node in a serial run). A piece's nodes
+carry their numbers in the whole run (io.vtu.NODE_ID), and Particle_ID and Fragment_ID name
+the whole run's particles and fragments, so the pieces joined are the one-file frame.
+"""
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+import numpy as np
+from numpy.typing import NDArray
+
 from granulate.io import write_vtu
+from granulate.io.vtu import NODE_ID, write_pvtu
 
 if TYPE_CHECKING:
+    from granulate.simulation import Simulation
     from granulate.writers.outputs import Outputs
     from granulate.writers.step_data import StepData
 
@@ -25,32 +38,106 @@ FIELDS = (
     "Fixity",
     "Nodal_Volume",
 )
+#: Each field's type and number of components, as a frame writes it.
+FIELD_TYPES: dict[str, tuple[np.dtype[np.generic], int]] = {
+    "Displacement": (np.dtype(np.float64), 3),
+    "Velocity": (np.dtype(np.float64), 3),
+    "Force_Density": (np.dtype(np.float64), 3),
+    "Force": (np.dtype(np.float64), 3),
+    "Damage": (np.dtype(np.float64), 1),
+    "Damage_Z": (np.dtype(np.float64), 1),
+    "Dilatation": (np.dtype(np.float64), 1),
+    "Particle_ID": (np.dtype(np.uint32), 1),
+    "Fragment_ID": (np.dtype(np.uint32), 1),
+    "Fixity": (np.dtype(np.uint8), 1),
+    "Nodal_Volume": (np.dtype(np.float64), 1),
+}
+#: A piece's node numbers in the whole run.
+_NODE_ID_TYPE = np.dtype(np.int64)
+
+#: A part's node and particle numbers in the whole run (a distributed run's rank holds a part).
+Numbering = tuple[NDArray[np.int64], NDArray[np.int64]]
+
+
+def point_fields(
+    sim: Simulation,
+    fields: tuple[str, ...],
+    damage: tuple[NDArray[np.float64], NDArray[np.float64]],
+    numbering: Numbering | None = None,
+) -> dict[str, NDArray[np.generic]]:
+    """The point fields `fields` of every node of `sim` (FIELD_TYPES); `damage`: phi and
+    PeriDEM's Z per node (core.damage()); `numbering`: how the whole run numbers the nodes and
+    particles of `sim` when it is a part (Particle_ID and Fragment_ID are the whole run's)."""
+    core, model = sim.core, sim.model
+    volumes = model.volumes
+
+    def particles() -> NDArray[np.generic]:
+        owner = np.asarray(model.node_particle)
+        return owner if numbering is None else numbering[1][owner]
+
+    def fragments() -> NDArray[np.generic]:
+        labels = sim.analysis.fragment_labels()  # a piece's smallest node, of one particle
+        return labels if numbering is None else numbering[0][labels]
+
+    available: dict[str, Callable[[], NDArray[np.generic]]] = {
+        "Displacement": lambda: sim.displacements,
+        "Velocity": lambda: core.velocities,
+        "Force_Density": lambda: core.forces,
+        "Force": lambda: core.forces * volumes[:, None],
+        "Damage": lambda: damage[0],
+        "Damage_Z": lambda: damage[1],
+        "Dilatation": lambda: core.dilatation,
+        "Particle_ID": particles,
+        "Fragment_ID": fragments,
+        "Fixity": lambda: core.fixity(),
+        "Nodal_Volume": lambda: volumes,
+    }
+    return {f: np.asarray(available[f](), dtype=FIELD_TYPES[f][0]) for f in fields}
+
+
+def write_piece(
+    path: Path,
+    sim: Simulation,
+    fields: tuple[str, ...],
+    nodes: NDArray[np.int64] | None = None,
+    numbering: Numbering | None = None,
+) -> None:
+    """One piece of a frame: the nodes `nodes` of `sim` (all when None), their `fields` and
+    their numbers in the whole run (`numbering`, for a part of a distributed run)."""
+    values = point_fields(sim, fields, sim.core.damage(), numbering)
+    chosen = np.arange(sim.node_count) if nodes is None else nodes
+    numbers = chosen if numbering is None else numbering[0][chosen]
+    path.parent.mkdir(parents=True, exist_ok=True)
+    write_vtu(
+        path,
+        sim.core.positions[chosen],
+        {
+            **{name: field[chosen] for name, field in values.items()},
+            NODE_ID: numbers.astype(_NODE_ID_TYPE),
+        },
+    )
 
 
 class VtuFrame:
-    """The node frame: positions and the fields of ``Simulation.output(fields=...)``."""
+    """The node frame: positions and the fields of ``Simulation.output(fields=...)``, in one
+    file or in pieces (module docstring)."""
 
     def write(self, data: StepData, outputs: Outputs) -> None:
         sim = data.simulation
-        core, model = sim.core, sim.model
-        volumes = model.volumes
-        available = {
-            "Displacement": lambda: sim.displacements,
-            "Velocity": lambda: core.velocities,
-            "Force_Density": lambda: core.forces,
-            "Force": lambda: core.forces * volumes[:, None],
-            "Damage": lambda: data.damage,
-            "Damage_Z": lambda: data.damage_z,
-            "Dilatation": lambda: core.dilatation,
-            "Particle_ID": lambda: model.node_particle,
-            "Fragment_ID": sim.analysis.fragment_labels,
-            "Fixity": lambda: core.fixity(),
-            "Nodal_Volume": lambda: volumes,
-        }
-        name = f"frame_{outputs.frames:06d}.vtu"
-        write_vtu(
-            outputs.directory / "frames" / name,
-            core.positions,
-            {f: available[f]() for f in outputs.fields},
-        )
-        outputs.pvd.add(core.time, Path("frames") / name)
+        name = f"frame_{outputs.frames:06d}"
+        frames = outputs.directory / "frames"
+        if not outputs.pieces:
+            values = point_fields(sim, outputs.fields, (data.damage, data.damage_z))
+            write_vtu(frames / f"{name}.vtu", sim.core.positions, values)
+            outputs.pvd.add(sim.core.time, Path("frames") / f"{name}.vtu")
+            return
+        if not outputs.piece_ranks:  # a serial run's one piece; else the ranks wrote theirs
+            write_piece(frames / name / "piece_0.vtu", sim, outputs.fields)
+        count = outputs.piece_ranks or 1
+        pieces = [f"piece_{r}.vtu" for r in range(count)]
+        for stale in (frames / name).glob("piece_*.vtu"):  # of a run cut short on more ranks
+            if stale.name not in pieces:
+                stale.unlink()
+        arrays = [(f, *FIELD_TYPES[f]) for f in outputs.fields] + [(NODE_ID, _NODE_ID_TYPE, 1)]
+        write_pvtu(frames / f"{name}.pvtu", [f"{name}/{piece}" for piece in pieces], arrays)
+        outputs.pvd.add(sim.core.time, Path("frames") / f"{name}.pvtu")
