@@ -696,15 +696,15 @@ void ContactModel::sum_slot_stiffness() {
   }
   body_motion_.resize(touching_bodies_.size());
   body_load_.resize(touching_bodies_.size());
-  release_excess(body_motion_);
-  release_excess(body_load_);
+  fit_exactly(body_motion_);
+  fit_exactly(body_load_);
   slot_force_.assign(in_contact, 0.0);
   slot_normal_.assign(in_contact, vec3{0, 0, 0});
   slot_point_.assign(in_contact, vec3{0, 0, 0});
   slot_surface_normal_.assign(in_contact, vec3{0, 0, 0});
   slot_load_.assign(in_contact, vec3{0, 0, 0});
-  release_excess(slot_force_);
-  for (auto* v : {&slot_normal_, &slot_point_, &slot_surface_normal_, &slot_load_}) release_excess(*v);
+  fit_exactly(slot_force_);
+  for (auto* v : {&slot_normal_, &slot_point_, &slot_surface_normal_, &slot_load_}) fit_exactly(*v);
 }
 
 void ContactModel::measure_bodies(const Model& model, const State& state) {

@@ -32,4 +32,12 @@ void release_excess(std::vector<T>& v) {
   if (v.capacity() > 2 * v.size() + 64) v.shrink_to_fit();
 }
 
+/// Keeps a vector's capacity at its size: for the per-step arrays of the touching bodies and
+/// contacts, whose few entries are cheap to reallocate when their count changes, so that their
+/// memory is what the step needs rather than what the busiest step of the run did.
+template <class T>
+void fit_exactly(std::vector<T>& v) {
+  if (v.capacity() > v.size()) v.shrink_to_fit();
+}
+
 }  // namespace granulate::contact_vectors
