@@ -71,6 +71,18 @@ def test_a_blow_up_is_caught_on_the_step_it_happens() -> None:
     assert sim.step < 20
 
 
+def test_a_blow_up_quotes_the_estimate_it_is_given() -> None:
+    """A distributed run's part quotes the whole run's stable estimate, which its own grains
+    need not give (core.set_reported_stable_time_step; DistributedRun sets it); 0 restores
+    the part's own."""
+    probe = plate()
+    for given, quoted in ((1.25e-7, "1.25e-07"), (0.0, f"{probe.stable_dt:.6g}")):
+        sim = plate(dt=5 * probe.stable_dt)
+        sim.core.set_reported_stable_time_step(given)
+        with pytest.raises(gr.InstabilityError, match=f"the stable estimate is {quoted} s"):
+            sim.run(20)
+
+
 def test_a_non_finite_velocity_stops_the_run_at_once() -> None:
     """An initial velocity of 1e308 m/s: an InstabilityError at step 1 (a 60-step run ended
     "finished" with NaN energies)."""

@@ -351,7 +351,8 @@ void Simulation::check_stability() const {
             << " m per step";
       else
         msg << " has a non-finite position or velocity";
-      msg << ". The time step is " << time_step_ << " s and the stable estimate is " << stable_time_step()
+      const real estimate = reported_stable_time_step_ > 0 ? reported_stable_time_step_ : stable_time_step();
+      msg << ". The time step is " << time_step_ << " s and the stable estimate is " << estimate
           << " s; use a smaller time step, a slower loading or smaller initial velocities";
       throw InstabilityError(msg.str());
     }

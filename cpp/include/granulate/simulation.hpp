@@ -137,6 +137,9 @@ class Simulation {
   /// part names them as the whole run does): one per node and one per particle; empty, their
   /// own indices. InputError for the wrong sizes.
   void set_reported_numbers(std::vector<index_t> nodes, std::vector<index_t> particles);
+  /// The stable time-step estimate [s] error messages quote (a distributed run's part quotes
+  /// the whole run's, which its own grains and ghosts do not give); 0: its own.
+  void set_reported_stable_time_step(real estimate) { reported_stable_time_step_ = estimate; }
   /// From now on each step measures how far the farthest node is from where it is now [m]
   /// (largest_travel), in its last half kick: a distributed run's check that its ghosts still
   /// hold. Off until called (a serial run measures nothing).
@@ -190,6 +193,7 @@ class Simulation {
   std::vector<std::uint8_t> ghost_;  // per particle: 1 if another process evaluates it;
                                      // empty when none is
   std::vector<index_t> reported_node_, reported_particle_;  // set_reported_numbers; or empty
+  real reported_stable_time_step_ = 0;                      // set_reported_stable_time_step
   std::vector<real> travel_origin_;  // positions largest_travel is measured from; or empty
   real largest_travel_ = 0;
   std::vector<std::array<index_t, 2>> breaks_;  // the bonds pass 1 (and the owners) broke

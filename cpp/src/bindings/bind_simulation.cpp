@@ -158,6 +158,8 @@ void bind_loading(nb::class_<Simulation>& cls) {
           "Leave these nodes out of the contact lists (ContactModel::set_inert_nodes); [] for none.")
       .def("set_reported_numbers", &Simulation::set_reported_numbers, "nodes"_a, "particles"_a,
            "The node and particle numbers error messages give (Simulation::set_reported_numbers).")
+      .def("set_reported_stable_time_step", &Simulation::set_reported_stable_time_step, "estimate"_a,
+           "The stable time-step estimate [s] error messages quote; 0: the simulation's own.")
       .def("set_travel_origin", &Simulation::set_travel_origin,
            "Measure each step how far the farthest node is from where it is now (largest_travel).")
       .def_prop_ro("largest_travel", &Simulation::largest_travel,

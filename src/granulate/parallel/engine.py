@@ -204,6 +204,7 @@ class DistributedRun:
         ghost_particles = np.flatnonzero(owner[self.held] != rank)  # the part's particle order
         self.local.core.set_ghost_particles(ghost_particles.tolist())
         self.local.core.set_reported_numbers(self._to_global.tolist(), self.held.tolist())
+        self.local.core.set_reported_stable_time_step(self.stable_dt)
         self._owned_nodes = self._nodes_of(self._owned, node_map)
         self._is_owned = _mask(len(self._to_global), self._owned_nodes)
         self._send_grains = {
