@@ -9,6 +9,7 @@ import pytest
 
 import granulate as gr
 from granulate.parallel import bisect, ghosts, near_pairs
+from granulate.parallel.partition import near_nodes, near_pairs_with_large
 
 
 def grains(count: int, dimension: int, seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
@@ -67,6 +68,47 @@ def test_bisection_does_not_depend_on_the_order_of_the_grains() -> None:
     permuted = bisect(centres[permutation], radii[permutation] ** 3, 6).owner
     np.testing.assert_array_equal(first, again)
     np.testing.assert_array_equal(permuted, first[permutation])
+
+
+def wall_nodes(dimension: int, axis: int) -> np.ndarray:
+    """A box wall's nodes, 0.5 mm apart (1 mm in 3D) over its 50 mm side(s): the plane where
+    coordinate `axis` is 0."""
+    line = np.arange(0, 0.05, 0.5e-3 if dimension == 2 else 1e-3)
+    grid = np.meshgrid(*[line] * (dimension - 1), indexing="ij")
+    nodes = np.zeros((grid[0].size, 3))
+    others = [k for k in range(dimension) if k != axis]
+    for k, g in zip(others, grid, strict=True):
+        nodes[:, k] = g.ravel()
+    return nodes
+
+
+@pytest.mark.parametrize("dimension", [2, 3])
+def test_a_large_bodys_pairs_are_the_grains_its_nodes_come_near(dimension: int) -> None:
+    """Two large bodies (the floor and a side of a box of 50 mm, as nodes) among 1,500 grains:
+    a grain is paired with a wall when one of the wall's nodes lies within the largest grain
+    radius plus the reach of its centre (not when the walls' bounding spheres, which hold the
+    whole box, reach it); other pairs as near_pairs finds them."""
+    centres, radii = grains(1500, dimension)
+    reach = 0.3e-3
+    walls = [wall_nodes(dimension, 1), wall_nodes(dimension, 0)]
+    large = np.array([1500, 1501])
+    every_centre = np.vstack([centres, [w[len(w) // 2, :dimension] for w in walls]])
+    every_radius = np.concatenate([radii, [0.04, 0.04]])
+    found = [
+        near_nodes(every_centre, every_radius, reach, g, w, large)
+        for g, w in zip(large, walls, strict=True)
+    ]
+    large_pairs = tuple(np.concatenate([f[k] for f in found]) for k in (0, 1))
+    first, last = near_pairs_with_large(every_centre, every_radius, reach, large, large_pairs)
+    expected = [tuple(pair) for pair in brute_force_pairs(centres, radii, reach)]
+    expected.append((1500, 1501))
+    for k, w in enumerate(walls):
+        c, x = centres, w[:, :dimension]
+        gap2 = (c**2).sum(1)[:, None] - 2 * c @ x.T + (x**2).sum(1)[None]
+        near = np.flatnonzero(gap2.min(axis=1) <= (radii.max() + reach) ** 2)
+        assert 20 < len(near) < 300
+        expected += [(int(g), 1500 + k) for g in near]
+    assert sorted(zip(first.tolist(), last.tolist(), strict=True)) == sorted(expected)
 
 
 @pytest.mark.parametrize("dimension", [2, 3])

@@ -165,7 +165,7 @@ class Interactions:
         """PeriDEM's damping per pair of core materials: beta_n = factor x (-2 ln e /
         sqrt(pi^2 + ln^2 e)), the harmonic mean of the bulk moduli, the contact radius
         (contact/peridem_damping.hpp)."""
-        walls = {self._assembly.body(b).index for b in self.peridem_walls}
+        walls = set(self.peridem_wall_indices())
         centers, radii = self._assembly.centres_and_radii()
         count = len(materials)
         betan, kappa, radius = np.zeros((3, count, count))
@@ -189,6 +189,10 @@ class Interactions:
             kappa.ravel(),
             radius.ravel(),
         )
+
+    def peridem_wall_indices(self) -> list[int]:
+        """The bodies PeriDEM's damping takes for walls (set_peridem_walls), by index."""
+        return sorted(self._assembly.body(b).index for b in self.peridem_walls)
 
     def peridem_reach(self) -> float:
         """How far apart PeriDEM's damping acts at most [m], beyond the particles' radii
@@ -293,5 +297,5 @@ class Interactions:
             for (a, b), setting in self.peridem_damping.items()
             if a in order and b in order
         )
-        walls = sorted(self._assembly.body(b).index for b in self.peridem_walls)
+        walls = self.peridem_wall_indices()
         return [repr(self.walls), repr(self.contact), repr(pairs), repr(damping), repr(walls)]

@@ -147,6 +147,15 @@ class Loading:
         density = self._assembly.vector(vector, "force density")
         self.loads.append(ForceDensity(ids, density, function or Constant(1.0)))
 
+    def prescribed(self) -> NDArray[np.bool_]:
+        """Per node of the assembly, whether its motion is prescribed in some direction: fixed,
+        displaced or rotated (the nodes of a meshed wall or a loading platen)."""
+        held = np.zeros(self._assembly.node_count, dtype=bool)
+        for load in self.loads:
+            if isinstance(load, PrescribedDisplacement | PrescribedRotation):
+                held[load.nodes] = True
+        return held
+
     def subset(self, assembly: Assembly, node_map: NDArray[np.int64]) -> Loading:
         """The loads on `assembly`, a subset of this one's (Assembly.subset and its node map):
         each load on the nodes it keeps, renumbered; loads that keep no node are left out."""

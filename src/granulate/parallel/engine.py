@@ -41,7 +41,14 @@ from granulate import checkpoints
 from granulate._core import points_within
 from granulate.errors import InputError
 from granulate.parallel.agreement import RankFailed, on_root, together
-from granulate.parallel.partition import Partition, bisect, ghosts, near_pairs
+from granulate.parallel.partition import (
+    Partition,
+    bisect,
+    ghosts,
+    near_nodes,
+    near_pairs,
+    near_pairs_with_large,
+)
 from granulate.parallel.transplant import (
     GrainState,
     body_first_nodes,
@@ -67,10 +74,14 @@ class DistributedRun:
     """`sim` (set up, not built) stepped on the ranks of `comm` (an mpi4py communicator).
 
     ``margin`` [m]: how much farther than the contact lists' cutoff a ghost is taken; default
-    the largest grain's bounding radius. The ghosts hold while every node stays within margin/2
-    of where it was when the grains were last distributed; once one may have moved margin/4,
-    the ranks ``migrate`` (cut the assembly anew and hand grains over with their whole state),
-    or with ``migrate=False`` stop with an InputError past margin/2.
+    the largest bounding radius of a grain none of whose nodes is prescribed (fixed, displaced
+    or rotated: not a PeriDEM deck's wall particles, whose radius is the container's), or of
+    any grain when every one has such nodes. The ghosts hold while every node stays within
+    margin/2 of where it was when the grains were last distributed; once one may have moved
+    margin/4, the ranks ``migrate`` (cut the assembly anew and hand grains over with their
+    whole state), or with ``migrate=False`` stop with an InputError past margin/2. Bodies over
+    twice as large as that grain (meshed walls, containers) are near the grains their nodes
+    come near, not all those their bounding spheres take in.
 
     ``cap_margin`` [m]: the same for the caps, the ghost nodes whose positions and velocities
     travel in each step (_exchange_caps); default margin/4, but at least four times the
@@ -113,8 +124,12 @@ class DistributedRun:
         # PeriDEM's damping (--peridem-compat): between particles whose centre nodes come within
         # their radii plus this reach, and from wall nodes within it of a node (0: none).
         self._damping_reach = sim._interactions.peridem_reach()
-        damped, self._damping_radii = sim._assembly.centres_and_radii()
+        damped, damping_radii = sim._assembly.centres_and_radii()
         self._damped_centres = np.asarray(damped, dtype=np.int64)  # global nodes
+        self._damping_radii = np.asarray(damping_radii)
+        # Its walls are damped by nor damp through their centres (contact/peridem_damping.hpp).
+        walls = sim._interactions.peridem_wall_indices()
+        self._centre_damped = np.setdiff1d(np.arange(len(self._slices)), walls)
         first = bisect(centres, self._weights, comm.Get_size()).grains_of(comm.Get_rank())
         # The cutoff, skin and dt of the first grains, each met by a grain of every kind.
         probe = together(self.comm, lambda: sim._subdomain(np.union1d(first, _kinds(sim)))[0].core)
@@ -124,7 +139,13 @@ class DistributedRun:
         self._dt = comm.allreduce(probe.time_step, op=MPI.MIN)
         #: The stable time-step estimate [s]: the least of every grain's (as the serial one).
         self.stable_dt = comm.allreduce(probe.stable_time_step, op=MPI.MIN)
-        self.margin = float(radii.max() if margin is None else margin)
+        held = sim._loading.prescribed()  # a wall particle's nodes move as they are told
+        free = [g for g, where in enumerate(self._slices) if not held[where].any()]
+        grain = float((radii[free] if free else radii).max())
+        self.margin = float(grain if margin is None else margin)
+        #: Bodies over twice as large as the largest free grain (meshed walls, containers):
+        #: their pairs with the grains are found from their nodes (partition.near_nodes).
+        self._large = np.flatnonzero(radii > 2 * grain)
         self._reach = cutoff + self.margin
         largest_mesh = max(body.mesh_size for body in sim.bodies)
         default = min(self.margin, max(0.25 * self.margin, 4 * largest_mesh))
@@ -153,7 +174,10 @@ class DistributedRun:
         self._migration_due = False
         # The wall reactions a loaded checkpoint holds, until the next step evaluates them.
         self._loaded_walls: NDArray[np.float64] | None = None
-        held = self._distribute(centres, radii, start[self._damped_centres, : sim.dimension])
+        large = self._pairs_of_large(
+            centres, radii, {int(g): start[self._slices[g]] for g in self._large}
+        )
+        held = self._distribute(centres, radii, start[self._damped_centres, : sim.dimension], large)
         together(self.comm, lambda: self._build(held))
         self._exchange_state()
         self._exchange_caps()
@@ -176,19 +200,42 @@ class DistributedRun:
         centres: NDArray[np.float64],
         radii: NDArray[np.float64],
         damped_centres: NDArray[np.float64],
+        large_pairs: tuple[NDArray[np.int64], NDArray[np.int64]],
     ) -> NDArray[np.int64]:
         """Owners by recursive coordinate bisection of the grains' `centres` and the ghosts of
-        every rank from their bounding spheres (`radii`), and with PeriDEM's damping also from
-        where their centre nodes are (`damped_centres`); the grains this rank holds (sorted)."""
+        every rank from their bounding spheres (`radii`) and the large bodies' `large_pairs`
+        (_pairs_of_large), and with PeriDEM's damping also from where their centre nodes are
+        (`damped_centres`); the grains this rank holds (sorted)."""
         rank = self.comm.Get_rank()
         self.partition: Partition = bisect(centres, self._weights, self.comm.Get_size())
-        first, last = near_pairs(centres, radii, self._reach)
+        first, last = near_pairs_with_large(centres, radii, self._reach, self._large, large_pairs)
         if self._damping_reach > 0:  # centres within radii + reach, each moving < margin/2
             reach = self._damping_reach + self.margin
-            more = near_pairs(damped_centres, self._damping_radii, reach)
-            first, last = np.concatenate([first, more[0]]), np.concatenate([last, more[1]])
+            ids = self._centre_damped
+            more = near_pairs(damped_centres[ids], self._damping_radii[ids], reach)
+            first, last = (
+                np.concatenate([first, ids[more[0]]]),
+                np.concatenate([last, ids[more[1]]]),
+            )
         self.ghosts = ghosts(self.partition, (first, last))
         return np.union1d(self.partition.grains_of(rank), self.ghosts[rank])
+
+    def _pairs_of_large(
+        self,
+        centres: NDArray[np.float64],
+        radii: NDArray[np.float64],
+        nodes: dict[int, NDArray[np.float64]],
+    ) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+        """The pairs of the large bodies in `nodes` (their nodes' positions now) with the
+        grains whose `centres` and `radii` are given (partition.near_nodes)."""
+        pairs = [
+            near_nodes(centres, radii, self._reach, g, x, self._large) for g, x in nodes.items()
+        ]
+        none = np.zeros(0, np.int64)
+        return (
+            np.concatenate([none, *(first for first, _ in pairs)]),
+            np.concatenate([none, *(last for _, last in pairs)]),
+        )
 
     def _plan(self, node_map: NDArray[np.int64]) -> None:
         """Which grains go to which rank and come from which, and the positions the nodes'
@@ -529,7 +576,19 @@ class DistributedRun:
         self._migration_due = False
         self._exchange_state()
         before, owners_before = self._held_by_rank(), self.partition.owner
-        held = self._distribute(*self._current_spheres())
+        centres, radii, damped = self._current_spheres()
+        positions = self.local.core.positions
+        mine = self._pairs_of_large(  # each large body's owner finds its pairs
+            centres,
+            radii,
+            {
+                int(g): positions[self._local_slice(g)]
+                for g in np.intersect1d(self._large, self._owned)
+            },
+        )
+        everyone = self.comm.allgather(mine)
+        large = tuple(np.concatenate([pairs[k] for pairs in everyone]) for k in (0, 1))
+        held = self._distribute(centres, radii, damped, large)
         self.handed_over += int(np.count_nonzero(self.partition.owner != owners_before))
         after = self._held_by_rank()
         owner = self.partition.owner
@@ -660,7 +719,9 @@ class DistributedRun:
             nodes[centre - where.start, :dimension]
             for nodes, centre, where in zip(grains, self._damped_centres, self._slices, strict=True)
         ]
-        held = self._distribute(*_spheres(grains, dimension), np.array(damped))
+        centres, radii = _spheres(grains, dimension)
+        large = self._pairs_of_large(centres, radii, {int(g): grains[g] for g in self._large})
+        held = self._distribute(centres, radii, np.array(damped), large)
         together(self.comm, lambda: self._rebuild(held, states, moment))
         self._exchange_caps()
         self._loaded_walls = np.asarray(moment["contact_wall_reactions"]).reshape(-1, 6)

@@ -7,9 +7,13 @@ bounding sphere comes within ``reach`` (the contact reach plus the neighbour ski
 rank owns: |c_i - c_j| <= r_i + r_j + reach, the particle-level broad phase the contact lists
 start from.
 
+A meshed wall or container is a body too, but a large one: its bounding sphere would take every
+grain in, so its pairs with the grains are found from its nodes (near_pairs_with_large,
+near_nodes).
+
 Everything here is deterministic: the same grains give the same owners and ghosts on every rank
 and machine (ties are broken by grain index), so each rank can compute the partition itself.
-Plain NumPy; no MPI is needed to partition or to measure a partition.
+NumPy and the core's point grid; no MPI is needed to partition or to measure a partition.
 
 Reference: Berger & Bokhari (1987), "A partitioning strategy for nonuniform problems on
 multiprocessors", IEEE Trans. Computers 36(5), for recursive coordinate bisection.
@@ -22,6 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from granulate._core import points_within
 from granulate.errors import InputError
 
 
@@ -133,6 +138,58 @@ def near_pairs(
     first, last = np.concatenate(firsts), np.concatenate(lasts)
     by_pair = np.lexsort((last, first))
     return first[by_pair], last[by_pair]
+
+
+def near_pairs_with_large(
+    centres: ArrayLike,
+    radii: ArrayLike,
+    reach: float,
+    large: ArrayLike,
+    large_pairs: tuple[NDArray[np.int64], NDArray[np.int64]],
+) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+    """near_pairs for an assembly with a few `large` bodies (grain indices: meshed walls and
+    containers, whose bounding spheres would make them near every grain, and the grid's cells
+    as wide as them): between two other grains or two large bodies, their bounding spheres;
+    between a large body and another grain, `large_pairs` (near_nodes). Sorted as near_pairs
+    sorts them."""
+    points = np.asarray(centres, dtype=float)
+    size = np.asarray(radii, dtype=float)
+    big = np.zeros(len(points), dtype=bool)
+    big[np.asarray(large, dtype=np.int64)] = True
+    firsts, lasts = [large_pairs[0]], [large_pairs[1]]
+    for group in (np.flatnonzero(~big), np.flatnonzero(big)):
+        if len(group) > 1:
+            first, last = near_pairs(points[group], size[group], reach)
+            firsts.append(group[first])
+            lasts.append(group[last])
+    first, last = np.concatenate(firsts), np.concatenate(lasts)
+    pairs = np.unique(np.column_stack([first, last]), axis=0)
+    return pairs[:, 0], pairs[:, 1]
+
+
+def near_nodes(
+    centres: ArrayLike,
+    radii: ArrayLike,
+    reach: float,
+    body: int,
+    nodes: ArrayLike,
+    large: ArrayLike,
+) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+    """The pairs (i < j) of the large body `body`, whose nodes are at `nodes` (k, 3), with the
+    grains not in `large` that one of its nodes comes within `reach` [m] of: |x - c_g| <= r +
+    reach for a node x, r the largest of those grains' radii (so that every pair whose nodes
+    come within `reach` is found)."""
+    points = np.asarray(centres, dtype=float)
+    size = np.asarray(radii, dtype=float)
+    others = np.setdiff1d(np.arange(len(points)), np.asarray(large, dtype=np.int64))
+    if len(others) == 0:
+        return np.zeros(0, np.int64), np.zeros(0, np.int64)
+    probes = np.zeros((len(others), 3))
+    probes[:, : points.shape[1]] = points[others]
+    targets = np.ascontiguousarray(np.asarray(nodes, dtype=float).reshape(-1, 3))
+    close = np.asarray(points_within(probes, targets, size[others].max() + reach), dtype=bool)
+    near = others[close]
+    return np.minimum(near, body), np.maximum(near, body)
 
 
 def _half_neighbourhood(dimension: int) -> NDArray[np.int64]:
