@@ -95,13 +95,15 @@ def test_ghosts_exchanged_as_caps_keep_the_serial_run_bit_for_bit() -> None:
 
 def test_peridem_damping_on_ranks_keeps_the_serial_run_bit_for_bit() -> None:
     """PeriDEM's damping (--peridem-compat decks) between the fine discs, which acts between
-    the particles' centre nodes, and from a PeriDEM wall (a fixed slab under them), on 3 ranks
-    whose caps are a small part of their ghosts: the caps take every ghost's centre node
-    (without, the forces differ by 2e5 N/m^3 after 150 steps). Every node ends as in the
-    serial run."""
-    done = run_ranks(3, "fine", "150", "4e-4", "4e-5", "peridem")
+    the particles' centre nodes, and from a PeriDEM wall (a fixed slab under them, a large
+    body: paired with the discs its nodes come near, by its owner at each migration), on 3
+    ranks whose caps are a small part of their ghosts, with a ghost margin of 2e-5 m (5
+    migrations in 150 steps): the caps take every ghost's centre node (without, the forces
+    differ by 2e5 N/m^3 after 150 steps). Every node ends as in the serial run."""
+    done = run_ranks(3, "fine", "150", "2e-5", "2e-5", "peridem")
     assert done.returncode == 0, done.stdout + done.stderr
     assert "'positions': 0.0, 'velocities': 0.0, 'forces': 0.0, 'walls': 0.0}" in done.stdout
+    assert int(done.stdout.split("migrations ")[1].split(",")[0]) >= 3
     held = done.stdout.split("sent a step per rank [")[1].split("]")[0]
     for ghosts, sent in (map(int, pair.strip("() ").split(",")) for pair in held.split("), (")):
         assert sent < 0.5 * ghosts
