@@ -47,12 +47,14 @@ def motion(
     centre /= total[:, None]
     velocity /= total[:, None]
     arm, relative = x - centre[p], v - velocity[p]
-    momentum = np.zeros((count, 3))
-    np.add.at(momentum, p, m[:, None] * np.cross(arm, relative))
+    moment = m[:, None] * np.cross(arm, relative)
+    momentum = np.column_stack([np.bincount(p, moment[:, k], count) for k in range(3)])
     r2 = np.einsum("ij,ij->i", arm, arm)
-    inertia = np.zeros((count, 3, 3))
-    outer = arm[:, :, None] * arm[:, None, :]
-    np.add.at(inertia, p, m[:, None, None] * (r2[:, None, None] * np.eye(3) - outer))
+    inertia = np.empty((count, 3, 3))
+    for a in range(3):  # m (r^2 delta_ab - arm_a arm_b), summed node by node as np.add.at
+        for b in range(a, 3):
+            term = r2 - arm[:, a] * arm[:, a] if a == b else 0.0 - arm[:, a] * arm[:, b]
+            inertia[:, a, b] = inertia[:, b, a] = np.bincount(p, m * term, count)
     spin = np.zeros((count, 3))
     solvable = np.linalg.matrix_rank(inertia) == 3
     spin[solvable] = np.linalg.solve(inertia[solvable], momentum[solvable][:, :, None])[:, :, 0]
