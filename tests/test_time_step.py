@@ -62,7 +62,8 @@ def test_a_blow_up_is_caught_on_the_step_it_happens() -> None:
     a 20-step run ended "finished" with an exploded state; it now runs every step (measured:
     stopped at step 4)."""
     probe = plate()
-    sim = plate(dt=5 * probe.stable_dt)
+    with pytest.warns(gr.GranulateWarning, match="exceeds the stable estimate"):
+        sim = plate(dt=5 * probe.stable_dt)
     with pytest.raises(gr.InstabilityError) as error:
         sim.run(20)
     message = str(error.value)
@@ -77,7 +78,8 @@ def test_a_blow_up_quotes_the_estimate_it_is_given() -> None:
     the part's own."""
     probe = plate()
     for given, quoted in ((1.25e-7, "1.25e-07"), (0.0, f"{probe.stable_dt:.6g}")):
-        sim = plate(dt=5 * probe.stable_dt)
+        with pytest.warns(gr.GranulateWarning, match="exceeds the stable estimate"):
+            sim = plate(dt=5 * probe.stable_dt)
         sim.core.set_reported_stable_time_step(given)
         with pytest.raises(gr.InstabilityError, match=f"the stable estimate is {quoted} s"):
             sim.run(20)

@@ -121,15 +121,7 @@ class DistributedRun:
         self._weights = np.array([body.node_count for body in sim.bodies], dtype=float)
         start = _start_positions(sim)
         centres, radii = _spheres([start[body.node_slice] for body in sim.bodies], sim.dimension)
-        # PeriDEM's damping (--peridem-compat): between particles whose centre nodes come within
-        # their radii plus this reach, and from wall nodes within it of a node (0: none).
-        self._damping_reach = sim._interactions.peridem_reach()
-        damped, damping_radii = sim._assembly.centres_and_radii()
-        self._damped_centres = np.asarray(damped, dtype=np.int64)  # global nodes
-        self._damping_radii = np.asarray(damping_radii)
-        # Its walls are damped by nor damp through their centres (contact/peridem_damping.hpp).
-        walls = sim._interactions.peridem_wall_indices()
-        self._centre_damped = np.setdiff1d(np.arange(len(self._slices)), walls)
+        self._set_up_damping(sim)
         first = bisect(centres, self._weights, comm.Get_size()).grains_of(comm.Get_rank())
         # The cutoff, skin and dt of the first grains, each met by a grain of every kind.
         probe = together(self.comm, lambda: sim._subdomain(np.union1d(first, _kinds(sim)))[0].core)
@@ -139,9 +131,7 @@ class DistributedRun:
         self._dt = comm.allreduce(probe.time_step, op=MPI.MIN)
         #: The stable time-step estimate [s]: the least of every grain's (as the serial one).
         self.stable_dt = comm.allreduce(probe.stable_time_step, op=MPI.MIN)
-        held = sim._loading.prescribed()  # a wall particle's nodes move as they are told
-        free = [g for g, where in enumerate(self._slices) if not held[where].any()]
-        grain = float((radii[free] if free else radii).max())
+        grain = _largest_free_radius(sim, radii)
         self.margin = float(grain if margin is None else margin)
         #: Bodies over twice as large as the largest free grain (meshed walls, containers):
         #: their pairs with the grains are found from their nodes (partition.near_nodes).
@@ -186,6 +176,18 @@ class DistributedRun:
         self.seconds = dict.fromkeys(
             ("steps", "exchange", "check", "caps", "migrate", "collect"), 0.0
         )
+
+    def _set_up_damping(self, sim: Simulation) -> None:
+        """What PeriDEM's damping (--peridem-compat) needs of the ghosts: it acts between
+        particles whose centre nodes come within their radii plus `_damping_reach` (0: no
+        damping), PeriDEM's wall particles left out, and from wall nodes within that reach of
+        a node (contact/peridem_damping.hpp)."""
+        self._damping_reach = sim._interactions.peridem_reach()
+        centres, radii = sim._assembly.centres_and_radii()
+        self._damped_centres = np.asarray(centres, dtype=np.int64)  # global nodes
+        self._damping_radii = np.asarray(radii)
+        walls = sim._interactions.peridem_wall_indices()
+        self._centre_damped = np.setdiff1d(np.arange(len(self._slices)), walls)
 
     def _build(self, held: NDArray[np.int64]) -> None:
         """This rank's part of the grains `held` at the start, with its first forces (the
@@ -917,6 +919,14 @@ def _kinds(sim: Simulation) -> NDArray[np.int64]:
     for body, volumes in zip(sim.bodies, sim._assembly.volumes, strict=True):
         first.setdefault((id(body.material), body.mesh_size, float(volumes.max())), body.index)
     return np.array(sorted(first.values()), dtype=np.int64)
+
+
+def _largest_free_radius(sim: Simulation, radii: NDArray[np.float64]) -> float:
+    """The largest of `radii` (one per grain) of a grain none of whose nodes is prescribed (a
+    wall particle's nodes move as they are told), or of all when every grain has such nodes."""
+    held = sim._loading.prescribed()
+    free = [body.index for body in sim.bodies if not held[body.node_slice].any()]
+    return float((radii[free] if free else radii).max())
 
 
 def _start_positions(sim: Simulation) -> NDArray[np.float64]:
