@@ -16,6 +16,7 @@ import numpy as np
 import pytest
 
 import granulate as gr
+from granulate.plots import render
 
 
 def pulled_plate(out: Path, steps: int = 100, **output) -> gr.Simulation:
@@ -110,6 +111,8 @@ def test_frames_in_pieces_are_the_one_file_frames(tmp_path: Path) -> None:
             np.testing.assert_array_equal(values, b.fields[name])
     chains = ET.parse(tmp_path / "pieces" / "contacts.pvd").getroot().iter("DataSet")
     assert [d.get("file") for d in chains][-1] == "frames/contacts_000004.vtu"
+    (image,) = render(tmp_path / "pieces", frame=4)
+    assert image.name == "frame_000004.png" and image.stat().st_size > 1000
     pulled_plate(tmp_path / "pieces", overwrite=True)
     assert not [p for p in frames.iterdir() if p.is_dir()]
 
