@@ -117,6 +117,23 @@ def test_frames_in_pieces_are_the_one_file_frames(tmp_path: Path) -> None:
     assert not [p for p in frames.iterdir() if p.is_dir()]
 
 
+def test_pieces_other_ranks_wrote_where_rank_0_cannot_see_them_stop_the_run(
+    tmp_path: Path,
+) -> None:
+    """Rank 0 writes a frame's .pvtu once every rank has written its piece; a piece it cannot
+    see (ranks on machines that do not share the output directory) stops the run with one
+    InputError saying so, instead of a .pvtu naming files that are not there. Here rank 0's
+    outputs are told that 2 ranks wrote pieces, and none did."""
+    material = gr.Material(density=2500, youngs_modulus=70e9, poisson_ratio=0.22, fracture=False)
+    sim = gr.Simulation(2)
+    sim.add_body(gr.Rectangle((0, 0), (0.02, 0.005)), material, 1e-3)
+    sim.output(tmp_path, every=10, pieces=True)
+    sim._output.piece_ranks = 2
+    with pytest.raises(gr.InputError, match=r"piece_0\.vtu, piece_1\.vtu written by the other"):
+        sim.run(10)
+    assert not list((tmp_path / "frames").glob("*.pvtu"))
+
+
 def test_a_parallel_frame_with_bad_pieces_is_refused(tmp_path: Path) -> None:
     """A .pvtu whose piece is missing, or whose pieces number a node twice: one InputError
     naming the file."""

@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import NDArray
 
+from granulate.errors import InputError
 from granulate.io import write_vtu
 from granulate.io.vtu import NODE_ID, write_pvtu
 
@@ -135,9 +136,22 @@ class VtuFrame:
             write_piece(frames / name / "piece_0.vtu", sim, outputs.fields)
         count = outputs.piece_ranks or 1
         pieces = [f"piece_{r}.vtu" for r in range(count)]
+        _check_pieces(frames / name, pieces)
         for stale in (frames / name).glob("piece_*.vtu"):  # of a run cut short on more ranks
             if stale.name not in pieces:
                 stale.unlink()
         arrays = [(f, *FIELD_TYPES[f]) for f in outputs.fields] + [(NODE_ID, _NODE_ID_TYPE, 1)]
         write_pvtu(frames / f"{name}.pvtu", [f"{name}/{piece}" for piece in pieces], arrays)
         outputs.pvd.add(sim.core.time, Path("frames") / f"{name}.pvtu")
+
+
+def _check_pieces(folder: Path, pieces: list[str]) -> None:
+    """InputError unless every rank's piece is in `folder` as this process sees it: the ranks
+    of a distributed run on several machines must write into a file system they share."""
+    missing = [name for name in pieces if not (folder / name).is_file()]
+    if missing:
+        raise InputError(
+            f"{folder}: {', '.join(missing)} written by the other ranks cannot be seen here: "
+            "the output directory must be on a file system every rank shares (on a cluster, "
+            "not a node's local disk); choose one with --out"
+        )
