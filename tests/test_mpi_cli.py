@@ -188,6 +188,23 @@ def test_frames_in_pieces_join_to_the_serial_runs_frames(serial_run: Path, tmp_p
         ]
 
 
+def test_a_polydisperse_pile_runs_on_ranks_at_the_serial_time_step(tmp_path: Path) -> None:
+    """The example pile (examples/cases/pile_2d.yaml: 30 discs and hexagons packed from size
+    distributions, each grain its own mesh size) on 3 ranks, 3,000 steps: each rank's
+    time-step probe builds its own grains and each material's coarsest, and finds the contact
+    estimate against every grain as a partner (their summaries gathered), so the time step,
+    and with it every frame and history column but the searches, is the serial run's."""
+    case = Path(__file__).parents[1] / "examples" / "cases" / "pile_2d.yaml"
+    for ranks, name in ((1, "serial"), (3, "ranks")):
+        done = granulate(tmp_path, "--out", name, "--steps", "3000", ranks=ranks, case=case)
+        assert done.returncode == 0, done.stderr
+    assert differing(tmp_path / "serial", tmp_path / "ranks") == []
+    rows = [history(tmp_path / name) for name in ("serial", "ranks")]
+    for row in (*rows[0], *rows[1]):
+        del row[SEARCHES]
+    assert rows[0] == rows[1] and len(rows[0]) == 2
+
+
 def test_a_peridem_deck_with_peridems_damping_runs_on_ranks(tmp_path: Path) -> None:
     """PeriDEM's small compression deck with its contact damping on (Damping_On: true) under
     --peridem-compat (PeriDEM's damping between particle centres, and from its wall particles'

@@ -90,3 +90,37 @@ def test_translated_copies_in_a_subdomain_keep_the_whole_assemblys_bonds() -> No
     alone._assembly.parent = None  # the part as if it were a whole assembly of its own
     alone.core.run(0)
     assert np.any(alone.core.dilatation[node_map[disc]] != whole.core.dilatation[disc])
+
+
+def two_materials() -> gr.Simulation:
+    """Discs of a heavy and a light material at mesh sizes 0.08-0.4 mm, the pair of materials
+    with a contact law of its own (ten times stiffer)."""
+    heavy = gr.Material(density=8000, youngs_modulus=1e9, poisson_ratio=0.25, fracture=False)
+    light = gr.Material(density=300, youngs_modulus=1e9, poisson_ratio=0.25, fracture=False)
+    sim = gr.Simulation(2)
+    sim.set_contact(heavy, light, gr.Contact(stiffness_factor=10))
+    for k, (material, h) in enumerate(
+        [(heavy, 0.08e-3), (heavy, 0.3e-3), (heavy, 0.4e-3), (light, 0.2e-3), (light, 0.35e-3)]
+    ):
+        sim.add_body(gr.Disc((2.5e-3 * k, 0.0), 1e-3), material, h)
+    return sim
+
+
+def test_a_part_finds_the_contact_time_step_against_every_grain_as_a_partner() -> None:
+    """A distributed run's part builds its own grains (and each material's coarsest) and takes
+    every grain of the run as a contact partner (core.contact_partners, gathered, then
+    core.contact_stable_time_step_against): the least over parts that cover the grains is
+    the whole run's estimate, bit for bit; the whole's own rows give its own estimate."""
+    whole = two_materials()
+    rows = np.asarray(whole.core.contact_partners()).reshape(-1, 5)
+    expected = whole.core.contact_stable_time_step
+    assert whole.core.contact_stable_time_step_against(rows.ravel()) == expected
+    estimates = []
+    for grains in ([0, 2, 4], [1, 2, 3, 4]):  # 2 and 4 are each material's coarsest
+        part = whole._subdomain(np.array(grains))[0]
+        core = part.core  # numbers its materials
+        numbers = {id(m): k for k, m in enumerate(part._core_materials)}
+        table = rows.copy()
+        table[:, 0] = [numbers[id(whole._core_materials[int(m)])] for m in rows[:, 0]]
+        estimates.append(core.contact_stable_time_step_against(table.ravel()))
+    assert min(estimates) == expected

@@ -204,8 +204,22 @@ void ContactModel::set_skin(real skin) {
   built_ = false;
 }
 
-real ContactModel::stable_time_step(const Model& model) const {
-  const real partners = dimension_ == 2 ? 4.0 : 6.0;
+std::vector<ContactModel::Partner> ContactModel::partners(const Model& model) const {
+  const auto& particles = model.particles();
+  std::vector<Partner> result(particles.size());
+  for (std::size_t p = 0; p < particles.size(); ++p) {
+    result[p].material = particles[p].material;
+    result[p].side = particle_side_[p];
+  }
+  for (index_t i = 0; i < model.node_count(); ++i) {
+    Partner& partner = result[model.node_particle()[i]];
+    partner.largest_volume = std::max(partner.largest_volume, model.volumes()[i]);
+  }
+  return result;
+}
+
+real ContactModel::stable_time_step(const Model& model, const std::vector<Partner>& partners) const {
+  const real neighbours = dimension_ == 2 ? 4.0 : 6.0;
   const auto& particles = model.particles();
   const std::size_t count = particles.size();
   std::vector<real> largest_volume(count, 0);
@@ -215,16 +229,19 @@ real ContactModel::stable_time_step(const Model& model) const {
   }
   // max over partners q of kn(p, q) V_max(q) for partners as fine or finer, kn(p, q)
   // min(V_max(p), V_max(q)) for coarser ones (node-pair law: V_max(q) for all). kn depends on q only
-  // through the finer particle's horizon, so sort each material's particles by mesh size: partners
+  // through the finer particle's horizon, so sort each material's partners by mesh size: partners
   // finer than p give kn(q) V(q) (a prefix maximum), coarser ones kn(p) V(q) (a suffix maximum of V).
   std::vector<real> stiffness(count, 0);
-  std::vector<std::vector<index_t>> by_material(material_count_);
-  for (std::size_t p = 0; p < count; ++p)
-    by_material[particles[p].material].push_back(static_cast<index_t>(p));
+  std::vector<std::vector<index_t>> own(material_count_), by_material(material_count_);
+  for (std::size_t p = 0; p < count; ++p) own[particles[p].material].push_back(static_cast<index_t>(p));
+  for (std::size_t q = 0; q < partners.size(); ++q) {
+    if (partners[q].material >= material_count_) throw InputError("contact partner of an unknown material");
+    by_material[partners[q].material].push_back(static_cast<index_t>(q));
+  }
   for (auto& list : by_material) {
     std::sort(list.begin(), list.end(), [&](index_t p, index_t q) {
-      return particle_side_[p].mesh_size < particle_side_[q].mesh_size ||
-             (particle_side_[p].mesh_size == particle_side_[q].mesh_size && p < q);
+      return partners[p].side.mesh_size < partners[q].side.mesh_size ||
+             (partners[p].side.mesh_size == partners[q].side.mesh_size && p < q);
     });
   }
   for (index_t a = 0; a < material_count_; ++a) {
@@ -235,31 +252,35 @@ real ContactModel::stable_time_step(const Model& model) const {
       const auto& partners_b = by_material[b];
       std::vector<real> prefix(partners_b.size()), suffix(partners_b.size());
       for (std::size_t k = 0; k < partners_b.size(); ++k) {
-        const contact::ContactSide& q = particle_side_[partners_b[k]];
+        const Partner& q = partners[partners_b[k]];
         const real kn =
-            contact::resolve(law, {q.mesh_size, q.horizon, modulus_a}, q, dimension_).normal_stiffness;
-        prefix[k] = std::max(k ? prefix[k - 1] : 0.0, kn * largest_volume[partners_b[k]]);
+            contact::resolve(law, {q.side.mesh_size, q.side.horizon, modulus_a}, q.side, dimension_)
+                .normal_stiffness;
+        prefix[k] = std::max(k ? prefix[k - 1] : 0.0, kn * q.largest_volume);
       }
       for (std::size_t k = partners_b.size(); k-- > 0;) {
-        suffix[k] = std::max(k + 1 < partners_b.size() ? suffix[k + 1] : 0.0, largest_volume[partners_b[k]]);
+        suffix[k] =
+            std::max(k + 1 < partners_b.size() ? suffix[k + 1] : 0.0, partners[partners_b[k]].largest_volume);
       }
-      for (const index_t p : by_material[a]) {
+      for (const index_t p : own[a]) {
         const real h = particle_side_[p].mesh_size;
         // Finer-or-equal partners: those up to the last with mesh size <= h.
         const auto split =
             std::upper_bound(partners_b.begin(), partners_b.end(), h,
-                             [&](real value, index_t q) { return value < particle_side_[q].mesh_size; });
+                             [&](real value, index_t q) { return value < partners[q].side.mesh_size; });
         const std::size_t k = static_cast<std::size_t>(split - partners_b.begin());
         // Same-size partners may have a smaller horizon: count them on both sides.
         const auto first_equal =
             std::lower_bound(partners_b.begin(), partners_b.end(), h,
-                             [&](index_t q, real value) { return particle_side_[q].mesh_size < value; });
+                             [&](index_t q, real value) { return partners[q].side.mesh_size < value; });
         const std::size_t e = static_cast<std::size_t>(first_equal - partners_b.begin());
         const real finer = k > 0 ? prefix[k - 1] : 0.0;
-        const real coarser = e < partners_b.size()
-                                 ? pair_law(p, partners_b[e]).normal_stiffness *
-                                       (law.node_pair ? suffix[e] : std::min(largest_volume[p], suffix[e]))
-                                 : 0.0;
+        const real coarser =
+            e < partners_b.size()
+                ? contact::resolve(law, particle_side_[p], partners[partners_b[e]].side, dimension_)
+                          .normal_stiffness *
+                      (law.node_pair ? suffix[e] : std::min(largest_volume[p], suffix[e]))
+                : 0.0;
         stiffness[p] = std::max({stiffness[p], finer, coarser});
       }
     }
@@ -275,7 +296,7 @@ real ContactModel::stable_time_step(const Model& model) const {
     }
     if (stiffness[p] > 0) {
       const real density = model.materials()[particles[p].material].params.density;
-      dt = std::min(dt, std::sqrt(2.0 * density / (2.0 * partners * stiffness[p])));
+      dt = std::min(dt, std::sqrt(2.0 * density / (2.0 * neighbours * stiffness[p])));
     }
   }
   return dt;

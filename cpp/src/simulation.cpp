@@ -98,12 +98,6 @@ Simulation::Simulation(std::shared_ptr<Model> model) : model_(std::move(model)) 
   time_step_ = 0.8 * stable_time_step_;
 }
 
-real Simulation::stable_time_step() const {
-  const real contact = contact_.stable_time_step(*model_);
-  if (!std::isfinite(contact)) return stable_time_step_;
-  return 1.0 / std::sqrt(1.0 / (stable_time_step_ * stable_time_step_) + 1.0 / (contact * contact));
-}
-
 void Simulation::set_time_step(real dt) {
   if (!(dt > 0) || !std::isfinite(dt)) {
     std::ostringstream msg;

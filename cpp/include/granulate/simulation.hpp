@@ -37,7 +37,16 @@ class Simulation {
   real time_step() const { return time_step_; }
   void set_time_step(real dt);
   /// Stable estimate combining peridynamics and contact: 1/dt^2 = 1/dt_pd^2 + 1/dt_contact^2.
-  real stable_time_step() const;
+  real stable_time_step() const {
+    return combined_time_step(stable_time_step_, contact_.stable_time_step(*model_));
+  }
+  /// The peridynamic part of it alone (Model::stable_time_step) [s].
+  real peridynamic_stable_time_step() const { return stable_time_step_; }
+  /// 1 / sqrt(1/dt_pd^2 + 1/dt_contact^2) [s]; dt_pd when there is no contact (infinite).
+  static real combined_time_step(real peridynamic, real contact) {
+    if (!std::isfinite(contact)) return peridynamic;
+    return 1.0 / std::sqrt(1.0 / (peridynamic * peridynamic) + 1.0 / (contact * contact));
+  }
 
   /// Uniform body acceleration g (gravity) [m/s^2]: adds rho g to every node's force density.
   void set_body_acceleration(const std::array<real, 3>& g);

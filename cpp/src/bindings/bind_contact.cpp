@@ -21,6 +21,8 @@ void bind_contact(nb::module_& m) {
       .def_rw("peridem_friction", &contact::Law::peridem_friction)
       .def_rw("node_pair", &contact::Law::node_pair)
       .def_rw("surface", &contact::Law::surface);
+  m.def("combined_time_step", &Simulation::combined_time_step, "peridynamic"_a, "contact"_a,
+        "1 / sqrt(1/dt_pd^2 + 1/dt_contact^2) [s] (dt_pd for an infinite dt_contact).");
   m.def("damping_ratio_from_restitution", &contact::damping_ratio_from_restitution, "restitution"_a);
   m.def("power_law_restitution", &contact::power_law_restitution, "damping_ratio"_a, "exponent"_a);
   m.def("power_law_damping_ratio", &contact::power_law_damping_ratio, "restitution"_a, "exponent"_a,

@@ -32,6 +32,33 @@ void bind_run_setup(nb::class_<Simulation>& cls) {
       .def_prop_ro("stable_time_step", &Simulation::stable_time_step)
       .def_prop_ro("contact_stable_time_step",
                    [](const Simulation& self) { return self.contact().stable_time_step(self.model()); })
+      .def_prop_ro("peridynamic_stable_time_step", &Simulation::peridynamic_stable_time_step)
+      .def(
+          "contact_partners",
+          [](const Simulation& self) {
+            std::vector<real> rows;
+            for (const ContactModel::Partner& q : self.contact().partners(self.model())) {
+              rows.insert(rows.end(), {static_cast<real>(q.material), q.side.mesh_size, q.side.horizon,
+                                       q.side.modulus, q.largest_volume});
+            }
+            return copy_out(rows);
+          },
+          "Each particle as the contact's stable time step reads a partner, flat (k x 5): its "
+          "material, mesh size, horizon, dilatation modulus and largest node volume.")
+      .def(
+          "contact_stable_time_step_against",
+          [](const Simulation& self, Scalars rows) {
+            if (rows.shape(0) % 5 != 0) throw InputError("contact partners: give 5 numbers per particle");
+            std::vector<ContactModel::Partner> partners(rows.shape(0) / 5);
+            for (std::size_t q = 0; q < partners.size(); ++q) {
+              const double* row = rows.data() + 5 * q;
+              partners[q] = {static_cast<index_t>(row[0]), {row[1], row[2], row[3]}, row[4]};
+            }
+            return self.contact().stable_time_step(self.model(), partners);
+          },
+          "rows"_a,
+          "The contact's stable time step of this model's particles against these partners "
+          "(contact_partners' rows, materials in this model's numbering) [s].")
       .def(
           "set_peridem_damping",
           [](Simulation& self, Indices centers, Scalars radii, Indices walls, Scalars betan, Scalars kappa,

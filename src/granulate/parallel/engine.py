@@ -38,7 +38,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from granulate import checkpoints
-from granulate._core import points_within
+from granulate._core import combined_time_step, points_within
 from granulate.errors import InputError
 from granulate.parallel.agreement import RankFailed, on_root, together
 from granulate.parallel.partition import (
@@ -122,15 +122,18 @@ class DistributedRun:
         start = _start_positions(sim)
         centres, radii = _spheres([start[body.node_slice] for body in sim.bodies], sim.dimension)
         self._set_up_damping(sim)
-        first = bisect(centres, self._weights, comm.Get_size()).grains_of(comm.Get_rank())
-        # The cutoff, skin and dt of the first grains, each met by a grain of every kind.
-        probe = together(self.comm, lambda: sim._subdomain(np.union1d(first, _kinds(sim)))[0].core)
-        self._skin = comm.allreduce(probe.contact_skin, op=MPI.MAX)
-        cutoff = comm.allreduce(probe.contact_reach - probe.contact_skin, op=MPI.MAX) + self._skin
-        cutoff = max(cutoff, self._damping_reach)
-        self._dt = comm.allreduce(probe.time_step, op=MPI.MIN)
-        #: The stable time-step estimate [s]: the least of every grain's (as the serial one).
-        self.stable_dt = comm.allreduce(probe.stable_time_step, op=MPI.MIN)
+        start_partition = bisect(centres, self._weights, comm.Get_size())
+        first = start_partition.grains_of(comm.Get_rank())
+        # The cutoff, skin and dt from the first grains and each material's coarsest grain.
+        probed = np.union1d(first, _coarsest_of_each_material(sim))
+        probe = together(self.comm, lambda: _built(sim._subdomain(probed)[0]))
+        self._skin = comm.allreduce(probe.core.contact_skin, op=MPI.MAX)
+        reach = probe.core.contact_reach - probe.core.contact_skin
+        cutoff = max(comm.allreduce(reach, op=MPI.MAX) + self._skin, self._damping_reach)
+        #: The stable time-step estimate [s]: the serial run's (_stable_time_step).
+        own = np.searchsorted(probed, first)
+        self.stable_dt = self._stable_time_step(probe, own, start_partition)
+        self._dt = sim._dt_safety * self.stable_dt if sim._dt is None else float(sim._dt)
         grain = _largest_free_radius(sim, radii)
         self.margin = float(grain if margin is None else margin)
         #: Bodies over twice as large as the largest free grain (meshed walls, containers):
@@ -176,6 +179,37 @@ class DistributedRun:
         self.seconds = dict.fromkeys(
             ("steps", "exchange", "check", "caps", "migrate", "collect"), 0.0
         )
+
+    def _stable_time_step(
+        self, probe: Simulation, own: NDArray[np.int64], partition: Partition
+    ) -> float:
+        """The serial run's stable time-step estimate, 1/dt^2 = 1/dt_pd^2 + 1/dt_contact^2
+        (core.combined_time_step), from `probe`, a part of this rank's grains in `partition`
+        (its particles `own`) and each material's coarsest grain: dt_pd the least over the ranks of
+        their grains' peridynamic estimates; dt_contact the least of their grains' contact
+        estimates, each against every grain of the run as a partner (ContactModel's
+        stable_time_step: each grain's material, mesh size, horizon, modulus and largest node
+        volume, sent by its owner), not only those the part holds."""
+        core = probe.core
+        materials = _material_numbers(self._sim)
+        to_run = np.array([materials[id(m)] for m in probe._core_materials])
+        rows = np.asarray(core.contact_partners()).reshape(-1, 5)[own]
+        rows[:, 0] = to_run[rows[:, 0].astype(np.int64)]
+        table = np.empty((len(self._slices), 5))
+        for owner, their_rows in enumerate(self.comm.allgather(rows)):
+            table[partition.grains_of(owner)] = their_rows
+        to_probe = np.full(len(materials), -1)
+        to_probe[to_run] = np.arange(len(to_run))
+        table[:, 0] = to_probe[table[:, 0].astype(np.int64)]
+        mine = np.array(
+            [
+                core.peridynamic_stable_time_step,
+                core.contact_stable_time_step_against(table.ravel()),
+            ]
+        )
+        least = np.empty(2)
+        self.comm.Allreduce(mine, least, op=self.mpi.MIN)
+        return float(combined_time_step(least[0], least[1]))
 
     def _set_up_damping(self, sim: Simulation) -> None:
         """What PeriDEM's damping (--peridem-compat) needs of the ghosts: it acts between
@@ -910,15 +944,31 @@ def _sum_wall_terms(parts: list[tuple[NDArray[Any], ...]], walls: int) -> NDArra
     return total
 
 
-def _kinds(sim: Simulation) -> NDArray[np.int64]:
-    """The first grain of each kind: material, mesh size and largest node volume. The contact
-    springs' stable time step of a grain (ContactModel::stable_time_step) depends on the
-    others through these alone, so a rank that holds its grains and one of each kind finds
-    their serial estimates, and the least over the ranks is the serial time step."""
-    first: dict[tuple[int, float, float], int] = {}
-    for body, volumes in zip(sim.bodies, sim._assembly.volumes, strict=True):
-        first.setdefault((id(body.material), body.mesh_size, float(volumes.max())), body.index)
-    return np.array(sorted(first.values()), dtype=np.int64)
+def _coarsest_of_each_material(sim: Simulation) -> NDArray[np.int64]:
+    """Each material's coarsest grain (the largest mesh size; the first of a tie). A rank's
+    time-step probe holds them besides its own grains, so that it knows every material's
+    contact laws and its largest contact radius (ContactModel's coarsest mesh size per
+    material), as the whole run does."""
+    coarsest: dict[int, int] = {}
+    for body in sim.bodies:
+        best = coarsest.get(id(body.material))
+        if best is None or body.mesh_size > sim.bodies[best].mesh_size:
+            coarsest[id(body.material)] = body.index
+    return np.array(sorted(coarsest.values()), dtype=np.int64)
+
+
+def _material_numbers(sim: Simulation) -> dict[int, int]:
+    """The run's materials (by identity) numbered in the order its bodies first use them."""
+    numbers: dict[int, int] = {}
+    for body in sim.bodies:
+        numbers.setdefault(id(body.material), len(numbers))
+    return numbers
+
+
+def _built(part: Simulation) -> Simulation:
+    """`part` with its core built."""
+    part._build()
+    return part
 
 
 def _largest_free_radius(sim: Simulation, radii: NDArray[np.float64]) -> float:

@@ -133,7 +133,20 @@ class ContactModel {
   /// kn V_j^2, and their sum per unit volume of the node stays below that), and
   /// S = 2 n kn min(V_i, V_j) against a coarser particle; the maximum over every particle and
   /// wall it has a law with. Infinity without contact.
-  real stable_time_step(const Model& model) const;
+  real stable_time_step(const Model& model) const { return stable_time_step(model, partners(model)); }
+  /// What that estimate reads of a particle that is a partner: its material (this model's
+  /// index), side (h, delta, kappa_d) and largest node volume [m^3; m^2 in 2D].
+  struct Partner {
+    index_t material = 0;
+    contact::ContactSide side;
+    real largest_volume = 0;
+  };
+  /// Every particle of the model as a partner, in particle order.
+  std::vector<Partner> partners(const Model& model) const;
+  /// The estimate for the model's particles against `partners` instead of one another (a
+  /// distributed run's part: every particle of the run, so that its particles' estimates are
+  /// the whole run's while it builds only its own).
+  real stable_time_step(const Model& model, const std::vector<Partner>& partners) const;
   /// Energy stored in the normal contact springs [J; J/m in 2D]: sum of k overlap^2 / 2 over
   /// node pairs (each once) and node-wall points in contact at the state's positions, and of
   /// P^2 / (2 k tau) over the surface probes of the last evaluation: node_contact_terms' energy
