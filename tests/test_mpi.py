@@ -98,8 +98,9 @@ def test_peridem_damping_on_ranks_keeps_the_serial_run_bit_for_bit() -> None:
     the particles' centre nodes, and from a PeriDEM wall (a fixed slab under them, a large
     body: paired with the discs its nodes come near, by its owner at each migration), on 3
     ranks whose caps are a small part of their ghosts, with a ghost margin of 2e-5 m (5
-    migrations in 150 steps): the caps take every ghost's centre node (without, the forces
-    differ by 2e5 N/m^3 after 150 steps). Every node ends as in the serial run."""
+    migrations in 150 steps): the caps take every ghost's centre node (without, at a margin of
+    4e-4 m, the forces differ by 2e5 N/m^3 after 150 steps; without the slab's pairs found at
+    migrations, by 3.5e8). Every node ends as in the serial run."""
     done = run_ranks(3, "fine", "150", "2e-5", "2e-5", "peridem")
     assert done.returncode == 0, done.stdout + done.stderr
     assert "'positions': 0.0, 'velocities': 0.0, 'forces': 0.0, 'walls': 0.0}" in done.stdout
