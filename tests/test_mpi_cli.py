@@ -4,7 +4,8 @@ across restarts on another number of ranks; errors reported once, every rank end
 
 The case (tests/cases/drum_mpi.yaml) is the checkpoint tests' drum: four grains tumbling and
 breaking in a turning drum with a lifter, the surface law, friction, a moving wall; its grains
-migrate between the ranks many times in its 3,000 steps."""
+migrate between the ranks many times in its 3,000 steps. Also: its frames in pieces, the
+example pile (grains of many sizes) and PeriDEM's compression deck under --peridem-compat."""
 
 from __future__ import annotations
 
