@@ -79,12 +79,7 @@ class Interactions:
         other.walls = list(self.walls)
         other.skin = self.skin
         other.peridem_damping = dict(self.peridem_damping)
-        materials = {id(body.material): body.material for body in self._assembly.bodies}
-        other._peridem_radii = {
-            (a, b): self._peridem_radius(materials[a], materials[b])
-            for a, b in self.peridem_damping
-            if a in materials and b in materials
-        }
+        other._peridem_radii = self._peridem_pair_radii()
         held = {body.name for body in assembly.bodies}
         walls = (self._assembly.body(b).name for b in self.peridem_walls)
         other.peridem_walls = [name for name in walls if name in held]
@@ -198,13 +193,17 @@ class Interactions:
         """How far apart PeriDEM's damping acts at most [m], beyond the particles' radii
         between their centre nodes, and between a node and a wall node: 1.01 times the
         largest of its contact radii (contact/peridem_damping.hpp); 0 without it."""
+        return PERIDEM_CENTRE_REACH * max(self._peridem_pair_radii().values(), default=0.0)
+
+    def _peridem_pair_radii(self) -> dict[tuple[int, int], float]:
+        """PeriDEM damping's contact radius for each pair of materials it is set for whose
+        materials this assembly's bodies use (_peridem_radius), keyed as peridem_damping."""
         materials = {id(body.material): body.material for body in self._assembly.bodies}
-        radii = [
-            self._peridem_radius(materials[a], materials[b])
+        return {
+            (a, b): self._peridem_radius(materials[a], materials[b])
             for a, b in self.peridem_damping
             if a in materials and b in materials
-        ]
-        return PERIDEM_CENTRE_REACH * max(radii, default=0.0)
+        }
 
     def _peridem_radius(self, a: Material, b: Material) -> float:
         """The contact radius PeriDEM's damping uses between materials a and b: the law's, or

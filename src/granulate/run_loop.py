@@ -302,8 +302,10 @@ def write_outputs(
     """The current step's outputs, written by rank 0 (Outputs.write_step; with `final`,
     write_final with that frame flag) once every rank has written its piece of the frame
     they write, when the frames go in pieces written by the ranks."""
-    folder = out.piece_folder(stepper.step, final) if out is not None else None
-    pieces = stepper.agree(None if folder is None or out is None else (folder, out.fields))
+    mine = None  # rank 0's: where the pieces go and their fields, when the frame has pieces
+    if out is not None and (folder := out.piece_folder(stepper.step, final)) is not None:
+        mine = (folder, out.fields)
+    pieces = stepper.agree(mine)
     if pieces is not None:
         stepper.write_pieces(*pieces)
     if final is None:

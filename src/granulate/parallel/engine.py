@@ -167,10 +167,7 @@ class DistributedRun:
         self._migration_due = False
         # The wall reactions a loaded checkpoint holds, until the next step evaluates them.
         self._loaded_walls: NDArray[np.float64] | None = None
-        large = self._pairs_of_large(
-            centres, radii, {int(g): start[self._slices[g]] for g in self._large}
-        )
-        held = self._distribute(centres, radii, start[self._damped_centres, : sim.dimension], large)
+        held = self._distribute_whole([start[where] for where in self._slices], centres, radii)
         together(self.comm, lambda: self._build(held))
         self._exchange_state()
         self._exchange_caps()
@@ -217,8 +214,11 @@ class DistributedRun:
         damping), PeriDEM's wall particles left out, and from wall nodes within that reach of
         a node (contact/peridem_damping.hpp)."""
         self._damping_reach = sim._interactions.peridem_reach()
+        self._damped_centres: NDArray[np.int64] | None = None  # global nodes, with damping
+        if self._damping_reach == 0:
+            return
         centres, radii = sim._assembly.centres_and_radii()
-        self._damped_centres = np.asarray(centres, dtype=np.int64)  # global nodes
+        self._damped_centres = np.asarray(centres, dtype=np.int64)
         self._damping_radii = np.asarray(radii)
         walls = sim._interactions.peridem_wall_indices()
         self._centre_damped = np.setdiff1d(np.arange(len(self._slices)), walls)
@@ -235,17 +235,17 @@ class DistributedRun:
         self,
         centres: NDArray[np.float64],
         radii: NDArray[np.float64],
-        damped_centres: NDArray[np.float64],
+        damped_centres: NDArray[np.float64] | None,
         large_pairs: tuple[NDArray[np.int64], NDArray[np.int64]],
     ) -> NDArray[np.int64]:
         """Owners by recursive coordinate bisection of the grains' `centres` and the ghosts of
         every rank from their bounding spheres (`radii`) and the large bodies' `large_pairs`
         (_pairs_of_large), and with PeriDEM's damping also from where their centre nodes are
-        (`damped_centres`); the grains this rank holds (sorted)."""
+        (`damped_centres`; None without it); the grains this rank holds (sorted)."""
         rank = self.comm.Get_rank()
         self.partition: Partition = bisect(centres, self._weights, self.comm.Get_size())
         first, last = near_pairs_with_large(centres, radii, self._reach, self._large, large_pairs)
-        if self._damping_reach > 0:  # centres within radii + reach, each moving < margin/2
+        if damped_centres is not None:  # centres within radii + reach, each moving < margin/2
             reach = self._damping_reach + self.margin
             ids = self._centre_damped
             more = near_pairs(damped_centres[ids], self._damping_radii[ids], reach)
@@ -255,6 +255,29 @@ class DistributedRun:
             )
         self.ghosts = ghosts(self.partition, (first, last))
         return np.union1d(self.partition.grains_of(rank), self.ghosts[rank])
+
+    def _distribute_whole(
+        self,
+        grains: list[NDArray[np.float64]],
+        centres: NDArray[np.float64],
+        radii: NDArray[np.float64],
+    ) -> NDArray[np.int64]:
+        """_distribute from every grain's node positions (`grains`), which every rank has at
+        the start and from a checkpoint, and their bounding spheres (_spheres)."""
+        damped = None
+        if self._damped_centres is not None:
+            starts = [where.start for where in self._slices]
+            dimension = self._sim.dimension
+            damped = np.array(
+                [
+                    nodes[centre - start, :dimension]
+                    for nodes, centre, start in zip(
+                        grains, self._damped_centres, starts, strict=True
+                    )
+                ]
+            )
+        large = self._pairs_of_large(centres, radii, {int(g): grains[g] for g in self._large})
+        return self._distribute(centres, radii, damped, large)
 
     def _pairs_of_large(
         self,
@@ -336,7 +359,7 @@ class DistributedRun:
         for q, nodes in self._receive_whole.items():
             near = nodes[close[nodes]]
             caps[q] = np.union1d(near, np.asarray(self.local.model.bond_partners(near.tolist())))
-            if self._damping_reach > 0:  # PeriDEM's damping reads every ghost's centre node
+            if self._damped_centres is not None:  # PeriDEM's damping reads ghosts' centres
                 centres = self._node_map[self._damped_centres[self._receive_grains[q]]]
                 caps[q] = np.union1d(caps[q], centres)
         requests = [
@@ -656,18 +679,22 @@ class DistributedRun:
 
     def _current_spheres(
         self,
-    ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
-        """Every grain's bounding sphere now and where its centre node is (PeriDEM's damping),
-        from its owner (one allgather)."""
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64] | None]:
+        """Every grain's bounding sphere now and, with PeriDEM's damping, where its centre
+        node is (else None), from its owner (one allgather)."""
         positions = self.local.core.positions
         dimension = self._sim.dimension
         mine = _spheres([positions[self._local_slice(g)] for g in self._owned], dimension)
-        points = positions[self._node_map[self._damped_centres[self._owned]], :dimension]
+        points = None
+        if self._damped_centres is not None:
+            points = positions[self._node_map[self._damped_centres[self._owned]], :dimension]
         centres = np.empty((len(self._slices), dimension))
         radii = np.empty(len(self._slices))
-        damped = np.empty((len(self._slices), dimension))
+        damped = None if points is None else np.empty((len(self._slices), dimension))
         for grains, spheres, their_points in self.comm.allgather((self._owned, mine, points)):
-            centres[grains], radii[grains], damped[grains] = *spheres, their_points
+            centres[grains], radii[grains] = spheres
+            if damped is not None:
+                damped[grains] = their_points
         return centres, radii, damped
 
     def _hand_over(
@@ -749,15 +776,8 @@ class DistributedRun:
 
         start = time.perf_counter()
         states, moment = self.comm.bcast(on_root(self.comm, read), root=0)
-        dimension = self._sim.dimension
         grains = [states[g].positions for g in range(len(self._slices))]
-        damped = [
-            nodes[centre - where.start, :dimension]
-            for nodes, centre, where in zip(grains, self._damped_centres, self._slices, strict=True)
-        ]
-        centres, radii = _spheres(grains, dimension)
-        large = self._pairs_of_large(centres, radii, {int(g): grains[g] for g in self._large})
-        held = self._distribute(centres, radii, np.array(damped), large)
+        held = self._distribute_whole(grains, *_spheres(grains, self._sim.dimension))
         together(self.comm, lambda: self._rebuild(held, states, moment))
         self._exchange_caps()
         self._loaded_walls = np.asarray(moment["contact_wall_reactions"]).reshape(-1, 6)

@@ -154,8 +154,11 @@ def near_pairs_with_large(
     sorts them."""
     points = np.asarray(centres, dtype=float)
     size = np.asarray(radii, dtype=float)
+    large = np.asarray(large, dtype=np.int64)
+    if len(large) == 0:
+        return near_pairs(points, size, reach)
     big = np.zeros(len(points), dtype=bool)
-    big[np.asarray(large, dtype=np.int64)] = True
+    big[large] = True
     firsts, lasts = [large_pairs[0]], [large_pairs[1]]
     for group in (np.flatnonzero(~big), np.flatnonzero(big)):
         if len(group) > 1:

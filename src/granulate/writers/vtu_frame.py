@@ -102,10 +102,12 @@ def write_piece(
     fields: tuple[str, ...],
     nodes: NDArray[np.int64] | None = None,
     numbering: Numbering | None = None,
+    damage: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None,
 ) -> None:
     """One piece of a frame: the nodes `nodes` of `sim` (all when None), their `fields` and
-    their numbers in the whole run (`numbering`, for a part of a distributed run)."""
-    values = point_fields(sim, fields, sim.core.damage(), numbering)
+    their numbers in the whole run (`numbering`, for a part of a distributed run); `damage`
+    as point_fields takes it (core.damage() when not given)."""
+    values = point_fields(sim, fields, damage or sim.core.damage(), numbering)
     chosen = np.arange(sim.node_count) if nodes is None else nodes
     numbers = chosen if numbering is None else numbering[0][chosen]
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -127,13 +129,14 @@ class VtuFrame:
         sim = data.simulation
         name = f"frame_{outputs.frames:06d}"
         frames = outputs.directory / "frames"
+        damage = (data.damage, data.damage_z)
         if not outputs.pieces:
-            values = point_fields(sim, outputs.fields, (data.damage, data.damage_z))
+            values = point_fields(sim, outputs.fields, damage)
             write_vtu(frames / f"{name}.vtu", sim.core.positions, values)
             outputs.pvd.add(sim.core.time, Path("frames") / f"{name}.vtu")
             return
         if not outputs.piece_ranks:  # a serial run's one piece; else the ranks wrote theirs
-            write_piece(frames / name / "piece_0.vtu", sim, outputs.fields)
+            write_piece(frames / name / "piece_0.vtu", sim, outputs.fields, damage=damage)
         count = outputs.piece_ranks or 1
         pieces = [f"piece_{r}.vtu" for r in range(count)]
         _check_pieces(frames / name, pieces)
