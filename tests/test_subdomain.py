@@ -92,6 +92,23 @@ def test_translated_copies_in_a_subdomain_keep_the_whole_assemblys_bonds() -> No
     assert np.any(alone.core.dilatation[node_map[disc]] != whole.core.dilatation[disc])
 
 
+def test_a_grains_critical_stretch_does_not_depend_on_the_grains_held_with_it() -> None:
+    """Three discs of one material meshed at 0.25, 0.19 and 0.22 mm (each its own horizon, 3
+    mesh sizes): each grain's s0 is the material's at its own horizon. It was the material's
+    s0 at the horizon of the model's first grain of that material, scaled by sqrt(h_first /
+    h): a part without disc 0 made its discs' s0 one rounding apart from the whole run's
+    (1.7e-16 and 1.8e-16 relative), so a bond could break on one rank and not in the serial
+    run, and PeriDEM's Z differed in the last bits."""
+    whole = gr.Simulation(2)
+    for k, mesh in enumerate((2.5e-4, 1.9e-4, 2.2e-4)):
+        whole.add_body(gr.Disc((2.2e-3 * k, 0.0), 1e-3), ROCK, mesh)
+    part, _ = whole._subdomain(np.array([1, 2]))
+    for grain, held in ((1, 0), (2, 1)):
+        s0 = ROCK.critical_stretch(whole.bodies[grain].mesh_size, 2)
+        assert whole.model.particle_critical_stretch(grain) == s0
+        assert part.model.particle_critical_stretch(held) == s0
+
+
 def two_materials() -> gr.Simulation:
     """Discs of a heavy and a light material at mesh sizes 0.08-0.4 mm, the pair of materials
     with a contact law of its own (ten times stiffer)."""

@@ -101,6 +101,39 @@ FractureCoefficients fracture_coefficients(ForceModel model, InfluenceKind influ
   return result;
 }
 
+namespace {
+
+/// The continuum PMB micromodulus c at horizon delta (Material::micromodulus).
+real pmb_micromodulus(const Material& m, real delta) {
+  const InfluenceKind influence = m.params.influence;
+  if (m.dimension == 3) {
+    return 18.0 * m.params.bulk_modulus /
+           (4.0 * std::numbers::pi * std::pow(delta, 4) * influence_moment(influence, 3));
+  }
+  return 8.0 * m.dilatation_modulus /
+         (2.0 * std::numbers::pi * std::pow(delta, 3) * influence_moment(influence, 2));
+}
+
+}  // namespace
+
+real Material::critical_stretch_at(real delta) const {
+  if (!params.fracture) return std::numeric_limits<real>::infinity();
+  const real K = params.bulk_modulus;
+  const real G = params.shear_modulus;
+  real energy_per_stretch2;  // Gc / s0^2
+  if (dimension == 2 && plane == PlaneMode::peridem) {
+    energy_per_stretch2 = (3.0 * G + std::pow(0.75, 4) * (K - 5.0 * G / 3.0)) * delta;
+  } else if (params.model == ForceModel::lps) {
+    const real d = dimension;
+    energy_per_stretch2 =
+        delta *
+        (fracture.pair * G + fracture.dilatation * (dilatation_modulus - deviatoric_factor * G / (d * d)));
+  } else {
+    energy_per_stretch2 = fracture.pair * pmb_micromodulus(*this, delta) * std::pow(delta, dimension + 2);
+  }
+  return energy_per_stretch2 > 0 ? std::sqrt(params.fracture_energy / energy_per_stretch2) : 0.0;
+}
+
 Material Material::make(const MaterialParams& params, int dimension, PlaneMode plane,
                         const FractureCoefficients* known) {
   if (dimension != 2 && dimension != 3) {
@@ -141,45 +174,15 @@ Material Material::make(const MaterialParams& params, int dimension, PlaneMode p
     m.dilatation_modulus = plane == PlaneMode::strain ? K + G / 3.0 : 9.0 * K * G / (3.0 * K + 4.0 * G);
     m.deviatoric_factor = 8.0;
   }
-  const real delta = params.horizon;
-  // PMB matches the classical energy of an isotropic expansion, d^2 kappa_d eps^2 / 2, with the
-  // same kappa_d as LPS; being bond-based it cannot match G as well (its Poisson ratio is 1/4 in
-  // 3D and plane strain, 1/3 in plane stress).
-  if (params.model == ForceModel::pmb) {
-    if (dimension == 3) {
-      m.micromodulus =
-          18.0 * K / (4.0 * std::numbers::pi * std::pow(delta, 4) * influence_moment(params.influence, 3));
-    } else {
-      m.micromodulus = 8.0 * m.dilatation_modulus /
-                       (2.0 * std::numbers::pi * std::pow(delta, 3) * influence_moment(params.influence, 2));
-    }
+  if (params.model == ForceModel::pmb) m.micromodulus = pmb_micromodulus(m, params.horizon);
+  if (params.fracture && !peridem) {
+    m.fracture = known ? *known : fracture_coefficients(params.model, params.influence, dimension);
   }
-
-  m.critical_stretch = std::numeric_limits<real>::infinity();
-  if (params.fracture && peridem) {
-    const real energy_per_stretch2 = (3.0 * G + std::pow(0.75, 4) * (K - 5.0 * G / 3.0)) * delta;
-    if (!(energy_per_stretch2 > 0)) {
-      throw InputError("material constants give a non-positive fracture energy per stretch; check K and G");
-    }
-    m.critical_stretch = std::sqrt(params.fracture_energy / energy_per_stretch2);
-  } else if (params.fracture) {
-    const FractureCoefficients coefficients =
-        known ? *known : fracture_coefficients(params.model, params.influence, dimension);
-    real energy_per_stretch2;  // Gc / s0^2
-    if (params.model == ForceModel::lps) {
-      const real d = dimension;
-      energy_per_stretch2 =
-          delta * (coefficients.pair * G +
-                   coefficients.dilatation * (m.dilatation_modulus - m.deviatoric_factor * G / (d * d)));
-    } else {
-      energy_per_stretch2 = coefficients.pair * m.micromodulus * std::pow(delta, dimension + 2);
-    }
-    if (!(energy_per_stretch2 > 0)) {
-      throw InputError(
-          "material constants give a non-positive fracture energy per stretch; "
-          "check K and G (Poisson ratio near -1?)");
-    }
-    m.critical_stretch = std::sqrt(params.fracture_energy / energy_per_stretch2);
+  m.critical_stretch = m.critical_stretch_at(params.horizon);
+  if (!(m.critical_stretch > 0)) {
+    throw InputError(
+        "material constants give a non-positive fracture energy per stretch; "
+        "check K and G (Poisson ratio near -1?)");
   }
   return m;
 }

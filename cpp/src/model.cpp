@@ -155,9 +155,7 @@ index_t Model::add_particle(index_t shape_index, index_t material, std::span<con
   p.scale = scale;
   p.horizon = horizon;
   const Material& m = materials_[material];
-  p.critical_stretch = std::isfinite(m.critical_stretch)
-                           ? m.critical_stretch * std::sqrt(m.params.horizon / horizon)
-                           : m.critical_stretch;
+  p.critical_stretch = m.critical_stretch_at(horizon);
   particles_.push_back(p);
   const real volume_scale = std::pow(scale, dimension_);
   reference_positions_.insert(reference_positions_.end(), positions.begin(), positions.end());

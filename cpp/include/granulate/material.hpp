@@ -45,8 +45,18 @@ struct Material {
   /// Continuum PMB micromodulus c: 3D 18K / I1, 2D 8 kappa_d / I1, I1 = int J(r/delta) r dV
   /// [Pa/m^(d+1)]; used to derive s0. The force loop uses the per-node discrete form (pmb.hpp).
   real micromodulus = 0;
-  /// s0, critical bond stretch; infinity when fracture is off.
+  /// s0, critical bond stretch at params.horizon (critical_stretch_at); infinity when fracture
+  /// is off.
   real critical_stretch = 0;
+  /// The fracture coefficients s0 is derived with (zero without fracture, and for PeriDEM's
+  /// 2D constants, which have their own).
+  FractureCoefficients fracture;
+
+  /// s0 at horizon delta [m]: sqrt(Gc / (energy per squared stretch at delta)), from the
+  /// material's constants alone, so that a particle's s0 does not depend on which particle's
+  /// horizon made the material (a distributed run's parts make it of other particles than the
+  /// whole run); 0 when the constants give no positive energy (make refuses them).
+  real critical_stretch_at(real delta) const;
 
   /// Validates the parameters (throws InputError naming the bad one) and derives the constants.
   /// `coefficients`: fracture_coefficients(params.model, params.influence, dimension) if already
