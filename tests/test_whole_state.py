@@ -10,6 +10,8 @@ import numpy as np
 import pytest
 
 import granulate as gr
+from granulate import particle_table
+from granulate.analysis import GivenMeasures
 from test_checkpoint import tumbling_drum
 
 
@@ -44,3 +46,41 @@ def test_bonds_assigned_whole_set_the_broken_count(tmp_path: Path) -> None:
     assert np.array_equal(fresh.core.bond_intact, broken.core.bond_intact)
     with pytest.raises(gr.InputError, match="one byte per bond copy"):
         fresh.core.assign_bonds(np.ones(3, dtype=np.uint8))
+
+
+def test_the_strain_energy_sums_its_densities_in_node_order(tmp_path: Path) -> None:
+    """What rank 0 sums of the densities the ranks measure (_core.volume_weighted_total):
+    the core's strain energy to the bit, in the tumbling drum as it breaks."""
+    sim = tumbling_drum(tmp_path)
+    for _ in range(3):
+        sim.core.run(300)
+        density = np.asarray(sim.core.strain_energy_density())
+        total = gr._core.volume_weighted_total(density, np.asarray(sim.model.volumes))
+        assert total == sim.core.strain_energy() > 0
+    with pytest.raises(gr.InputError, match="one density per node volume"):
+        gr._core.volume_weighted_total(density[1:], np.asarray(sim.model.volumes))
+
+
+def test_given_measures_stand_for_the_cores_until_the_state_changes(tmp_path: Path) -> None:
+    """Analysis.give (rank 0 takes the measures the ranks made of their grains): the damage, Z,
+    fragment labels, strain energy and particle motion given are what the simulation reports
+    at that step, and the core's again once a step is taken or when None is given."""
+    sim = tumbling_drum(tmp_path)
+    sim.core.run(600)
+    nodes, grains = sim.node_count, len(sim.bodies)
+    motion = {key: np.full(grains, 7.0) for key in particle_table.MOTION_COLUMNS}
+    density = np.full(nodes, 2.0)
+    given = GivenMeasures(
+        np.full(nodes, 0.25), np.full(nodes, 0.5), np.zeros(nodes, np.uint32), density, motion
+    )
+    sim.analysis.give(given)
+    assert np.all(sim.damage == 0.25) and np.all(sim.damage_z == 0.5)
+    assert sim.strain_energy() == 2.0 * np.add.accumulate(np.asarray(sim.model.volumes))[-1]
+    assert len(sim.fragment_table()["fragment"]) == 1  # every node labelled 0
+    assert np.all(sim.particle_table()["vx"] == 7.0)
+    sim.analysis.give(None)
+    assert sim.strain_energy() == sim.core.strain_energy()
+    sim.analysis.give(given)
+    sim.core.run(1)
+    assert np.array_equal(sim.damage, sim.core.damage()[0])
+    assert np.all(sim.particle_table()["vx"] != 7.0)

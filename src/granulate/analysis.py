@@ -1,13 +1,15 @@
-"""Measures of a built simulation's current state: fragments (pieces held together by intact
-bonds) and their table, particles broken, the particle table (motion, damage, coordination,
-Love-Weber stress), the contact network and particle stresses, and the gravity energy. Each
-reads the core's live state when called; the fragment labels are kept for one step and bond
-count. The formulas are in granulate.fragments, granulate.particle_table and
-granulate.network."""
+"""Measures of a built simulation's current state: damage, strain energy, fragments (pieces
+held together by intact bonds) and their table, particles broken, the particle table (motion,
+damage, coordination, Love-Weber stress), the contact network and particle stresses, and the
+gravity energy. Each reads the core's live state when called; the fragment labels are kept for
+one step and bond count. A distributed run's rank 0 is given the measures its ranks made of
+their own grains instead (GivenMeasures), for the state it gathered. The formulas are in
+granulate.fragments, granulate.particle_table and granulate.network."""
 
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
@@ -18,6 +20,22 @@ from granulate.assembly import Body
 from granulate.errors import InputError
 
 
+@dataclass(frozen=True)
+class GivenMeasures:
+    """The measures of every grain at one step made where its bonds are evaluated (each rank of
+    a distributed run, of the grains it owns; whole_state.install puts them together), bit for
+    bit what the whole core gives: per node the damage phi and PeriDEM's Z (core.damage), the
+    fragment label (core.fragments), the strain energy density W [J/m^3]
+    (core.strain_energy_density), and per particle the motion columns (particle_table.motion).
+    These are the measures that read the bonds or sum over every node."""
+
+    damage: NDArray[np.float64]
+    damage_z: NDArray[np.float64]
+    labels: NDArray[np.uint32]
+    strain_energy_density: NDArray[np.float64]
+    motion: particle_table.Table
+
+
 class Analysis:
     """The measures of one core simulation with `particles` particles (Simulation.analysis)."""
 
@@ -25,18 +43,54 @@ class Analysis:
         self._core, self._model = core, model
         self._dimension, self._particles = model.dimension, particles
         self._labels: tuple[tuple[int, int], NDArray[np.uint32]] | None = None
+        self._given: tuple[tuple[int, int], GivenMeasures] | None = None
+
+    def _key(self) -> tuple[int, int]:
+        """The step and the broken bonds: the state the kept labels and given measures are of."""
+        return int(self._core.step), int(self._core.broken_bonds())
+
+    def give(self, measures: GivenMeasures | None) -> None:
+        """The measures of the current state made elsewhere (a distributed run's rank 0: its
+        ranks', whole_state.install), used in place of the core's until the step or the
+        broken bonds change; None: none (the core's are made)."""
+        self._given = None if measures is None else (self._key(), measures)
+
+    def _given_now(self) -> GivenMeasures | None:
+        """The given measures, when they are of the current state."""
+        if self._given is None or self._given[0] != self._key():
+            return None
+        return self._given[1]
+
+    def damage(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """Per node the damage phi and PeriDEM's Z (core.damage)."""
+        given = self._given_now()
+        if given is not None:
+            return given.damage, given.damage_z
+        phi, z = self._core.damage()
+        return np.asarray(phi), np.asarray(z)
+
+    def strain_energy(self) -> float:
+        """sum_i W_i V_i [J; J/m in 2D] (core.strain_energy)."""
+        given = self._given_now()
+        if given is None:
+            return float(self._core.strain_energy())
+        return _core.volume_weighted_total(given.strain_energy_density, self._model.volumes)
 
     def fragment_labels(self) -> NDArray[np.uint32]:
         """Each node's piece: its smallest node (computed once per step and bond count)."""
-        core = self._core
-        key = (int(core.step), int(core.broken_bonds()))
+        given = self._given_now()
+        if given is not None:
+            return given.labels
+        key = self._key()
         if self._labels is None or self._labels[0] != key:
-            self._labels = (key, core.fragments())
+            self._labels = (key, self._core.fragments())
         return self._labels[1]
 
     def forget_fragments(self) -> None:
-        """Drop the kept labels (the bonds were restored from a checkpoint)."""
+        """Drop the kept labels and given measures (the bonds were restored from a
+        checkpoint)."""
         self._labels = None
+        self._given = None
 
     def fragments(self, min_nodes: int) -> list[NDArray[np.uint32]]:
         """Pieces of at least `min_nodes` nodes, largest first, as node indices."""
@@ -93,7 +147,7 @@ class Analysis:
         phi per node (the core's, when None)."""
         core, count = self._core, self._particles
         owner, volumes, table = self._motion()
-        phi = core.damage()[0] if damage is None else np.asarray(damage)
+        phi = self.damage()[0] if damage is None else np.asarray(damage)
         particle_volume = np.bincount(owner, volumes, count)
         table["particle"] = np.arange(count)
         table["time"] = np.full(count, float(core.time))
@@ -109,6 +163,9 @@ class Analysis:
         (granulate.particle_table.motion)."""
         model, core = self._model, self._core
         owner, volumes = np.asarray(model.node_particle), np.asarray(model.volumes)
+        given = self._given_now()
+        if given is not None:
+            return owner, volumes, dict(given.motion)  # the callers add columns
         mass = np.asarray(model.node_density) * volumes
         motion = particle_table.motion(
             owner, mass, core.positions, core.velocities, self._particles

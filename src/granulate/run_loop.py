@@ -70,8 +70,10 @@ class Stepper(Protocol):
     def first_forces(self) -> None:
         """The forces of the current step, before any step (for step 0's frame)."""
 
-    def collect(self) -> None:
-        """The whole state in the simulation the outputs and stop criteria read."""
+    def collect(self, measures: bool = True) -> None:
+        """The whole state in the simulation the outputs and stop criteria read; with
+        `measures`, for outputs (a distributed run's ranks then measure their grains for them:
+        analysis.GivenMeasures)."""
 
     def agree(self, value: T) -> T:
         """Rank 0's `value`, on every rank."""
@@ -113,7 +115,7 @@ class CoreStepper:
     def first_forces(self) -> None:
         self.core.run(0)  # prescribed motion and contact of the current step
 
-    def collect(self) -> None:
+    def collect(self, measures: bool = True) -> None:
         pass
 
     def agree(self, value: T) -> T:
@@ -350,7 +352,7 @@ class _Chunks:
         saves = checkpoint is not None and checkpoint.is_due(step)
         writes, saves = stepper.agree((writes, saves))
         if writes or checks:
-            stepper.collect()
+            stepper.collect(measures=writes)
         if writes:
             write_outputs(stepper, sim, out)
         reason = None

@@ -102,12 +102,12 @@ class SimulationResults:
     @property
     def damage(self) -> NDArray[np.float64]:
         """(n,) damage phi = 1 - intact / initial influence-weighted volume of the bonds."""
-        return self._build().damage()[0]
+        return self.analysis.damage()[0]
 
     @property
     def damage_z(self) -> NDArray[np.float64]:
         """(n,) PeriDEM's Damage_Z: max over a node's bonds of |stretch| / s0."""
-        return self._build().damage()[1]
+        return self.analysis.damage()[1]
 
     @property
     def time(self) -> float:
@@ -129,7 +129,7 @@ class SimulationResults:
 
     def strain_energy(self) -> float:
         """sum W_i V_i over intact bonds [J; J/m in 2D]."""
-        return self._build().strain_energy()
+        return self.analysis.strain_energy()
 
     def broken_bonds(self) -> int:
         """Number of broken bonds, each counted once."""

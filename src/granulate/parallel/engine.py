@@ -827,14 +827,16 @@ class DistributedRun:
             total = _sum_wall_terms(parts, len(core.wall_reactions()))
         return self.comm.bcast(total, root=0)
 
-    def collect(self) -> None:
+    def collect(self, measures: bool = True) -> None:
         """Every rank: rank 0's simulation (the one the run was made of, built whole on the
         first call) takes every grain's state and the last step's contacts, contact energy
         and counts and wall reactions, in the serial order (whole_state.py): its outputs,
-        measures and stop criteria are then the serial run's at this step."""
+        measures and stop criteria are then the serial run's at this step. With `measures`
+        (for outputs), each rank also measures its grains (damage, fragments, strain energy,
+        motion: analysis.GivenMeasures), which rank 0's analysis then takes."""
         start = time.perf_counter()
         walls = self.wall_reactions()
-        parts = self.comm.gather(owned_part(self), root=0)
+        parts = self.comm.gather(owned_part(self, measures), root=0)
         if parts is not None:
             core = self.local.core
             install(self._sim, parts, (float(core.time), int(core.step)), walls)

@@ -40,8 +40,8 @@ class DistributedStepper:
     def first_forces(self) -> None:
         """Nothing to do: every part evaluated its forces when it was built."""
 
-    def collect(self) -> None:
-        self.run.collect()
+    def collect(self, measures: bool = True) -> None:
+        self.run.collect(measures)
 
     def agree(self, value: T) -> T:
         return self.comm.bcast(value, root=0)  # type: ignore[no-any-return]

@@ -10,6 +10,12 @@ the energy summed node by node in node order as the serial core sums it. Every v
 serial run's at that step, bit for bit, except the number of list searches, which each rank
 makes for its own part (the largest over the ranks is given).
 
+The measures that read every bond or sum over every node (the damage, the fragment labels, the
+strain energy densities and the particles' motion: analysis.GivenMeasures) each rank makes of
+its own grains, as the serial core makes them node by node and particle by particle, and rank 0
+puts them together (its Analysis uses them for that step) instead of making them all from the
+gathered state: the history rows and frames cost rank 0 that much less while the ranks wait.
+
 Rank 0 holds the whole model and state for this, as it holds the whole frame it writes; that
 bounds the size of a distributed run to what one process can hold (docs/parallel.md).
 """
@@ -22,7 +28,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
-from granulate import network
+from granulate import network, particle_table
+from granulate.analysis import GivenMeasures
 from granulate.evaluation import Evaluation
 
 if TYPE_CHECKING:
@@ -50,10 +57,13 @@ class OwnedPart:
     node_contacts: int
     wall_contacts: int
     searches: int
+    #: of the grains' nodes and of the grains (labels: global nodes), when asked for
+    measures: GivenMeasures | None
 
 
-def owned_part(run: DistributedRun) -> OwnedPart:
-    """This rank's OwnedPart (the run's part holds the last step's evaluation)."""
+def owned_part(run: DistributedRun, measures: bool = True) -> OwnedPart:
+    """This rank's OwnedPart (the run's part holds the last step's evaluation), with its
+    grains' measures or without."""
     core, nodes = run.local.core, run.owned_nodes
     offsets = np.asarray(run.local.model.bond_offsets, dtype=np.int64)
     intact = np.asarray(core.bond_intact)
@@ -71,7 +81,27 @@ def owned_part(run: DistributedRun) -> OwnedPart:
         int(pairs[nodes].sum()),
         int(walls[nodes].sum()),
         int(core.contact_statistics.rebuilds),
+        _owned_measures(run) if measures else None,
     )
+
+
+def _owned_measures(run: DistributedRun) -> GivenMeasures:
+    """The measures of the rank's own grains (analysis.GivenMeasures): per own node, in grain
+    order, its damage, Z, fragment label (a global node) and strain energy density, and per
+    own grain its motion. Each node's and each grain's are the whole core's, bit for bit: a
+    node's reads only its own bonds, and a grain's sums run over its nodes in the serial order
+    (np.bincount adds in the order given), whatever else the part holds."""
+    local, nodes = run.local, run.owned_nodes
+    core, model = local.core, local.model
+    phi, z = (np.asarray(a)[nodes] for a in core.damage())
+    labels = run.global_nodes(np.asarray(core.fragments())[nodes]).astype(np.uint32)
+    grain = np.searchsorted(run.owned, run.held[np.asarray(model.node_particle)[nodes]])
+    mass = (np.asarray(model.node_density) * np.asarray(model.volumes))[nodes]
+    motion = particle_table.motion(
+        grain, mass, core.positions[nodes], core.velocities[nodes], len(run.owned)
+    )
+    density = np.asarray(core.strain_energy_density())[nodes]
+    return GivenMeasures(phi, z, labels, density, motion)
 
 
 def _owned_contacts(run: DistributedRun, local: dict[str, Any]) -> dict[str, NDArray[Any]]:
@@ -111,6 +141,8 @@ def install(
         _place(part, core, (starts, bond_starts), bonds, energy)
     core.assign_bonds(bonds)
     core.time, core.step = moment
+    given = all(part.measures is not None for part in parts)
+    sim.analysis.give(_measures_of_all(parts, starts, len(sim.bodies)) if given else None)
     sim._gathered = Evaluation(
         network.contact_table(_serial_order([part.contacts for part in parts])),
         float(np.add.accumulate(energy)[-1]) if len(energy) else 0.0,  # the core's order
@@ -118,6 +150,31 @@ def install(
         sum(part.wall_contacts for part in parts),
         max(part.searches for part in parts),
         wall_reactions,
+    )
+
+
+def _measures_of_all(
+    parts: list[OwnedPart], starts: NDArray[np.int64], grains: int
+) -> GivenMeasures:
+    """The ranks' measures of their grains as the whole core's: per node in node order, per
+    grain in grain order. `starts`: each grain's first node and the node count after the last."""
+    nodes = starts[-1]
+    fields = {name: np.empty(nodes) for name in ("damage", "damage_z", "strain_energy_density")}
+    labels = np.empty(nodes, dtype=np.uint32)
+    motion = {column: np.empty(grains) for column in particle_table.MOTION_COLUMNS}
+    for part in parts:
+        index = np.concatenate(
+            [np.zeros(0, np.int64)] + [np.arange(starts[g], starts[g + 1]) for g in part.grains]
+        )
+        given = part.measures
+        assert given is not None
+        for name, values in fields.items():
+            values[index] = getattr(given, name)
+        labels[index] = given.labels
+        for column, values in motion.items():
+            values[part.grains] = given.motion[column]
+    return GivenMeasures(
+        fields["damage"], fields["damage_z"], labels, fields["strain_energy_density"], motion
     )
 
 

@@ -33,7 +33,7 @@ class StepData:
 
     @classmethod
     def of(cls, simulation: Simulation) -> StepData:
-        phi, z = simulation.core.damage()
+        phi, z = simulation.analysis.damage()
         table = simulation.fragment_table()
         evaluation = simulation.evaluation()
         contacts = evaluation.contacts
