@@ -127,8 +127,9 @@ def test_a_ghost_grain_needs_only_its_owners_cap_motion_and_breaks(
     any use of them would show) and out of the contact lists (core.set_inert_contact_nodes,
     the cap picked anew each step): the other grains' nodes
     agree bit for bit through 900 steps of contact and breaking, the part breaks the other
-    grains' bonds as the whole run does, and every bond ends the same. The ghost's own forces
-    and dilatation are not computed."""
+    grains' bonds as the whole run does, and every bond ends the same, and so do the damage, Z
+    and strain energy density of its own nodes. The ghost's own forces, dilatation and
+    measures are not computed."""
     whole = tumbling_drum(tmp_path / "whole", fracture=fracture, law=law, rolling=rolling)
     part = tumbling_drum(tmp_path / "part", fracture=fracture, law=law, rolling=rolling)
     whole.core.run(0)
@@ -171,6 +172,18 @@ def test_a_ghost_grain_needs_only_its_owners_cap_motion_and_breaks(
     assert part.broken_bonds() == whole.broken_bonds()
     assert np.all(np.asarray(part.core.dilatation)[ghost] == 0)
     assert np.abs(np.asarray(whole.core.dilatation)[ghost]).max() > 0
+    # What the part measures of its own grains for rank 0's outputs (whole_state): the whole
+    # run's, bit for bit; nothing of the ghost's, which its owner measures.
+    measures = {
+        "phi": lambda core: np.asarray(core.damage()[0]),
+        "z": lambda core: np.asarray(core.damage()[1]),
+        "strain": lambda core: np.asarray(core.strain_energy_density()),
+    }
+    for name, measure in measures.items():
+        ours, theirs = measure(whole.core), measure(part.core)
+        np.testing.assert_array_equal(ours[others], theirs[others], err_msg=name)
+        assert np.all(theirs[ghost] == 0), name
+        assert np.any(ours[ghost] != 0) or (name != "strain" and not fracture), name
 
 
 def test_a_ghost_body_in_contact_needs_its_owners_motion(tmp_path: Path) -> None:

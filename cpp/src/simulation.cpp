@@ -370,6 +370,10 @@ void Simulation::strain_energy_density(real* out) const {
 #pragma omp parallel for schedule(static)
   for (std::int64_t ii = 0; ii < static_cast<std::int64_t>(m.node_count()); ++ii) {
     const index_t i = static_cast<index_t>(ii);
+    if (ghost_node(i)) {  // another process's: it measures them
+      out[i] = 0;
+      continue;
+    }
     const Material& material = m.materials()[m.node_material()[i]];
     const bool is_lps = material.params.model == ForceModel::lps;
     const real theta = state_.dilatation[i];
@@ -409,6 +413,11 @@ void Simulation::damage(real* phi, real* z) const {
 #pragma omp parallel for schedule(static)
   for (std::int64_t ii = 0; ii < static_cast<std::int64_t>(m.node_count()); ++ii) {
     const index_t i = static_cast<index_t>(ii);
+    if (ghost_node(i)) {  // another process's: it measures them
+      if (phi) phi[i] = 0;
+      if (z) z[i] = 0;
+      continue;
+    }
     const real s0 = m.particles()[m.node_particle()[i]].critical_stretch;
     const NodeBonds bonds = m.node_bonds(i);
     real all = 0, intact = 0, max_stretch = 0;

@@ -93,9 +93,11 @@ class Simulation {
   /// the ranks measured of their grains, to the serial run's bits.
   static real volume_weighted_total(std::span<const real> density, std::span<const real> volumes);
   real contact_energy() const { return contact_.spring_energy(*model_, state_); }  ///< [J; J/m]
-  /// W_i per node [J/m^3, also in 2D]: LPS and PMB energy densities (see the evaluators).
+  /// W_i per node [J/m^3, also in 2D]: LPS and PMB energy densities (see the evaluators); 0
+  /// on ghost particles (set_ghost_particles: their owners measure them).
   void strain_energy_density(real* out) const;
-  /// phi_i = 1 - (intact weighted volume)/(initial weighted volume); z_i = max_j |s_ij| / s0.
+  /// phi_i = 1 - (intact weighted volume)/(initial weighted volume); z_i = max_j |s_ij| / s0;
+  /// 0 on ghost particles.
   void damage(real* phi, real* z) const;
   std::uint64_t broken_bonds() const;  ///< broken bonds, each counted once
   /// Replaces every bond copy's state (one byte each, in the model's bond order, as checkpoints
