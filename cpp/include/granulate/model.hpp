@@ -43,7 +43,7 @@ struct Particle {
   index_t shape = 0;
   real scale = 1;
   real horizon = 0;           ///< delta [m] of this particle's bonds
-  real critical_stretch = 0;  ///< s0 at this horizon (s0 ~ delta^-1/2, see Material::make)
+  real critical_stretch = 0;  ///< s0 at this horizon (Material::critical_stretch_at)
   index_t family = 0;         ///< shared bond family (see Model::node_bonds)
 };
 
