@@ -24,8 +24,8 @@ besides and those it receives each step (the caps), its owned node-steps per sec
 shares of its wall-clock time spent in the ghost exchange, in the partition check (a
 reduction), in picking the caps anew, in migrations and, with
 ``--collect-every N``, in gathering the whole state into rank 0's simulation every N steps (as a
-run with outputs or stop criteria every N steps does, DistributedRun.collect; nothing is
-written); then the migrations and grains handed over. With ``--json``, one JSON object instead.
+run with outputs every N steps does, DistributedRun.collect, the ranks measuring their grains
+for the outputs too; nothing is written, and the row rank 0 would compute is not); then the migrations and grains handed over. With ``--json``, one JSON object instead.
 On fewer cores than ranks (oversubscribed) the shares include waiting for the other ranks and
 are an upper bound.
 """
