@@ -199,6 +199,7 @@ def as_built(
     rate: float,
     ghost_saving: float,
     args: argparse.Namespace,
+    caps: tuple[np.ndarray, np.ndarray, float] | None = None,
 ) -> dict[str, float]:
     """The engine as built (granulate.parallel.DistributedRun), for the rank with the most ghost
     grains per owned grain: its ghosts are whole grains within the reach plus the margin (the
@@ -207,15 +208,23 @@ def as_built(
     receives 48 bytes (x, v) of every ghost node and the bonds broken (one message per
     neighbouring rank), checks after each step (CHECK_SHARE of a step, measured) and reduces
     once. Efficiency: its own nodes' compute over its step; the same with the ghosts stepped in
-    full, and if ghosts were not stepped at all (not built)."""
+    full, and if ghosts were not stepped at all (not built). With `caps` (the grains' radii,
+    the unit grain's nodes and a depth [m]), it receives only the ghost nodes within that
+    depth of one of its grains' bounding spheres (exchanged_nodes), the ghosts still held and
+    stepped whole."""
     partition = bisect(centres, np.ones(len(centres)), ranks)
     needed = ghosts(partition, pairs)
     owned = np.bincount(partition.owner, minlength=ranks)
     worst = int(np.argmax([len(g) / o for g, o in zip(needed, owned, strict=True)]))
     own, ghost = owned[worst] * nodes_per_grain, len(needed[worst]) * nodes_per_grain
     neighbours = len(np.unique(partition.owner[needed[worst]]))
+    sent = ghost
+    if caps is not None:
+        radii, unit_nodes, depth = caps
+        counts = exchanged_nodes(centres, radii, partition.owner, ranks, pairs, unit_nodes, depth)
+        sent = int(counts[worst])
     # one message per neighbour within a step: x and v of the ghost nodes, the bonds broken
-    exchange, reduction = communication_seconds(1, neighbours, 48.0 * ghost, ranks, args)
+    exchange, reduction = communication_seconds(1, neighbours, 48.0 * sent, ranks, args)
     useful = own / rate
     stepped = (own + (1.0 - ghost_saving) * ghost) / rate * (1 + CHECK_SHARE)
     in_full = (own + ghost) / rate * (1 + CHECK_SHARE)
@@ -286,6 +295,61 @@ def engine_as_built(
     return rows
 
 
+#: Cap depths at R/h = 6 (h = R/6, horizon 3 h, the cutoff the reach): as the engine picks them
+#: (the cutoff, the cap margin of 4 h, 2 h for the contact centres' offset, and the bonded
+#: neighbours a horizon deeper, taken here as depth), the whole of a near ghost; without the
+#: bonded neighbours (their anchored vectors sent instead); without the 2 h too (the contact
+#: centres sent); the cutoff alone (caps picked by the owners every step: no cap margin).
+CAP_LAYERS = (
+    ("as picked", lambda reach, h: reach + 4 * h + 2 * h + 3 * h),
+    ("no neighbours", lambda reach, h: reach + 4 * h + 2 * h),
+    ("no offset", lambda reach, h: reach + 4 * h),
+    ("cutoff only", lambda reach, h: reach),
+)
+
+
+def engine_caps(
+    pack: gr.Packing,
+    unit_nodes: np.ndarray,
+    rate: float,
+    ghost_saving: float,
+    args: argparse.Namespace,
+) -> list[dict[str, float]]:
+    """as_built's communication share for 2, 4, ... ranks with caps (CAP_LAYERS) instead of
+    whole ghosts: as the engine picks them (a ghost grain farther than the cap's depth from
+    the rank's grains sends nothing; a near one, all of it at this mesh) and thinner."""
+    margin = float(pack.radii.max())
+    pairs = near_pairs(pack.positions, pack.radii, args.reach + margin)
+    h = RADIUS / args.nodes_across_radius
+    depths = [(name, layer(args.reach, h)) for name, layer in CAP_LAYERS]
+    print(
+        "\nthe engine with caps: communication % of the step (x, v of the ghost nodes within a "
+        "depth of the rank's grains' spheres; ghosts still held and stepped whole)"
+    )
+    print(
+        f"{'ranks':>6} {'whole':>8}" + "".join(f" {f'{n} {1e3 * d:.2f} mm':>24}" for n, d in depths)
+    )
+    rows = []
+    ranks = 2
+    while ranks <= min(args.largest, args.grains):
+        row = {"ranks": ranks}
+        whole = as_built(pack.positions, pairs, ranks, len(unit_nodes), rate, ghost_saving, args)
+        row["whole"] = whole["communication_share"]
+        for name, depth in depths:
+            capped = as_built(
+                pack.positions, pairs, ranks, len(unit_nodes), rate, ghost_saving, args,
+                (pack.radii, unit_nodes, depth),
+            )  # fmt: skip
+            row[name] = capped["communication_share"]
+        rows.append(row)
+        print(
+            f"{ranks:6d} {100 * row['whole']:8.1f}"
+            + "".join(f" {100 * row[n]:24.1f}" for n, _ in depths)
+        )
+        ranks *= 2
+    return rows
+
+
 def single_body(args: argparse.Namespace) -> list[dict[str, float]]:
     """The node-level split of one N^3 block: per rank nodes, halo nodes, neighbouring ranks,
     and the modelled share of the two exchanges in an LPS step."""
@@ -342,6 +406,9 @@ def main() -> None:
     parser.add_argument("--largest", type=int, default=2048, help="ranks: 2, 4, ... this")
     parser.add_argument("--block", type=int, default=100, help="one body: N^3 nodes (0: none)")
     parser.add_argument("--largest-split", type=int, default=64, help="its ranks: 2 ... this")
+    parser.add_argument(
+        "--caps", action="store_true", help="also the engine with thinner caps (CAP_LAYERS)"
+    )
     parser.add_argument("--json", type=Path, default=None)
     args = parser.parse_args()
 
@@ -381,6 +448,7 @@ def main() -> None:
         ranks *= 2
     print(f"broad phase: {rows[0]['candidates_per_grain']:.1f} candidate partners per grain")
     built = engine_as_built(pack, unit_nodes, rate, ghost_saving, args)
+    capped = engine_caps(pack, unit_nodes, rate, ghost_saving, args) if args.caps else []
     body = single_body(args) if args.block else []
     if args.json is not None:
         settings = vars(args) | {
@@ -389,7 +457,13 @@ def main() -> None:
             "bond_share": bond_share,
             "ghost_saving": ghost_saving,
         }
-        result = {"arguments": settings, "grains": rows, "as_built": built, "one_body": body}
+        result = {
+            "arguments": settings,
+            "grains": rows,
+            "as_built": built,
+            "caps": capped,
+            "one_body": body,
+        }
         args.json.write_text(json.dumps(result, indent=1))
 
 
