@@ -25,9 +25,10 @@ shares of its wall-clock time spent in the ghost exchange, in the partition chec
 reduction), in picking the caps anew, in migrations and, with
 ``--collect-every N``, in gathering the whole state into rank 0's simulation every N steps (as a
 run with outputs every N steps does, DistributedRun.collect, the ranks measuring their grains
-for the outputs too; nothing is written, and the row rank 0 would compute is not); then the migrations and grains handed over. With ``--json``, one JSON object instead.
-On fewer cores than ranks (oversubscribed) the shares include waiting for the other ranks and
-are an upper bound.
+for the outputs too; nothing is written, and the row rank 0 would compute is not); then the
+migrations and grains handed over. With ``--json``, one JSON object instead. On fewer cores
+than ranks (oversubscribed) the shares include waiting for the other ranks and are an upper
+bound.
 """
 
 from __future__ import annotations
