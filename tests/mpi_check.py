@@ -129,10 +129,11 @@ def main() -> int:
             narrow=True,
         )
     if sys.argv[1] == "drum":
-        variant, steps, renew = sys.argv[2], int(sys.argv[3]), sys.argv[4:] == ["renew"]
+        variant, steps = sys.argv[2], int(sys.argv[3])
+        renew, widen = sys.argv[4:] == ["renew"], sys.argv[4:] == ["widen"]
         with tempfile.TemporaryDirectory() as folder:
             make = functools.partial(drum, variant, Path(folder))
-            return compare(make, f"drum {variant}", steps, comm, renew)
+            return compare(make, f"drum {variant}", steps, comm, renew, widen=widen)
     dimension, steps = int(sys.argv[1]), int(sys.argv[2])
     if len(sys.argv) > 3 and sys.argv[3] == "fail":
         return check_failure(dimension, steps, comm)
@@ -165,18 +166,22 @@ def compare(
     margin: float | None = None,
     cap_margin: float | None = None,
     narrow: bool = False,
+    widen: bool = False,
 ) -> int:
     """0 when `steps` steps of make() distributed over the ranks end with every node's
     position, velocity and force equal to the serial run's, at the same dt. `renew`: every
     rank builds its part anew from the owners' states at every migration, and narrow messages;
     `margin`, `cap_margin`: the ghost and cap margins [m] (default DistributedRun's);
     `narrow`: a step's message carries one break and one body per grain at most (the others go
-    in a second message, NarrowMessages)."""
+    in a second message, NarrowMessages); `widen`: the default margin widens after short
+    distributions, as in a run (else it stays, so that the grains migrate often)."""
     serial = make()
     serial.core.run(steps)
     kind = NarrowMessages if renew or narrow else DistributedRun
     distributed = kind(make(), comm, margin=margin, cap_margin=cap_margin)
     distributed.always_renew = renew
+    if not widen:
+        distributed.short_distribution = 0
     distributed.run(steps)
     fields = {name: distributed.gather(name) for name in ("positions", "velocities", "forces")}
     walls = distributed.wall_reactions()
@@ -191,7 +196,8 @@ def compare(
     ghosts = [len(g) for g in distributed.ghosts]
     print(
         f"ranks {comm.Get_size()}, {name}, {steps} steps, dt equal {same_dt}, ghosts per "
-        f"rank {ghosts}, migrations {distributed.migrations}, grains handed over "
+        f"rank {ghosts}, migrations {distributed.migrations}, margin widened "
+        f"{distributed.margin_widenings} times to {distributed.margin:.3g} m, grains handed over "
         f"{distributed.handed_over}, parts built anew per rank {renewals}, caps picked anew "
         f"{distributed.cap_refreshes}, ghost nodes held and sent a step per rank {held}, "
         f"second messages {seconds}, "

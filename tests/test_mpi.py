@@ -76,6 +76,19 @@ def test_grains_migrating_between_ranks_keep_the_serial_run_bit_for_bit(
     assert renewals == ", ".join([str(migrations)] * ranks) if renew else renewals != "0, 0, 0"
 
 
+def test_the_default_margin_widens_when_grains_migrate_often() -> None:
+    """The drum's grains cross a quarter of the default margin (the largest grain's radius)
+    within a few dozen steps: after such short distributions the ranks double the margin, up
+    to four grain radii, and migrate less; the run stays the serial one, bit for bit."""
+    done = run_ranks(2, "drum", "lattice", "3000", "widen")
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert "'positions': 0.0, 'velocities': 0.0, 'forces': 0.0, 'walls': 0.0}" in done.stdout
+    widened = int(done.stdout.split("margin widened ")[1].split(" ")[0])
+    migrations = int(done.stdout.split("migrations ")[1].split(",")[0])
+    assert widened == 2  # twice the radius, then four times: the widest
+    assert 0 < migrations < 20  # at least 20 without (the test above)
+
+
 def test_ghosts_exchanged_as_caps_keep_the_serial_run_bit_for_bit() -> None:
     """Finely meshed brittle discs (R/h = 12) thrown at each other on 3 ranks, with a cap margin
     of 4e-5 m: each step sends about a third of the ghost nodes held (the caps), the others stay

@@ -46,7 +46,7 @@ def assert_same_run(
 ) -> None:
     """The frames, tables and PVD series byte for byte; history.csv's every column's text
     equal, but the searches, which each rank makes for its own part: they stay within
-    `searches_within` (10 %, or 2) of the serial run's (None: not compared); `row_count` rows
+    `searches_within` (10 %, or 5) of the serial run's (None: not compared); `row_count` rows
     (13: steps 0, 250, ..., 3000)."""
     assert len(outputs(serial)) > 10
     assert differing(serial, distributed) == []
@@ -56,7 +56,7 @@ def assert_same_run(
         searches, serial_searches = int(row.pop(SEARCHES)), int(serial_row.pop(SEARCHES))
         assert row == serial_row
         if searches_within is not None:
-            assert abs(searches - serial_searches) <= max(2, searches_within * serial_searches)
+            assert abs(searches - serial_searches) <= max(5, searches_within * serial_searches)
 
 
 @pytest.fixture(scope="module")

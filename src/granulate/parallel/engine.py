@@ -81,7 +81,11 @@ class DistributedRun:
     margin/4, the ranks ``migrate`` (cut the assembly anew and hand grains over with their
     whole state), or with ``migrate=False`` stop with an InputError past margin/2. Bodies over
     twice as large as that grain (meshed walls, containers) are near the grains their nodes
-    come near, not all those their bounding spheres take in.
+    come near, not all those their bounding spheres take in. The default margin doubles, up to
+    ``widest_margin`` times that radius, at a migration after a distribution that lasted fewer
+    than ``short_distribution`` steps: grains that flow that fast make migrations (each costs
+    about 20 steps) dearer than the wider ghosts (which the ranks hold, but whose caps alone
+    travel). A margin given is kept.
 
     ``cap_margin`` [m]: the same for the caps, the ghost nodes whose positions and velocities
     travel in each step (_exchange_caps); default margin/4, but at least four times the
@@ -102,6 +106,10 @@ class DistributedRun:
     #: Bodies' motions it carries beyond one per grain sent (a grain's fragments, each its
     #: first node and 15 numbers); more go in the second message too.
     body_slots = 64
+    #: A distribution of the grains shorter than this many steps widens the default margin.
+    short_distribution = 200
+    #: The widest default margin, in radii of the largest free grain.
+    widest_margin = 4.0
 
     def __init__(
         self,
@@ -136,6 +144,10 @@ class DistributedRun:
         self._dt = sim._dt_safety * self.stable_dt if sim._dt is None else float(sim._dt)
         grain = _largest_free_radius(sim, radii)
         self.margin = float(grain if margin is None else margin)
+        self._widest = self.widest_margin * grain if margin is None else self.margin
+        #: How many times the default margin was widened (_widen_margin).
+        self.margin_widenings = 0
+        self._cutoff = cutoff
         #: Bodies over twice as large as the largest free grain (meshed walls, containers):
         #: their pairs with the grains are found from their nodes (partition.near_nodes).
         self._large = np.flatnonzero(radii > 2 * grain)
@@ -337,6 +349,7 @@ class DistributedRun:
         self._node_particle = np.asarray(self.local.model.node_particle, dtype=np.int64)
         self.local.core.set_travel_origin()
         self._travelled = 0.0  # the farthest travel of each cap period since, summed
+        self._distributed_at = int(self.local.core.step)
         self._caps_due = False  # _exchange_caps picks them where the nodes are
 
     def _exchange_caps(self) -> None:
@@ -633,6 +646,7 @@ class DistributedRun:
         are picked anew. Either way the run goes on as the serial run, bit for bit."""
         start = time.perf_counter()
         self._migration_due = False
+        self._widen_margin()
         self._exchange_state()
         before, owners_before = self._held_by_rank(), self.partition.owner
         centres, radii, damped = self._current_spheres()
@@ -669,6 +683,16 @@ class DistributedRun:
         self._exchange_caps()
         self.migrations += 1
         self.seconds["migrate"] += time.perf_counter() - start
+
+    def _widen_margin(self) -> None:
+        """The default margin doubled, up to widest_margin grain radii, when the grains' last
+        distribution lasted fewer than short_distribution steps (the same on every rank: the
+        steps are)."""
+        lasted = int(self.local.core.step) - self._distributed_at
+        if lasted < self.short_distribution and self.margin < self._widest:
+            self.margin = min(2 * self.margin, self._widest)
+            self._reach = self._cutoff + self.margin
+            self.margin_widenings += 1
 
     def _held_by_rank(self) -> list[NDArray[np.int64]]:
         """The grains each rank holds (owned and ghosts), sorted."""
