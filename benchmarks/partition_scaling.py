@@ -259,6 +259,13 @@ def lps_node_steps_per_second(steps: int = 30) -> float:
     return sim.node_count * steps / (time.perf_counter() - start)
 
 
+def ghost_pairs(pack: gr.Packing, args: argparse.Namespace) -> tuple[float, tuple]:
+    """The engine's default margin (the largest radius) and the pairs of grains within the
+    reach plus it (near_pairs): whose ghosts it holds."""
+    margin = float(pack.radii.max())
+    return margin, near_pairs(pack.positions, pack.radii, args.reach + margin)
+
+
 def engine_as_built(
     pack: gr.Packing,
     unit_nodes: np.ndarray,
@@ -267,8 +274,7 @@ def engine_as_built(
     args: argparse.Namespace,
 ) -> list[dict[str, float]]:
     """The table of as_built for 2, 4, ... ranks."""
-    margin = float(pack.radii.max())
-    pairs = near_pairs(pack.positions, pack.radii, args.reach + margin)
+    margin, pairs = ghost_pairs(pack, args)
     print(
         f"\nthe engine as built: whole ghost grains within {1e3 * (args.reach + margin):.2f} mm "
         f"(reach + margin) stepped but for their bonds ({100 * ghost_saving:.0f} % of a "
@@ -318,8 +324,7 @@ def engine_caps(
     """as_built's communication share for 2, 4, ... ranks with caps (CAP_LAYERS) instead of
     whole ghosts: as the engine picks them (a ghost grain farther than the cap's depth from
     the rank's grains sends nothing; a near one, all of it at this mesh) and thinner."""
-    margin = float(pack.radii.max())
-    pairs = near_pairs(pack.positions, pack.radii, args.reach + margin)
+    _, pairs = ghost_pairs(pack, args)
     h = RADIUS / args.nodes_across_radius
     depths = [(name, layer(args.reach, h)) for name, layer in CAP_LAYERS]
     print(
