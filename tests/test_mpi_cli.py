@@ -237,8 +237,8 @@ def bench_ranks(*arguments: str, ranks: int = 2) -> subprocess.CompletedProcess[
 def test_bench_ranks_prints_each_ranks_speed_and_communication() -> None:
     """`mpiexec -n 2 granulate bench --ranks --quick --json` (the 3D pile, 200 grains): one JSON
     object, from rank 0: a row per rank, whose grains and nodes add up to the case's, each
-    rank holding the other's nearby grains as ghosts, with its speed and time shares; one
-    thread per rank by default."""
+    rank holding the other's nearby grains as ghosts, with its speed and time shares, and the
+    ghost margin; one thread per rank by default."""
     done = bench_ranks("--quick", "--json")
     assert done.returncode == 0, done.stderr
     (line,) = done.stdout.splitlines()
@@ -252,6 +252,10 @@ def test_bench_ranks_prints_each_ranks_speed_and_communication() -> None:
     rows = result["rows"]
     assert len(rows) == 2
     assert sum(row["grains"] for row in rows) == result["grains"] == 200
+    # at rest: no migration, and the default margin kept: the largest grain's bounding radius
+    # (a cube's, its nodes' corner 1.08 mm from its centre)
+    assert (result["migrations"], result["margin_widenings"]) == (0, 0)
+    assert 1e-3 < result["margin"] < 1.2e-3
     assert sum(row["nodes"] for row in rows) == 51_712
     for row in rows:
         assert 0 < row["ghost_nodes"] < row["nodes"]

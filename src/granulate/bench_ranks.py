@@ -192,6 +192,8 @@ def measure(
         "rows": rows,
         "migrations": run.migrations - migrations,
         "handed_over": run.handed_over - handed,
+        "margin": run.margin,
+        "margin_widenings": run.margin_widenings,
     }
 
 
@@ -228,7 +230,8 @@ def table(result: dict[str, Any]) -> str:
         )
     lines.append(
         f"{result['migrations']} migrations, {result['handed_over']} grains handed over in the "
-        "timed steps"
+        f"timed steps; ghost margin {1e3 * result['margin']:.3g} mm (widened "
+        f"{result['margin_widenings']} times)"
     )
     return "\n".join(lines)
 
