@@ -193,14 +193,15 @@ def modelled(
 
 def as_built(
     centres: np.ndarray,
+    radii: np.ndarray,
     pairs,
     ranks: int,
-    nodes_per_grain: int,
+    unit_nodes: np.ndarray,
     rate: float,
     ghost_saving: float,
     args: argparse.Namespace,
-    caps: tuple[np.ndarray, np.ndarray, float] | None = None,
-) -> dict[str, float]:
+    depths: dict[str, float],
+) -> dict:
     """The engine as built (granulate.parallel.DistributedRun), for the rank with the most ghost
     grains per owned grain: its ghosts are whole grains within the reach plus the margin (the
     largest bounding radius; `pairs`: near_pairs at that distance), stepped but for their
@@ -208,36 +209,41 @@ def as_built(
     receives 48 bytes (x, v) of every ghost node and the bonds broken (one message per
     neighbouring rank), checks after each step (CHECK_SHARE of a step, measured) and reduces
     once. Efficiency: its own nodes' compute over its step; the same with the ghosts stepped in
-    full, and if ghosts were not stepped at all (not built). With `caps` (the grains' radii,
-    the unit grain's nodes and a depth [m]), it receives only the ghost nodes within that
-    depth of one of its grains' bounding spheres (exchanged_nodes), the ghosts still held and
-    stepped whole."""
+    full, and if ghosts were not stepped at all (not built). "cap_shares": the communication
+    share when it receives, instead of whole ghosts, only the ghost nodes within each of
+    `depths` [m] of one of its grains' bounding spheres (exchanged_nodes; the ghosts still held
+    and stepped whole)."""
     partition = bisect(centres, np.ones(len(centres)), ranks)
     needed = ghosts(partition, pairs)
     owned = np.bincount(partition.owner, minlength=ranks)
     worst = int(np.argmax([len(g) / o for g, o in zip(needed, owned, strict=True)]))
-    own, ghost = owned[worst] * nodes_per_grain, len(needed[worst]) * nodes_per_grain
+    own, ghost = owned[worst] * len(unit_nodes), len(needed[worst]) * len(unit_nodes)
     neighbours = len(np.unique(partition.owner[needed[worst]]))
-    sent = ghost
-    if caps is not None:
-        radii, unit_nodes, depth = caps
-        counts = exchanged_nodes(centres, radii, partition.owner, ranks, pairs, unit_nodes, depth)
-        sent = int(counts[worst])
-    # one message per neighbour within a step: x and v of the ghost nodes, the bonds broken
-    exchange, reduction = communication_seconds(1, neighbours, 48.0 * sent, ranks, args)
     useful = own / rate
     stepped = (own + (1.0 - ghost_saving) * ghost) / rate * (1 + CHECK_SHARE)
     in_full = (own + ghost) / rate * (1 + CHECK_SHARE)
     lean = useful * (1 + CHECK_SHARE)
+
+    def communication(sent: int) -> float:
+        # one message per neighbour within a step: x and v of the nodes sent, the bonds broken
+        return sum(communication_seconds(1, neighbours, 48.0 * sent, ranks, args))
+
+    talk = communication(ghost)
+    cap_shares = {}
+    for name, depth in depths.items():
+        counts = exchanged_nodes(centres, radii, partition.owner, ranks, pairs, unit_nodes, depth)
+        capped = communication(int(counts[worst]))
+        cap_shares[name] = capped / (stepped + capped)
     return {
         "ranks": ranks,
         "ghost_grains_over_owned": len(needed[worst]) / owned[worst],
         "neighbours": neighbours,
         "exchange_bytes": 48.0 * ghost,
-        "communication_share": (exchange + reduction) / (stepped + exchange + reduction),
-        "efficiency": useful / (stepped + exchange + reduction),
-        "efficiency_ghosts_in_full": useful / (in_full + exchange + reduction),
-        "efficiency_without_ghost_steps": useful / (lean + exchange + reduction),
+        "communication_share": talk / (stepped + talk),
+        "efficiency": useful / (stepped + talk),
+        "efficiency_ghosts_in_full": useful / (in_full + talk),
+        "efficiency_without_ghost_steps": useful / (lean + talk),
+        "cap_shares": cap_shares,
     }
 
 
@@ -259,11 +265,17 @@ def lps_node_steps_per_second(steps: int = 30) -> float:
     return sim.node_count * steps / (time.perf_counter() - start)
 
 
-def ghost_pairs(pack: gr.Packing, args: argparse.Namespace) -> tuple[float, tuple]:
-    """The engine's default margin (the largest radius) and the pairs of grains within the
-    reach plus it (near_pairs): whose ghosts it holds."""
-    margin = float(pack.radii.max())
-    return margin, near_pairs(pack.positions, pack.radii, args.reach + margin)
+#: Cap depths at R/h = 6 (h = R/6, horizon 3 h, the cutoff the reach): as the engine picks them
+#: (the cutoff, the cap margin of 4 h, 2 h for the contact centres' offset, and the bonded
+#: neighbours a horizon deeper, taken here as depth), the whole of a near ghost; without the
+#: bonded neighbours (their anchored vectors sent instead); without the 2 h too (the contact
+#: centres sent); the cutoff alone (caps picked by the owners every step: no cap margin).
+CAP_LAYERS = (
+    ("as picked", lambda reach, h: reach + 4 * h + 2 * h + 3 * h),
+    ("no neighbours", lambda reach, h: reach + 4 * h + 2 * h),
+    ("no offset", lambda reach, h: reach + 4 * h),
+    ("cutoff only", lambda reach, h: reach),
+)
 
 
 def engine_as_built(
@@ -272,9 +284,15 @@ def engine_as_built(
     rate: float,
     ghost_saving: float,
     args: argparse.Namespace,
-) -> list[dict[str, float]]:
-    """The table of as_built for 2, 4, ... ranks."""
-    margin, pairs = ghost_pairs(pack, args)
+) -> list[dict]:
+    """The table of as_built for 2, 4, ... ranks, and with --caps the table of its
+    communication share with the caps of CAP_LAYERS instead of whole ghosts (as the engine
+    picks them: a ghost grain farther than the cap's depth from the rank's grains sends
+    nothing, a near one all of it at this mesh; and thinner)."""
+    margin = float(pack.radii.max())
+    pairs = near_pairs(pack.positions, pack.radii, args.reach + margin)
+    h = RADIUS / args.nodes_across_radius
+    depths = {name: layer(args.reach, h) for name, layer in CAP_LAYERS} if args.caps else {}
     print(
         f"\nthe engine as built: whole ghost grains within {1e3 * (args.reach + margin):.2f} mm "
         f"(reach + margin) stepped but for their bonds ({100 * ghost_saving:.0f} % of a "
@@ -289,7 +307,9 @@ def engine_as_built(
     rows = []
     ranks = 2
     while ranks <= min(args.largest, args.grains):
-        row = as_built(pack.positions, pairs, ranks, len(unit_nodes), rate, ghost_saving, args)
+        row = as_built(
+            pack.positions, pack.radii, pairs, ranks, unit_nodes, rate, ghost_saving, args, depths
+        )
         rows.append(row)
         print(
             f"{ranks:6d} {row['ghost_grains_over_owned']:9.2f} {row['neighbours']:10d} "
@@ -298,60 +318,16 @@ def engine_as_built(
             f"{row['efficiency_without_ghost_steps']:14.2f}"
         )
         ranks *= 2
-    return rows
-
-
-#: Cap depths at R/h = 6 (h = R/6, horizon 3 h, the cutoff the reach): as the engine picks them
-#: (the cutoff, the cap margin of 4 h, 2 h for the contact centres' offset, and the bonded
-#: neighbours a horizon deeper, taken here as depth), the whole of a near ghost; without the
-#: bonded neighbours (their anchored vectors sent instead); without the 2 h too (the contact
-#: centres sent); the cutoff alone (caps picked by the owners every step: no cap margin).
-CAP_LAYERS = (
-    ("as picked", lambda reach, h: reach + 4 * h + 2 * h + 3 * h),
-    ("no neighbours", lambda reach, h: reach + 4 * h + 2 * h),
-    ("no offset", lambda reach, h: reach + 4 * h),
-    ("cutoff only", lambda reach, h: reach),
-)
-
-
-def engine_caps(
-    pack: gr.Packing,
-    unit_nodes: np.ndarray,
-    rate: float,
-    ghost_saving: float,
-    args: argparse.Namespace,
-) -> list[dict[str, float]]:
-    """as_built's communication share for 2, 4, ... ranks with caps (CAP_LAYERS) instead of
-    whole ghosts: as the engine picks them (a ghost grain farther than the cap's depth from
-    the rank's grains sends nothing; a near one, all of it at this mesh) and thinner."""
-    _, pairs = ghost_pairs(pack, args)
-    h = RADIUS / args.nodes_across_radius
-    depths = [(name, layer(args.reach, h)) for name, layer in CAP_LAYERS]
-    print(
-        "\nthe engine with caps: communication % of the step (x, v of the ghost nodes within a "
-        "depth of the rank's grains' spheres; ghosts still held and stepped whole)"
-    )
-    print(
-        f"{'ranks':>6} {'whole':>8}" + "".join(f" {f'{n} {1e3 * d:.2f} mm':>24}" for n, d in depths)
-    )
-    rows = []
-    ranks = 2
-    while ranks <= min(args.largest, args.grains):
-        row = {"ranks": ranks}
-        whole = as_built(pack.positions, pairs, ranks, len(unit_nodes), rate, ghost_saving, args)
-        row["whole"] = whole["communication_share"]
-        for name, depth in depths:
-            capped = as_built(
-                pack.positions, pairs, ranks, len(unit_nodes), rate, ghost_saving, args,
-                (pack.radii, unit_nodes, depth),
-            )  # fmt: skip
-            row[name] = capped["communication_share"]
-        rows.append(row)
+    if depths:
         print(
-            f"{ranks:6d} {100 * row['whole']:8.1f}"
-            + "".join(f" {100 * row[n]:24.1f}" for n, _ in depths)
+            "\nthe engine with caps: communication % of the step (x, v of the ghost nodes within "
+            "a depth of the rank's grains' spheres; ghosts still held and stepped whole)"
         )
-        ranks *= 2
+        heads = "".join(f" {f'{n} {1e3 * d:.2f} mm':>24}" for n, d in depths.items())
+        print(f"{'ranks':>6} {'whole':>8}" + heads)
+        for row in rows:
+            shares = "".join(f" {100 * share:24.1f}" for share in row["cap_shares"].values())
+            print(f"{row['ranks']:6d} {100 * row['communication_share']:8.1f}" + shares)
     return rows
 
 
@@ -453,7 +429,6 @@ def main() -> None:
         ranks *= 2
     print(f"broad phase: {rows[0]['candidates_per_grain']:.1f} candidate partners per grain")
     built = engine_as_built(pack, unit_nodes, rate, ghost_saving, args)
-    capped = engine_caps(pack, unit_nodes, rate, ghost_saving, args) if args.caps else []
     body = single_body(args) if args.block else []
     if args.json is not None:
         settings = vars(args) | {
@@ -466,7 +441,6 @@ def main() -> None:
             "arguments": settings,
             "grains": rows,
             "as_built": built,
-            "caps": capped,
             "one_body": body,
         }
         args.json.write_text(json.dumps(result, indent=1))

@@ -10,7 +10,6 @@ import numpy as np
 import pytest
 
 import granulate as gr
-from granulate import particle_table
 from granulate.analysis import GivenMeasures
 from test_checkpoint import tumbling_drum
 
@@ -68,7 +67,8 @@ def test_given_measures_stand_for_the_cores_until_the_state_changes(tmp_path: Pa
     sim = tumbling_drum(tmp_path)
     sim.core.run(600)
     nodes, grains = sim.node_count, len(sim.bodies)
-    motion = {key: np.full(grains, 7.0) for key in particle_table.MOTION_COLUMNS}
+    columns = sim.analysis.particles(sim.contact_table(), None)[0]  # motion's among them
+    motion = {key: np.full(grains, 7.0) for key in columns}
     density = np.full(nodes, 2.0)
     given = GivenMeasures(
         np.full(nodes, 0.25), np.full(nodes, 0.5), np.zeros(nodes, np.uint32), density, motion

@@ -25,10 +25,6 @@ COLUMNS = (
     "particle", "time", "x", "y", "z", "vx", "vy", "vz", "wx", "wy", "wz", "mass",
     "gyration_radius", "damage", "coordination", "sxx", "syy", "szz", "sxy", "sxz", "syz",
 )  # fmt: skip
-#: The columns particle_table.motion gives.
-MOTION_COLUMNS = (
-    "mass", "x", "vx", "wx", "y", "vy", "wy", "z", "vz", "wz", "gyration_radius",
-)  # fmt: skip
 _INTEGERS = ("particle", "coordination")
 _STRESS = (("sxx", 0, 0), ("syy", 1, 1), ("szz", 2, 2), ("sxy", 0, 1), ("sxz", 0, 2), ("syz", 1, 2))
 

@@ -151,7 +151,6 @@ class DistributedRun:
         #: Bodies over twice as large as the largest free grain (meshed walls, containers):
         #: their pairs with the grains are found from their nodes (partition.near_nodes).
         self._large = np.flatnonzero(radii > 2 * grain)
-        self._reach = cutoff + self.margin
         largest_mesh = max(body.mesh_size for body in sim.bodies)
         default = min(self.margin, max(0.25 * self.margin, 4 * largest_mesh))
         self.cap_margin = float(default if cap_margin is None else cap_margin)
@@ -234,6 +233,12 @@ class DistributedRun:
         self._damping_radii = np.asarray(radii)
         walls = sim._interactions.peridem_wall_indices()
         self._centre_damped = np.setdiff1d(np.arange(len(self._slices)), walls)
+
+    @property
+    def _reach(self) -> float:
+        """How near a grain's bounding sphere must come to a rank's grains for it to be held
+        there as a ghost [m]: the cutoff plus the margin."""
+        return self._cutoff + self.margin
 
     def _build(self, held: NDArray[np.int64]) -> None:
         """This rank's part of the grains `held` at the start, with its first forces (the
@@ -691,7 +696,6 @@ class DistributedRun:
         lasted = int(self.local.core.step) - self._distributed_at
         if lasted < self.short_distribution and self.margin < self._widest:
             self.margin = min(2 * self.margin, self._widest)
-            self._reach = self._cutoff + self.margin
             self.margin_widenings += 1
 
     def _held_by_rank(self) -> list[NDArray[np.int64]]:

@@ -131,18 +131,33 @@ def install(
     wall_reactions: NDArray[np.float64],
 ) -> None:
     """Rank 0: `parts` (every rank's) into `sim`, built whole on first use: its nodes and bonds
-    at `moment` (time [s], step), and its last evaluation (Simulation.evaluation)."""
+    at `moment` (time [s], step), its last evaluation (Simulation.evaluation) and, when every
+    part has them, its grains' measures (Analysis.give)."""
     core = sim._build()
     starts = np.array([body.first_node for body in sim.bodies] + [sim.node_count])
     bond_starts = np.asarray(sim.model.bond_offsets, dtype=np.int64)[starts]
     bonds = np.empty(bond_starts[-1], dtype=np.uint8)
     energy = np.zeros(sim.node_count)
+    measured = [part.measures for part in parts if part.measures is not None]
+    given = _empty_measures(measured[0], sim.node_count, len(sim.bodies)) if measured else None
+    x, v, f, dilatation = core.positions, core.velocities, core.forces, core.dilatation
     for part in parts:  # every grain is one rank's: every node and bond is written
-        _place(part, core, (starts, bond_starts), bonds, energy)
+        rows = [
+            (x, part.positions),
+            (v, part.velocities),
+            (f, part.forces),
+            (dilatation, part.dilatation),
+            (energy, part.contact_energy),
+        ]
+        if given is not None and part.measures is not None:
+            rows += _measured_rows(given, part.measures)
+            for column, values in given.motion.items():
+                values[part.grains] = part.measures.motion[column]
+        _place(part.grains, starts, rows)
+        _place(part.grains, bond_starts, [(bonds, part.bonds)])
     core.assign_bonds(bonds)
     core.time, core.step = moment
-    given = all(part.measures is not None for part in parts)
-    sim.analysis.give(_measures_of_all(parts, starts, len(sim.bodies)) if given else None)
+    sim.analysis.give(given if len(measured) == len(parts) else None)
     sim._gathered = Evaluation(
         network.contact_table(_serial_order([part.contacts for part in parts])),
         float(np.add.accumulate(energy)[-1]) if len(energy) else 0.0,  # the core's order
@@ -153,53 +168,44 @@ def install(
     )
 
 
-def _measures_of_all(
-    parts: list[OwnedPart], starts: NDArray[np.int64], grains: int
-) -> GivenMeasures:
-    """The ranks' measures of their grains as the whole core's: per node in node order, per
-    grain in grain order. `starts`: each grain's first node and the node count after the last."""
-    nodes = starts[-1]
-    fields = {name: np.empty(nodes) for name in ("damage", "damage_z", "strain_energy_density")}
-    labels = np.empty(nodes, dtype=np.uint32)
-    motion = {column: np.empty(grains) for column in particle_table.MOTION_COLUMNS}
-    for part in parts:
-        index = np.concatenate(
-            [np.zeros(0, np.int64)] + [np.arange(starts[g], starts[g + 1]) for g in part.grains]
-        )
-        given = part.measures
-        assert given is not None
-        for name, values in fields.items():
-            values[index] = getattr(given, name)
-        labels[index] = given.labels
-        for column, values in motion.items():
-            values[part.grains] = given.motion[column]
+def _empty_measures(like: GivenMeasures, nodes: int, grains: int) -> GivenMeasures:
+    """GivenMeasures of `nodes` nodes and `grains` grains to fill, with `like`'s motion
+    columns (particle_table.motion's)."""
     return GivenMeasures(
-        fields["damage"], fields["damage_z"], labels, fields["strain_energy_density"], motion
+        np.empty(nodes),
+        np.empty(nodes),
+        np.empty(nodes, dtype=np.uint32),
+        np.empty(nodes),
+        {column: np.empty(grains) for column in like.motion},
     )
 
 
+def _measured_rows(
+    whole: GivenMeasures, part: GivenMeasures
+) -> list[tuple[NDArray[Any], NDArray[Any]]]:
+    """The per-node measures of a part, each with the whole's array it goes into (_place)."""
+    return [
+        (whole.damage, part.damage),
+        (whole.damage_z, part.damage_z),
+        (whole.labels, part.labels),
+        (whole.strain_energy_density, part.strain_energy_density),
+    ]
+
+
 def _place(
-    part: OwnedPart,
-    core: Any,
-    starts: tuple[NDArray[np.int64], NDArray[np.int64]],
-    bonds: NDArray[np.uint8],
-    energy: NDArray[np.float64],
+    grains: NDArray[np.int64],
+    starts: NDArray[np.int64],
+    rows: list[tuple[NDArray[Any], NDArray[Any]]],
 ) -> None:
-    """One rank's grains into the whole `core` (its nodes), `bonds` and the nodes' contact
-    `energy`, grain by grain; `starts`: each grain's first node and first bond copy (and the
-    totals after the last)."""
-    node_starts, bond_starts = starts
-    x, v, f, dilatation = core.positions, core.velocities, core.forces, core.dilatation
-    node, bond = 0, 0  # where the grain's rows begin in the part's arrays
-    for g in part.grains:
-        nodes = slice(node_starts[g], node_starts[g + 1])
-        rows = slice(node, node + nodes.stop - nodes.start)
-        x[nodes], v[nodes] = part.positions[rows], part.velocities[rows]
-        f[nodes], dilatation[nodes] = part.forces[rows], part.dilatation[rows]
-        energy[nodes] = part.contact_energy[rows]
-        count = bond_starts[g + 1] - bond_starts[g]
-        bonds[bond_starts[g] : bond_starts[g + 1]] = part.bonds[bond : bond + count]
-        node, bond = rows.stop, bond + count
+    """A part's rows of `grains` (one after the other, in grain order) into the whole's arrays:
+    for each (whole, part) of `rows`, grain g's rows go to whole[starts[g] : starts[g + 1]]."""
+    at = 0
+    for g in grains:
+        whole = slice(starts[g], starts[g + 1])
+        mine = slice(at, at + whole.stop - whole.start)
+        for target, source in rows:
+            target[whole] = source[mine]
+        at = mine.stop
 
 
 def _serial_order(pieces: list[dict[str, NDArray[Any]]]) -> dict[str, NDArray[Any]]:
