@@ -281,9 +281,10 @@ def test_ghost_breaks_are_checked(tmp_path: Path) -> None:
 
 
 def test_the_core_measures_how_far_the_nodes_travelled(tmp_path: Path) -> None:
-    """core.largest_travel (a rank's check that its ghosts still hold): after each step, the
-    largest distance of a node from where it was at set_travel_origin [m], as NumPy finds it;
-    0 before the first step and with no origin set."""
+    """core.largest_travel (a rank's check that its ghosts still hold): once a step has moved
+    the nodes (begin_step, before its contact), the largest distance of a node from where it
+    was at set_travel_origin [m], as NumPy finds it; 0 before the first step and with no
+    origin set."""
     sim = tumbling_drum(tmp_path)
     sim.core.run(100)
     assert sim.core.largest_travel == 0.0
@@ -294,7 +295,43 @@ def test_the_core_measures_how_far_the_nodes_travelled(tmp_path: Path) -> None:
         sim.core.run(40)
         moved = np.linalg.norm(sim.core.positions - origin, axis=1).max()
         assert sim.core.largest_travel == pytest.approx(moved, rel=1e-14)
+        sim.core.begin_step()
+        moved = np.linalg.norm(sim.core.positions - origin, axis=1).max()
+        assert sim.core.largest_travel == pytest.approx(moved, rel=1e-14)
+        sim.core.finish_step(np.zeros((0, 2), np.uint32))
+        assert sim.core.largest_travel == pytest.approx(moved, rel=1e-14)
     assert sim.core.largest_travel > 1e-4  # the grains fall and tumble
+
+
+@pytest.mark.parametrize("law", ["granulate", "surface"])
+def test_the_core_counts_list_positions_beyond_the_allowance_as_travel(
+    tmp_path: Path, law: str
+) -> None:
+    """core.largest_list_length: the largest distance of a node's list position (its contact
+    centre, the grid square's surface nodes' centred inside them; its surface point under the
+    surface law) from the node at rest, as the lists see it after a search; with
+    set_travel_origin(allowance), a node whose list position lies farther than the allowance
+    off it travels that much farther: with none allowed, largest_travel is the largest of
+    |y - y0| + |list position - y| over the nodes."""
+    sim = tumbling_drum(tmp_path, grid=True, law=law)
+    sim.core.run(0)
+    sim.core.search_contacts()
+    listed = np.asarray(sim.core.checkpoint()["contact_positions_at_build"]).reshape(-1, 3)
+    offset = np.linalg.norm(listed - sim.core.positions, axis=1)
+    # (the lists keep their positions in single precision: 1e-8 m at these coordinates)
+    assert 0 < sim.core.largest_list_length == pytest.approx(offset.max(), abs=1e-8)
+    origin = sim.core.positions.copy()
+    sim.core.set_travel_origin(list_allowance=0.0)
+    sim.core.run(30)
+    sim.core.search_contacts()
+    listed = np.asarray(sim.core.checkpoint()["contact_positions_at_build"]).reshape(-1, 3)
+    travel = np.linalg.norm(sim.core.positions - origin, axis=1)
+    offset = np.linalg.norm(listed - sim.core.positions, axis=1)
+    assert sim.core.largest_travel == pytest.approx((travel + offset).max(), abs=1e-8)
+    sim.core.set_travel_origin(list_allowance=sim.core.largest_list_length)
+    sim.core.run(30)
+    travel = np.linalg.norm(sim.core.positions - origin, axis=1)
+    assert sim.core.largest_travel <= travel.max()  # within its rest length: the node's travel
 
 
 def test_a_ghosts_speed_is_its_owners_to_check(tmp_path: Path) -> None:

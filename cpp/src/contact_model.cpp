@@ -55,6 +55,14 @@ void ContactModel::configure(const Model& model) {
   opened_rest_.clear();
 }
 
+bool ContactModel::reads_bonded_neighbours() const {
+  if (!centres_.found() || centres_.any()) return true;
+  for (std::size_t k = 0; k < laws_.size(); ++k) {
+    if (law_set_[k] && !laws_[k].node_pair) return true;
+  }
+  return false;
+}
+
 bool ContactModel::centres_particle(const Model& model, index_t p) const {
   const Particle& particle = model.particles()[p];
   if (model.shapes()[particle.shape].anchors.anchors.empty()) return false;

@@ -45,20 +45,16 @@ void kick_and_drift(const Model& m, State& state, real dt, const std::uint8_t* g
 }
 
 /// The second half kick of every node (with SkipGhosts, but the ghosts'), and the first node
-/// that moves more than its mesh size in a step or is not finite (n if none) and, with an
-/// `origin`, the largest squared distance of a node from it.
+/// that moves more than its mesh size in a step or is not finite (n if none).
 template <bool SkipGhosts>
-std::pair<std::int64_t, real> second_half_kick(const Model& m, State& state, real dt, const real* origin,
-                                               const std::uint8_t* ghost) {
+std::int64_t second_half_kick(const Model& m, State& state, real dt, const std::uint8_t* ghost) {
   const std::int64_t n = m.node_count();
   const auto& particles = m.particles();
   const auto& node_particle = m.node_particle();
-  const auto& x = state.positions;
   auto& v = state.velocities;
   const auto& f = state.forces;
   std::int64_t first_unstable = n;
-  real travel2 = 0;
-#pragma omp parallel for schedule(static) reduction(min : first_unstable) reduction(max : travel2)
+#pragma omp parallel for schedule(static) reduction(min : first_unstable)
   for (std::int64_t i = 0; i < n; ++i) {
     if constexpr (SkipGhosts) {
       if (ghost[node_particle[i]]) continue;
@@ -71,13 +67,35 @@ std::pair<std::int64_t, real> second_half_kick(const Model& m, State& state, rea
     }
     const real limit = particles[node_particle[i]].mesh_size / dt;
     if (!(speed2 <= limit * limit)) first_unstable = std::min(first_unstable, i);
-    if (origin) {
-      const real dx = x[3 * i] - origin[3 * i], dy = x[3 * i + 1] - origin[3 * i + 1],
-                 dz = x[3 * i + 2] - origin[3 * i + 2];
-      travel2 = std::max(travel2, dx * dx + dy * dy + dz * dz);
-    }
   }
-  return {first_unstable, travel2};
+  return first_unstable;
+}
+
+/// The largest distance of a node (but the ghosts', which `ghost` flags per particle; null:
+/// none) from its place in `origin` [m], each node counted farther by how far its list
+/// position lies beyond `allowance` off it (ContactModel::list_offset_excess; not looked at
+/// with an infinite allowance).
+real farthest_travel(const Model& m, const State& state, const ContactModel& contact,
+                     const std::vector<real>& origin, real allowance, const std::uint8_t* ghost) {
+  const std::int64_t n = m.node_count();
+  const auto& node_particle = m.node_particle();
+  const auto& x = state.positions;
+  const bool offsets = std::isfinite(allowance);
+  real farthest = 0;  // squared unless offsets are added
+#pragma omp parallel for schedule(static) reduction(max : farthest)
+  for (std::int64_t i = 0; i < n; ++i) {
+    if (ghost && ghost[node_particle[i]]) continue;
+    const real dx = x[3 * i] - origin[3 * i], dy = x[3 * i + 1] - origin[3 * i + 1],
+               dz = x[3 * i + 2] - origin[3 * i + 2];
+    const real d2 = dx * dx + dy * dy + dz * dz;
+    if (!offsets) {
+      farthest = std::max(farthest, d2);
+      continue;
+    }
+    const real excess = contact.list_offset_excess(m, state, static_cast<index_t>(i), allowance);
+    farthest = std::max(farthest, std::sqrt(d2) + excess);
+  }
+  return offsets ? farthest : std::sqrt(farthest);
 }
 
 }  // namespace
@@ -256,6 +274,10 @@ void Simulation::move_and_break_bonds() {
   start = clock_type::now();
   apply_prescribed_motion(true);
   phase_times_.loading += seconds_since(start);
+  if (!travel_origin_.empty()) {  // where the nodes stay for the rest of the step
+    largest_travel_ = farthest_travel(*model_, state_, contact_, travel_origin_, list_allowance_,
+                                      ghost_.empty() ? nullptr : ghost_.data());
+  }
 
   start = clock_type::now();
   update_kinematic_nodes();
@@ -273,13 +295,10 @@ void Simulation::finish_step_after_breaks(std::span<const std::array<index_t, 2>
   start = clock_type::now();
   // The second half kick, and the first node (if any) that moved more than its mesh size in
   // the step or became non-finite: checked every step, at the cost of one comparison per node
-  // (not on ghosts, which their owners move and check). With a travel origin, also the largest
-  // squared distance of a node from it.
-  const real* const origin = travel_origin_.empty() ? nullptr : travel_origin_.data();
-  const auto [first_unstable, travel2] =
-      ghost_.empty() ? second_half_kick<false>(*model_, state_, time_step_, origin, nullptr)
-                     : second_half_kick<true>(*model_, state_, time_step_, origin, ghost_.data());
-  if (origin) largest_travel_ = std::sqrt(travel2);
+  // (not on ghosts, which their owners move and check).
+  const std::int64_t first_unstable =
+      ghost_.empty() ? second_half_kick<false>(*model_, state_, time_step_, nullptr)
+                     : second_half_kick<true>(*model_, state_, time_step_, ghost_.data());
   apply_prescribed_motion(false);
   ++state_.step;
   if (first_unstable < n) check_stability();  // names the node (a prescribed one is fine)

@@ -16,6 +16,9 @@ void SurfaceCentres::find(const Model& model, const State& state, std::vector<re
   any_ = std::any_of(depth_.begin(), depth_.end(), [](real s) { return s > 0; });
   std::vector<std::uint8_t> round_shape(model.shapes().size());
   for (std::size_t s = 0; s < round_shape.size(); ++s) round_shape[s] = is_round(model.shapes()[s]);
+  any_linear_ = false;
+  for (std::size_t p = 0; p < depth_.size(); ++p)
+    any_linear_ = any_linear_ || (depth_[p] > 0 && !surface_[p]);
   round_.assign(surface_.size(), 0);
   for (index_t p = 0; p < round_.size(); ++p)
     round_[p] = surface_[p] && depth_[p] > 0 && round_shape[model.particles()[p].shape];

@@ -3,6 +3,7 @@
 
 #include <array>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <span>
 #include <vector>
@@ -155,16 +156,27 @@ class Simulation {
   /// The stable time-step estimate [s] error messages quote (a distributed run's part quotes
   /// the whole run's, which its own grains and ghosts do not give); 0: its own.
   void set_reported_stable_time_step(real estimate) { reported_stable_time_step_ = estimate; }
-  /// From now on each step measures how far the farthest node is from where it is now [m]
-  /// (largest_travel), in its last half kick: a distributed run's check that its ghosts still
-  /// hold. Off until called (a serial run measures nothing).
-  void set_travel_origin() {
+  /// From now on each step measures how far the farthest node (but the ghosts) is from where
+  /// it is now [m] (largest_travel), once the step has moved the nodes (its drift and
+  /// prescribed motion, in begin_step): a distributed run's check, before the step's contact,
+  /// that its ghosts still hold. With a finite `list_allowance` [m], a node whose list
+  /// position lies farther than that from it counts that much farther
+  /// (ContactModel::list_offset_excess). Off until called (a serial run measures nothing).
+  void set_travel_origin(real list_allowance = std::numeric_limits<real>::infinity()) {
     travel_origin_ = state_.positions;
+    const bool within =
+        !std::isfinite(list_allowance) || contact_.list_offsets_within(*model_, list_allowance);
+    list_allowance_ = within ? std::numeric_limits<real>::infinity() : list_allowance;  // inf: none read
     largest_travel_ = 0;
   }
-  /// The largest distance of a node from the travel origin after the last step [m] (0 before
-  /// a step, or with no origin set).
+  /// The largest distance of a node from the travel origin where the last step (begun or
+  /// finished) put the nodes [m] (0 before a step, or with no origin set).
   real largest_travel() const { return largest_travel_; }
+  /// The largest length at rest of a node's list position off the node [m]
+  /// (ContactModel::largest_list_length): the allowance a distributed run's caps take.
+  real largest_list_length() const { return contact_.largest_list_length(*model_); }
+  /// Whether a node's contact reads its bonded neighbours (ContactModel::reads_bonded_neighbours).
+  bool contact_reads_bonded_neighbours() const { return contact_.reads_bonded_neighbours(); }
 
  private:
   // The phases of compute_forces, in order.
@@ -211,6 +223,7 @@ class Simulation {
   real reported_stable_time_step_ = 0;                      // set_reported_stable_time_step
   std::vector<real> travel_origin_;  // positions largest_travel is measured from; or empty
   real largest_travel_ = 0;
+  real list_allowance_ = 0;  // how far off its node a list position may lie, for largest_travel
   std::vector<std::array<index_t, 2>> breaks_;  // the bonds pass 1 (and the owners) broke
   bool step_begun_ = false;                     // begin_step called, finish_step not yet
   std::uint64_t broken_bond_copies_ = 0;        // both copies of a broken bond count

@@ -188,9 +188,19 @@ void bind_loading(nb::class_<Simulation>& cls) {
       .def("set_reported_stable_time_step", &Simulation::set_reported_stable_time_step, "estimate"_a,
            "The stable time-step estimate [s] error messages quote; 0: the simulation's own.")
       .def("set_travel_origin", &Simulation::set_travel_origin,
-           "Measure each step how far the farthest node is from where it is now (largest_travel).")
+           "list_allowance"_a = std::numeric_limits<real>::infinity(),
+           "Measure each step how far the farthest node is from where it is now (largest_travel), a "
+           "node whose list position lies farther than list_allowance [m] off it counting that much "
+           "farther.")
       .def_prop_ro("largest_travel", &Simulation::largest_travel,
-                   "The largest distance of a node from the travel origin after the last step [m].")
+                   "The largest distance of a node (but the ghosts) from the travel origin where the last "
+                   "step, begun or finished, put the nodes [m].")
+      .def_prop_ro("largest_list_length", &Simulation::largest_list_length,
+                   "The largest length at rest of a node's list position (surface point or contact "
+                   "centre) off the node [m]; 0 where every node is seen at itself.")
+      .def_prop_ro("contact_reads_bonded_neighbours", &Simulation::contact_reads_bonded_neighbours,
+                   "Whether a node's contact reads the nodes bonded to it (its anchors, its surface "
+                   "normal), not the node alone.")
       .def("search_contacts", &Simulation::search_contacts,
            "List every node's contact partners again now, carrying collisions and friction springs over.")
       .def(

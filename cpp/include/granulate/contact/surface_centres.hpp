@@ -64,6 +64,9 @@ class SurfaceCentres {
   bool found() const { return found_; }
   void forget() { found_ = false; }
   bool any() const { return any_; }
+  /// Whether a particle outside the surface law has its nodes centred (the linear form, whose
+  /// points stretch with the anchors).
+  bool any_linear() const { return any_linear_; }
 
   /// The nodes whose bond to one of their anchors is among `pairs` (bonds that broke, already
   /// broken in `state`) take new anchors, or are detached (see above); returns those detached.
@@ -168,6 +171,7 @@ class SurfaceCentres {
 
   bool found_ = false;
   bool any_ = false;
+  bool any_linear_ = false;
   std::vector<real> depth_;             // per particle
   std::vector<std::uint8_t> surface_;   // per particle: under the surface law
   std::vector<std::uint8_t> round_;     // per particle: round (see above)
