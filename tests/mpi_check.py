@@ -67,18 +67,21 @@ def set_up(dimension: int) -> gr.Simulation:
     return sim
 
 
-def fine_discs(peridem: bool = False) -> gr.Simulation:
+def fine_discs(peridem: bool = False, node_pairs: bool = False) -> gr.Simulation:
     """The 2D locality layout's grains as discs meshed finely (R/h = 12, horizon 3h: a ghost's
     caps are a small part of it), brittle, thrown at each other under gravity on a floor,
     placed 2.02 mm apart (the layout's pressed grains would overlap at this mesh). With
     `peridem`, PeriDEM's damping (--peridem-compat decks) acts between them, and the floor is
-    a PeriDEM wall: a fixed slab of nodes that damps the grains near it."""
+    a PeriDEM wall: a fixed slab of nodes that damps the grains near it. With `node_pairs`,
+    PeriDEM's node-pair contact law (whose contact reads a node alone, not its bonded
+    neighbours)."""
     centres, rows = layout(2)
     centres = centres * (2.02 / 1.9)
     h = RADIUS / 12
     brittle = rock(3 * h, fracture_energy=0.01)
     sim = gr.Simulation(2, gravity=(0.0, -9.81, 0.0))
-    sim.contact = gr.Contact(restitution=0.6, friction=0.5)
+    law = "peridem" if node_pairs else "surface"
+    sim.contact = gr.Contact(restitution=0.6, friction=0.5, pair_law=law)
     for centre, row in zip(centres, rows, strict=True):
         sim.add_body(gr.Disc(tuple(centre), row[0]), brittle, h, velocity=row[1:])
     floor = centres[:, 1].min() - 0.99 * RADIUS
@@ -117,11 +120,12 @@ def main() -> int:
     if sys.argv[1] == "api":
         return check_api(sys.argv[2], int(sys.argv[3]), comm)
     if sys.argv[1] == "fine":
-        steps, margin, cap_margin = int(sys.argv[2]), float(sys.argv[3]), float(sys.argv[4])
-        peridem = sys.argv[5:] == ["peridem"]
+        steps, margin = int(sys.argv[2]), float(sys.argv[3])
+        cap_margin = None if sys.argv[4] == "default" else float(sys.argv[4])
+        peridem, node_pairs = "peridem" in sys.argv[5:], "node-pairs" in sys.argv[5:]
         return compare(
-            functools.partial(fine_discs, peridem),
-            "fine peridem" if peridem else "fine",
+            functools.partial(fine_discs, peridem, node_pairs),
+            " ".join(["fine", *sys.argv[5:]]),
             steps,
             comm,
             margin=margin,
@@ -199,9 +203,9 @@ def compare(
         f"rank {ghosts}, migrations {distributed.migrations}, margin widened "
         f"{distributed.margin_widenings} times to {distributed.margin:.3g} m, grains handed over "
         f"{distributed.handed_over}, parts built anew per rank {renewals}, caps picked anew "
-        f"{distributed.cap_refreshes}, ghost nodes held and sent a step per rank {held}, "
-        f"second messages {seconds}, "
-        "bonds broken "
+        f"{distributed.cap_refreshes}, cap margin widened "
+        f"{distributed.cap_margin_widenings} times to {distributed.cap_margin:.3g} m, ghost "
+        f"nodes held and sent a step per rank {held}, second messages {seconds}, bonds broken "
         f"{serial.broken_bonds()}, largest differences {worst}"
     )
     return 0 if same_dt and not any(worst.values()) else 1

@@ -238,7 +238,7 @@ def test_bench_ranks_prints_each_ranks_speed_and_communication() -> None:
     """`mpiexec -n 2 granulate bench --ranks --quick --json` (the 3D pile, 200 grains): one JSON
     object, from rank 0: a row per rank, whose grains and nodes add up to the case's, each
     rank holding the other's nearby grains as ghosts, with its speed and time shares, and the
-    ghost margin; one thread per rank by default."""
+    ghost and cap margins; one thread per rank by default."""
     done = bench_ranks("--quick", "--json")
     assert done.returncode == 0, done.stderr
     (line,) = done.stdout.splitlines()
@@ -256,10 +256,12 @@ def test_bench_ranks_prints_each_ranks_speed_and_communication() -> None:
     # (a cube's, its nodes' corner 1.08 mm from its centre)
     assert (result["migrations"], result["margin_widenings"]) == (0, 0)
     assert 1e-3 < result["margin"] < 1.2e-3
+    # and the default cap margin kept: half the mesh size (R/h = 4)
+    assert (result["cap_margin"], result["cap_margin_widenings"]) == (0.125e-3, 0)
     assert sum(row["nodes"] for row in rows) == 51_712
     for row in rows:
         assert 0 < row["ghost_nodes"] < row["nodes"]
-        assert row["exchanged_nodes"] == row["ghost_nodes"]  # coarse grains: whole caps
+        assert 0 < row["exchanged_nodes"] <= row["ghost_nodes"]  # the caps: near nodes
         assert row["node_steps_per_s"] > 0
         shares = ("exchange", "check", "caps", "migrate")
         assert all(0 <= row[f"{name}_share"] < 1 for name in shares)

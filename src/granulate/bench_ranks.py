@@ -20,13 +20,15 @@ fine2d  (200 grains, 149,127 nodes) the pile at R/h = 16 (horizon three mesh siz
 Each rank runs one thread unless ``granulate --threads N`` says otherwise. After 20 untimed
 steps (lists built, caches warm) the ranks' clocks start together and run the steps. Rank 0
 prints a table: per rank the grains and nodes it owns at the end, the ghost nodes it holds
-besides and those it receives each step (the caps), its owned node-steps per second, and the
-shares of its wall-clock time spent in the ghost exchange, in the partition check (a
-reduction), in picking the caps anew, in migrations and, with
+besides and those it received a step on average (the caps), its owned node-steps per second,
+and the shares of its wall-clock time spent in the ghost exchange, in the checks (a reduction
+after each step, and one within each step whose caps leave ghost nodes out), in picking the
+caps anew, in migrations and, with
 ``--collect-every N``, in gathering the whole state into rank 0's simulation every N steps (as a
 run with outputs every N steps does, DistributedRun.collect, the ranks measuring their grains
 for the outputs too; nothing is written, and the row rank 0 would compute is not); then the
-migrations and grains handed over. With ``--json``, one JSON object instead. On fewer cores
+migrations and grains handed over, the ghost and cap margins and how often the caps were
+picked anew. With ``--json``, one JSON object instead. On fewer cores
 than ranks (oversubscribed) the shares include waiting for the other ranks and are an upper
 bound.
 """
@@ -170,12 +172,13 @@ def measure(
         run = DistributedRun(make(grains), comm)
         run.run(20)  # lists built, caches warm
     migrations, handed = run.migrations, run.handed_over
+    refreshes, received = run.cap_refreshes, run.nodes_received
     wall = _timed(run, steps, collect_every, comm)
     row = {
         "grains": len(run.owned),
         "nodes": run.owned_node_count,
         "ghost_nodes": run.ghost_node_count,
-        "exchanged_nodes": run.exchanged_node_count,
+        "exchanged_nodes": (run.nodes_received - received) / steps,
         "seconds": wall,
         "node_steps_per_s": run.owned_node_count * steps / wall,
     } | {f"{name}_share": run.seconds[name] / wall for name in SHARES}
@@ -194,6 +197,9 @@ def measure(
         "handed_over": run.handed_over - handed,
         "margin": run.margin,
         "margin_widenings": run.margin_widenings,
+        "cap_margin": run.cap_margin,
+        "cap_refreshes": run.cap_refreshes - refreshes,
+        "cap_margin_widenings": run.cap_margin_widenings,
     }
 
 
@@ -226,12 +232,14 @@ def table(result: dict[str, Any]) -> str:
         shares = " | ".join(f"{100 * row[f'{name}_share']:.1f}" for name in SHARES)
         lines.append(
             f"| {rank} | {row['grains']} | {row['nodes']:,} | {row['ghost_nodes']:,} | "
-            f"{row['exchanged_nodes']:,} | {row['node_steps_per_s'] / 1e6:.2f} M | {shares} |"
+            f"{row['exchanged_nodes']:,.0f} | {row['node_steps_per_s'] / 1e6:.2f} M | {shares} |"
         )
     lines.append(
         f"{result['migrations']} migrations, {result['handed_over']} grains handed over in the "
         f"timed steps; ghost margin {1e3 * result['margin']:.3g} mm (widened "
-        f"{result['margin_widenings']} times)"
+        f"{result['margin_widenings']} times); cap margin {1e3 * result['cap_margin']:.3g} mm ("
+        f"widened {result['cap_margin_widenings']} times), caps picked anew "
+        f"{result['cap_refreshes']} times"
     )
     return "\n".join(lines)
 

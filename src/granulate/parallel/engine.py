@@ -88,13 +88,15 @@ class DistributedRun:
     travel). A margin given is kept.
 
     ``cap_margin`` [m]: the same for the caps, the ghost nodes whose positions and velocities
-    travel in each step (_exchange_caps); default margin/4, but at least four times the
-    largest mesh size (a node that moves more than its mesh size in a step is unstable, so the
-    caps are always picked anew in time) and at most the margin. Once a node has moved
-    cap_margin/4 since they were picked, the ranks pick them anew (refresh_caps: the ghosts
-    made their owners' grains whole, no grain changes hands); past cap_margin/2 they stop
-    with an InputError. A smaller cap margin sends fewer nodes each step and refreshes more
-    often. Caps that hold every ghost node (coarse grains) are never picked anew.
+    travel in each step (_exchange_caps); at most the margin. The caps hold while every node
+    stays within cap_margin/2 of where it was when they were picked; each step checks that
+    once it has moved the nodes, before its contact, and where one has moved farther the ranks
+    pick them anew there (refresh_caps: the ghosts made their owners' grains whole, no grain
+    changes hands). A smaller cap margin sends fewer nodes each step and refreshes more often.
+    The default starts at half the largest mesh size (grains at rest or loaded slowly keep
+    thin caps) and doubles, up to the margin, when the caps last fewer than
+    ``short_cap_period`` steps (flowing grains refresh less often); a cap margin given is
+    kept. Caps that hold every ghost node (coarse grains) are never picked anew.
 
     Every rank calls the constructor and each method together.
     """
@@ -110,6 +112,9 @@ class DistributedRun:
     short_distribution = 200
     #: The widest default margin, in radii of the largest free grain.
     widest_margin = 4.0
+    #: Caps picked anew fewer than this many steps after they were picked widen the default
+    #: cap margin.
+    short_cap_period = 50
 
     def __init__(
         self,
@@ -151,17 +156,21 @@ class DistributedRun:
         #: Bodies over twice as large as the largest free grain (meshed walls, containers):
         #: their pairs with the grains are found from their nodes (partition.near_nodes).
         self._large = np.flatnonzero(radii > 2 * grain)
-        largest_mesh = max(body.mesh_size for body in sim.bodies)
-        default = min(self.margin, max(0.25 * self.margin, 4 * largest_mesh))
-        self.cap_margin = float(default if cap_margin is None else cap_margin)
+        self._largest_mesh = max(body.mesh_size for body in sim.bodies)
+        start_cap = min(0.5 * self._largest_mesh, self.margin)
+        self.cap_margin = float(start_cap if cap_margin is None else cap_margin)
         if not 0 < self.cap_margin <= self.margin:
             raise InputError(
                 f"cap_margin must be a length in m above 0 and at most the margin "
                 f"({self.margin:.3g} m), got {cap_margin!r}"
             )
-        self._cap_reach = cutoff + self.cap_margin + 2 * largest_mesh
+        self._adapt_caps = cap_margin is None
+        #: How many times the default cap margin was widened (_widen_cap_margin).
+        self.cap_margin_widenings = 0
         #: How many times the caps were picked anew between distributions (refresh_caps).
         self.cap_refreshes = 0
+        #: The ghost nodes this rank received in all its steps (each step, its caps').
+        self.nodes_received = 0
         #: How many of this rank's step messages had a second one for the breaks and bodies'
         #: motions they had no room for.
         self.second_messages = 0
@@ -233,6 +242,14 @@ class DistributedRun:
         self._damping_radii = np.asarray(radii)
         walls = sim._interactions.peridem_wall_indices()
         self._centre_damped = np.setdiff1d(np.arange(len(self._slices)), walls)
+
+    @property
+    def _cap_reach(self) -> float:
+        """How near a ghost node must be to one of the rank's own nodes to be in its caps [m]:
+        the cutoff, the cap margin and, for each of the two nodes, how far off it the lists
+        may see it (its surface point or contact centre: the largest length at rest over the
+        ranks, core.largest_list_length; a point stretched farther counts as travel)."""
+        return self._cutoff + self.cap_margin + 2 * self._list_allowance
 
     @property
     def _reach(self) -> float:
@@ -352,31 +369,41 @@ class DistributedRun:
         self._rooms_in = {q: self._rooms(len(g)) for q, g in self._receive_grains.items()}
         self._particle_to = {q: _mask(len(self.held), p) for q, p in particles.items()}
         self._node_particle = np.asarray(self.local.model.node_particle, dtype=np.int64)
-        self.local.core.set_travel_origin()
-        self._travelled = 0.0  # the farthest travel of each cap period since, summed
+        # Where the own nodes were distributed, and the farthest any was from there when the
+        # caps were last picked (refresh_caps).
+        self._distributed_positions = self.local.core.positions[self._owned_nodes]
+        self._travelled = 0.0
         self._distributed_at = int(self.local.core.step)
-        self._caps_due = False  # _exchange_caps picks them where the nodes are
 
     def _exchange_caps(self) -> None:
         """Which of the ghosts' nodes each step sends (the caps): of each ghost grain, the
-        nodes within the cutoff plus the cap margin (and twice the largest mesh size, by which
-        a contact centre may lie off its node) of one of this rank's own nodes, and the nodes
-        bonded to those (a node's surface normal and anchors are its bonded neighbours), and
-        under PeriDEM's damping every ghost's centre node (the damping reads it). No
+        nodes within the cutoff plus the cap margin (and twice how far off its node the lists
+        may see a node, _cap_reach) of one of this rank's own nodes, and the nodes bonded to
+        those where the contact reads them (a node's surface normal and anchors are its bonded
+        neighbours; PeriDEM's node pairs read neither: core.contact_reads_bonded_neighbours),
+        and under PeriDEM's damping every ghost's centre node (the damping reads it). No
         other ghost node can come within the cutoff of an own node, or of where one of them
         is, before the caps are picked again (each moves less than cap_margin/2), so a ghost
         node outside the cap stays where it was, out of every own node's contact, and out of
         the contact lists (core.set_inert_contact_nodes). Each rank picks its caps from the
         ghosts' positions now, which are their owners' (after _exchange_state or a rebuild),
-        and tells the owners; one message per neighbour."""
-        x = self.local.core.positions
+        and tells the owners; one message per neighbour. The nodes' travel is measured from
+        here (core.set_travel_origin)."""
+        core = self.local.core
+        mine = np.array([core.largest_list_length, core.contact_reads_bonded_neighbours])
+        most = np.empty(2)
+        self.comm.Allreduce(mine, most, op=self.mpi.MAX)  # the same caps' rules on every rank
+        self._list_allowance, neighbours = float(most[0]), bool(most[1])
+        core.set_travel_origin(self._list_allowance)
+        x = core.positions
         ghosts = np.concatenate([np.zeros(0, np.int64), *self._receive_whole.values()])
         close = np.zeros(len(x), dtype=bool)  # one grid over the own nodes for every ghost
         close[ghosts] = points_within(x[ghosts], x[self._owned_nodes], self._cap_reach)
         caps = {}
         for q, nodes in self._receive_whole.items():
             near = nodes[close[nodes]]
-            caps[q] = np.union1d(near, np.asarray(self.local.model.bond_partners(near.tolist())))
+            partners = self.local.model.bond_partners(near.tolist()) if neighbours else []
+            caps[q] = np.union1d(near, np.asarray(partners, dtype=np.int64))
             if self._damped_centres is not None:  # PeriDEM's damping reads ghosts' centres
                 centres = self._node_map[self._damped_centres[self._receive_grains[q]]]
                 caps[q] = np.union1d(caps[q], centres)
@@ -390,6 +417,7 @@ class DistributedRun:
         self._receive = caps
         outside = [np.setdiff1d(self._receive_whole[q], cap) for q, cap in caps.items()]
         self.local.core.set_inert_contact_nodes(np.concatenate([[], *outside]).astype(int).tolist())
+        self._caps_picked_at = int(self.local.core.step)
         #: Whether some rank's caps leave ghost nodes out (else no need to pick them anew).
         self.caps_partial = self.comm.allreduce(any(len(o) for o in outside), op=self.mpi.LOR)
         self._outbox = {q: _message(len(n), self._rooms_out[q]) for q, n in self._send.items()}
@@ -498,6 +526,7 @@ class DistributedRun:
                 self.second_messages += 1
         self.mpi.Request.Waitall(requests)
         received = [self._unpack(q, nodes, (x, v)) for q, nodes in self._receive.items()]
+        self.nodes_received += self.exchanged_node_count
         self.mpi.Request.Waitall(overflow)
         motions = np.concatenate([np.zeros((0, _BODY)), *(m for _, m in received)])
         first = self._node_map[motions[:, 0].astype(np.int64)].astype(np.uint32)
@@ -544,28 +573,28 @@ class DistributedRun:
 
     def run(self, steps: int) -> None:
         """Advance every rank `steps` time steps, migrating grains before a step once a node
-        may have moved a quarter of the margin, or picking the caps anew once one has moved a
-        quarter of the cap margin. Raises InputError (on every rank) when a node may have
-        moved more than half the margin, or half the cap margin since the caps were picked:
-        the ghosts, or the caps, would no longer be enough. An error in one
+        may have moved a quarter of the margin, and picking the caps anew within a step whose
+        drift took a node farther than half the cap margin from where it was when they were
+        picked (_caps_hold). Raises InputError (on every rank) when a node may have moved
+        more than half the margin: the ghosts would no longer be enough. An error in one
         rank's step ends every rank: that rank raises its own, the others RankFailed naming
         it (no rank is left waiting for a message)."""
         for _ in range(steps):
             if self._migration_due:  # before the step, so the parts hold its evaluation after
                 self.migrate()
-            elif self._caps_due:
-                self.refresh_caps()
             self._step()
 
     def refresh_caps(self) -> None:
         """Pick the caps anew (_exchange_caps) where the nodes are now, after making every
-        ghost its owner's grain (_exchange_state); the travel since is measured afresh, the
-        travel before counted towards the next migration."""
+        ghost its owner's grain (_exchange_state); the travel since is measured afresh, and
+        the farthest a node has moved since the grains were distributed, which the next
+        migration waits for, exactly. Between steps, or within one after
+        its drift (_caps_hold): the ghosts then take their owners' half-step velocities and
+        last forces, which only their caps' motion reads before the next exchange."""
         start = time.perf_counter()
-        self._caps_due = False
         self._exchange_state()
-        self._travelled += self._cap_travel
-        self.local.core.set_travel_origin()
+        self._travelled = self._travel_since_distributed()
+        self._widen_cap_margin()
         self._exchange_caps()
         self.cap_refreshes += 1
         self.seconds["caps"] += time.perf_counter() - start
@@ -582,6 +611,9 @@ class DistributedRun:
         except Exception as error:  # re-raised by the check, after the ranks agree to stop
             failure = error
         began = time.perf_counter()
+        if self.caps_partial:
+            self._caps_hold(failure is None)
+        checked = time.perf_counter()
         ghost_breaks, motions = self._exchange_within_step(broken)
         told = time.perf_counter()
         if failure is None:
@@ -593,20 +625,35 @@ class DistributedRun:
         stepped = time.perf_counter()
         farthest = self._check_step(int(core.step), failure)
         self._loaded_walls = None
-        self._cap_travel = farthest
         self._migration_due = self._migrates and self._travelled + farthest > 0.25 * self.margin
-        self._caps_due = self.caps_partial and farthest > 0.25 * self.cap_margin
         self.seconds["steps"] += (began - start) + (stepped - told)
         self.seconds["check"] += time.perf_counter() - stepped
-        self.seconds["exchange"] += told - began
+        self.seconds["exchange"] += told - checked
+
+    def _caps_hold(self, moved: bool) -> None:
+        """Within a step, once its drift has moved the nodes (`moved`: begin_step did not
+        fail): one reduction of the largest distance of a node from where it was when the caps
+        were picked (core.largest_travel) and whether a rank's step failed; past half the cap
+        margin, and none failed, the caps are picked anew here, before the step's exchange and
+        contact (refresh_caps), so that a ghost node outside them never comes within the
+        cutoff of an own node however far a step moves them."""
+        start = time.perf_counter()
+        size = self.comm.Get_size()
+        travel = float(self.local.core.largest_travel) if moved else 0.0
+        mine = np.array([-travel, self.comm.Get_rank() if not moved else size])
+        least = np.empty(2)
+        self.comm.Allreduce(mine, least, op=self.mpi.MIN)
+        self.seconds["check"] += time.perf_counter() - start
+        if -least[0] > 0.5 * self.cap_margin and int(least[1]) == size:
+            self.refresh_caps()
 
     def _check_step(self, step: int, failure: Exception | None) -> float:
         """One reduction after each step: the first rank whose step failed, and the largest
         distance of an own node from where it was when the caps were picked
-        (core.largest_travel, measured in the step's second half). Stops every rank on either,
-        and when a node may have moved more than half the margin since the grains were
-        distributed (the travels of the caps' periods summed) or half the cap margin since the
-        caps were picked; returns that distance [m]."""
+        (core.largest_travel, measured once the step moved the nodes). Stops every rank on
+        either, and when a node may have moved more than half the margin since the grains were
+        distributed (at most that distance plus how far one was from there when the caps were
+        picked); returns that distance [m]."""
         farthest = float(self.local.core.largest_travel)
         size = self.comm.Get_size()
         failed_rank = self.comm.Get_rank() if failure is not None else size
@@ -631,12 +678,6 @@ class DistributedRun:
                 f"step {step}: a node may have moved {travelled:.3g} m from where the grains "
                 f"were distributed, more than half the ghost margin ({self.margin:.3g} m): "
                 f"{advice}"
-            )
-        if self.caps_partial and farthest > 0.5 * self.cap_margin:
-            raise InputError(
-                f"step {step}: a node moved {farthest:.3g} m from where it was when the caps "
-                f"were picked, more than half the cap margin ({self.cap_margin:.3g} m): give "
-                "DistributedRun a larger cap_margin"
             )
         return farthest
 
@@ -688,6 +729,21 @@ class DistributedRun:
         self._exchange_caps()
         self.migrations += 1
         self.seconds["migrate"] += time.perf_counter() - start
+
+    def _travel_since_distributed(self) -> float:
+        """The largest distance of a node from where it was when the grains were distributed
+        [m], over every rank (one reduction)."""
+        moved = self.local.core.positions[self._owned_nodes] - self._distributed_positions
+        farthest = float(np.sqrt((moved**2).sum(axis=1).max(initial=0.0)))
+        return float(self.comm.allreduce(farthest, op=self.mpi.MAX))
+
+    def _widen_cap_margin(self) -> None:
+        """The default cap margin doubled, up to the margin, when the caps being picked anew
+        lasted fewer than short_cap_period steps (the same on every rank: the steps are)."""
+        lasted = int(self.local.core.step) - self._caps_picked_at
+        if self._adapt_caps and lasted < self.short_cap_period and self.cap_margin < self.margin:
+            self.cap_margin = min(2 * self.cap_margin, self.margin)
+            self.cap_margin_widenings += 1
 
     def _widen_margin(self) -> None:
         """The default margin doubled, up to widest_margin grain radii, when the grains' last
