@@ -212,7 +212,7 @@ def as_built(
     full, and if ghosts were not stepped at all (not built). "cap_shares": the communication
     share when it receives, instead of whole ghosts, only the ghost nodes within each of
     `depths` [m] of one of its grains' bounding spheres (exchanged_nodes; the ghosts still held
-    and stepped whole)."""
+    and stepped whole), with a second reduction per step (the caps' check within the step)."""
     partition = bisect(centres, np.ones(len(centres)), ranks)
     needed = ghosts(partition, pairs)
     owned = np.bincount(partition.owner, minlength=ranks)
@@ -224,15 +224,16 @@ def as_built(
     in_full = (own + ghost) / rate * (1 + CHECK_SHARE)
     lean = useful * (1 + CHECK_SHARE)
 
-    def communication(sent: int) -> float:
+    def communication(sent: int, reductions: int = 1) -> float:
         # one message per neighbour within a step: x and v of the nodes sent, the bonds broken
-        return sum(communication_seconds(1, neighbours, 48.0 * sent, ranks, args))
+        exchange, reduction = communication_seconds(1, neighbours, 48.0 * sent, ranks, args)
+        return exchange + reductions * reduction
 
     talk = communication(ghost)
     cap_shares = {}
-    for name, depth in depths.items():
+    for name, depth in depths.items():  # caps that leave nodes out: a check within the step
         counts = exchanged_nodes(centres, radii, partition.owner, ranks, pairs, unit_nodes, depth)
-        capped = communication(int(counts[worst]))
+        capped = communication(int(counts[worst]), reductions=2)
         cap_shares[name] = capped / (stepped + capped)
     return {
         "ranks": ranks,
@@ -265,15 +266,20 @@ def lps_node_steps_per_second(steps: int = 30) -> float:
     return sim.node_count * steps / (time.perf_counter() - start)
 
 
-#: Cap depths at R/h = 6 (h = R/6, horizon 3 h, the cutoff the reach): as the engine picks them
-#: (the cutoff, the cap margin of 4 h, 2 h for the contact centres' offset, and the bonded
-#: neighbours a horizon deeper, taken here as depth), the whole of a near ghost; without the
-#: bonded neighbours (their anchored vectors sent instead); without the 2 h too (the contact
-#: centres sent); the cutoff alone (caps picked by the owners every step: no cap margin).
+#: Cap depths at R/h = 6 (h = R/6, horizon 3 h, the cutoff the reach): as the engine picked them
+#: before its check within the step (the cutoff, a cap margin of at least 4 h, 2 h for the
+#: surface points' offset, and the bonded neighbours a horizon deeper, taken here as depth),
+#: the whole of a near ghost; as it picks them now under the surface law for grains at rest or
+#: loaded slowly (the default cap margin h/2, which widens only where the caps last under 50
+#: steps; the points' offset about h each); the same without the bonded neighbours (their
+#: anchored vectors sent instead); as it picks them now under PeriDEM's node pairs (no offset,
+#: no neighbours: the contact reads the node alone); the cutoff alone (caps picked by the
+#: owners every step: no cap margin).
 CAP_LAYERS = (
-    ("as picked", lambda reach, h: reach + 4 * h + 2 * h + 3 * h),
-    ("no neighbours", lambda reach, h: reach + 4 * h + 2 * h),
-    ("no offset", lambda reach, h: reach + 4 * h),
+    ("before", lambda reach, h: reach + 4 * h + 2 * h + 3 * h),
+    ("surface law", lambda reach, h: reach + 0.5 * h + 2 * h + 3 * h),
+    ("no neighbours", lambda reach, h: reach + 0.5 * h + 2 * h),
+    ("node pairs", lambda reach, h: reach + 0.5 * h),
     ("cutoff only", lambda reach, h: reach),
 )
 
