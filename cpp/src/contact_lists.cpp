@@ -47,7 +47,7 @@ real ContactModel::list_offset_excess(const Model& model, const State& state, in
                                       real allowance) const {
   if (!centres_.found() || !centres_.moved(i)) return 0;
   const SurfaceCentres::Seen s = centres_.seen(model, i);
-  const real length = s.along_normal ? s.surface_length : s.centre_length;
+  const real length = SurfaceCentres::list_length(s);
   if (s.along_normal && std::abs(length) <= allowance) return 0;
   const vec3 x = centres_.point(state, s, i, length);
   real d2 = 0;
@@ -63,8 +63,7 @@ real ContactModel::largest_list_length(const Model& model) const {
   real largest = 0;
   for (index_t i = 0; i < model.node_count(); ++i) {
     if (!centres_.moved(i)) continue;
-    const SurfaceCentres::Seen s = centres_.seen(model, i);
-    largest = std::max(largest, std::abs(s.along_normal ? s.surface_length : s.centre_length));
+    largest = std::max(largest, std::abs(SurfaceCentres::list_length(centres_.seen(model, i))));
   }
   return largest;
 }

@@ -156,8 +156,8 @@ class DistributedRun:
         #: Bodies over twice as large as the largest free grain (meshed walls, containers):
         #: their pairs with the grains are found from their nodes (partition.near_nodes).
         self._large = np.flatnonzero(radii > 2 * grain)
-        self._largest_mesh = max(body.mesh_size for body in sim.bodies)
-        start_cap = min(0.5 * self._largest_mesh, self.margin)
+        largest_mesh = max(body.mesh_size for body in sim.bodies)
+        start_cap = min(0.5 * largest_mesh, self.margin)
         self.cap_margin = float(start_cap if cap_margin is None else cap_margin)
         if not 0 < self.cap_margin <= self.margin:
             raise InputError(
@@ -638,14 +638,19 @@ class DistributedRun:
         contact (refresh_caps), so that a ghost node outside them never comes within the
         cutoff of an own node however far a step moves them."""
         start = time.perf_counter()
-        size = self.comm.Get_size()
-        travel = float(self.local.core.largest_travel) if moved else 0.0
-        mine = np.array([-travel, self.comm.Get_rank() if not moved else size])
-        least = np.empty(2)
-        self.comm.Allreduce(mine, least, op=self.mpi.MIN)
+        first_failed, farthest = self._first_failed_and_farthest(not moved)
         self.seconds["check"] += time.perf_counter() - start
-        if -least[0] > 0.5 * self.cap_margin and int(least[1]) == size:
+        if farthest > 0.5 * self.cap_margin and first_failed == self.comm.Get_size():
             self.refresh_caps()
+
+    def _first_failed_and_farthest(self, failed: bool) -> tuple[int, float]:
+        """One reduction: the first rank that `failed` (the number of ranks if none) and the
+        largest core.largest_travel over the others [m]."""
+        travel = 0.0 if failed else float(self.local.core.largest_travel)
+        mine = np.array([self.comm.Get_rank() if failed else self.comm.Get_size(), -travel])
+        least = np.empty(2)
+        self.comm.Allreduce(mine, least, op=self.mpi.MIN)  # elementwise minima: both in one
+        return int(least[0]), -float(least[1])
 
     def _check_step(self, step: int, failure: Exception | None) -> float:
         """One reduction after each step: the first rank whose step failed, and the largest
@@ -654,16 +659,10 @@ class DistributedRun:
         either, and when a node may have moved more than half the margin since the grains were
         distributed (at most that distance plus how far one was from there when the caps were
         picked); returns that distance [m]."""
-        farthest = float(self.local.core.largest_travel)
-        size = self.comm.Get_size()
-        failed_rank = self.comm.Get_rank() if failure is not None else size
-        mine = np.array([failed_rank, -farthest])  # elementwise minima: both in one reduction
-        least = np.empty(2)
-        self.comm.Allreduce(mine, least, op=self.mpi.MIN)
-        first_failed, farthest = int(least[0]), -float(least[1])
+        first_failed, farthest = self._first_failed_and_farthest(failure is not None)
         if failure is not None:
             raise failure
-        if first_failed < size:
+        if first_failed < self.comm.Get_size():
             raise RankFailed(f"step {step}: rank {first_failed} failed; every rank stops")
         travelled = self._travelled + farthest  # since the grains were distributed, at most
         if travelled > 0.5 * self.margin:

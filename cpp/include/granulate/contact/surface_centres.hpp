@@ -124,10 +124,14 @@ class SurfaceCentres {
     const Seen s = seen(model, i);
     return point(state, s, i, s.surface_length);
   }
+  /// How far out along the normal the lists see a node at rest [m]: its surface point's
+  /// length under the surface law, else its contact centre's (0 for a node seen at itself).
+  static real list_length(const Seen& s) { return s.along_normal ? s.surface_length : s.centre_length; }
   /// Where the node-pair lists see node i: its surface point on a particle under the surface
   /// law, else its contact centre.
   vec3 at_list(const Model& model, const State& state, index_t i) const {
-    return surface_[model.node_particle()[i]] ? at_surface(model, state, i) : at_centre(model, state, i);
+    const Seen s = seen(model, i);
+    return point(state, s, i, list_length(s));
   }
   /// Every node's list position (at_list), into x (n x 3).
   void fill_positions(const Model& model, const State& state, std::vector<float>& x) const;
