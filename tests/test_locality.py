@@ -280,58 +280,64 @@ def test_ghost_breaks_are_checked(tmp_path: Path) -> None:
         sim.core.set_reported_numbers([0, 1], [0])
 
 
-def test_the_core_measures_how_far_the_nodes_travelled(tmp_path: Path) -> None:
-    """core.largest_travel (a rank's check that its ghosts still hold): once a step has moved
-    the nodes (begin_step, before its contact), the largest distance of a node from where it
-    was at set_travel_origin [m], as NumPy finds it; 0 before the first step and with no
-    origin set."""
-    sim = tumbling_drum(tmp_path)
+def farthest(now: np.ndarray, origin: np.ndarray) -> float:
+    """The largest distance of a row of `now` from its row in `origin` [m]."""
+    return float(np.linalg.norm(now - origin, axis=1).max())
+
+
+@pytest.mark.parametrize("law", ["granulate", "surface"])
+def test_the_core_measures_how_far_the_nodes_and_list_positions_travelled(
+    tmp_path: Path, law: str
+) -> None:
+    """core.largest_travel (a rank's check that its ghosts and caps still hold): once a step
+    has moved the nodes (begin_step, before its contact), the largest distance of a node, or
+    of where the contact lists see it (core.list_positions: the grid square's surface nodes'
+    contact centres inside them, surface points under the surface law), from where it was at
+    set_travel_origin [m], as NumPy finds it; 0 before the first step and with no origin set.
+    The list positions are where a search lists the nodes (the lists keep them in single
+    precision: 1e-8 m at these coordinates)."""
+    sim = tumbling_drum(tmp_path, grid=True, law=law)
     sim.core.run(100)
     assert sim.core.largest_travel == 0.0
-    origin = sim.core.positions.copy()
+    sim.core.search_contacts()
+    listed = np.asarray(sim.core.checkpoint()["contact_positions_at_build"]).reshape(-1, 3)
+    assert np.abs(sim.core.list_positions - listed).max() < 1e-8
+    assert farthest(sim.core.list_positions, sim.core.positions) > 0.1e-3  # centres off nodes
+    origin, list_origin = sim.core.positions.copy(), sim.core.list_positions
     sim.core.set_travel_origin()
     assert sim.core.largest_travel == 0.0
-    for _ in range(5):
+    for _ in range(4):
         sim.core.run(40)
-        moved = np.linalg.norm(sim.core.positions - origin, axis=1).max()
+        moved = max(
+            farthest(sim.core.positions, origin), farthest(sim.core.list_positions, list_origin)
+        )
         assert sim.core.largest_travel == pytest.approx(moved, rel=1e-14)
         sim.core.begin_step()
-        moved = np.linalg.norm(sim.core.positions - origin, axis=1).max()
+        moved = max(
+            farthest(sim.core.positions, origin), farthest(sim.core.list_positions, list_origin)
+        )
         assert sim.core.largest_travel == pytest.approx(moved, rel=1e-14)
         sim.core.finish_step(np.zeros((0, 2), np.uint32))
         assert sim.core.largest_travel == pytest.approx(moved, rel=1e-14)
     assert sim.core.largest_travel > 1e-4  # the grains fall and tumble
 
 
-@pytest.mark.parametrize("law", ["granulate", "surface"])
-def test_the_core_counts_list_positions_beyond_the_allowance_as_travel(
-    tmp_path: Path, law: str
-) -> None:
-    """core.largest_list_length: the largest distance of a node's list position (its contact
-    centre, the grid square's surface nodes' centred inside them; its surface point under the
-    surface law) from the node at rest, as the lists see it after a search; with
-    set_travel_origin(allowance), a node whose list position lies farther than the allowance
-    off it travels that much farther: with none allowed, largest_travel is the largest of
-    |y - y0| + |list position - y| over the nodes."""
-    sim = tumbling_drum(tmp_path, grid=True, law=law)
+def test_a_steps_list_positions_are_settled_when_it_begins(tmp_path: Path) -> None:
+    """The anchors a step's breaks change are taken anew in begin_step, so where the lists
+    see each node (core.list_positions, which the travel is measured at) is, bit for bit,
+    where its contact sees it in finish_step: the grid square breaking under the surface law,
+    whose surface nodes lose their anchors as it cracks (seen at themselves after)."""
+    sim = tumbling_drum(tmp_path, grid=True, law="surface")
     sim.core.run(0)
-    sim.core.search_contacts()
-    listed = np.asarray(sim.core.checkpoint()["contact_positions_at_build"]).reshape(-1, 3)
-    offset = np.linalg.norm(listed - sim.core.positions, axis=1)
-    # (the lists keep their positions in single precision: 1e-8 m at these coordinates)
-    assert 0 < sim.core.largest_list_length == pytest.approx(offset.max(), abs=1e-8)
-    origin = sim.core.positions.copy()
-    sim.core.set_travel_origin(list_allowance=0.0)
-    sim.core.run(30)
-    sim.core.search_contacts()
-    listed = np.asarray(sim.core.checkpoint()["contact_positions_at_build"]).reshape(-1, 3)
-    travel = np.linalg.norm(sim.core.positions - origin, axis=1)
-    offset = np.linalg.norm(listed - sim.core.positions, axis=1)
-    assert sim.core.largest_travel == pytest.approx((travel + offset).max(), abs=1e-8)
-    sim.core.set_travel_origin(list_allowance=sim.core.largest_list_length)
-    sim.core.run(30)
-    travel = np.linalg.norm(sim.core.positions - origin, axis=1)
-    assert sim.core.largest_travel <= travel.max()  # within its rest length: the node's travel
+    at_node = [int(np.all(sim.core.list_positions == sim.core.positions, axis=1).sum())]
+    for _ in range(1500):
+        broken = sim.core.begin_step()
+        begun = sim.core.list_positions
+        sim.core.finish_step(np.zeros((0, 2), np.uint32))
+        np.testing.assert_array_equal(begun, sim.core.list_positions)
+        if len(broken):
+            at_node.append(int(np.all(begun == sim.core.positions, axis=1).sum()))
+    assert at_node[-1] > at_node[0]  # anchors broke in these steps
 
 
 def test_a_ghosts_speed_is_its_owners_to_check(tmp_path: Path) -> None:

@@ -42,11 +42,12 @@ def granulate(
 
 
 def assert_same_run(
-    serial: Path, distributed: Path, row_count: int = 13, searches_within: float | None = 0.1
+    serial: Path, distributed: Path, row_count: int = 13, searches_within: float | None = 0.2
 ) -> None:
     """The frames, tables and PVD series byte for byte; history.csv's every column's text
-    equal, but the searches, which each rank makes for its own part: they stay within
-    `searches_within` (10 %, or 5) of the serial run's (None: not compared); `row_count` rows
+    equal, but the searches, which each rank makes for its own part (whose nodes and cap
+    nodes, fewer than the run's, call for a search less often): they stay within
+    `searches_within` (20 %, or 5) of the serial run's (None: not compared); `row_count` rows
     (13: steps 0, 250, ..., 3000)."""
     assert len(outputs(serial)) > 10
     assert differing(serial, distributed) == []

@@ -43,31 +43,6 @@ real ContactModel::largest_displacement(const Model& model, const State& state) 
   return std::sqrt(worst);
 }
 
-real ContactModel::list_offset_excess(const Model& model, const State& state, index_t i,
-                                      real allowance) const {
-  if (!centres_.found() || !centres_.moved(i)) return 0;
-  const SurfaceCentres::Seen s = centres_.seen(model, i);
-  const real length = SurfaceCentres::list_length(s);
-  if (s.along_normal && std::abs(length) <= allowance) return 0;
-  const vec3 x = centres_.point(state, s, i, length);
-  real d2 = 0;
-  for (int k = 0; k < 3; ++k) {
-    const real d = x[k] - state.positions[3 * i + k];
-    d2 += d * d;
-  }
-  return std::max(real{0}, std::sqrt(d2) - allowance);
-}
-
-real ContactModel::largest_list_length(const Model& model) const {
-  if (!centres_.found() || !centres_.any()) return 0;
-  real largest = 0;
-  for (index_t i = 0; i < model.node_count(); ++i) {
-    if (!centres_.moved(i)) continue;
-    largest = std::max(largest, std::abs(SurfaceCentres::list_length(centres_.seen(model, i))));
-  }
-  return largest;
-}
-
 std::vector<index_t> ContactModel::nodes_moved_past(const Model& model, const State& state,
                                                     real limit) const {
   std::vector<index_t> moved;

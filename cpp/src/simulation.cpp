@@ -72,30 +72,27 @@ std::int64_t second_half_kick(const Model& m, State& state, real dt, const std::
 }
 
 /// The largest distance of a node (but the ghosts', which `ghost` flags per particle; null:
-/// none) from its place in `origin` [m], each node counted farther by how far its list
-/// position lies beyond `allowance` off it (ContactModel::list_offset_excess; not looked at
-/// with an infinite allowance).
+/// none), or of its list position (ContactModel::list_position), from its place in `origin`
+/// (`list_origin`) [m].
 real farthest_travel(const Model& m, const State& state, const ContactModel& contact,
-                     const std::vector<real>& origin, real allowance, const std::uint8_t* ghost) {
+                     const std::vector<real>& origin, const std::vector<real>& list_origin,
+                     const std::uint8_t* ghost) {
   const std::int64_t n = m.node_count();
   const auto& node_particle = m.node_particle();
   const auto& x = state.positions;
-  const bool offsets = std::isfinite(allowance);
-  real farthest = 0;  // squared unless offsets are added
+  auto squared = [](const real* a, const real* b) {
+    const real dx = a[0] - b[0], dy = a[1] - b[1], dz = a[2] - b[2];
+    return dx * dx + dy * dy + dz * dz;
+  };
+  real farthest = 0;  // squared
 #pragma omp parallel for schedule(static) reduction(max : farthest)
   for (std::int64_t i = 0; i < n; ++i) {
     if (ghost && ghost[node_particle[i]]) continue;
-    const real dx = x[3 * i] - origin[3 * i], dy = x[3 * i + 1] - origin[3 * i + 1],
-               dz = x[3 * i + 2] - origin[3 * i + 2];
-    const real d2 = dx * dx + dy * dy + dz * dz;
-    if (!offsets) {
-      farthest = std::max(farthest, d2);
-      continue;
-    }
-    const real excess = contact.list_offset_excess(m, state, static_cast<index_t>(i), allowance);
-    farthest = std::max(farthest, std::sqrt(d2) + excess);
+    const auto seen = contact.list_position(m, state, static_cast<index_t>(i));
+    farthest =
+        std::max({farthest, squared(&x[3 * i], &origin[3 * i]), squared(seen.data(), &list_origin[3 * i])});
   }
-  return offsets ? farthest : std::sqrt(farthest);
+  return std::sqrt(farthest);
 }
 
 }  // namespace
@@ -274,15 +271,32 @@ void Simulation::move_and_break_bonds() {
   start = clock_type::now();
   apply_prescribed_motion(true);
   phase_times_.loading += seconds_since(start);
-  if (!travel_origin_.empty()) {  // where the nodes stay for the rest of the step
-    largest_travel_ = farthest_travel(*model_, state_, contact_, travel_origin_, list_allowance_,
-                                      ghost_.empty() ? nullptr : ghost_.data());
-  }
 
   start = clock_type::now();
   update_kinematic_nodes();
   sum_dilatation_and_break_bonds();  // pass 1
   phase_times_.peridynamics += seconds_since(start);
+  if (!travel_origin_.empty()) {  // where the nodes and list positions stay for the step
+    largest_travel_ = farthest_travel(*model_, state_, contact_, travel_origin_, list_origin_,
+                                      ghost_.empty() ? nullptr : ghost_.data());
+  }
+}
+
+void Simulation::set_travel_origin() {
+  travel_origin_ = state_.positions;
+  list_origin_ = list_positions();
+  largest_travel_ = 0;
+}
+
+std::vector<real> Simulation::list_positions() const {
+  std::vector<real> x(state_.positions.size());
+  const std::int64_t n = model_->node_count();
+#pragma omp parallel for schedule(static)
+  for (std::int64_t i = 0; i < n; ++i) {
+    const auto at = contact_.list_position(*model_, state_, static_cast<index_t>(i));
+    for (int k = 0; k < 3; ++k) x[3 * i + k] = at[k];
+  }
+  return x;
 }
 
 void Simulation::finish_step_after_breaks(std::span<const std::array<index_t, 2>> ghost_breaks) {

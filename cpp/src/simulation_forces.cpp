@@ -163,8 +163,9 @@ void Simulation::compute_forces() {
 }
 
 void Simulation::finish_forces(std::span<const std::array<index_t, 2>> ghost_breaks) {
+  const std::size_t own = breaks_.size();
   break_ghost_bonds(ghost_breaks);
-  contact_.bonds_broke(*model_, state_, breaks_);
+  contact_.bonds_broke(*model_, state_, std::span(breaks_).subspan(own));
   start_node_forces();
   add_bond_forces(state_.forces.data());  // pass 2
   broken_bond_copies_ += 2 * breaks_.size();
@@ -177,8 +178,9 @@ void Simulation::sum_dilatation_and_break_bonds() {
   // Pass 1: stretch, irreversible breaking, sum_j w r e at both ends. A bond breaks at the end
   // that evaluates it; its other copy is cleared below, before any loop reads it (when both
   // ends gather, both see bitwise the same stretch and each clears its own). The bonds broken
-  // are left in breaks_ for finish_forces. Ghost particles are skipped (set_ghost_particles):
-  // their breaks come from their owners.
+  // are left in breaks_ for finish_forces, and the anchors they change are taken anew here, so
+  // that a step's list positions are settled once it has begun. Ghost particles are skipped
+  // (set_ghost_particles): their breaks come from their owners.
   const Model& m = *model_;
   const auto& materials = m.materials();
   const auto& node_material = m.node_material();
@@ -227,6 +229,7 @@ void Simulation::sum_dilatation_and_break_bonds() {
     BondStates::clear(intact.node(j), bonds.find(i));
   }
   breaks_ = std::move(broken);
+  contact_.bonds_broke(m, state_, breaks_);
 }
 
 void Simulation::start_node_forces() {

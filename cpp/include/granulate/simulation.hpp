@@ -156,39 +156,32 @@ class Simulation {
   /// The stable time-step estimate [s] error messages quote (a distributed run's part quotes
   /// the whole run's, which its own grains and ghosts do not give); 0: its own.
   void set_reported_stable_time_step(real estimate) { reported_stable_time_step_ = estimate; }
-  /// From now on each step measures how far the farthest node (but the ghosts) is from where
-  /// it is now [m] (largest_travel), once the step has moved the nodes (its drift and
-  /// prescribed motion, in begin_step): a distributed run's check, before the step's contact,
-  /// that its ghosts still hold. With a finite `list_allowance` [m], a node whose list
-  /// position lies farther than that from it counts that much farther
-  /// (ContactModel::list_offset_excess). Off until called (a serial run measures nothing).
-  void set_travel_origin(real list_allowance = std::numeric_limits<real>::infinity()) {
-    travel_origin_ = state_.positions;
-    const bool within =
-        !std::isfinite(list_allowance) || contact_.list_offsets_within(*model_, list_allowance);
-    list_allowance_ = within ? std::numeric_limits<real>::infinity() : list_allowance;  // inf: none read
-    largest_travel_ = 0;
-  }
-  /// The largest distance of a node from the travel origin where the last step (begun or
-  /// finished) put the nodes [m] (0 before a step, or with no origin set).
+  /// From now on each step measures how far the farthest node (but the ghosts), or where the
+  /// contact lists see it (ContactModel::list_position), is from where it is now [m]
+  /// (largest_travel), once the step has moved the nodes and taken its bonds' breaks (its
+  /// drift, prescribed motion, pass 1 and the anchors its breaks change, in begin_step): a
+  /// distributed run's check, before the step's contact, that its ghosts and caps still hold.
+  /// Off until called (a serial run measures nothing).
+  void set_travel_origin();
+  /// The largest distance of a node, or of its list position, from the travel origin where
+  /// the last step (begun or finished) put them [m] (0 before a step, or with no origin set).
   real largest_travel() const { return largest_travel_; }
-  /// The largest length at rest of a node's list position off the node [m]
-  /// (ContactModel::largest_list_length): the allowance a distributed run's caps take.
-  real largest_list_length() const { return contact_.largest_list_length(*model_); }
+  /// Every node's list position now (ContactModel::list_position), n x 3 [m].
+  std::vector<real> list_positions() const;
   /// Whether a node's contact reads its bonded neighbours (ContactModel::reads_bonded_neighbours).
   bool contact_reads_bonded_neighbours() const { return contact_.reads_bonded_neighbours(); }
 
  private:
   // The phases of compute_forces, in order.
   /// Pass 1 of the bonds: each node's dilatation sum; bonds past their critical stretch break
-  /// (both copies), left in breaks_.
+  /// (both copies), left in breaks_, and contact is told of them (the anchors they change).
   void sum_dilatation_and_break_bonds();
   /// InputError unless every pair is an intact bond of a ghost particle.
   void check_ghost_breaks(std::span<const std::array<index_t, 2>> pairs) const;
   /// The ghosts' bonds their owners broke (both copies), appended to breaks_.
   void break_ghost_bonds(std::span<const std::array<index_t, 2>> pairs);
-  /// After pass 1 and the ghosts' breaks: contact told of breaks_, then the LPS pressures and
-  /// body forces, pass 2, contact forces and nodal loads.
+  /// After pass 1: the ghosts' breaks (contact told of them), then the LPS pressures and body
+  /// forces, pass 2, contact forces and nodal loads.
   void finish_forces(std::span<const std::array<index_t, 2>> ghost_breaks);
   /// The forces at the current state unless they are current (prescribed motion first).
   void evaluate_if_stale();
@@ -222,8 +215,8 @@ class Simulation {
   std::vector<index_t> reported_node_, reported_particle_;  // set_reported_numbers; or empty
   real reported_stable_time_step_ = 0;                      // set_reported_stable_time_step
   std::vector<real> travel_origin_;  // positions largest_travel is measured from; or empty
+  std::vector<real> list_origin_;    // and the list positions
   real largest_travel_ = 0;
-  real list_allowance_ = 0;  // how far off its node a list position may lie, for largest_travel
   std::vector<std::array<index_t, 2>> breaks_;  // the bonds pass 1 (and the owners) broke
   bool step_begun_ = false;                     // begin_step called, finish_step not yet
   std::uint64_t broken_bond_copies_ = 0;        // both copies of a broken bond count

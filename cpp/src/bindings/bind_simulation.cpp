@@ -188,16 +188,16 @@ void bind_loading(nb::class_<Simulation>& cls) {
       .def("set_reported_stable_time_step", &Simulation::set_reported_stable_time_step, "estimate"_a,
            "The stable time-step estimate [s] error messages quote; 0: the simulation's own.")
       .def("set_travel_origin", &Simulation::set_travel_origin,
-           "list_allowance"_a = std::numeric_limits<real>::infinity(),
-           "Measure each step how far the farthest node is from where it is now (largest_travel), a "
-           "node whose list position lies farther than list_allowance [m] off it counting that much "
-           "farther.")
+           "Measure each step how far the farthest node, or where the contact lists see it, is from "
+           "where it is now (largest_travel).")
       .def_prop_ro("largest_travel", &Simulation::largest_travel,
-                   "The largest distance of a node (but the ghosts) from the travel origin where the last "
-                   "step, begun or finished, put the nodes [m].")
-      .def_prop_ro("largest_list_length", &Simulation::largest_list_length,
-                   "The largest length at rest of a node's list position (surface point or contact "
-                   "centre) off the node [m]; 0 where every node is seen at itself.")
+                   "The largest distance of a node (but the ghosts), or of its list position, from the "
+                   "travel origin where the last step, begun or finished, put them [m].")
+      .def_prop_ro(
+          "list_positions", [](const Simulation& s) { return rows_out(s.list_positions(), 3); },
+          nb::rv_policy::move,
+          "Where the contact lists see each node now (its surface point or contact centre, or the node), "
+          "n x 3 [m].")
       .def_prop_ro("contact_reads_bonded_neighbours", &Simulation::contact_reads_bonded_neighbours,
                    "Whether a node's contact reads the nodes bonded to it (its anchors, its surface "
                    "normal), not the node alone.")

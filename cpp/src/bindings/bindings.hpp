@@ -32,6 +32,14 @@ nb::ndarray<nb::numpy, T> copy_out(const std::vector<T>& values) {
   return nb::ndarray<nb::numpy, T>(data->data(), {data->size()}, owner);
 }
 
+/// `values` handed to NumPy as rows of `columns`, without a copy.
+template <class T>
+nb::ndarray<nb::numpy, T> rows_out(std::vector<T>&& values, std::size_t columns) {
+  auto* data = new std::vector<T>(std::move(values));
+  nb::capsule owner(data, [](void* p) noexcept { delete static_cast<std::vector<T>*>(p); });
+  return nb::ndarray<nb::numpy, T>(data->data(), {data->size() / columns, columns}, owner);
+}
+
 inline std::vector<index_t> to_vector(const Indices& nodes) {
   return std::vector<index_t>(nodes.data(), nodes.data() + nodes.shape(0));
 }

@@ -244,14 +244,6 @@ class DistributedRun:
         self._centre_damped = np.setdiff1d(np.arange(len(self._slices)), walls)
 
     @property
-    def _cap_reach(self) -> float:
-        """How near a ghost node must be to one of the rank's own nodes to be in its caps [m]:
-        the cutoff, the cap margin and, for each of the two nodes, how far off it the lists
-        may see it (its surface point or contact centre: the largest length at rest over the
-        ranks, core.largest_list_length; a point stretched farther counts as travel)."""
-        return self._cutoff + self.cap_margin + 2 * self._list_allowance
-
-    @property
     def _reach(self) -> float:
         """How near a grain's bounding sphere must come to a rank's grains for it to be held
         there as a ghost [m]: the cutoff plus the margin."""
@@ -377,28 +369,29 @@ class DistributedRun:
 
     def _exchange_caps(self) -> None:
         """Which of the ghosts' nodes each step sends (the caps): of each ghost grain, the
-        nodes within the cutoff plus the cap margin (and twice how far off its node the lists
-        may see a node, _cap_reach) of one of this rank's own nodes, and the nodes bonded to
-        those where the contact reads them (a node's surface normal and anchors are its bonded
+        nodes whose list positions (where the contact lists see them: a surface point,
+        contact centre or the node, core.list_positions) lie within the cutoff plus the cap
+        margin of one of this rank's own nodes' list positions, and the nodes bonded to those
+        where the contact reads them (a node's surface normal and anchors are its bonded
         neighbours; PeriDEM's node pairs read neither: core.contact_reads_bonded_neighbours),
         and under PeriDEM's damping every ghost's centre node (the damping reads it). No
-        other ghost node can come within the cutoff of an own node, or of where one of them
-        is, before the caps are picked again (each moves less than cap_margin/2), so a ghost
-        node outside the cap stays where it was, out of every own node's contact, and out of
-        the contact lists (core.set_inert_contact_nodes). Each rank picks its caps from the
-        ghosts' positions now, which are their owners' (after _exchange_state or a rebuild),
-        and tells the owners; one message per neighbour. The nodes' travel is measured from
-        here (core.set_travel_origin)."""
+        other ghost node can come within the cutoff of an own node, as the lists see them,
+        before the caps are picked again (each node and list position moves less than
+        cap_margin/2: core.largest_travel), so a ghost node outside the cap stays where it
+        was, out of every own node's contact, and out of the contact lists
+        (core.set_inert_contact_nodes). Each rank picks its caps from the ghosts' positions
+        now, which are their owners' (after _exchange_state or a rebuild), and tells the
+        owners; one message per neighbour. The travel is measured from here
+        (core.set_travel_origin)."""
         core = self.local.core
-        mine = np.array([core.largest_list_length, core.contact_reads_bonded_neighbours])
-        most = np.empty(2)
-        self.comm.Allreduce(mine, most, op=self.mpi.MAX)  # the same caps' rules on every rank
-        self._list_allowance, neighbours = float(most[0]), bool(most[1])
-        core.set_travel_origin(self._list_allowance)
-        x = core.positions
+        reads = core.contact_reads_bonded_neighbours
+        neighbours = self.comm.allreduce(reads, op=self.mpi.LOR)  # the same rules everywhere
+        core.set_travel_origin()
+        x = core.list_positions
         ghosts = np.concatenate([np.zeros(0, np.int64), *self._receive_whole.values()])
         close = np.zeros(len(x), dtype=bool)  # one grid over the own nodes for every ghost
-        close[ghosts] = points_within(x[ghosts], x[self._owned_nodes], self._cap_reach)
+        reach = self._cutoff + self.cap_margin
+        close[ghosts] = points_within(x[ghosts], x[self._owned_nodes], reach)
         caps = {}
         for q, nodes in self._receive_whole.items():
             near = nodes[close[nodes]]

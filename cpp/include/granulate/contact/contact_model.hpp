@@ -236,23 +236,11 @@ class ContactModel {
   /// (first_surface_overlap).
   std::array<index_t, 2> first_overlap(const Model& model, const State& state, real fraction);
 
-  /// How much farther than `allowance` [m] node i's list position (where the lists see it)
-  /// lies from the node [m]; 0 within it, and for a node seen at itself. Under the surface law
-  /// the point lies at most its length at rest out (its fade is at most 1), so its position is
-  /// read only where that length exceeds the allowance; the linear form stretches with the
-  /// node's anchors and is read always. For a distributed run's caps, which allow each node's
-  /// list position that far off it.
-  real list_offset_excess(const Model& model, const State& state, index_t i, real allowance) const;
-  /// The largest length at rest of a node's list position off the node [m] (the surface
-  /// point's depth under the surface law, else the contact centre's; 0 where every node is
-  /// seen at itself, or before the first evaluation finds the points).
-  real largest_list_length(const Model& model) const;
-  /// Whether every node's list position stays within `allowance` [m] of the node whatever
-  /// the nodes do: under the surface law a point lies at most its length at rest out, so when
-  /// no particle has the linear form and no length at rest exceeds the allowance
-  /// (list_offset_excess is then 0 everywhere).
-  bool list_offsets_within(const Model& model, real allowance) const {
-    return centres_.found() && !centres_.any_linear() && largest_list_length(model) <= allowance;
+  /// Where the lists see node i now (SurfaceCentres::at_list: its surface point under the
+  /// surface law, else its contact centre; the node itself for a node seen at itself, and
+  /// before the first evaluation finds the points) [m].
+  vec3 list_position(const Model& model, const State& state, index_t i) const {
+    return centres_.at_list(model, state, i);
   }
   /// Whether the contact of a node reads the positions of the nodes bonded to it: a node seen
   /// at its anchors (a surface point or contact centre) reads them, and so does the surface
