@@ -118,9 +118,11 @@ def test_a_ghost_grain_needs_only_its_owners_cap_motion_and_breaks(
 ) -> None:
     """A rank skips its ghosts' bonds and moves (core.set_ghost_particles): between the halves
     of a step (core.begin_step, finish_step) their owners give them the positions and
-    velocities of their nodes within reach of the rank's own (the cap: within the lists'
-    cutoff plus twice the mesh size, by which a contact centre may lie off its node, and the
-    nodes bonded to those), the breaks, and the motion of each of their bodies
+    velocities of their nodes within reach of the rank's own (the cap: those whose list
+    positions lie within the lists' cutoff of an own node's, the nodes their anchored vectors
+    read, and the nodes bonded to those within the reach at which the contact reads surface
+    normals, as DistributedRun._exchange_caps takes them), the breaks, and the motion of each
+    of their bodies
     (core.fragment_motions, core.give_ghost_motions). The tumbling drum run twice, once with
     grain 1 a ghost given that within each step (node spheres, and the surface law with rolling
     resistance), its other nodes a little off (1e-9 of their positions and velocities, so that
@@ -138,16 +140,21 @@ def test_a_ghost_grain_needs_only_its_owners_cap_motion_and_breaks(
     ghost = part.bodies[1].node_slice
     others = np.ones(part.core.positions.shape[0], dtype=bool)
     others[ghost] = False
-    reach = part.core.contact_reach + 2 * max(body.mesh_size for body in part.bodies)
+    reach, normal_reach = part.core.contact_reach, part.core.contact_surface_normal_reach
     differed, given, left_out = 0, 0, 0
     for _ in range(900):
         broken = np.asarray(whole.core.begin_step()).reshape(-1, 2)
         own = np.asarray(part.core.begin_step()).reshape(-1, 2)
         in_ghost = (broken[:, 0] >= ghost.start) & (broken[:, 0] < ghost.stop)
         assert sorted(map(tuple, own)) == sorted(map(tuple, broken[~in_ghost]))
-        x = whole.core.positions
+        x = whole.core.list_positions  # where the lists see the nodes: what the caps go by
         near = ghost.start + np.flatnonzero(within_reach(x[ghost], x[others], reach))
-        cap = np.union1d(near, part.model.bond_partners(near.tolist())).astype(np.int64)
+        normal = near[within_reach(x[near], x[others], normal_reach)]
+        read = (
+            part.core.anchor_candidates(near.tolist()),
+            part.model.bond_partners(normal.tolist()),
+        )
+        cap = np.unique(np.concatenate([near, *(np.asarray(r, np.int64) for r in read)]))
         rest = np.setdiff1d(np.arange(ghost.start, ghost.stop), cap)
         left_out += len(rest)
         for field in ("positions", "velocities"):  # as the ranks' exchange within the step
@@ -291,11 +298,12 @@ def test_the_core_measures_how_far_the_nodes_and_list_positions_travelled(
 ) -> None:
     """core.largest_travel (a rank's check that its ghosts and caps still hold): once a step
     has moved the nodes (begin_step, before its contact), the largest distance of a node, or
-    of where the contact lists see it (core.list_positions: the grid square's surface nodes'
-    contact centres inside them, surface points under the surface law), from where it was at
-    set_travel_origin [m], as NumPy finds it; 0 before the first step and with no origin set.
-    The list positions are where a search lists the nodes (the lists keep them in single
-    precision: 1e-8 m at these coordinates)."""
+    of where the contact lists see a node watched (core.list_positions: the grid square's
+    surface nodes' contact centres inside them, surface points under the surface law), from
+    where it was at set_travel_origin [m], as NumPy finds it; 0 before the first step and with
+    no origin set. The list positions are where a search lists the nodes (the lists keep them
+    in single precision: 1e-8 m at these coordinates). The nodes watched are the grid square's
+    (the fourth grain); a node that does not exist is refused."""
     sim = tumbling_drum(tmp_path, grid=True, law=law)
     sim.core.run(100)
     assert sim.core.largest_travel == 0.0
@@ -303,23 +311,49 @@ def test_the_core_measures_how_far_the_nodes_and_list_positions_travelled(
     listed = np.asarray(sim.core.checkpoint()["contact_positions_at_build"]).reshape(-1, 3)
     assert np.abs(sim.core.list_positions - listed).max() < 1e-8
     assert farthest(sim.core.list_positions, sim.core.positions) > 0.1e-3  # centres off nodes
-    origin, list_origin = sim.core.positions.copy(), sim.core.list_positions
-    sim.core.set_travel_origin()
+    square = sim.bodies[3].node_slice
+    with pytest.raises(gr.InputError, match="node 100000 is not one of this process's nodes"):
+        sim.core.set_travel_origin([0, 100_000])
+    origin, list_origin = sim.core.positions.copy(), sim.core.list_positions[square]
+    sim.core.set_travel_origin(list(range(square.start, square.stop)))
     assert sim.core.largest_travel == 0.0
+
+    def moved() -> float:
+        listed = farthest(sim.core.list_positions[square], list_origin)
+        return max(farthest(sim.core.positions, origin), listed)
+
     for _ in range(4):
         sim.core.run(40)
-        moved = max(
-            farthest(sim.core.positions, origin), farthest(sim.core.list_positions, list_origin)
-        )
-        assert sim.core.largest_travel == pytest.approx(moved, rel=1e-14)
+        assert sim.core.largest_travel == pytest.approx(moved(), rel=1e-14)
         sim.core.begin_step()
-        moved = max(
-            farthest(sim.core.positions, origin), farthest(sim.core.list_positions, list_origin)
-        )
-        assert sim.core.largest_travel == pytest.approx(moved, rel=1e-14)
+        now = moved()
+        assert sim.core.largest_travel == pytest.approx(now, rel=1e-14)
         sim.core.finish_step(np.zeros((0, 2), np.uint32))
-        assert sim.core.largest_travel == pytest.approx(moved, rel=1e-14)
+        assert sim.core.largest_travel == pytest.approx(now, rel=1e-14)
     assert sim.core.largest_travel > 1e-4  # the grains fall and tumble
+
+
+@pytest.mark.parametrize("watch", [True, False])
+def test_a_turned_grains_surface_points_travel_farther_than_its_nodes(
+    tmp_path: Path, watch: bool
+) -> None:
+    """A disc turned by 0.2 rad about its centre under the surface law: its outer nodes'
+    surface points lie on its circle, outside them, so they move farther than any node, and
+    core.largest_travel is theirs when its nodes are watched, the nodes' when they are not
+    (rel 1e-12)."""
+    sim = tumbling_drum(tmp_path, law="surface")
+    sim.core.run(0)
+    disc = sim.bodies[0].node_slice
+    y, listed = sim.core.positions.copy(), sim.core.list_positions[disc]
+    sim.core.set_travel_origin(list(range(disc.start, disc.stop)) if watch else [])
+    centre = y[disc].mean(axis=0)
+    turn = np.array([[np.cos(0.2), -np.sin(0.2), 0], [np.sin(0.2), np.cos(0.2), 0], [0, 0, 1]])
+    sim.core.positions[disc] = centre + (y[disc] - centre) @ turn.T
+    sim.core.begin_step()  # and the drift
+    nodes = farthest(sim.core.positions, y)
+    points = farthest(sim.core.list_positions[disc], listed)
+    assert points > 1.02 * nodes
+    assert sim.core.largest_travel == pytest.approx(points if watch else nodes, rel=1e-12)
 
 
 def test_a_steps_list_positions_are_settled_when_it_begins(tmp_path: Path) -> None:

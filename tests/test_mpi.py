@@ -117,7 +117,7 @@ def test_ghosts_exchanged_as_caps_keep_the_serial_run_bit_for_bit() -> None:
 
 def test_caps_without_bonded_neighbours_under_peridems_node_pairs_keep_the_serial_run() -> None:
     """The fine discs under PeriDEM's node-pair law, whose contact reads a ghost node alone
-    (no surface normal, no anchors: core.contact_reads_bonded_neighbours), on 3 ranks with the
+    (no surface normal, no anchors: core.contact_surface_normal_reach 0), on 3 ranks with the
     default cap margin (half a mesh size, widened as the discs fly): the caps are the nodes
     within reach, without the horizon of bonded neighbours, so each step sends about a tenth
     of the ghost nodes held (a fifth with the neighbours). Every node ends as in the

@@ -55,12 +55,14 @@ void ContactModel::configure(const Model& model) {
   opened_rest_.clear();
 }
 
-bool ContactModel::reads_bonded_neighbours() const {
-  if (!centres_.found() || centres_.any()) return true;
+real ContactModel::surface_normal_reach(const Model& model) const {
+  bool spheres = false, surface = false;  // some law's sphere pairs anywhere / under the surface law
   for (std::size_t k = 0; k < laws_.size(); ++k) {
-    if (law_set_[k] && !laws_[k].node_pair) return true;
+    if (!law_set_[k] || laws_[k].node_pair) continue;
+    (laws_[k].surface ? surface : spheres) = true;
   }
-  return false;
+  if (spheres) return largest_pair_reach(model) + list_skin();
+  return surface ? max_contact_radius_ + list_skin() : 0;
 }
 
 bool ContactModel::centres_particle(const Model& model, index_t p) const {

@@ -72,25 +72,31 @@ std::int64_t second_half_kick(const Model& m, State& state, real dt, const std::
 }
 
 /// The largest distance of a node (but the ghosts', which `ghost` flags per particle; null:
-/// none), or of its list position (ContactModel::list_position), from its place in `origin`
-/// (`list_origin`) [m].
+/// none) from its place in `origin`, and of the list position of each node in `watched`
+/// (ContactModel::list_position) from its row in `list_origin` [m].
 real farthest_travel(const Model& m, const State& state, const ContactModel& contact,
-                     const std::vector<real>& origin, const std::vector<real>& list_origin,
-                     const std::uint8_t* ghost) {
-  const std::int64_t n = m.node_count();
+                     const std::vector<real>& origin, std::span<const index_t> watched,
+                     const std::vector<real>& list_origin, const std::uint8_t* ghost) {
+  const std::int64_t n = m.node_count(), listed = static_cast<std::int64_t>(watched.size());
   const auto& node_particle = m.node_particle();
-  const auto& x = state.positions;
   auto squared = [](const real* a, const real* b) {
     const real dx = a[0] - b[0], dy = a[1] - b[1], dz = a[2] - b[2];
     return dx * dx + dy * dy + dz * dz;
   };
+  const real* x = state.positions.data();
   real farthest = 0;  // squared
-#pragma omp parallel for schedule(static) reduction(max : farthest)
-  for (std::int64_t i = 0; i < n; ++i) {
-    if (ghost && ghost[node_particle[i]]) continue;
-    const auto seen = contact.list_position(m, state, static_cast<index_t>(i));
-    farthest =
-        std::max({farthest, squared(&x[3 * i], &origin[3 * i]), squared(seen.data(), &list_origin[3 * i])});
+#pragma omp parallel
+  {
+#pragma omp for schedule(static) reduction(max : farthest)
+    for (std::int64_t i = 0; i < n; ++i) {
+      if (!ghost || !ghost[node_particle[i]])
+        farthest = std::max(farthest, squared(&x[3 * i], &origin[3 * i]));
+    }
+#pragma omp for schedule(static) reduction(max : farthest)
+    for (std::int64_t k = 0; k < listed; ++k) {
+      const auto seen = contact.list_position(m, state, watched[k]);
+      farthest = std::max(farthest, squared(seen.data(), &list_origin[3 * k]));
+    }
   }
   return std::sqrt(farthest);
 }
@@ -277,15 +283,37 @@ void Simulation::move_and_break_bonds() {
   sum_dilatation_and_break_bonds();  // pass 1
   phase_times_.peridynamics += seconds_since(start);
   if (!travel_origin_.empty()) {  // where the nodes and list positions stay for the step
-    largest_travel_ = farthest_travel(*model_, state_, contact_, travel_origin_, list_origin_,
+    largest_travel_ = farthest_travel(*model_, state_, contact_, travel_origin_, list_watched_, list_origin_,
                                       ghost_.empty() ? nullptr : ghost_.data());
   }
 }
 
-void Simulation::set_travel_origin() {
+void Simulation::set_travel_origin(std::vector<index_t> watched) {
+  for (const index_t i : watched) {
+    if (i >= model_->node_count() || (!ghost_.empty() && ghost_node(i))) {
+      throw InputError("set_travel_origin: node " + std::to_string(i) +
+                       " is not one of this process's nodes");
+    }
+  }
   travel_origin_ = state_.positions;
-  list_origin_ = list_positions();
+  list_watched_ = std::move(watched);
+  list_origin_.resize(3 * list_watched_.size());
+  for (std::size_t k = 0; k < list_watched_.size(); ++k) {
+    const auto at = contact_.list_position(*model_, state_, list_watched_[k]);
+    std::copy(at.begin(), at.end(), list_origin_.begin() + 3 * static_cast<std::ptrdiff_t>(k));
+  }
   largest_travel_ = 0;
+}
+
+std::vector<index_t> Simulation::anchor_candidates(const std::vector<index_t>& nodes) const {
+  std::vector<index_t> found;
+  for (const index_t i : nodes) {
+    if (i >= model_->node_count()) throw InputError("anchor_candidates: no node " + std::to_string(i));
+    contact_.anchor_candidates(*model_, state_, i, found);
+  }
+  std::sort(found.begin(), found.end());
+  found.erase(std::unique(found.begin(), found.end()), found.end());
+  return found;
 }
 
 std::vector<real> Simulation::list_positions() const {

@@ -55,6 +55,37 @@ bool SurfaceCentres::anchor_bond_broken(const Model& model, const State& state, 
   return false;
 }
 
+std::vector<index_t> SurfaceCentres::bonded_within_reach(const Model& model, const State& state, index_t i) {
+  const std::vector<real>& x = model.reference_positions();
+  const real radius = anchor_reach * model.particles()[model.node_particle()[i]].mesh_size;
+  const NodeBonds bonds = model.node_bonds(i);
+  std::vector<std::pair<real, index_t>> near;
+  for (index_t b = 0; b < bonds.count; ++b) {
+    if (!state.bonds.intact(i, b)) continue;
+    const index_t j = bonds.neighbor(b);
+    real r2 = 0;
+    for (int c = 0; c < 3; ++c) r2 += (x[3 * j + c] - x[3 * i + c]) * (x[3 * j + c] - x[3 * i + c]);
+    if (r2 <= radius * radius) near.push_back({r2, j});
+  }
+  std::sort(near.begin(), near.end());
+  std::vector<index_t> nodes;
+  for (const auto& entry : near) nodes.push_back(entry.second);
+  return nodes;
+}
+
+void SurfaceCentres::anchor_candidates(const Model& model, const State& state, index_t i,
+                                       std::vector<index_t>& out) const {
+  const SurfaceAnchor* a = anchor(model, i);
+  if (a == nullptr) return;
+  const index_t first = model.particles()[model.node_particle()[i]].first_node;
+  for (const index_t k : a->nodes) {
+    if (k != SurfaceAnchor::no_anchor) out.push_back(first + k);
+  }
+  if (!anchor_slot_.empty() && surface_[model.node_particle()[i]]) {  // reanchor may take these
+    for (const index_t j : bonded_within_reach(model, state, i)) out.push_back(j);
+  }
+}
+
 bool SurfaceCentres::reanchor(const Model& model, const State& state, index_t i) {
   // The same anchored vector in the reference, A_0 = sum_k w_k (X_k - X_i) of the shape's
   // anchors, from all the intact bonds within 1.75 h, nearest first (ties by index). A function
@@ -73,19 +104,7 @@ bool SurfaceCentres::reanchor(const Model& model, const State& state, index_t i)
   reference.anchor = primary;
   reference.first = particle.first_node;
   const vec3 target = anchored_vector(reference, x, i);
-  const real radius = 1.75 * particle.mesh_size;
-  const NodeBonds bonds = model.node_bonds(i);
-  std::vector<std::pair<real, index_t>> near;
-  for (index_t b = 0; b < bonds.count; ++b) {
-    if (!state.bonds.intact(i, b)) continue;
-    const index_t j = bonds.neighbor(b);
-    real r2 = 0;
-    for (int c = 0; c < 3; ++c) r2 += (x[3 * j + c] - x[3 * i + c]) * (x[3 * j + c] - x[3 * i + c]);
-    if (r2 <= radius * radius) near.push_back({r2, j});
-  }
-  std::sort(near.begin(), near.end());
-  std::vector<index_t> candidates;
-  for (const auto& entry : near) candidates.push_back(entry.second);
+  const std::vector<index_t> candidates = bonded_within_reach(model, state, i);
   SurfaceAnchor anchor = *primary;
   if (!span_anchors(x, i, candidates, target, model.dimension(), particle.first_node, anchor)) {
     detach(i);

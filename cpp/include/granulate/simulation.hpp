@@ -157,19 +157,26 @@ class Simulation {
   /// the whole run's, which its own grains and ghosts do not give); 0: its own.
   void set_reported_stable_time_step(real estimate) { reported_stable_time_step_ = estimate; }
   /// From now on each step measures how far the farthest node (but the ghosts), or where the
-  /// contact lists see it (ContactModel::list_position), is from where it is now [m]
-  /// (largest_travel), once the step has moved the nodes and taken its bonds' breaks (its
-  /// drift, prescribed motion, pass 1 and the anchors its breaks change, in begin_step): a
-  /// distributed run's check, before the step's contact, that its ghosts and caps still hold.
-  /// Off until called (a serial run measures nothing).
-  void set_travel_origin();
-  /// The largest distance of a node, or of its list position, from the travel origin where
+  /// contact lists see one of the nodes `watched` (ContactModel::list_position), is from where
+  /// it is now [m] (largest_travel), once the step has moved the nodes and taken its bonds'
+  /// breaks (its drift, prescribed motion, pass 1 and the anchors its breaks change, in
+  /// begin_step): a distributed run's check, before the step's contact, that its ghosts and
+  /// caps still hold (it watches the nodes of the grains other ranks hold as ghosts). Off until
+  /// called (a serial run measures nothing). InputError for a ghost's node or one that does not
+  /// exist.
+  void set_travel_origin(std::vector<index_t> watched);
+  /// The largest distance of a node, or of a watched node's list position, from the travel origin where
   /// the last step (begun or finished) put them [m] (0 before a step, or with no origin set).
   real largest_travel() const { return largest_travel_; }
   /// Every node's list position now (ContactModel::list_position), n x 3 [m].
   std::vector<real> list_positions() const;
-  /// Whether a node's contact reads its bonded neighbours (ContactModel::reads_bonded_neighbours).
-  bool contact_reads_bonded_neighbours() const { return contact_.reads_bonded_neighbours(); }
+  /// How near two nodes of different bodies must come, as the lists see them, before their
+  /// contact reads their surface normals, sums over their bonds [m]
+  /// (ContactModel::surface_normal_reach; 0: never).
+  real contact_surface_normal_reach() const { return contact_.surface_normal_reach(*model_); }
+  /// The nodes whose positions the anchored vectors of `nodes` read, now or after bonds break
+  /// (ContactModel::anchor_candidates), sorted, each once.
+  std::vector<index_t> anchor_candidates(const std::vector<index_t>& nodes) const;
 
  private:
   // The phases of compute_forces, in order.
@@ -214,8 +221,9 @@ class Simulation {
                                      // empty when none is
   std::vector<index_t> reported_node_, reported_particle_;  // set_reported_numbers; or empty
   real reported_stable_time_step_ = 0;                      // set_reported_stable_time_step
-  std::vector<real> travel_origin_;  // positions largest_travel is measured from; or empty
-  std::vector<real> list_origin_;    // and the list positions
+  std::vector<real> travel_origin_;    // positions largest_travel is measured from; or empty
+  std::vector<index_t> list_watched_;  // the nodes whose list positions it is measured for
+  std::vector<real> list_origin_;      // and where they were (3 per watched node)
   real largest_travel_ = 0;
   std::vector<std::array<index_t, 2>> breaks_;  // the bonds pass 1 (and the owners) broke
   bool step_begun_ = false;                     // begin_step called, finish_step not yet

@@ -187,20 +187,29 @@ void bind_loading(nb::class_<Simulation>& cls) {
            "The node and particle numbers error messages give (Simulation::set_reported_numbers).")
       .def("set_reported_stable_time_step", &Simulation::set_reported_stable_time_step, "estimate"_a,
            "The stable time-step estimate [s] error messages quote; 0: the simulation's own.")
-      .def("set_travel_origin", &Simulation::set_travel_origin,
-           "Measure each step how far the farthest node, or where the contact lists see it, is from "
-           "where it is now (largest_travel).")
-      .def_prop_ro("largest_travel", &Simulation::largest_travel,
-                   "The largest distance of a node (but the ghosts), or of its list position, from the "
-                   "travel origin where the last step, begun or finished, put them [m].")
+      .def("set_travel_origin", &Simulation::set_travel_origin, "watched"_a,
+           "Measure each step how far the farthest node, or where the contact lists see one of the "
+           "nodes watched, is from where it is now (largest_travel).")
+      .def_prop_ro(
+          "largest_travel", &Simulation::largest_travel,
+          "The largest distance of a node (but the ghosts), or of a watched node's list position, from the "
+          "travel origin where the last step, begun or finished, put them [m].")
       .def_prop_ro(
           "list_positions", [](const Simulation& s) { return rows_out(s.list_positions(), 3); },
           nb::rv_policy::move,
           "Where the contact lists see each node now (its surface point or contact centre, or the node), "
           "n x 3 [m].")
-      .def_prop_ro("contact_reads_bonded_neighbours", &Simulation::contact_reads_bonded_neighbours,
-                   "Whether a node's contact reads the nodes bonded to it (its anchors, its surface "
-                   "normal), not the node alone.")
+      .def_prop_ro("contact_surface_normal_reach", &Simulation::contact_surface_normal_reach,
+                   "How near two nodes of different bodies must come, as the lists see them, before "
+                   "their contact reads their surface normals (sums over their bonds) [m]; 0: never.")
+      .def(
+          "anchor_candidates",
+          [](const Simulation& s, const std::vector<index_t>& nodes) {
+            return copy_out(s.anchor_candidates(nodes));
+          },
+          "nodes"_a,
+          "The nodes whose positions these nodes' anchored vectors read, now or after bonds break "
+          "(sorted, each once).")
       .def("search_contacts", &Simulation::search_contacts,
            "List every node's contact partners again now, carrying collisions and friction springs over.")
       .def(

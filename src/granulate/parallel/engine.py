@@ -351,6 +351,10 @@ class DistributedRun:
             q: self._nodes_of(g, node_map) for q, g in self._receive_grains.items()
         }
         self._sent_to = {q: _mask(len(self._to_global), n) for q, n in self._send_whole.items()}
+        # The own nodes near another rank's (those of the grains it holds as ghosts): where the
+        # lists see them is what the caps' check watches (_exchange_caps).
+        sent = np.concatenate([np.zeros(0, np.int64), *self._send_whole.values()])
+        self._watched = np.unique(sent).tolist()
         particles = {q: np.searchsorted(self.held, g) for q, g in self._send_grains.items()}
         self._motion_particles = np.unique(
             np.concatenate([np.zeros(0, np.int64), *particles.values()])
@@ -371,32 +375,41 @@ class DistributedRun:
         """Which of the ghosts' nodes each step sends (the caps): of each ghost grain, the
         nodes whose list positions (where the contact lists see them: a surface point,
         contact centre or the node, core.list_positions) lie within the cutoff plus the cap
-        margin of one of this rank's own nodes' list positions, and the nodes bonded to those
-        where the contact reads them (a node's surface normal and anchors are its bonded
-        neighbours; PeriDEM's node pairs read neither: core.contact_reads_bonded_neighbours),
-        and under PeriDEM's damping every ghost's centre node (the damping reads it). No
-        other ghost node can come within the cutoff of an own node, as the lists see them,
-        before the caps are picked again (each node and list position moves less than
-        cap_margin/2: core.largest_travel), so a ghost node outside the cap stays where it
-        was, out of every own node's contact, and out of the contact lists
-        (core.set_inert_contact_nodes). Each rank picks its caps from the ghosts' positions
-        now, which are their owners' (after _exchange_state or a rebuild), and tells the
-        owners; one message per neighbour. The travel is measured from here
+        margin of one of this rank's own nodes' list positions, and the nodes those read:
+        their anchors and the neighbours they may take as anchors when bonds break
+        (core.anchor_candidates), and, for those within the reach at which the contact reads
+        surface normals (sums over a node's bonds: core.contact_surface_normal_reach, none
+        under PeriDEM's node pairs) plus the cap margin, every node bonded to them; under
+        PeriDEM's damping also every ghost's centre node (the damping reads it). No other
+        ghost node can come within those reaches of an own node, as the lists see them,
+        before the caps are picked again (each node, and each list position of a grain
+        another rank holds, moves less than cap_margin/2: core.largest_travel), so a ghost
+        node outside the cap is read by no own node's contact, and stays out of the contact
+        lists (core.set_inert_contact_nodes). Each rank picks its caps from the ghosts'
+        positions now, which are their owners' (after _exchange_state or a rebuild), and
+        tells the owners; one message per neighbour. The travel is measured from here
         (core.set_travel_origin)."""
         core = self.local.core
-        reads = core.contact_reads_bonded_neighbours
-        neighbours = self.comm.allreduce(reads, op=self.mpi.LOR)  # the same rules everywhere
-        core.set_travel_origin()
+        normal_reach = self.comm.allreduce(core.contact_surface_normal_reach, op=self.mpi.MAX)
+        core.set_travel_origin(self._watched)
         x = core.list_positions
+        own = x[self._owned_nodes]
         ghosts = np.concatenate([np.zeros(0, np.int64), *self._receive_whole.values()])
         close = np.zeros(len(x), dtype=bool)  # one grid over the own nodes for every ghost
-        reach = self._cutoff + self.cap_margin
-        close[ghosts] = points_within(x[ghosts], x[self._owned_nodes], reach)
+        close[ghosts] = points_within(x[ghosts], own, self._cutoff + self.cap_margin)
+        normals = np.zeros(len(x), dtype=bool)  # nodes whose surface normal may be read
+        if normal_reach > 0:
+            near = ghosts[close[ghosts]]
+            normals[near] = points_within(x[near], own, normal_reach + self.cap_margin)
         caps = {}
         for q, nodes in self._receive_whole.items():
             near = nodes[close[nodes]]
-            partners = self.local.model.bond_partners(near.tolist()) if neighbours else []
-            caps[q] = np.union1d(near, np.asarray(partners, dtype=np.int64))
+            read = (
+                near,
+                core.anchor_candidates(near.tolist()),
+                self.local.model.bond_partners(near[normals[near]].tolist()),
+            )
+            caps[q] = np.unique(np.concatenate([np.asarray(r, dtype=np.int64) for r in read]))
             if self._damped_centres is not None:  # PeriDEM's damping reads ghosts' centres
                 centres = self._node_map[self._damped_centres[self._receive_grains[q]]]
                 caps[q] = np.union1d(caps[q], centres)

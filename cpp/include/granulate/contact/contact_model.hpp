@@ -242,11 +242,18 @@ class ContactModel {
   vec3 list_position(const Model& model, const State& state, index_t i) const {
     return centres_.at_list(model, state, i);
   }
-  /// Whether the contact of a node reads the positions of the nodes bonded to it: a node seen
-  /// at its anchors (a surface point or contact centre) reads them, and so does the surface
-  /// normal of a node touching another body's under any law but PeriDEM's node pairs (true
-  /// before the first evaluation finds the points). Else it reads the node alone.
-  bool reads_bonded_neighbours() const;
+  /// How near two nodes of different bodies must come [m], as the lists see them (list
+  /// positions, the skin included), before their contact reads their surface normals (each
+  /// a sum over the node's intact bonds, pair_surface_normal): the sphere pairs of every law
+  /// but PeriDEM's node pairs; under the surface law only those of two nodes seen at
+  /// themselves, within Rc. 0 where no law reads them. The bonded neighbours a distributed
+  /// run's caps must hold for a node that near.
+  real surface_normal_reach(const Model& model) const;
+  /// The nodes whose positions node i's anchored vector reads, now or after its bonds break
+  /// (SurfaceCentres::anchor_candidates), appended to `out`.
+  void anchor_candidates(const Model& model, const State& state, index_t i, std::vector<index_t>& out) const {
+    centres_.anchor_candidates(model, state, i, out);
+  }
 
   ContactCheckpoint checkpoint() const;
   /// Restores a checkpoint taken with the same model, laws and walls; `state` is the restored

@@ -73,6 +73,11 @@ class SurfaceCentres {
   std::vector<index_t> detach_anchored(const Model& model, const State& state,
                                        std::span<const std::array<index_t, 2>> pairs);
 
+  /// The nodes whose positions node i's anchored vector reads, now or after bonds break, appended
+  /// to `out`: its anchors and, under the surface law, its neighbours within 1.75 h still bonded
+  /// to it (those it may take as anchors: bonds only break); none for a node seen at itself.
+  void anchor_candidates(const Model& model, const State& state, index_t i, std::vector<index_t>& out) const;
+
   /// Whether node i is seen away from itself (it has anchors): a cheap test for the hot loops.
   bool moved(index_t i) const { return any_ && anchored_[i]; }
   /// The anchors of node i if it carries a surface point (its particle's nodes are centred and
@@ -155,6 +160,11 @@ class SurfaceCentres {
   /// Node i's anchors from the bonds it still has (see above), or detached if none span (or
   /// outside the surface law): returns whether it keeps anchors.
   bool reanchor(const Model& model, const State& state, index_t i);
+  /// Node i's neighbours within anchor_reach h still bonded to it, nearest first (ties by
+  /// index): those reanchor chooses from.
+  static std::vector<index_t> bonded_within_reach(const Model& model, const State& state, index_t i);
+  /// How near a node's new anchors lie, in mesh sizes (reference distance).
+  static constexpr real anchor_reach = 1.75;
   /// Whether one of the bonds of node i to the anchors `a` has broken.
   static bool anchor_bond_broken(const Model& model, const State& state, index_t i, const SurfaceAnchor& a);
   /// Whether every surface point of the shape has a curvature radius within the round bounds.
