@@ -269,16 +269,17 @@ def lps_node_steps_per_second(steps: int = 30) -> float:
 #: Cap depths at R/h = 6 (h = R/6, horizon 3 h, the cutoff the reach): as the engine picked them
 #: before its check within the step (the cutoff, a cap margin of at least 4 h, 2 h for the
 #: surface points' offset, and the bonded neighbours a horizon deeper, taken here as depth),
-#: the whole of a near ghost; as it picks them now under the surface law for grains at rest or
-#: loaded slowly (the default cap margin h/2, which widens only where the caps last under 50
-#: steps; the points' offset about h each); the same without the bonded neighbours (their
-#: anchored vectors sent instead); as it picks them now under PeriDEM's node pairs (no offset,
-#: no neighbours: the contact reads the node alone); the cutoff alone (caps picked by the
-#: owners every step: no cap margin).
+#: the whole of a near ghost; as it picked them in session 45 under the surface law for grains
+#: at rest or loaded slowly (the default cap margin h/2, which widens only where the caps last
+#: under 50 steps; the points' offset about h each; the neighbours); as it picks them now under
+#: the surface law (caps by list positions, so no offset; of the neighbours only those a node's
+#: anchors may be, within 1.75 h; the whole horizon of the nodes within Rc of a contact, a patch
+#: this model leaves out); under PeriDEM's node pairs (the contact reads the node alone); the
+#: cutoff alone (caps picked by the owners every step: no cap margin).
 CAP_LAYERS = (
     ("before", lambda reach, h: reach + 4 * h + 2 * h + 3 * h),
-    ("surface law", lambda reach, h: reach + 0.5 * h + 2 * h + 3 * h),
-    ("no neighbours", lambda reach, h: reach + 0.5 * h + 2 * h),
+    ("session 45", lambda reach, h: reach + 0.5 * h + 2 * h + 3 * h),
+    ("surface law", lambda reach, h: reach + 0.5 * h + 1.75 * h),
     ("node pairs", lambda reach, h: reach + 0.5 * h),
     ("cutoff only", lambda reach, h: reach),
 )

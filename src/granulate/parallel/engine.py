@@ -15,10 +15,11 @@ grains move bit for bit as in the serial run, for any number of ranks (tests/tes
 
 The ghost sets hold while no node has moved more than half the margin from where it was when
 the grains were last distributed, since then no pair left out can come within the cutoff; the
-caps, while none has moved half the cap margin since they were picked. The run checks both
-every step: past a quarter of the cap margin the ranks pick the caps anew, past a quarter of
-the margin they cut the grains anew where they are (which also rebalances) and hand grains over
-with their whole state (transplant.py).
+caps, while no node, nor where the lists see a node near another rank's, has moved half the
+cap margin since they were picked. The run checks both every step: within the step, past half
+the cap margin, the ranks pick the caps anew; after it, past a quarter of the margin, they cut
+the grains anew where they are (which also rebalances) and hand grains over with their whole
+state (transplant.py).
 Wall reactions are summed on rank 0 in the serial order. `collect` gathers every grain's state
 and the last evaluation into rank 0's simulation (whole_state.py), whose serial writers, stop
 criteria and checkpoints then see the serial run (Simulation(comm=...) runs through
@@ -88,8 +89,9 @@ class DistributedRun:
     travel). A margin given is kept.
 
     ``cap_margin`` [m]: the same for the caps, the ghost nodes whose positions and velocities
-    travel in each step (_exchange_caps); at most the margin. The caps hold while every node
-    stays within cap_margin/2 of where it was when they were picked; each step checks that
+    travel in each step (_exchange_caps); at most the margin. The caps hold while every node,
+    and where the lists see each node of a grain another rank holds, stays within
+    cap_margin/2 of where it was when they were picked; each step checks that
     once it has moved the nodes, before its contact, and where one has moved farther the ranks
     pick them anew there (refresh_caps: the ghosts made their owners' grains whole, no grain
     changes hands). A smaller cap margin sends fewer nodes each step and refreshes more often.
