@@ -61,7 +61,7 @@ real ContactModel::surface_normal_reach(const Model& model) const {
     if (!law_set_[k] || laws_[k].node_pair) continue;
     (laws_[k].surface ? surface : spheres) = true;
   }
-  if (spheres) return largest_pair_reach(model) + list_skin();
+  if (spheres) return list_cutoff(model);
   return surface ? max_contact_radius_ + list_skin() : 0;
 }
 

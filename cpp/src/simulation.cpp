@@ -317,13 +317,8 @@ std::vector<index_t> Simulation::anchor_candidates(const std::vector<index_t>& n
 }
 
 std::vector<real> Simulation::list_positions() const {
-  std::vector<real> x(state_.positions.size());
-  const std::int64_t n = model_->node_count();
-#pragma omp parallel for schedule(static)
-  for (std::int64_t i = 0; i < n; ++i) {
-    const auto at = contact_.list_position(*model_, state_, static_cast<index_t>(i));
-    for (int k = 0; k < 3; ++k) x[3 * i + k] = at[k];
-  }
+  std::vector<real> x;
+  contact_.fill_list_positions(*model_, state_, x);
   return x;
 }
 

@@ -158,10 +158,7 @@ void bind_loading(nb::class_<Simulation>& cls) {
           },
           "wall"_a, "material"_a, "law"_a)
       .def_prop_ro(
-          "contact_reach",
-          [](const Simulation& self) {
-            return self.contact().largest_pair_reach(self.model()) + self.contact().list_skin();
-          },
+          "contact_reach", [](const Simulation& self) { return self.contact().list_cutoff(self.model()); },
           "The neighbour lists' cutoff [m]: the largest reach of a pair of nodes plus the skin.")
       .def_prop_ro(
           "contact_skin", [](const Simulation& self) { return self.contact().list_skin(); },

@@ -124,6 +124,8 @@ class ContactModel {
   real list_skin() const { return skin_ < 0 ? 0.5 * max_contact_radius_ : skin_; }
   /// The largest pair_reach any two nodes can have [m] (the lists' cutoff less the skin).
   real largest_pair_reach(const Model& model) const;
+  /// The lists' cutoff [m]: the largest pair reach plus the skin.
+  real list_cutoff(const Model& model) const { return largest_pair_reach(model) + list_skin(); }
 
   bool active() const { return any_law_ || !walls_.empty(); }
 
@@ -241,6 +243,10 @@ class ContactModel {
   /// before the first evaluation finds the points) [m].
   vec3 list_position(const Model& model, const State& state, index_t i) const {
     return centres_.at_list(model, state, i);
+  }
+  /// Every node's list position, into x (n x 3) [m].
+  void fill_list_positions(const Model& model, const State& state, std::vector<real>& x) const {
+    centres_.fill_positions(model, state, x);
   }
   /// How near two nodes of different bodies must come [m], as the lists see them (list
   /// positions, the skin included), before their contact reads their surface normals (each

@@ -138,8 +138,10 @@ class SurfaceCentres {
     const Seen s = seen(model, i);
     return point(state, s, i, list_length(s));
   }
-  /// Every node's list position (at_list), into x (n x 3).
-  void fill_positions(const Model& model, const State& state, std::vector<float>& x) const;
+  /// Every node's list position (at_list), into x (n x 3; float for the lists, double for a
+  /// distributed run's caps).
+  template <class T>
+  void fill_positions(const Model& model, const State& state, std::vector<T>& x) const;
 
   std::size_t memory_bytes() const {
     return depth_.capacity() * sizeof(real) + anchor_slot_.capacity() * sizeof(index_t) +
