@@ -102,15 +102,6 @@ vec surface_normal(const Model& model, const State& state, index_t i) {
 
 }  // namespace
 
-void ContactModel::anchored_vectors(const Model& model, const State& state, index_t i,
-                                    std::vector<real>& out) const {
-  const SurfaceCentres::Seen seen = centres_.seen(model, i);
-  const vec3 y = SurfaceCentres::anchored_vector(seen, state.positions, i);
-  const vec3 v = SurfaceCentres::anchored_vector(seen, state.velocities, i);
-  out.insert(out.end(), y.begin(), y.end());
-  out.insert(out.end(), v.begin(), v.end());
-}
-
 vec3 ContactModel::contact_position(const Model& model, const State& state, index_t i) const {
   if (!centres_.moved(i))
     return {state.positions[3 * i], state.positions[3 * i + 1], state.positions[3 * i + 2]};
@@ -348,7 +339,7 @@ void ContactModel::measure_surface_points(const Model& model, const State& state
 
 contact::SurfacePoint ContactModel::surface_point_now(const SurfaceCentres::Seen& seen, const State& state,
                                                       index_t j, real& size) {
-  const vec3 a = SurfaceCentres::position_vector(seen, state, j);
+  const vec3 a = SurfaceCentres::anchored_vector(seen, state.positions, j);
   size = std::sqrt(dot(a, a));
   const real offset = SurfaceCentres::faded_length(seen, seen.surface_length, size);  // as point() has it
   contact::SurfacePoint point;
@@ -499,8 +490,8 @@ vec3 ContactModel::osculating_normal(const Model& model, const State& state, con
   // anchored normal A / |A| otherwise.
   const index_t slot = body_rotation_slot_[node_body_[i]];
   const bool turned = slot != no_rotation && body_rotated_[slot] != 0;
-  const vec3 a = turned ? SurfaceCentres::anchored_vector(seen, model.reference_positions(), i)
-                        : SurfaceCentres::position_vector(seen, state, i);
+  const vec3 a =
+      SurfaceCentres::anchored_vector(seen, turned ? model.reference_positions() : state.positions, i);
   const real size = std::sqrt(dot(a, a));
   const vec3 n{a[0] / size, a[1] / size, a[2] / size};
   return turned ? contact::rotate(body_rotation_[slot], n) : n;

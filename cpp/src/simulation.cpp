@@ -250,7 +250,6 @@ std::vector<std::array<index_t, 2>> Simulation::begin_step() {
         "begin_step: evaluate the forces (run(0)) before marking ghost particles, "
         "whose bonds the first evaluation breaks too");
   }
-  contact_.forget_given();  // a step that failed after give_anchored_vectors left them
   evaluate_if_stale();
   move_and_break_bonds();
   step_begun_ = true;
@@ -262,7 +261,6 @@ void Simulation::finish_step(std::span<const std::array<index_t, 2>> ghost_break
   check_ghost_breaks(ghost_breaks);  // before anything changes: the step can be finished again
   step_begun_ = false;
   finish_step_after_breaks(ghost_breaks);
-  contact_.forget_given();
 }
 
 void Simulation::move_and_break_bonds() {
@@ -305,6 +303,17 @@ void Simulation::set_travel_origin(std::vector<index_t> watched) {
     std::copy(at.begin(), at.end(), list_origin_.begin() + 3 * static_cast<std::ptrdiff_t>(k));
   }
   largest_travel_ = 0;
+}
+
+std::vector<index_t> Simulation::anchor_candidates(const std::vector<index_t>& nodes) const {
+  std::vector<index_t> found;
+  for (const index_t i : nodes) {
+    if (i >= model_->node_count()) throw InputError("anchor_candidates: no node " + std::to_string(i));
+    contact_.anchor_candidates(*model_, state_, i, found);
+  }
+  std::sort(found.begin(), found.end());
+  found.erase(std::unique(found.begin(), found.end()), found.end());
+  return found;
 }
 
 std::vector<real> Simulation::list_positions() const {

@@ -112,38 +112,4 @@ void Simulation::give_ghost_motions(std::vector<std::pair<index_t, BodyMotion>> 
   contact_.give_ghost_motions(std::move(motions));
 }
 
-std::vector<index_t> Simulation::anchored_nodes(const std::vector<index_t>& nodes) const {
-  std::vector<index_t> anchored;
-  for (const index_t i : nodes) {
-    if (i >= model_->node_count()) throw InputError("anchored_nodes: no node " + std::to_string(i));
-    if (contact_.anchored(i)) anchored.push_back(i);
-  }
-  return anchored;
-}
-
-std::vector<real> Simulation::anchored_vectors(const std::vector<index_t>& nodes) const {
-  std::vector<real> vectors;
-  vectors.reserve(6 * nodes.size());
-  for (const index_t i : nodes) {
-    if (i >= model_->node_count()) throw InputError("anchored_vectors: no node " + std::to_string(i));
-    contact_.anchored_vectors(*model_, state_, i, vectors);
-  }
-  return vectors;
-}
-
-void Simulation::give_anchored_vectors(const std::vector<index_t>& nodes, std::span<const real> vectors) {
-  if (!step_begun_) throw InputError("give_anchored_vectors: only between begin_step and finish_step");
-  if (vectors.size() != 6 * nodes.size()) {
-    throw InputError("give_anchored_vectors: " + std::to_string(vectors.size()) + " numbers for " +
-                     std::to_string(nodes.size()) + " nodes (6 a node)");
-  }
-  for (const index_t i : nodes) {
-    if (i >= model_->node_count() || !ghost_node(i)) {
-      throw InputError("give_anchored_vectors: node " + std::to_string(i) +
-                       " is not a node of a ghost particle");
-    }
-  }
-  contact_.give_anchored_vectors(*model_, nodes, vectors);
-}
-
 }  // namespace granulate

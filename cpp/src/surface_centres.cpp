@@ -73,6 +73,19 @@ std::vector<index_t> SurfaceCentres::bonded_within_reach(const Model& model, con
   return nodes;
 }
 
+void SurfaceCentres::anchor_candidates(const Model& model, const State& state, index_t i,
+                                       std::vector<index_t>& out) const {
+  const SurfaceAnchor* a = anchor(model, i);
+  if (a == nullptr) return;
+  const index_t first = model.particles()[model.node_particle()[i]].first_node;
+  for (const index_t k : a->nodes) {
+    if (k != SurfaceAnchor::no_anchor) out.push_back(first + k);
+  }
+  if (!anchor_slot_.empty() && surface_[model.node_particle()[i]]) {  // reanchor may take these
+    for (const index_t j : bonded_within_reach(model, state, i)) out.push_back(j);
+  }
+}
+
 bool SurfaceCentres::reanchor(const Model& model, const State& state, index_t i) {
   // The same anchored vector in the reference, A_0 = sum_k w_k (X_k - X_i) of the shape's
   // anchors, from all the intact bonds within 1.75 h, nearest first (ties by index). A function
@@ -142,21 +155,6 @@ std::vector<index_t> SurfaceCentres::detach_anchored(const Model& model, const S
     }
   }
   return detached;
-}
-
-void SurfaceCentres::give(std::span<const index_t> nodes, std::span<const real> vectors, index_t node_count) {
-  forget_given();
-  if (nodes.empty()) return;
-  given_slot_.resize(node_count, no_given);
-  given_.assign(vectors.begin(), vectors.end());
-  given_nodes_.assign(nodes.begin(), nodes.end());
-  for (std::size_t k = 0; k < nodes.size(); ++k) given_slot_[nodes[k]] = static_cast<index_t>(k);
-}
-
-void SurfaceCentres::forget_given() {
-  for (const index_t i : given_nodes_) given_slot_[i] = no_given;
-  given_nodes_.clear();
-  given_.clear();
 }
 
 template <class T>

@@ -174,19 +174,9 @@ class Simulation {
   /// contact reads their surface normals, sums over their bonds [m]
   /// (ContactModel::surface_normal_reach; 0: never).
   real contact_surface_normal_reach() const { return contact_.surface_normal_reach(*model_); }
-  /// Those of `nodes` the contact sees at their anchors (ContactModel::anchored: a surface
-  /// point or contact centre read through the anchored vector A_i), in the order given.
-  std::vector<index_t> anchored_nodes(const std::vector<index_t>& nodes) const;
-  /// A_i(y) and A_i(v) of each of `nodes` now, 6 numbers a node (zeros for a node seen at
-  /// itself) [m, m/s]: on the owner, between begin_step and finish_step, all that a process
-  /// holding them as ghosts reads of their anchors (give_anchored_vectors).
-  std::vector<real> anchored_vectors(const std::vector<index_t>& nodes) const;
-  /// Between begin_step and finish_step, where ghosts are held: their owners' anchored_vectors
-  /// of these ghost nodes, which this step's contact reads instead of the positions and
-  /// velocities of their anchors (so the caps need not hold the anchors); forgotten when the
-  /// step finishes. InputError for a node that is not a ghost's, a count that is not 6 a node,
-  /// or outside a begun step.
-  void give_anchored_vectors(const std::vector<index_t>& nodes, std::span<const real> vectors);
+  /// The nodes whose positions the anchored vectors of `nodes` read, now or after bonds break
+  /// (ContactModel::anchor_candidates), sorted, each once.
+  std::vector<index_t> anchor_candidates(const std::vector<index_t>& nodes) const;
 
  private:
   // The phases of compute_forces, in order.

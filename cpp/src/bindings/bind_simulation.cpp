@@ -200,38 +200,13 @@ void bind_loading(nb::class_<Simulation>& cls) {
                    "How near two nodes of different bodies must come, as the lists see them, before "
                    "their contact reads their surface normals (sums over their bonds) [m]; 0: never.")
       .def(
-          "anchored_nodes",
+          "anchor_candidates",
           [](const Simulation& s, const std::vector<index_t>& nodes) {
-            return copy_out(s.anchored_nodes(nodes));
+            return copy_out(s.anchor_candidates(nodes));
           },
           "nodes"_a,
-          "Those of these nodes the contact sees at their anchors (a surface point or contact centre read "
-          "through the anchored vector A), in the order given.")
-      .def(
-          "anchored_vectors",
-          [](const Simulation& s, const std::vector<index_t>& nodes) {
-            return rows_out(s.anchored_vectors(nodes), 6);
-          },
-          "nodes"_a, nb::rv_policy::move,
-          "A(y) and A(v) of each of these nodes now, (k, 6) [m, m/s] (zeros for a node seen at itself): what "
-          "a "
-          "process holding them as ghosts reads of their anchors (give_anchored_vectors).")
-      .def(
-          "give_anchored_vectors",
-          [](Simulation& self, const Indices& nodes,
-             nb::ndarray<const double, nb::shape<-1, 6>, nb::c_contig> vectors) {
-            if (nodes.shape(0) != vectors.shape(0))
-              throw InputError("give_anchored_vectors: one node per row, got " +
-                               std::to_string(nodes.shape(0)) + " nodes and " +
-                               std::to_string(vectors.shape(0)) + " rows");
-            self.give_anchored_vectors(to_vector(nodes),
-                                       std::span<const real>(vectors.data(), vectors.size()));
-          },
-          "nodes"_a, "vectors"_a,
-          "Between begin_step and finish_step: ghost nodes' A(y) and A(v) from their owners' "
-          "anchored_vectors, "
-          "(k, 6), which this step's contact reads instead of their anchors "
-          "(Simulation::give_anchored_vectors).")
+          "The nodes whose positions these nodes' anchored vectors read, now or after bonds break "
+          "(sorted, each once).")
       .def("search_contacts", &Simulation::search_contacts,
            "List every node's contact partners again now, carrying collisions and friction springs over.")
       .def(

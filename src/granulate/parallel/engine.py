@@ -173,8 +173,6 @@ class DistributedRun:
         self.cap_refreshes = 0
         #: The ghost nodes this rank received in all its steps (each step, its caps').
         self.nodes_received = 0
-        #: Of them, the nodes whose anchored vectors it received too (_exchange_caps).
-        self.anchored_received = 0
         #: How many of this rank's step messages had a second one for the breaks and bodies'
         #: motions they had no room for.
         self.second_messages = 0
@@ -379,14 +377,12 @@ class DistributedRun:
         """Which of the ghosts' nodes each step sends (the caps): of each ghost grain, the
         nodes whose list positions (where the contact lists see them: a surface point,
         contact centre or the node, core.list_positions) lie within the cutoff plus the cap
-        margin of one of this rank's own nodes' list positions, and, for those within the
-        reach at which the contact reads surface normals (sums over a node's bonds:
-        core.contact_surface_normal_reach, none under PeriDEM's node pairs) plus the cap
-        margin, every node bonded to them; under PeriDEM's damping also every ghost's centre
-        node (the damping reads it). Of the cap's nodes the contact sees at their anchors
-        (core.anchored_nodes) the owner sends the anchored vectors too, A(y) and A(v), which
-        is all the contact reads of their anchors (core.give_anchored_vectors), so the anchors
-        need not be in the cap. No other
+        margin of one of this rank's own nodes' list positions, and the nodes those read:
+        their anchors and the neighbours they may take as anchors when bonds break
+        (core.anchor_candidates), and, for those within the reach at which the contact reads
+        surface normals (sums over a node's bonds: core.contact_surface_normal_reach, none
+        under PeriDEM's node pairs) plus the cap margin, every node bonded to them; under
+        PeriDEM's damping also every ghost's centre node (the damping reads it). No other
         ghost node can come within those reaches of an own node, as the lists see them,
         before the caps are picked again (each node, and each list position of a grain
         another rank holds, moves less than cap_margin/2: core.largest_travel), so a ghost
@@ -407,42 +403,33 @@ class DistributedRun:
         if normal_reach > 0:
             near = ghosts[close[ghosts]]
             normals[near] = points_within(x[near], own, normal_reach + self.cap_margin)
-        caps, anchored = {}, {}
+        caps = {}
         for q, nodes in self._receive_whole.items():
             near = nodes[close[nodes]]
-            partners = self.local.model.bond_partners(near[normals[near]].tolist())
-            caps[q] = np.union1d(near, np.asarray(partners, dtype=np.int64))
+            read = (
+                near,
+                core.anchor_candidates(near.tolist()),
+                self.local.model.bond_partners(near[normals[near]].tolist()),
+            )
+            caps[q] = np.unique(np.concatenate([np.asarray(r, dtype=np.int64) for r in read]))
             if self._damped_centres is not None:  # PeriDEM's damping reads ghosts' centres
                 centres = self._node_map[self._damped_centres[self._receive_grains[q]]]
                 caps[q] = np.union1d(caps[q], centres)
-            anchored[q] = np.asarray(core.anchored_nodes(caps[q].tolist()), dtype=np.int64)
         requests = [
-            self.comm.isend(
-                (self._to_global[cap], self._to_global[anchored[q]]), dest=q, tag=_CAP_TAG
-            )
-            for q, cap in caps.items()
+            self.comm.isend(self._to_global[cap], dest=q, tag=_CAP_TAG) for q, cap in caps.items()
         ]
-        self._send, self._send_anchored = {}, {}
-        for q in self._send_whole:
-            nodes, anchors_read = self.comm.recv(source=q, tag=_CAP_TAG)
-            self._send[q] = self._node_map[nodes]
-            self._send_anchored[q] = self._node_map[anchors_read].tolist()
+        self._send = {
+            q: self._node_map[self.comm.recv(source=q, tag=_CAP_TAG)] for q in self._send_whole
+        }
         self.mpi.Request.waitall(requests)
-        self._receive, self._receive_anchored = caps, anchored
+        self._receive = caps
         outside = [np.setdiff1d(self._receive_whole[q], cap) for q, cap in caps.items()]
         self.local.core.set_inert_contact_nodes(np.concatenate([[], *outside]).astype(int).tolist())
         self._caps_picked_at = int(self.local.core.step)
         #: Whether some rank's caps leave ghost nodes out (else no need to pick them anew).
         self.caps_partial = self.comm.allreduce(any(len(o) for o in outside), op=self.mpi.LOR)
-        self._outbox = {
-            q: _message(len(n) + len(self._send_anchored[q]), self._rooms_out[q])
-            for q, n in self._send.items()
-        }
-        self._inbox = {
-            q: _message(len(n) + len(anchored[q]), self._rooms_in[q])
-            for q, n in self._receive.items()
-        }
-        self._given_nodes = np.concatenate([np.zeros(0, np.int64), *anchored.values()])
+        self._outbox = {q: _message(len(n), self._rooms_out[q]) for q, n in self._send.items()}
+        self._inbox = {q: _message(len(n), self._rooms_in[q]) for q, n in self._receive.items()}
 
     def _rooms(self, grains: int) -> NDArray[np.int64]:
         """The rows a step's message about `grains` grains carries of each section: break_slots
@@ -518,23 +505,17 @@ class DistributedRun:
 
     def _exchange_within_step(
         self, broken: NDArray[np.uint32] | None
-    ) -> tuple[
-        NDArray[np.uint32],
-        tuple[NDArray[np.uint32], NDArray[np.float64]],
-        tuple[NDArray[np.uint32], NDArray[np.float64]],
-    ]:
+    ) -> tuple[NDArray[np.uint32], tuple[NDArray[np.uint32], NDArray[np.float64]]]:
         """After the first half of a step (the drift and pass 1): each rank sends the ranks that
         hold its grains as ghosts the positions and velocities now (the half-step velocities,
-        which the contact uses) of the nodes in their caps (_exchange_caps) and the anchored
-        vectors now of those the contact sees at their anchors (core.anchored_vectors), the
-        bonds that broke in those grains this step (`broken`: flat (i, j) local node pairs;
-        None when the step failed, and then no bodies either) and the motion of each of their
-        fragments (core.fragment_motions), all in global numbering; it takes the same for its
-        ghosts, overwriting their copies and giving the core their bodies' motions. One message per
+        which the contact uses) of the nodes in their caps (_exchange_caps), the bonds that
+        broke in those grains this step (`broken`: flat (i, j) local node pairs; None when
+        the step failed, and then no bodies either) and the motion of each of their fragments
+        (core.fragment_motions), all in global numbering; it takes the same for its ghosts,
+        overwriting their copies and giving the core their bodies' motions. One message per
         pair of neighbouring ranks (_pack); what it has no room for goes in a second. The
-        ghosts' breaks, as (k, 2) local node pairs, their bodies' motions (first nodes,
-        local; (k, 15) motions) for core.give_ghost_motions, and the anchored vectors (local
-        nodes; (k, 6)) for core.give_anchored_vectors."""
+        ghosts' breaks, as (k, 2) local node pairs, and their bodies' motions (first nodes,
+        local; (k, 15) motions) for core.give_ghost_motions."""
         core = self.local.core
         x, v = core.positions, core.velocities
         pairs = np.asarray([] if broken is None else broken, dtype=np.int64).reshape(-1, 2)
@@ -544,28 +525,23 @@ class DistributedRun:
         for q, nodes in self._send.items():
             theirs = self._to_global[pairs[self._sent_to[q][pairs[:, 0]]]]
             box = self._outbox[q]
-            motion = (
-                np.hstack([x[nodes], v[nodes]]),
-                core.anchored_vectors(self._send_anchored[q]),
+            used, rest = _pack(
+                box, (x[nodes], v[nodes]), [theirs, bodies[rows[q]]], self._rooms_out[q]
             )
-            used, rest = _pack(box, motion, [theirs, bodies[rows[q]]], self._rooms_out[q])
             requests.append(self.comm.Isend(box[:used], dest=q, tag=_TAG))
             if len(rest):
                 overflow.append(self.comm.Isend(rest, dest=q, tag=_REST_TAG))
                 self.second_messages += 1
         self.mpi.Request.Waitall(requests)
-        received = [self._unpack(q, nodes, x, v) for q, nodes in self._receive.items()]
+        received = [self._unpack(q, nodes, (x, v)) for q, nodes in self._receive.items()]
         self.nodes_received += self.exchanged_node_count
-        self.anchored_received += len(self._given_nodes)
         self.mpi.Request.Waitall(overflow)
-        motions = np.concatenate([np.zeros((0, _BODY)), *(m for _, m, _ in received)])
+        motions = np.concatenate([np.zeros((0, _BODY)), *(m for _, m in received)])
         first = self._node_map[motions[:, 0].astype(np.int64)].astype(np.uint32)
-        ghost_breaks = np.concatenate([np.zeros((0, 2), np.int64), *(b for b, _, _ in received)])
-        vectors = np.concatenate([np.zeros((0, 6)), *(a for _, _, a in received)])
-        return (
-            self._node_map[ghost_breaks].astype(np.uint32),
-            (first, np.ascontiguousarray(motions[:, 1:])),
-            (self._given_nodes.astype(np.uint32), vectors),
+        ghost_breaks = np.concatenate([np.zeros((0, 2), np.int64), *(b for b, _ in received)])
+        return self._node_map[ghost_breaks].astype(np.uint32), (
+            first,
+            np.ascontiguousarray(motions[:, 1:]),
         )
 
     def _own_motions(
@@ -585,23 +561,23 @@ class DistributedRun:
         return motions, {q: mask[particle] for q, mask in self._particle_to.items()}
 
     def _unpack(
-        self, q: int, nodes: NDArray[np.int64], x: NDArray[np.float64], v: NDArray[np.float64]
-    ) -> tuple[NDArray[np.int64], NDArray[np.float64], NDArray[np.float64]]:
-        """Rank q's message of this step into the ghosts' positions `x` and velocities `v`; its
-        breaks, (k, 2) global node pairs, bodies' motions, (k, 16) (with what the message had
-        no room for, received now from the second message), and the anchored vectors of the
-        cap's anchored nodes, (k, 6)."""
+        self, q: int, nodes: NDArray[np.int64], fields: tuple[NDArray[np.float64], ...]
+    ) -> tuple[NDArray[np.int64], NDArray[np.float64]]:
+        """Rank q's message of this step into the ghosts' `fields`; its breaks, (k, 2) global
+        node pairs, and bodies' motions, (k, 16) (with what the message had no room for,
+        received now from the second message)."""
         box = self._inbox[q]
-        count = 6 * (len(nodes) + len(self._receive_anchored[q]))
+        count = 6 * len(nodes)
         motion = box[:count].reshape(-1, 6)
-        x[nodes], v[nodes] = motion[: len(nodes), :3], motion[: len(nodes), 3:]
+        for k, field in enumerate(fields):
+            field[nodes] = motion[:, 3 * k : 3 * k + 3]
         totals = box[count : count + len(_WIDTHS)].astype(np.int64)
         kept = np.minimum(totals, self._rooms_in[q])
         rest = np.empty(int(((totals - kept) * _WIDTHS).sum()))
         if len(rest):
             self.comm.Recv(rest, source=q, tag=_REST_TAG)
         breaks, bodies = _sections(box[count + len(_WIDTHS) :], kept, rest, totals - kept)
-        return breaks.astype(np.int64), bodies, motion[len(nodes) :]
+        return breaks.astype(np.int64), bodies
 
     def run(self, steps: int) -> None:
         """Advance every rank `steps` time steps, migrating grains before a step once a node
@@ -646,12 +622,11 @@ class DistributedRun:
         if self.caps_partial:
             self._caps_hold(failure is None)
         checked = time.perf_counter()
-        ghost_breaks, motions, anchored = self._exchange_within_step(broken)
+        ghost_breaks, motions = self._exchange_within_step(broken)
         told = time.perf_counter()
         if failure is None:
             try:
                 core.give_ghost_motions(*motions)
-                core.give_anchored_vectors(*anchored)
                 core.finish_step(ghost_breaks)
             except Exception as error:
                 failure = error
@@ -1011,24 +986,26 @@ class DistributedRun:
         return whole
 
 
-def _message(rows: int, rooms: NDArray[np.int64]) -> NDArray[np.float64]:
-    """A buffer for the largest step message with `rows` rows of 6 numbers (_pack): the
+def _message(nodes: int, rooms: NDArray[np.int64]) -> NDArray[np.float64]:
+    """A buffer for the largest step message about `nodes` nodes (_pack): their x and v, the
     sections' counts, and each section's `rooms` rows."""
-    return np.empty(6 * rows + len(_WIDTHS) + int((rooms * _WIDTHS).sum()))
+    return np.empty(6 * nodes + len(_WIDTHS) + int((rooms * _WIDTHS).sum()))
 
 
 def _pack(
     box: NDArray[np.float64],
-    motion: tuple[NDArray[np.float64], ...],
+    fields: tuple[NDArray[np.float64], ...],
     sections: list[NDArray[Any]],
     rooms: NDArray[np.int64],
 ) -> tuple[int, NDArray[np.float64]]:
-    """A step's message: the rows of `motion`, 6 numbers each (the cap's x and v, then the
-    anchored nodes' A(y) and A(v)), then each section's row count, then each section's rows
-    (breaks, (k, 2); bodies, (k, 16)), up to its room; the numbers written, and the rows with
-    no room (every section's, flat, in order) for a second message."""
-    count = 6 * sum(len(rows) for rows in motion)
-    box[:count] = np.concatenate([np.asarray(rows).reshape(-1, 6) for rows in motion]).ravel()
+    """A step's message: the nodes' `fields` (x, v: 6 numbers a node), then each section's row
+    count, then each section's rows (breaks, (k, 2); bodies, (k, 16)), up to its room; the
+    numbers written, and the rows with no room (every section's, flat, in order) for a
+    second message."""
+    count = 6 * len(fields[0])
+    motion = box[:count].reshape(-1, 6)
+    for k, field in enumerate(fields):
+        motion[:, 3 * k : 3 * k + 3] = field
     box[count : count + len(sections)] = [len(rows) for rows in sections]
     start, rest = count + len(sections), []
     for rows, room in zip(sections, rooms, strict=True):

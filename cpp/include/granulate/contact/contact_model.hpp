@@ -255,19 +255,11 @@ class ContactModel {
   /// themselves, within Rc. 0 where no law reads them. The bonded neighbours a distributed
   /// run's caps must hold for a node that near.
   real surface_normal_reach(const Model& model) const;
-  /// Whether the contact sees node i at its anchors (through its anchored vector A_i).
-  bool anchored(index_t i) const { return centres_.moved(i); }
-  /// A_i(y) and A_i(v) of node i now, from its anchors (SurfaceCentres::anchored_vector; zeros
-  /// for a node seen at itself), appended to `out` (6 numbers).
-  void anchored_vectors(const Model& model, const State& state, index_t i, std::vector<real>& out) const;
-  /// A distributed run's ghost nodes' A_i(y) and A_i(v) as their owners measured them (6
-  /// numbers a node), which the contact reads instead of their anchors' until forget_given
-  /// (SurfaceCentres::give).
-  void give_anchored_vectors(const Model& model, std::span<const index_t> nodes,
-                             std::span<const real> vectors) {
-    centres_.give(nodes, vectors, model.node_count());
+  /// The nodes whose positions node i's anchored vector reads, now or after its bonds break
+  /// (SurfaceCentres::anchor_candidates), appended to `out`.
+  void anchor_candidates(const Model& model, const State& state, index_t i, std::vector<index_t>& out) const {
+    centres_.anchor_candidates(model, state, i, out);
   }
-  void forget_given() { centres_.forget_given(); }
 
   ContactCheckpoint checkpoint() const;
   /// Restores a checkpoint taken with the same model, laws and walls; `state` is the restored

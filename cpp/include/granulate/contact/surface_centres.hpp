@@ -73,6 +73,11 @@ class SurfaceCentres {
   std::vector<index_t> detach_anchored(const Model& model, const State& state,
                                        std::span<const std::array<index_t, 2>> pairs);
 
+  /// The nodes whose positions node i's anchored vector reads, now or after bonds break, appended
+  /// to `out`: its anchors and, under the surface law, its neighbours within 1.75 h still bonded
+  /// to it (those it may take as anchors: bonds only break); none for a node seen at itself.
+  void anchor_candidates(const Model& model, const State& state, index_t i, std::vector<index_t>& out) const;
+
   /// Whether node i is seen away from itself (it has anchors): a cheap test for the hot loops.
   bool moved(index_t i) const { return any_ && anchored_[i]; }
   /// The anchors of node i if it carries a surface point (its particle's nodes are centred and
@@ -92,8 +97,6 @@ class SurfaceCentres {
     real mesh_size = 0, surface_length = 0, centre_length = 0;
     real osculating_radius = 0;  ///< 1 / kappa_i [m] on a round particle, else 0
     bool along_normal = false;
-    /// A_i(y) and A_i(v), given for a distributed run's ghost node (give); null: from its anchors.
-    const real* given = nullptr;
   };
   Seen seen(const Model& model, index_t i) const;
   /// y_i + length n_i at the state's positions (y_i for a node without anchors).
@@ -105,22 +108,6 @@ class SurfaceCentres {
   vec3 lever(const State& state, const Seen& s, index_t i, real length, const vec3& force) const;
   /// A_i = sum_k w_k (f_k - f_i) of an anchored node for a nodal field f (zero without anchors).
   static vec3 anchored_vector(const Seen& s, const std::vector<real>& field, index_t i);
-  /// A_i(y) at the state's positions, or as given (give).
-  static vec3 position_vector(const Seen& s, const State& state, index_t i) {
-    if (s.given != nullptr) return {s.given[0], s.given[1], s.given[2]};
-    return anchored_vector(s, state.positions, i);
-  }
-  /// A_i(v) at the state's velocities, or as given (give).
-  static vec3 velocity_vector(const Seen& s, const State& state, index_t i) {
-    if (s.given != nullptr) return {s.given[3], s.given[4], s.given[5]};
-    return anchored_vector(s, state.velocities, i);
-  }
-  /// For a distributed run's ghost nodes, whose anchors need not be held: A_i(y) and A_i(v) of
-  /// each of `nodes` (6 numbers a node, as their owner measured them, anchored_vector), which
-  /// seen() hands the contact instead of its anchors' until forget_given. A node seen at itself
-  /// ignores its numbers. `node_count` is the model's.
-  void give(std::span<const index_t> nodes, std::span<const real> vectors, index_t node_count);
-  void forget_given();
   /// rho = |A_i| / |A_0|, |A_0| = (h/2) |o_i| the anchored vector's length in the reference
   /// (surface_anchors.hpp): 1 while the neighbourhood keeps its shape, towards 0 as it folds.
   static real stretch(const Seen& s, real size);
@@ -159,9 +146,7 @@ class SurfaceCentres {
   std::size_t memory_bytes() const {
     return depth_.capacity() * sizeof(real) + anchor_slot_.capacity() * sizeof(index_t) +
            anchored_.capacity() + surface_.capacity() + round_.capacity() +
-           spare_.capacity() * sizeof(SurfaceAnchor) +
-           (given_slot_.capacity() + given_nodes_.capacity()) * sizeof(index_t) +
-           given_.capacity() * sizeof(real);
+           spare_.capacity() * sizeof(SurfaceAnchor);
   }
 
   /// The bounds of a round particle's curvature radii, over its h (see above).
@@ -211,11 +196,6 @@ class SurfaceCentres {
   // or with spare_bit, in spare_.
   std::vector<index_t> anchor_slot_;
   std::vector<SurfaceAnchor> spare_;  // the anchors taken after bonds broke (reanchor)
-  // give(): per node a place in given_ (6 numbers each), or no_given; given_ empty when none is.
-  static constexpr index_t no_given = ~index_t{0};
-  std::vector<index_t> given_slot_;
-  std::vector<real> given_;
-  std::vector<index_t> given_nodes_;
 };
 
 inline real SurfaceCentres::linear_scale(const Seen& s, real length) {
@@ -239,7 +219,6 @@ inline SurfaceCentres::Seen SurfaceCentres::seen(const Model& model, index_t i) 
   s.surface_length = s.anchor->depth * particle.mesh_size;
   s.centre_length = (s.anchor->depth - 0.5 * depth_[p] * s.anchor->reach) * particle.mesh_size;
   if (round_[p]) s.osculating_radius = particle.mesh_size / s.anchor->curvature;
-  if (!given_.empty() && given_slot_[i] != no_given) s.given = given_.data() + 6 * given_slot_[i];
   return s;
 }
 
@@ -269,7 +248,7 @@ inline SurfaceCentres::vec3 SurfaceCentres::point(const State& state, const Seen
   const real* y = state.positions.data();
   vec3 q{y[3 * i], y[3 * i + 1], y[3 * i + 2]};
   if (length == 0 || s.anchor == nullptr) return q;
-  const vec3 a = position_vector(s, state, i);
+  const vec3 a = anchored_vector(s, state.positions, i);
   const real size = length_of(a);
   const real scale = s.along_normal ? faded_length(s, length, size) / size : linear_scale(s, length);
   for (int d = 0; d < 3; ++d) q[d] += scale * a[d];
@@ -281,7 +260,7 @@ inline SurfaceCentres::vec3 SurfaceCentres::point_velocity(const State& state, c
   // The rate of the point's offset is the lever map of A_i's rate.
   const real* v = state.velocities.data();
   if (length == 0 || s.anchor == nullptr) return {v[3 * i], v[3 * i + 1], v[3 * i + 2]};
-  const vec3 rate = lever(state, s, i, length, velocity_vector(s, state, i));
+  const vec3 rate = lever(state, s, i, length, anchored_vector(s, state.velocities, i));
   return {v[3 * i] + rate[0], v[3 * i + 1] + rate[1], v[3 * i + 2] + rate[2]};
 }
 
@@ -294,7 +273,7 @@ inline SurfaceCentres::vec3 SurfaceCentres::lever(const State& state, const Seen
   }
   // q = y + length phi(rho) n, rho = |A| / |A_0|: the tangential lever length phi / |A|, and
   // the fade's radial one length phi' / |A_0| = length phi' rho / |A| (0 unless folded).
-  const vec3 a = position_vector(s, state, i);
+  const vec3 a = anchored_vector(s, state.positions, i);
   const real size = length_of(a);
   const vec3 n{a[0] / size, a[1] / size, a[2] / size};
   const real normal_part = n[0] * force[0] + n[1] * force[1] + n[2] * force[2];
