@@ -278,6 +278,16 @@ def test_bench_ranks_fine_grains_send_caps() -> None:
     assert all(0 < row["exchanged_nodes"] < 0.5 * row["ghost_nodes"] for row in rows)
 
 
+def test_bench_ranks_shatter_breaks_grains() -> None:
+    """`--case shatter --quick` (40 brittle grains thrown into each other): bonds break in the
+    timed steps, and the result counts them."""
+    done = bench_ranks("--case", "shatter", "--quick", "--json")
+    assert done.returncode == 0, done.stderr
+    result = json.loads(done.stdout)
+    assert result["bonds_broken"] > 0
+    assert sum(row["grains"] for row in result["rows"]) == 40
+
+
 def test_bench_ranks_refuses_what_it_cannot_run_once() -> None:
     """A case it does not have, or --collect-every without --ranks: one message, exit 2 from
     every rank."""

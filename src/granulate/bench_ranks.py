@@ -15,6 +15,9 @@ drum    (300 grains) drum-like, flowing: the same grains on a hexagonal lattice 
         migrate grains every few dozen steps
 fine2d  (200 grains, 149,127 nodes) the pile at R/h = 16 (horizon three mesh sizes): grains of
         many nodes, of whose ghosts each step sends only the caps within reach
+shatter (400 grains) fracture: the pile's grains, brittle (fracture energy 0.5 J/m^2), each
+        thrown at 8 m/s in a random direction into its neighbours, so that they break from the
+        first steps (the bonds broken in the timed steps are counted)
 ======  ======================================================================================
 
 Each rank runs one thread unless ``granulate --threads N`` says otherwise. After 20 untimed
@@ -53,10 +56,13 @@ ROCK = gr.Material(
 SHARES = ("exchange", "check", "caps", "migrate", "collect")
 
 
-def pile(grains: int, material: gr.Material = ROCK, mesh: float = RADIUS / 5) -> gr.Simulation:
+def pile(
+    grains: int, material: gr.Material = ROCK, mesh: float = RADIUS / 5, speed: float = 0.0
+) -> gr.Simulation:
     """`grains` grains in rows of 20 on a hexagonal lattice, in a box open at the top, of
-    `material` meshed at `mesh` [m]."""
+    `material` meshed at `mesh` [m], each thrown at `speed` [m/s] in a random direction."""
     rng = np.random.default_rng(3)
+    throws = np.random.default_rng(7).uniform(0, 2 * np.pi, grains)
     spacing, columns = 2.0 * RADIUS, 20
     sim = gr.Simulation(2, gravity=(0, -9.81, 0))
     sim.contact = gr.Contact(restitution=0.5, friction=0.5)
@@ -69,7 +75,8 @@ def pile(grains: int, material: gr.Material = ROCK, mesh: float = RADIUS / 5) ->
             if k % 3 == 0
             else gr.Disc(centre, radius)
         )
-        sim.add_body(shape, material, mesh)
+        velocity = (speed * np.cos(throws[k]), speed * np.sin(throws[k]))
+        sim.add_body(shape, material, mesh, velocity=velocity)
     width = spacing * (columns + 0.5)
     sim.add_wall(gr.Wall(gr.Plane((0, -0.99 * RADIUS, 0), (0, 1, 0))), name="floor")
     sim.add_wall(gr.Wall(gr.Plane((-0.99 * RADIUS, 0, 0), (1, 0, 0))), name="left")
@@ -85,6 +92,14 @@ def fine2d(grains: int) -> gr.Simulation:
         density=1200, bulk_modulus=2.16e7, shear_modulus=1.296e7, fracture_energy=50, horizon=3 * h
     )
     return pile(grains, fine_rock, h)
+
+
+def shatter(grains: int) -> gr.Simulation:
+    """The pile's grains made brittle (fracture energy 0.5 J/m^2) and each thrown at 8 m/s in
+    a random direction into its touching neighbours: they crack and split from the first
+    steps, and their fragments' surfaces change where the contact sees them."""
+    brittle = ROCK.model_copy(update={"fracture_energy": 0.5})
+    return pile(grains, brittle, RADIUS / 5, speed=8.0)
 
 
 def drum(grains: int) -> gr.Simulation:
@@ -146,6 +161,7 @@ CASES: dict[str, tuple[Callable[[int], gr.Simulation], int, int]] = {
     "pile": (pile, 400, 40),
     "drum": (drum, 300, 40),
     "fine2d": (fine2d, 200, 40),
+    "shatter": (shatter, 400, 40),
 }
 
 
@@ -173,7 +189,9 @@ def measure(
         run.run(20)  # lists built, caches warm
     migrations, handed = run.migrations, run.handed_over
     refreshes, received = run.cap_refreshes, run.nodes_received
+    broken = run.broken_bonds()
     wall = _timed(run, steps, collect_every, comm)
+    broken = run.broken_bonds() - broken
     row = {
         "grains": len(run.owned),
         "nodes": run.owned_node_count,
@@ -200,6 +218,7 @@ def measure(
         "cap_margin": run.cap_margin,
         "cap_refreshes": run.cap_refreshes - refreshes,
         "cap_margin_widenings": run.cap_margin_widenings,
+        "bonds_broken": broken,
     }
 
 
@@ -239,7 +258,7 @@ def table(result: dict[str, Any]) -> str:
         f"timed steps; ghost margin {1e3 * result['margin']:.3g} mm (widened "
         f"{result['margin_widenings']} times); cap margin {1e3 * result['cap_margin']:.3g} mm ("
         f"widened {result['cap_margin_widenings']} times), caps picked anew "
-        f"{result['cap_refreshes']} times"
+        f"{result['cap_refreshes']} times; {result['bonds_broken']:,} bonds broken"
     )
     return "\n".join(lines)
 
