@@ -41,6 +41,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+from granulate._core import points_within
 
 import granulate as gr
 from granulate.parallel import bisect, ghosts, near_pairs
@@ -100,20 +101,26 @@ def exchanged_nodes(
     return counts
 
 
-def node_steps_per_second(nodes_across_radius: int, steps: int = 300) -> tuple[float, float, float]:
-    """One core's node-steps per second on 27 touching spheres in a box under gravity, the
-    share of the bond passes (peridynamics) in the step, and the share a ghost saves: the same
-    steps again from the same state with every sphere a ghost (core.set_ghost_particles: both
-    bond passes skipped), the time saved over the time taken."""
+def touching_spheres(nodes_across_radius: int, pair_law: str = "surface") -> gr.Simulation:
+    """27 touching spheres of the packing's mesh in a box under gravity (not yet run)."""
     gr.set_num_threads(1)
     sim = gr.Simulation(3, gravity=(0, -9.81, 0))
-    sim.contact = gr.Contact(restitution=0.5, friction=0.3)
+    sim.contact = gr.Contact(restitution=0.5, friction=0.3, pair_law=pair_law)
     sphere = gr.ReferenceShape.from_shape(
         gr.Sphere((0, 0, 0), RADIUS), RADIUS / nodes_across_radius, discretization="conforming"
     )
     for index in np.ndindex(3, 3, 3):
         sim.add_particle(sphere, MATERIAL, position=tuple(2.0e-3 * np.array(index) + 1.2e-3))
     sim.add_wall(gr.BoxContainer((0, 0, 0), (6.4e-3, 8e-3, 6.4e-3)), name="box")
+    return sim
+
+
+def node_steps_per_second(nodes_across_radius: int, steps: int = 300) -> tuple[float, float, float]:
+    """One core's node-steps per second on 27 touching spheres in a box under gravity, the
+    share of the bond passes (peridynamics) in the step, and the share a ghost saves: the same
+    steps again from the same state with every sphere a ghost (core.set_ghost_particles: both
+    bond passes skipped), the time saved over the time taken."""
+    sim = touching_spheres(nodes_across_radius)
     sim.run(20)
     saved = sim.core.checkpoint()
     before = sim.summary()["peridynamics_seconds"]
@@ -128,6 +135,41 @@ def node_steps_per_second(nodes_across_radius: int, steps: int = 300) -> tuple[f
     as_ghosts = time.perf_counter() - start
     ghost_saving = max(0.0, 1.0 - as_ghosts / seconds)
     return sim.node_count * steps / seconds, bonds / seconds, ghost_saving
+
+
+def measured_caps(nodes_across_radius: int, depth: float, pair_law: str) -> float:
+    """The engine's caps over this model's layer, measured on the 27 touching spheres after
+    320 steps under `pair_law`: for each sphere and each other one, the nodes the engine would
+    send of it (DistributedRun._exchange_caps: list positions within the cutoff plus the
+    default cap margin h/2 of the other's, their anchor candidates, and every bonded neighbour
+    of those within the reach at which the contact reads surface normals) over the nodes
+    within `depth` of the other's bounding sphere (exchanged_nodes' layer), summed over the
+    pairs with a node in that layer."""
+    sim = touching_spheres(nodes_across_radius, pair_law)
+    sim.run(320)
+    core = sim.core
+    x, nodes = core.list_positions, core.positions
+    margin = 0.5 * RADIUS / nodes_across_radius
+    cutoff, normal_reach = core.contact_reach, core.contact_surface_normal_reach
+    capped, layer = 0, 0
+    for body in sim.bodies:
+        mine = np.arange(body.node_slice.start, body.node_slice.stop)
+        for other in sim.bodies:
+            theirs = other.node_slice
+            centre = nodes[theirs].mean(axis=0)
+            within = np.linalg.norm(nodes[mine] - centre, axis=1) - RADIUS <= depth
+            if other is body or not within.any():
+                continue
+            near = mine[points_within(x[mine], x[theirs], cutoff + margin).astype(bool)]
+            normal = near[points_within(x[near], x[theirs], normal_reach + margin).astype(bool)]
+            read = (
+                near,
+                core.anchor_candidates(near.tolist()),
+                sim.model.bond_partners(normal.tolist()),
+            )
+            capped += len(np.unique(np.concatenate([np.asarray(r, np.int64) for r in read])))
+            layer += int(within.sum())
+    return capped / layer
 
 
 def communication_seconds(
@@ -200,7 +242,7 @@ def as_built(
     rate: float,
     ghost_saving: float,
     args: argparse.Namespace,
-    depths: dict[str, float],
+    depths: dict[str, tuple[float, float]],
 ) -> dict:
     """The engine as built (granulate.parallel.DistributedRun), for the rank with the most ghost
     grains per owned grain: its ghosts are whole grains within the reach plus the margin (the
@@ -211,8 +253,9 @@ def as_built(
     once. Efficiency: its own nodes' compute over its step; the same with the ghosts stepped in
     full, and if ghosts were not stepped at all (not built). "cap_shares": the communication
     share when it receives, instead of whole ghosts, only the ghost nodes within each of
-    `depths` [m] of one of its grains' bounding spheres (exchanged_nodes; the ghosts still held
-    and stepped whole), with a second reduction per step (the caps' check within the step)."""
+    `depths` (depth [m], factor) of one of its grains' bounding spheres (exchanged_nodes; the
+    ghosts still held and stepped whole) times the factor, with a second reduction per step
+    (the caps' check within the step)."""
     partition = bisect(centres, np.ones(len(centres)), ranks)
     needed = ghosts(partition, pairs)
     owned = np.bincount(partition.owner, minlength=ranks)
@@ -231,9 +274,9 @@ def as_built(
 
     talk = communication(ghost)
     cap_shares = {}
-    for name, depth in depths.items():  # caps that leave nodes out: a check within the step
+    for name, (depth, factor) in depths.items():  # caps leave nodes out: a check in the step
         counts = exchanged_nodes(centres, radii, partition.owner, ranks, pairs, unit_nodes, depth)
-        capped = communication(int(counts[worst]), reductions=2)
+        capped = communication(round(factor * counts[worst]), reductions=2)
         cap_shares[name] = capped / (stepped + capped)
     return {
         "ranks": ranks,
@@ -266,23 +309,42 @@ def lps_node_steps_per_second(steps: int = 30) -> float:
     return sim.node_count * steps / (time.perf_counter() - start)
 
 
-#: Cap depths at R/h = 6 (h = R/6, horizon 3 h, the cutoff the reach): as the engine picked them
-#: before its check within the step (the cutoff, a cap margin of at least 4 h, 2 h for the
-#: surface points' offset, and the bonded neighbours a horizon deeper, taken here as depth),
-#: the whole of a near ghost; as it picked them in session 45 under the surface law for grains
-#: at rest or loaded slowly (the default cap margin h/2, which widens only where the caps last
-#: under 50 steps; the points' offset about h each; the neighbours); as it picks them now under
-#: the surface law (caps by list positions, so no offset; of the neighbours only those a node's
-#: anchors may be, within 1.75 h; the whole horizon of the nodes within Rc of a contact, a patch
-#: this model leaves out); under PeriDEM's node pairs (the contact reads the node alone); the
-#: cutoff alone (caps picked by the owners every step: no cap margin).
+#: Cap depths at R/h = 6 (h = R/6, horizon 3 h, the cutoff the reach), each with the contact
+#: law whose caps the engine picks measured against it (measured_caps; None: the layer as it is):
+#: as the engine picked them before its check within the step (the cutoff, a cap margin of at
+#: least 4 h, 2 h for the surface points' offset, and the bonded neighbours a horizon deeper,
+#: taken here as depth), the whole of a near ghost; as it picked them in session 45 under the
+#: surface law for grains at rest or loaded slowly (the default cap margin h/2, which widens only
+#: where the caps last under 50 steps; the points' offset about h each; the neighbours); as it
+#: picks them now under the surface law and under PeriDEM's node pairs (measured on the model's
+#: own mesh: the layer of the cutoff and the default cap margin, times the engine's caps over
+#: that layer); the cutoff alone (caps picked by the owners every step: no cap margin).
 CAP_LAYERS = (
-    ("before", lambda reach, h: reach + 4 * h + 2 * h + 3 * h),
-    ("session 45", lambda reach, h: reach + 0.5 * h + 2 * h + 3 * h),
-    ("surface law", lambda reach, h: reach + 0.5 * h + 1.75 * h),
-    ("node pairs", lambda reach, h: reach + 0.5 * h),
-    ("cutoff only", lambda reach, h: reach),
+    ("before", lambda reach, h: reach + 4 * h + 2 * h + 3 * h, None),
+    ("session 45", lambda reach, h: reach + 0.5 * h + 2 * h + 3 * h, None),
+    ("surface law", lambda reach, h: reach + 0.5 * h, "surface"),
+    ("node pairs", lambda reach, h: reach + 0.5 * h, "peridem"),
+    ("cutoff only", lambda reach, h: reach, None),
 )
+
+
+def cap_depths(args: argparse.Namespace) -> dict[str, tuple[float, float]]:
+    """CAP_LAYERS' (depth [m], factor) at this mesh, the laws' factors measured (measured_caps),
+    printed."""
+    h = RADIUS / args.nodes_across_radius
+    depths = {}
+    for name, layer, law in CAP_LAYERS:
+        depth = layer(args.reach, h)
+        depths[name] = (
+            depth,
+            1.0 if law is None else measured_caps(args.nodes_across_radius, depth, law),
+        )
+        if law is not None:
+            print(
+                f"{name}: the engine's caps are {depths[name][1]:.2f} times the nodes within "
+                f"{1e3 * depth:.2f} mm of a neighbour's sphere (27 touching spheres, measured)"
+            )
+    return depths
 
 
 def engine_as_built(
@@ -298,8 +360,7 @@ def engine_as_built(
     nothing, a near one all of it at this mesh; and thinner)."""
     margin = float(pack.radii.max())
     pairs = near_pairs(pack.positions, pack.radii, args.reach + margin)
-    h = RADIUS / args.nodes_across_radius
-    depths = {name: layer(args.reach, h) for name, layer in CAP_LAYERS} if args.caps else {}
+    depths = cap_depths(args) if args.caps else {}
     print(
         f"\nthe engine as built: whole ghost grains within {1e3 * (args.reach + margin):.2f} mm "
         f"(reach + margin) stepped but for their bonds ({100 * ghost_saving:.0f} % of a "
@@ -330,10 +391,10 @@ def engine_as_built(
             "\nthe engine with caps: communication % of the step (x, v of the ghost nodes within "
             "a depth of the rank's grains' spheres; ghosts still held and stepped whole)"
         )
-        heads = "".join(f" {f'{n} {1e3 * d:.2f} mm':>24}" for n, d in depths.items())
+        heads = "".join(f" {f'{n} {1e3 * d:.2f} mm x{f:.2f}':>30}" for n, (d, f) in depths.items())
         print(f"{'ranks':>6} {'whole':>8}" + heads)
         for row in rows:
-            shares = "".join(f" {100 * share:24.1f}" for share in row["cap_shares"].values())
+            shares = "".join(f" {100 * share:30.1f}" for share in row["cap_shares"].values())
             print(f"{row['ranks']:6d} {100 * row['communication_share']:8.1f}" + shares)
     return rows
 
