@@ -141,7 +141,7 @@ def measured_caps(nodes_across_radius: int, depth: float, pair_law: str) -> floa
     """The engine's caps over this model's layer, measured on the 27 touching spheres after
     320 steps under `pair_law`: for each sphere and each other one, the nodes the engine would
     send of it (DistributedRun._exchange_caps: list positions within the cutoff plus the
-    default cap margin h/2 of the other's, their anchor candidates, and every bonded neighbour
+    default cap margin h/2 of the other's, their anchors, and every bonded neighbour
     of those within the reach at which the contact reads surface normals) over the nodes
     within `depth` of the other's bounding sphere (exchanged_nodes' layer), summed over the
     pairs with a node in that layer."""
@@ -164,7 +164,7 @@ def measured_caps(nodes_across_radius: int, depth: float, pair_law: str) -> floa
             normal = near[points_within(x[near], x[theirs], normal_reach + margin).astype(bool)]
             read = (
                 near,
-                core.anchor_candidates(near.tolist()),
+                core.contact_anchors(near.tolist()),
                 sim.model.bond_partners(normal.tolist()),
             )
             capped += len(np.unique(np.concatenate([np.asarray(r, np.int64) for r in read])))

@@ -192,6 +192,7 @@ def compare(
     renewals = comm.gather(distributed.renewals, root=0)
     held = comm.gather((distributed.ghost_node_count, distributed.exchanged_node_count), root=0)
     seconds = comm.allreduce(distributed.second_messages)
+    joined = comm.allreduce(distributed.nodes_joined)
     if comm.Get_rank() != 0:
         return 0
     worst = {name: float(np.abs(fields[name] - getattr(serial, name)).max()) for name in fields}
@@ -205,7 +206,8 @@ def compare(
         f"{distributed.handed_over}, parts built anew per rank {renewals}, caps picked anew "
         f"{distributed.cap_refreshes}, cap margin widened "
         f"{distributed.cap_margin_widenings} times to {distributed.cap_margin:.3g} m, ghost "
-        f"nodes held and sent a step per rank {held}, second messages {seconds}, bonds broken "
+        f"nodes held and sent a step per rank {held}, second messages {seconds}, nodes joining "
+        f"caps {joined}, bonds broken "
         f"{serial.broken_bonds()}, largest differences {worst}"
     )
     return 0 if same_dt and not any(worst.values()) else 1

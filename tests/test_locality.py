@@ -119,9 +119,10 @@ def test_a_ghost_grain_needs_only_its_owners_cap_motion_and_breaks(
     """A rank skips its ghosts' bonds and moves (core.set_ghost_particles): between the halves
     of a step (core.begin_step, finish_step) their owners give them the positions and
     velocities of their nodes within reach of the rank's own (the cap: those whose list
-    positions lie within the lists' cutoff of an own node's, the nodes their anchored vectors
-    read, and the nodes bonded to those within the reach at which the contact reads surface
-    normals, as DistributedRun._exchange_caps takes them), the breaks, and the motion of each
+    positions lie within the lists' cutoff of an own node's, their anchors before and after
+    the step's breaks, and the nodes bonded to those within the reach at which the contact
+    reads surface normals, as DistributedRun._exchange_caps and _joining take them), the
+    breaks, and the motion of each
     of their bodies
     (core.fragment_motions, core.give_ghost_motions). The tumbling drum run twice, once with
     grain 1 a ghost given that within each step (node spheres, and the surface law with rolling
@@ -150,8 +151,9 @@ def test_a_ghost_grain_needs_only_its_owners_cap_motion_and_breaks(
         x = whole.core.list_positions  # where the lists see the nodes: what the caps go by
         near = ghost.start + np.flatnonzero(within_reach(x[ghost], x[others], reach))
         normal = near[within_reach(x[near], x[others], normal_reach)]
-        read = (
-            part.core.anchor_candidates(near.tolist()),
+        read = (  # the anchors before and after this step's breaks (_joining's)
+            part.core.contact_anchors(near.tolist()),
+            whole.core.contact_anchors(near.tolist()),
             part.model.bond_partners(normal.tolist()),
         )
         cap = np.unique(np.concatenate([near, *(np.asarray(r, np.int64) for r in read)]))

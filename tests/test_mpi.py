@@ -106,10 +106,13 @@ def test_ghosts_exchanged_as_caps_keep_the_serial_run_bit_for_bit() -> None:
     anew some 60 times, within the steps whose drift, or whose breaks, took a node or where the
     lists see it past half the cap margin, and cut the grains anew a few times while the discs
     shatter (10,542 bonds), the messages with room for one break and one body per grain
-    (hundreds of second messages). Every node ends as in the serial run."""
+    (hundreds of second messages), and nodes join the caps within steps as the nodes of a cap
+    take new anchors when their bonds break (DistributedRun._joining). Every node ends as in
+    the serial run."""
     done = run_ranks(3, "fine", "400", "4e-4", "2e-5")
     assert done.returncode == 0, done.stdout + done.stderr
     assert "'positions': 0.0, 'velocities': 0.0, 'forces': 0.0, 'walls': 0.0}" in done.stdout
+    assert int(done.stdout.split("nodes joining caps ")[1].split(",")[0]) > 0
     assert int(done.stdout.split("caps picked anew ")[1].split(",")[0]) >= 20
     assert int(done.stdout.split("second messages ")[1].split(",")[0]) >= 100
     assert int(done.stdout.split("bonds broken ")[1].split(",")[0]) > 5000

@@ -316,6 +316,17 @@ std::vector<index_t> Simulation::anchor_candidates(const std::vector<index_t>& n
   return found;
 }
 
+std::vector<index_t> Simulation::contact_anchors(const std::vector<index_t>& nodes) const {
+  std::vector<index_t> found;
+  for (const index_t i : nodes) {
+    if (i >= model_->node_count()) throw InputError("contact_anchors: no node " + std::to_string(i));
+    contact_.anchors_of(*model_, i, found);
+  }
+  std::sort(found.begin(), found.end());
+  found.erase(std::unique(found.begin(), found.end()), found.end());
+  return found;
+}
+
 std::vector<real> Simulation::list_positions() const {
   std::vector<real> x;
   contact_.fill_list_positions(*model_, state_, x);

@@ -73,14 +73,19 @@ std::vector<index_t> SurfaceCentres::bonded_within_reach(const Model& model, con
   return nodes;
 }
 
-void SurfaceCentres::anchor_candidates(const Model& model, const State& state, index_t i,
-                                       std::vector<index_t>& out) const {
+void SurfaceCentres::anchors_of(const Model& model, index_t i, std::vector<index_t>& out) const {
   const SurfaceAnchor* a = anchor(model, i);
   if (a == nullptr) return;
   const index_t first = model.particles()[model.node_particle()[i]].first_node;
   for (const index_t k : a->nodes) {
     if (k != SurfaceAnchor::no_anchor) out.push_back(first + k);
   }
+}
+
+void SurfaceCentres::anchor_candidates(const Model& model, const State& state, index_t i,
+                                       std::vector<index_t>& out) const {
+  if (!moved(i)) return;
+  anchors_of(model, i, out);
   if (!anchor_slot_.empty() && surface_[model.node_particle()[i]]) {  // reanchor may take these
     for (const index_t j : bonded_within_reach(model, state, i)) out.push_back(j);
   }

@@ -177,6 +177,9 @@ class Simulation {
   /// The nodes whose positions the anchored vectors of `nodes` read, now or after bonds break
   /// (ContactModel::anchor_candidates), sorted, each once.
   std::vector<index_t> anchor_candidates(const std::vector<index_t>& nodes) const;
+  /// The nodes whose positions the anchored vectors of `nodes` read now (their anchors:
+  /// ContactModel::anchors_of), sorted, each once.
+  std::vector<index_t> contact_anchors(const std::vector<index_t>& nodes) const;
 
  private:
   // The phases of compute_forces, in order.

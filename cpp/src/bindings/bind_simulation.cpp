@@ -207,6 +207,14 @@ void bind_loading(nb::class_<Simulation>& cls) {
           "nodes"_a,
           "The nodes whose positions these nodes' anchored vectors read, now or after bonds break "
           "(sorted, each once).")
+      .def(
+          "contact_anchors",
+          [](const Simulation& s, const std::vector<index_t>& nodes) {
+            return copy_out(s.contact_anchors(nodes));
+          },
+          "nodes"_a,
+          "The nodes whose positions these nodes' anchored vectors read now: their anchors (sorted, each "
+          "once).")
       .def("search_contacts", &Simulation::search_contacts,
            "List every node's contact partners again now, carrying collisions and friction springs over.")
       .def(

@@ -68,7 +68,10 @@ _TAG = 17
 _REST_TAG = 18  # what a step's message has no room for
 _CAP_TAG = 19
 _BODY = 16  # numbers a body's motion takes in a message: its first node, then 15
-_WIDTHS = np.array([2, _BODY])  # a step message's sections: breaks (node pairs), bodies
+_JOINING = 7  # numbers a node joining a cap takes: its global number, x and v
+#: A step message's sections: breaks (node pairs), bodies, nodes joining the cap.
+_WIDTHS = np.array([2, _BODY, _JOINING])
+_NONE_JOINING = np.zeros((0, _JOINING))
 
 
 class DistributedRun:
@@ -110,6 +113,9 @@ class DistributedRun:
     #: Bodies' motions it carries beyond one per grain sent (a grain's fragments, each its
     #: first node and 15 numbers); more go in the second message too.
     body_slots = 64
+    #: Nodes joining the cap it carries (the new anchors of a cap's nodes whose bonds broke);
+    #: more go in the second message too.
+    joining_slots = 64
     #: A distribution of the grains shorter than this many steps widens the default margin.
     short_distribution = 200
     #: The widest default margin, in radii of the largest free grain.
@@ -173,6 +179,8 @@ class DistributedRun:
         self.cap_refreshes = 0
         #: The ghost nodes this rank received in all its steps (each step, its caps').
         self.nodes_received = 0
+        #: The nodes that joined its caps between picks (new anchors of cap nodes; _joining).
+        self.nodes_joined = 0
         #: How many of this rank's step messages had a second one for the breaks and bodies'
         #: motions they had no room for.
         self.second_messages = 0
@@ -378,8 +386,9 @@ class DistributedRun:
         nodes whose list positions (where the contact lists see them: a surface point,
         contact centre or the node, core.list_positions) lie within the cutoff plus the cap
         margin of one of this rank's own nodes' list positions, and the nodes those read:
-        their anchors and the neighbours they may take as anchors when bonds break
-        (core.anchor_candidates), and, for those within the reach at which the contact reads
+        their anchors (core.contact_anchors; a node that takes new anchors when its bonds
+        break brings them into the cap in that step's message, _joining), and, for those
+        within the reach at which the contact reads
         surface normals (sums over a node's bonds: core.contact_surface_normal_reach, none
         under PeriDEM's node pairs) plus the cap margin, every node bonded to them; under
         PeriDEM's damping also every ghost's centre node (the damping reads it). No other
@@ -408,7 +417,7 @@ class DistributedRun:
             near = nodes[close[nodes]]
             read = (
                 near,
-                core.anchor_candidates(near.tolist()),
+                core.contact_anchors(near.tolist()),
                 self.local.model.bond_partners(near[normals[near]].tolist()),
             )
             caps[q] = np.unique(np.concatenate([np.asarray(r, dtype=np.int64) for r in read]))
@@ -422,6 +431,7 @@ class DistributedRun:
             q: self._node_map[self.comm.recv(source=q, tag=_CAP_TAG)] for q in self._send_whole
         }
         self.mpi.Request.waitall(requests)
+        self._in_send = {q: _mask(len(self._to_global), n) for q, n in self._send.items()}
         self._receive = caps
         outside = [np.setdiff1d(self._receive_whole[q], cap) for q, cap in caps.items()]
         self.local.core.set_inert_contact_nodes(np.concatenate([[], *outside]).astype(int).tolist())
@@ -433,8 +443,8 @@ class DistributedRun:
 
     def _rooms(self, grains: int) -> NDArray[np.int64]:
         """The rows a step's message about `grains` grains carries of each section: break_slots
-        breaks, and one body per grain plus body_slots."""
-        return np.array([self.break_slots, grains + self.body_slots])
+        breaks, one body per grain plus body_slots, and joining_slots nodes joining the cap."""
+        return np.array([self.break_slots, grains + self.body_slots, self.joining_slots])
 
     def _local_slice(self, grain: int) -> slice:
         """The local nodes of a held grain."""
@@ -511,7 +521,8 @@ class DistributedRun:
         which the contact uses) of the nodes in their caps (_exchange_caps), the bonds that
         broke in those grains this step (`broken`: flat (i, j) local node pairs; None when
         the step failed, and then no bodies either) and the motion of each of their fragments
-        (core.fragment_motions), all in global numbering; it takes the same for its ghosts,
+        (core.fragment_motions), and the nodes joining their caps (_joining: number, x, v),
+        all in global numbering; it takes the same for its ghosts,
         overwriting their copies and giving the core their bodies' motions. One message per
         pair of neighbouring ranks (_pack); what it has no room for goes in a second. The
         ghosts' breaks, as (k, 2) local node pairs, and their bodies' motions (first nodes,
@@ -520,29 +531,64 @@ class DistributedRun:
         x, v = core.positions, core.velocities
         pairs = np.asarray([] if broken is None else broken, dtype=np.int64).reshape(-1, 2)
         bodies, rows = self._own_motions(broken is not None)
+        touched = np.unique(pairs)
         requests = [self.comm.Irecv(box, source=q, tag=_TAG) for q, box in self._inbox.items()]
-        overflow = []
+        overflow, joined = [], {}
         for q, nodes in self._send.items():
             theirs = self._to_global[pairs[self._sent_to[q][pairs[:, 0]]]]
-            box = self._outbox[q]
-            used, rest = _pack(
-                box, (x[nodes], v[nodes]), [theirs, bodies[rows[q]]], self._rooms_out[q]
+            joined[q] = self._joining(q, touched)
+            joining = (
+                np.hstack([self._to_global[joined[q], None], x[joined[q]], v[joined[q]]])
+                if len(joined[q])
+                else _NONE_JOINING
             )
+            box = self._outbox[q]
+            sections = [theirs, bodies[rows[q]], joining]
+            used, rest = _pack(box, (x[nodes], v[nodes]), sections, self._rooms_out[q])
             requests.append(self.comm.Isend(box[:used], dest=q, tag=_TAG))
             if len(rest):
                 overflow.append(self.comm.Isend(rest, dest=q, tag=_REST_TAG))
                 self.second_messages += 1
         self.mpi.Request.Waitall(requests)
-        received = [self._unpack(q, nodes, (x, v)) for q, nodes in self._receive.items()]
+        received = {q: self._unpack(q, nodes, (x, v)) for q, nodes in self._receive.items()}
         self.nodes_received += self.exchanged_node_count
         self.mpi.Request.Waitall(overflow)
-        motions = np.concatenate([np.zeros((0, _BODY)), *(m for _, m in received)])
+        self._grow_caps(joined, {q: joining for q, (_, _, joining) in received.items()})
+        motions = np.concatenate([np.zeros((0, _BODY)), *(m for _, m, _ in received.values())])
         first = self._node_map[motions[:, 0].astype(np.int64)].astype(np.uint32)
-        ghost_breaks = np.concatenate([np.zeros((0, 2), np.int64), *(b for b, _ in received)])
+        breaks = (b for b, _, _ in received.values())
+        ghost_breaks = np.concatenate([np.zeros((0, 2), np.int64), *breaks])
         return self._node_map[ghost_breaks].astype(np.uint32), (
             first,
             np.ascontiguousarray(motions[:, 1:]),
         )
+
+    def _joining(self, q: int, touched: NDArray[np.int64]) -> NDArray[np.int64]:
+        """The own nodes that join the cap rank q receives in this step: the anchors now
+        (core.contact_anchors, after this step's breaks) of its nodes among `touched` (those
+        whose bonds broke in this step, which may have taken new anchors) that it lacks."""
+        mine = touched[self._in_send[q][touched]] if len(touched) else touched
+        if len(mine) == 0:
+            return mine
+        anchors = np.asarray(self.local.core.contact_anchors(mine.tolist()), dtype=np.int64)
+        return anchors[~self._in_send[q][anchors]]
+
+    def _grow_caps(
+        self, sent: dict[int, NDArray[np.int64]], received: dict[int, NDArray[np.int64]]
+    ) -> None:
+        """The nodes that joined the caps in this step's messages (`sent`, `received`: local
+        nodes per rank, in the order of the message) are in them from now on, at their ends,
+        and the messages' buffers grow for them."""
+        for q, joined in sent.items():
+            if len(joined):
+                self._send[q] = np.concatenate([self._send[q], joined])
+                self._in_send[q][joined] = True
+                self._outbox[q] = _message(len(self._send[q]), self._rooms_out[q])
+        for q, joined in received.items():
+            if len(joined):
+                self._receive[q] = np.concatenate([self._receive[q], joined])
+                self._inbox[q] = _message(len(self._receive[q]), self._rooms_in[q])
+                self.nodes_joined += len(joined)
 
     def _own_motions(
         self, measured: bool
@@ -562,10 +608,11 @@ class DistributedRun:
 
     def _unpack(
         self, q: int, nodes: NDArray[np.int64], fields: tuple[NDArray[np.float64], ...]
-    ) -> tuple[NDArray[np.int64], NDArray[np.float64]]:
-        """Rank q's message of this step into the ghosts' `fields`; its breaks, (k, 2) global
-        node pairs, and bodies' motions, (k, 16) (with what the message had no room for,
-        received now from the second message)."""
+    ) -> tuple[NDArray[np.int64], NDArray[np.float64], NDArray[np.int64]]:
+        """Rank q's message of this step into the ghosts' `fields`, and the nodes joining its
+        cap (local, their x and v into `fields` too); its breaks, (k, 2) global node pairs,
+        bodies' motions, (k, 16) (with what the message had no room for, received now from the
+        second message), and the joining nodes."""
         box = self._inbox[q]
         count = 6 * len(nodes)
         motion = box[:count].reshape(-1, 6)
@@ -576,8 +623,11 @@ class DistributedRun:
         rest = np.empty(int(((totals - kept) * _WIDTHS).sum()))
         if len(rest):
             self.comm.Recv(rest, source=q, tag=_REST_TAG)
-        breaks, bodies = _sections(box[count + len(_WIDTHS) :], kept, rest, totals - kept)
-        return breaks.astype(np.int64), bodies
+        breaks, bodies, joining = _sections(box[count + len(_WIDTHS) :], kept, rest, totals - kept)
+        joined = self._node_map[joining[:, 0].astype(np.int64)]
+        for k, field in enumerate(fields):
+            field[joined] = joining[:, 1 + 3 * k : 4 + 3 * k]
+        return breaks.astype(np.int64), bodies, joined
 
     def run(self, steps: int) -> None:
         """Advance every rank `steps` time steps, migrating grains before a step once a node
@@ -999,7 +1049,8 @@ def _pack(
     rooms: NDArray[np.int64],
 ) -> tuple[int, NDArray[np.float64]]:
     """A step's message: the nodes' `fields` (x, v: 6 numbers a node), then each section's row
-    count, then each section's rows (breaks, (k, 2); bodies, (k, 16)), up to its room; the
+    count, then each section's rows (breaks, (k, 2); bodies, (k, 16); nodes joining the cap,
+    (k, 7)), up to its room; the
     numbers written, and the rows with no room (every section's, flat, in order) for a
     second message."""
     count = 6 * len(fields[0])

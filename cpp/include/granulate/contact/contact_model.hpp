@@ -260,6 +260,11 @@ class ContactModel {
   void anchor_candidates(const Model& model, const State& state, index_t i, std::vector<index_t>& out) const {
     centres_.anchor_candidates(model, state, i, out);
   }
+  /// The nodes node i's anchored vector reads now (SurfaceCentres::anchors_of), appended to
+  /// `out`.
+  void anchors_of(const Model& model, index_t i, std::vector<index_t>& out) const {
+    centres_.anchors_of(model, i, out);
+  }
 
   ContactCheckpoint checkpoint() const;
   /// Restores a checkpoint taken with the same model, laws and walls; `state` is the restored

@@ -77,6 +77,9 @@ class SurfaceCentres {
   /// to `out`: its anchors and, under the surface law, its neighbours within 1.75 h still bonded
   /// to it (those it may take as anchors: bonds only break); none for a node seen at itself.
   void anchor_candidates(const Model& model, const State& state, index_t i, std::vector<index_t>& out) const;
+  /// The nodes node i's anchored vector reads now (its anchors), appended to `out`; none for a
+  /// node seen at itself.
+  void anchors_of(const Model& model, index_t i, std::vector<index_t>& out) const;
 
   /// Whether node i is seen away from itself (it has anchors): a cheap test for the hot loops.
   bool moved(index_t i) const { return any_ && anchored_[i]; }
