@@ -305,17 +305,6 @@ void Simulation::set_travel_origin(std::vector<index_t> watched) {
   largest_travel_ = 0;
 }
 
-std::vector<index_t> Simulation::anchor_candidates(const std::vector<index_t>& nodes) const {
-  std::vector<index_t> found;
-  for (const index_t i : nodes) {
-    if (i >= model_->node_count()) throw InputError("anchor_candidates: no node " + std::to_string(i));
-    contact_.anchor_candidates(*model_, state_, i, found);
-  }
-  std::sort(found.begin(), found.end());
-  found.erase(std::unique(found.begin(), found.end()), found.end());
-  return found;
-}
-
 std::vector<index_t> Simulation::contact_anchors(const std::vector<index_t>& nodes) const {
   std::vector<index_t> found;
   for (const index_t i : nodes) {

@@ -82,15 +82,6 @@ void SurfaceCentres::anchors_of(const Model& model, index_t i, std::vector<index
   }
 }
 
-void SurfaceCentres::anchor_candidates(const Model& model, const State& state, index_t i,
-                                       std::vector<index_t>& out) const {
-  if (!moved(i)) return;
-  anchors_of(model, i, out);
-  if (!anchor_slot_.empty() && surface_[model.node_particle()[i]]) {  // reanchor may take these
-    for (const index_t j : bonded_within_reach(model, state, i)) out.push_back(j);
-  }
-}
-
 bool SurfaceCentres::reanchor(const Model& model, const State& state, index_t i) {
   // The same anchored vector in the reference, A_0 = sum_k w_k (X_k - X_i) of the shape's
   // anchors, from all the intact bonds within 1.75 h, nearest first (ties by index). A function

@@ -174,9 +174,6 @@ class Simulation {
   /// contact reads their surface normals, sums over their bonds [m]
   /// (ContactModel::surface_normal_reach; 0: never).
   real contact_surface_normal_reach() const { return contact_.surface_normal_reach(*model_); }
-  /// The nodes whose positions the anchored vectors of `nodes` read, now or after bonds break
-  /// (ContactModel::anchor_candidates), sorted, each once.
-  std::vector<index_t> anchor_candidates(const std::vector<index_t>& nodes) const;
   /// The nodes whose positions the anchored vectors of `nodes` read now (their anchors:
   /// ContactModel::anchors_of), sorted, each once.
   std::vector<index_t> contact_anchors(const std::vector<index_t>& nodes) const;

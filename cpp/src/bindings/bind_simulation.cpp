@@ -200,14 +200,6 @@ void bind_loading(nb::class_<Simulation>& cls) {
                    "How near two nodes of different bodies must come, as the lists see them, before "
                    "their contact reads their surface normals (sums over their bonds) [m]; 0: never.")
       .def(
-          "anchor_candidates",
-          [](const Simulation& s, const std::vector<index_t>& nodes) {
-            return copy_out(s.anchor_candidates(nodes));
-          },
-          "nodes"_a,
-          "The nodes whose positions these nodes' anchored vectors read, now or after bonds break "
-          "(sorted, each once).")
-      .def(
           "contact_anchors",
           [](const Simulation& s, const std::vector<index_t>& nodes) {
             return copy_out(s.contact_anchors(nodes));

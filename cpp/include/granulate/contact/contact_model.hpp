@@ -255,11 +255,6 @@ class ContactModel {
   /// themselves, within Rc. 0 where no law reads them. The bonded neighbours a distributed
   /// run's caps must hold for a node that near.
   real surface_normal_reach(const Model& model) const;
-  /// The nodes whose positions node i's anchored vector reads, now or after its bonds break
-  /// (SurfaceCentres::anchor_candidates), appended to `out`.
-  void anchor_candidates(const Model& model, const State& state, index_t i, std::vector<index_t>& out) const {
-    centres_.anchor_candidates(model, state, i, out);
-  }
   /// The nodes node i's anchored vector reads now (SurfaceCentres::anchors_of), appended to
   /// `out`.
   void anchors_of(const Model& model, index_t i, std::vector<index_t>& out) const {

@@ -73,10 +73,6 @@ class SurfaceCentres {
   std::vector<index_t> detach_anchored(const Model& model, const State& state,
                                        std::span<const std::array<index_t, 2>> pairs);
 
-  /// The nodes whose positions node i's anchored vector reads, now or after bonds break, appended
-  /// to `out`: its anchors and, under the surface law, its neighbours within 1.75 h still bonded
-  /// to it (those it may take as anchors: bonds only break); none for a node seen at itself.
-  void anchor_candidates(const Model& model, const State& state, index_t i, std::vector<index_t>& out) const;
   /// The nodes node i's anchored vector reads now (its anchors), appended to `out`; none for a
   /// node seen at itself.
   void anchors_of(const Model& model, index_t i, std::vector<index_t>& out) const;
