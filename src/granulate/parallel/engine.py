@@ -388,9 +388,9 @@ class DistributedRun:
         margin of one of this rank's own nodes' list positions, and the nodes those read:
         their anchors (core.contact_anchors; a node that takes new anchors when its bonds
         break brings them into the cap in that step's message, _joining), and, for those
-        within the reach at which the contact reads
-        surface normals (sums over a node's bonds: core.contact_surface_normal_reach, none
-        under PeriDEM's node pairs) plus the cap margin, every node bonded to them; under
+        within the reach at which the contact reads surface normals (sums over a node's
+        bonds: core.contact_surface_normal_reach, none under PeriDEM's node pairs) plus the
+        cap margin, every node bonded to them; under
         PeriDEM's damping also every ghost's centre node (the damping reads it). No other
         ghost node can come within those reaches of an own node, as the lists see them,
         before the caps are picked again (each node, and each list position of a grain
@@ -522,11 +522,11 @@ class DistributedRun:
         broke in those grains this step (`broken`: flat (i, j) local node pairs; None when
         the step failed, and then no bodies either) and the motion of each of their fragments
         (core.fragment_motions), and the nodes joining their caps (_joining: number, x, v),
-        all in global numbering; it takes the same for its ghosts,
-        overwriting their copies and giving the core their bodies' motions. One message per
-        pair of neighbouring ranks (_pack); what it has no room for goes in a second. The
-        ghosts' breaks, as (k, 2) local node pairs, and their bodies' motions (first nodes,
-        local; (k, 15) motions) for core.give_ghost_motions."""
+        all in global numbering; it takes the same for its ghosts, overwriting their copies
+        (the caps growing by the nodes that joined) and giving the core their bodies' motions.
+        One message per pair of neighbouring ranks (_pack); what it has no room for goes in a
+        second. The ghosts' breaks, as (k, 2) local node pairs, and their bodies' motions
+        (first nodes, local; (k, 15) motions) for core.give_ghost_motions."""
         core = self.local.core
         x, v = core.positions, core.velocities
         pairs = np.asarray([] if broken is None else broken, dtype=np.int64).reshape(-1, 2)
@@ -1050,9 +1050,8 @@ def _pack(
 ) -> tuple[int, NDArray[np.float64]]:
     """A step's message: the nodes' `fields` (x, v: 6 numbers a node), then each section's row
     count, then each section's rows (breaks, (k, 2); bodies, (k, 16); nodes joining the cap,
-    (k, 7)), up to its room; the
-    numbers written, and the rows with no room (every section's, flat, in order) for a
-    second message."""
+    (k, 7)), up to its room; the numbers written, and the rows with no room (every section's,
+    flat, in order) for a second message."""
     count = 6 * len(fields[0])
     motion = box[:count].reshape(-1, 6)
     for k, field in enumerate(fields):
