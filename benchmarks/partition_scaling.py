@@ -45,6 +45,7 @@ from granulate._core import points_within
 
 import granulate as gr
 from granulate.parallel import bisect, ghosts, near_pairs
+from granulate.parallel.engine import contact_reads
 
 RADIUS = 1e-3
 #: The check after each step (one reduction of the travel the core measures in its last half
@@ -140,9 +141,9 @@ def node_steps_per_second(nodes_across_radius: int, steps: int = 300) -> tuple[f
 def measured_caps(nodes_across_radius: int, depth: float, pair_law: str) -> float:
     """The engine's caps over this model's layer, measured on the 27 touching spheres after
     320 steps under `pair_law`: for each sphere and each other one, the nodes the engine would
-    send of it (DistributedRun._exchange_caps: list positions within the cutoff plus the
-    default cap margin h/2 of the other's, their anchors, and every bonded neighbour
-    of those within the reach at which the contact reads surface normals) over the nodes
+    send of it (as DistributedRun._exchange_caps picks them: list positions within the cutoff
+    plus the default cap margin h/2 of the other's, and what the contact reads of them,
+    contact_reads) over the nodes
     within `depth` of the other's bounding sphere (exchanged_nodes' layer), summed over the
     pairs with a node in that layer."""
     sim = touching_spheres(nodes_across_radius, pair_law)
@@ -162,12 +163,7 @@ def measured_caps(nodes_across_radius: int, depth: float, pair_law: str) -> floa
                 continue
             near = mine[points_within(x[mine], x[theirs], cutoff + margin).astype(bool)]
             normal = near[points_within(x[near], x[theirs], normal_reach + margin).astype(bool)]
-            read = (
-                near,
-                core.contact_anchors(near.tolist()),
-                sim.model.bond_partners(normal.tolist()),
-            )
-            capped += len(np.unique(np.concatenate([np.asarray(r, np.int64) for r in read])))
+            capped += len(contact_reads(core, sim.model, near, normal))
             layer += int(within.sum())
     return capped / layer
 

@@ -71,7 +71,6 @@ _BODY = 16  # numbers a body's motion takes in a message: its first node, then 1
 _JOINING = 7  # numbers a node joining a cap takes: its global number, x and v
 #: A step message's sections: breaks (node pairs), bodies, nodes joining the cap.
 _WIDTHS = np.array([2, _BODY, _JOINING])
-_NONE_JOINING = np.zeros((0, _JOINING))
 
 
 class DistributedRun:
@@ -415,12 +414,7 @@ class DistributedRun:
         caps = {}
         for q, nodes in self._receive_whole.items():
             near = nodes[close[nodes]]
-            read = (
-                near,
-                core.contact_anchors(near.tolist()),
-                self.local.model.bond_partners(near[normals[near]].tolist()),
-            )
-            caps[q] = np.unique(np.concatenate([np.asarray(r, dtype=np.int64) for r in read]))
+            caps[q] = contact_reads(core, self.local.model, near, near[normals[near]])
             if self._damped_centres is not None:  # PeriDEM's damping reads ghosts' centres
                 centres = self._node_map[self._damped_centres[self._receive_grains[q]]]
                 caps[q] = np.union1d(caps[q], centres)
@@ -537,11 +531,7 @@ class DistributedRun:
         for q, nodes in self._send.items():
             theirs = self._to_global[pairs[self._sent_to[q][pairs[:, 0]]]]
             joined[q] = self._joining(q, touched)
-            joining = (
-                np.hstack([self._to_global[joined[q], None], x[joined[q]], v[joined[q]]])
-                if len(joined[q])
-                else _NONE_JOINING
-            )
+            joining = np.hstack([self._to_global[joined[q], None], x[joined[q]], v[joined[q]]])
             box = self._outbox[q]
             sections = [theirs, bodies[rows[q]], joining]
             used, rest = _pack(box, (x[nodes], v[nodes]), sections, self._rooms_out[q])
@@ -567,7 +557,7 @@ class DistributedRun:
         """The own nodes that join the cap rank q receives in this step: the anchors now
         (core.contact_anchors, after this step's breaks) of its nodes among `touched` (those
         whose bonds broke in this step, which may have taken new anchors) that it lacks."""
-        mine = touched[self._in_send[q][touched]] if len(touched) else touched
+        mine = touched[self._in_send[q][touched]]
         if len(mine) == 0:
             return mine
         anchors = np.asarray(self.local.core.contact_anchors(mine.tolist()), dtype=np.int64)
@@ -1034,6 +1024,18 @@ class DistributedRun:
         for grains, values in parts:
             whole[self._nodes_of(grains)] = values
         return whole
+
+
+def contact_reads(
+    core: Any, model: Any, near: NDArray[np.int64], normal: NDArray[np.int64]
+) -> NDArray[np.int64]:
+    """The nodes whose positions and velocities the contact reads of the nodes `near` (within
+    reach of another body, as the lists see them): those, their anchors now
+    (core.contact_anchors), and every node bonded to those of them in `normal` (within the
+    reach at which the contact reads surface normals, sums over a node's bonds;
+    model.bond_partners); sorted, each once. What a cap holds (_exchange_caps)."""
+    read = (near, core.contact_anchors(near.tolist()), model.bond_partners(normal.tolist()))
+    return np.unique(np.concatenate([np.asarray(r, dtype=np.int64) for r in read]))
 
 
 def _message(nodes: int, rooms: NDArray[np.int64]) -> NDArray[np.float64]:
