@@ -210,3 +210,35 @@ def test_a_failure_building_one_ranks_part_ends_every_rank_without_a_hang(during
     done = run_ranks(3, "2", "0", f"fail-{during}")
     assert done.returncode == 0, done.stdout + done.stderr
     assert "rank 2 failed while building its part" in done.stdout
+
+
+SPLIT_CHECK = Path(__file__).with_name("mpi_split_check.py")
+
+
+@pytest.mark.parametrize(
+    ("ranks", "shape", "model", "steps"),
+    [(2, "plate", "lps", 300), (3, "strip", "pmb", 300), (3, "block", "lps", 200)],
+)
+def test_a_body_split_at_node_level_is_the_serial_run_bit_for_bit(
+    ranks: int, shape: str, model: str, steps: int
+) -> None:
+    """A notched body cut across the ranks (granulate.parallel.node_split), stretched until it
+    cracks: every node's position, velocity, force and dilatation after `steps` steps, and the
+    bonds broken, as serially."""
+    environment = {**os.environ, "OMP_NUM_THREADS": "1"}
+    command = [
+        mpiexec(),
+        "-n",
+        str(ranks),
+        sys.executable,
+        str(SPLIT_CHECK),
+        shape,
+        model,
+        str(steps),
+    ]
+    done = subprocess.run(command, capture_output=True, text=True, timeout=300, env=environment)
+    assert done.returncode == 0, done.stdout + done.stderr
+    zero = "{'positions': 0.0, 'velocities': 0.0, 'forces': 0.0, 'dilatation': 0.0}"
+    assert f"ranks {ranks}, {shape} {model}, {steps} steps: {zero}" in done.stdout
+    broken = done.stdout.split("bonds broken ")[1].split()
+    assert int(broken[0]) == int(broken[2]) > 100

@@ -22,19 +22,18 @@ double seconds_since(clock_type::time_point start) {
 }
 
 /// The first half kick and the drift, v += dt/2 f/rho, x += dt v, of every node (with
-/// SkipGhosts, but those of the particles `ghost` flags, which their owners move). A template so
-/// that a serial run's loop has no test per node.
-template <bool SkipGhosts>
-void kick_and_drift(const Model& m, State& state, real dt, const std::uint8_t* ghost) {
+/// SkipOthers, but those `others` flags, other processes' nodes, which their owners move). A
+/// template so that a serial run's loop has no test per node.
+template <bool SkipOthers>
+void kick_and_drift(const Model& m, State& state, real dt, const std::uint8_t* others) {
   const std::int64_t n = m.node_count();
   auto& x = state.positions;
   auto& v = state.velocities;
   const auto& f = state.forces;
-  const auto& node_particle = m.node_particle();
 #pragma omp parallel for schedule(static)
   for (std::int64_t i = 0; i < n; ++i) {
-    if constexpr (SkipGhosts) {
-      if (ghost[node_particle[i]]) continue;
+    if constexpr (SkipOthers) {
+      if (others[i]) continue;
     }
     const real density = m.density(static_cast<index_t>(i));
     for (std::int64_t k = 3 * i; k < 3 * i + 3; ++k) {
@@ -44,10 +43,10 @@ void kick_and_drift(const Model& m, State& state, real dt, const std::uint8_t* g
   }
 }
 
-/// The second half kick of every node (with SkipGhosts, but the ghosts'), and the first node
-/// that moves more than its mesh size in a step or is not finite (n if none).
-template <bool SkipGhosts>
-std::int64_t second_half_kick(const Model& m, State& state, real dt, const std::uint8_t* ghost) {
+/// The second half kick of every node (with SkipOthers, but other processes' nodes), and the
+/// first node that moves more than its mesh size in a step or is not finite (n if none).
+template <bool SkipOthers>
+std::int64_t second_half_kick(const Model& m, State& state, real dt, const std::uint8_t* others) {
   const std::int64_t n = m.node_count();
   const auto& particles = m.particles();
   const auto& node_particle = m.node_particle();
@@ -56,8 +55,8 @@ std::int64_t second_half_kick(const Model& m, State& state, real dt, const std::
   std::int64_t first_unstable = n;
 #pragma omp parallel for schedule(static) reduction(min : first_unstable)
   for (std::int64_t i = 0; i < n; ++i) {
-    if constexpr (SkipGhosts) {
-      if (ghost[node_particle[i]]) continue;
+    if constexpr (SkipOthers) {
+      if (others[i]) continue;
     }
     real speed2 = 0;
     const real density = m.density(static_cast<index_t>(i));
@@ -71,14 +70,13 @@ std::int64_t second_half_kick(const Model& m, State& state, real dt, const std::
   return first_unstable;
 }
 
-/// The largest distance of a node (but the ghosts', which `ghost` flags per particle; null:
+/// The largest distance of a node (but other processes', which `others` flags per node; null:
 /// none) from its place in `origin`, and of the list position of each node in `watched`
 /// (ContactModel::list_position) from its row in `list_origin` [m].
 real farthest_travel(const Model& m, const State& state, const ContactModel& contact,
                      const std::vector<real>& origin, std::span<const index_t> watched,
-                     const std::vector<real>& list_origin, const std::uint8_t* ghost) {
+                     const std::vector<real>& list_origin, const std::uint8_t* others) {
   const std::int64_t n = m.node_count(), listed = static_cast<std::int64_t>(watched.size());
-  const auto& node_particle = m.node_particle();
   auto squared = [](const real* a, const real* b) {
     const real dx = a[0] - b[0], dy = a[1] - b[1], dz = a[2] - b[2];
     return dx * dx + dy * dy + dz * dz;
@@ -89,8 +87,7 @@ real farthest_travel(const Model& m, const State& state, const ContactModel& con
   {
 #pragma omp for schedule(static) reduction(max : farthest)
     for (std::int64_t i = 0; i < n; ++i) {
-      if (!ghost || !ghost[node_particle[i]])
-        farthest = std::max(farthest, squared(&x[3 * i], &origin[3 * i]));
+      if (!others || !others[i]) farthest = std::max(farthest, squared(&x[3 * i], &origin[3 * i]));
     }
 #pragma omp for schedule(static) reduction(max : farthest)
     for (std::int64_t k = 0; k < listed; ++k) {
@@ -235,7 +232,7 @@ void Simulation::evaluate_if_stale() {
 }
 
 void Simulation::run(std::uint64_t steps) {
-  if (step_begun_) throw InputError("run: the step begin_step began is not finished (finish_step)");
+  if (step_begun_ || moved_) throw InputError("run: the step begun is not finished (finish_step)");
   evaluate_if_stale();
   for (std::uint64_t s = 0; s < steps; ++s) {
     move_and_break_bonds();
@@ -243,15 +240,23 @@ void Simulation::run(std::uint64_t steps) {
   }
 }
 
-std::vector<std::array<index_t, 2>> Simulation::begin_step() {
-  if (step_begun_) throw InputError("begin_step: the step begun before is not finished (finish_step)");
-  if (!forces_current_ && !ghost_.empty()) {
+void Simulation::move() {
+  if (step_begun_ || moved_) throw InputError("move: the step begun before is not finished (finish_step)");
+  if (!forces_current_ && !others_.empty()) {
     throw InputError(
-        "begin_step: evaluate the forces (run(0)) before marking ghost particles, "
+        "move: evaluate the forces (run(0)) before marking ghost particles or foreign nodes, "
         "whose bonds the first evaluation breaks too");
   }
   evaluate_if_stale();
-  move_and_break_bonds();
+  move_nodes();
+  moved_ = true;
+}
+
+std::vector<std::array<index_t, 2>> Simulation::begin_step() {
+  if (step_begun_) throw InputError("begin_step: the step begun before is not finished (finish_step)");
+  if (!moved_) move();
+  moved_ = false;
+  break_bonds_and_measure_travel();
   step_begun_ = true;
   return breaks_;
 }
@@ -264,12 +269,17 @@ void Simulation::finish_step(std::span<const std::array<index_t, 2>> ghost_break
 }
 
 void Simulation::move_and_break_bonds() {
+  move_nodes();
+  break_bonds_and_measure_travel();
+}
+
+void Simulation::move_nodes() {
   const real dt = time_step_;
   auto start = clock_type::now();
-  if (ghost_.empty()) {
+  if (others_.empty()) {
     kick_and_drift<false>(*model_, state_, dt, nullptr);
   } else {
-    kick_and_drift<true>(*model_, state_, dt, ghost_.data());
+    kick_and_drift<true>(*model_, state_, dt, others_.data());
   }
   state_.time += dt;
   phase_times_.integration += seconds_since(start);
@@ -277,20 +287,22 @@ void Simulation::move_and_break_bonds() {
   start = clock_type::now();
   apply_prescribed_motion(true);
   phase_times_.loading += seconds_since(start);
+}
 
-  start = clock_type::now();
+void Simulation::break_bonds_and_measure_travel() {
+  auto start = clock_type::now();
   update_kinematic_nodes();
   sum_dilatation_and_break_bonds();  // pass 1
   phase_times_.peridynamics += seconds_since(start);
   if (!travel_origin_.empty()) {  // where the nodes and list positions stay for the step
     largest_travel_ = farthest_travel(*model_, state_, contact_, travel_origin_, list_watched_, list_origin_,
-                                      ghost_.empty() ? nullptr : ghost_.data());
+                                      others_.empty() ? nullptr : others_.data());
   }
 }
 
 void Simulation::set_travel_origin(std::vector<index_t> watched) {
   for (const index_t i : watched) {
-    if (i >= model_->node_count() || (!ghost_.empty() && ghost_node(i))) {
+    if (i >= model_->node_count() || others_node(i)) {
       throw InputError("set_travel_origin: node " + std::to_string(i) +
                        " is not one of this process's nodes");
     }
@@ -334,8 +346,8 @@ void Simulation::finish_step_after_breaks(std::span<const std::array<index_t, 2>
   // the step or became non-finite: checked every step, at the cost of one comparison per node
   // (not on ghosts, which their owners move and check).
   const std::int64_t first_unstable =
-      ghost_.empty() ? second_half_kick<false>(*model_, state_, time_step_, nullptr)
-                     : second_half_kick<true>(*model_, state_, time_step_, ghost_.data());
+      others_.empty() ? second_half_kick<false>(*model_, state_, time_step_, nullptr)
+                      : second_half_kick<true>(*model_, state_, time_step_, others_.data());
   apply_prescribed_motion(false);
   ++state_.step;
   if (first_unstable < n) check_stability();  // names the node (a prescribed one is fine)
@@ -385,7 +397,7 @@ void Simulation::check_stability() const {
   const auto& x = state_.positions;
   const index_t n = model_->node_count();
   for (index_t i = 0; i < n; ++i) {
-    if (ghost_node(i)) continue;  // its owner checks it
+    if (others_node(i)) continue;  // its owner checks it
     const real speed2 = v[3 * i] * v[3 * i] + v[3 * i + 1] * v[3 * i + 1] + v[3 * i + 2] * v[3 * i + 2];
     const bool finite = std::isfinite(speed2) && std::isfinite(x[3 * i]) && std::isfinite(x[3 * i + 1]) &&
                         std::isfinite(x[3 * i + 2]);
@@ -426,7 +438,7 @@ void Simulation::strain_energy_density(real* out) const {
 #pragma omp parallel for schedule(static)
   for (std::int64_t ii = 0; ii < static_cast<std::int64_t>(m.node_count()); ++ii) {
     const index_t i = static_cast<index_t>(ii);
-    if (ghost_node(i)) {  // another process's: it measures them
+    if (others_node(i)) {  // another process's: it measures them
       out[i] = 0;
       continue;
     }
@@ -469,7 +481,7 @@ void Simulation::damage(real* phi, real* z) const {
 #pragma omp parallel for schedule(static)
   for (std::int64_t ii = 0; ii < static_cast<std::int64_t>(m.node_count()); ++ii) {
     const index_t i = static_cast<index_t>(ii);
-    if (ghost_node(i)) {  // another process's: it measures them
+    if (others_node(i)) {  // another process's: it measures them
       if (phi) phi[i] = 0;
       if (z) z[i] = 0;
       continue;

@@ -17,18 +17,23 @@ namespace granulate {
 namespace {
 
 /// Adds V_j J beta r e of node i's forward bonds to i's sum and V_i J beta r e to j's (the sums
-/// of w r e in the dilatation); with Gather, of all i's bonds to i's sum only. With CanBreak, a
-/// bond past the critical stretch breaks instead: its bit at i is cleared and (i, j) is
-/// appended to `broken` (by the lower-numbered end only, when both ends evaluate it).
-template <bool CanBreak, bool Gather>
+/// of w r e in the dilatation); with Gather, of all i's bonds to i's sum only; with ToOwn, of
+/// i's forward bonds to the nodes `foreign` does not flag only (i a foreign node). With
+/// CanBreak, a bond past the critical stretch breaks instead: its bit at i is cleared and
+/// (i, j) is appended to `broken` (by the lower-numbered end only, when both ends evaluate it).
+template <bool CanBreak, bool Gather, bool ToOwn = false>
 void add_dilatation_terms(index_t i, const NodeBonds& bonds, std::uint8_t* bond_bits,
                           CriticalStretch criterion, const real* x, const real* volumes, real* sums,
-                          std::vector<std::array<index_t, 2>>& broken) {
+                          std::vector<std::array<index_t, 2>>& broken,
+                          const std::uint8_t* foreign = nullptr) {
   const real volume_i = volumes[i];
   real sum = 0;
   for (index_t b = Gather ? 0 : bonds.forward; b < bonds.count; ++b) {
     if (!BondStates::intact(bond_bits, b)) continue;
     const index_t j = bonds.neighbor(b);
+    if constexpr (ToOwn) {
+      if (foreign[j]) continue;
+    }
     const real r = bonds.length(b);
     const real e = bond_extension(i, j, r, x);
     if constexpr (CanBreak) {
@@ -62,6 +67,9 @@ void for_each_node_in_colours(const BondSchedule& schedule, Body&& body) {
   }
 }
 
+/// Simulation::foreign_ of a foreign node with no bond to an own node (1: it has one).
+constexpr std::uint8_t far_foreign = 2;
+
 /// What the pair-force loop reads and writes, as raw pointers (kept in registers).
 struct PairForceArrays {
   const real* positions;
@@ -74,9 +82,11 @@ struct PairForceArrays {
 
 /// Adds the pair forces of node i's forward bonds to both ends: w_ij s y/|y| to i and
 /// -w_ji s y/|y| to j, with s the LPS (Lps) or PMB scalar force state of the bond without its
-/// weight and w_ij = J beta_ij V_j; with Gather, of all i's bonds to i only.
-template <bool Lps, bool Gather>
-void add_pair_forces(index_t i, const NodeBonds& bonds, const std::uint8_t* bond_bits, PairForceArrays a) {
+/// weight and w_ij = J beta_ij V_j; with Gather, of all i's bonds to i only; with ToOwn, of its
+/// forward bonds to the nodes `foreign` does not flag only (i a foreign node).
+template <bool Lps, bool Gather, bool ToOwn = false>
+void add_pair_forces(index_t i, const NodeBonds& bonds, const std::uint8_t* bond_bits, PairForceArrays a,
+                     const std::uint8_t* foreign = nullptr) {
   const real* const x = a.positions;
   real* const f = a.forces;
   const real pressure_i = Lps ? a.pressures[i] : 0;
@@ -88,6 +98,9 @@ void add_pair_forces(index_t i, const NodeBonds& bonds, const std::uint8_t* bond
   for (index_t b = Gather ? 0 : bonds.forward; b < bonds.count; ++b) {
     if (!BondStates::intact(bond_bits, b)) continue;
     const index_t j = bonds.neighbor(b);
+    if constexpr (ToOwn) {
+      if (foreign[j]) continue;
+    }
     const real* const xj = x + 3 * std::size_t{j};  // one base register for the three components
     const real dx = xj[0] - xi[0], dy = xj[1] - xi[1], dz = xj[2] - xi[2];
     const real length = std::sqrt(dx * dx + dy * dy + dz * dz);
@@ -125,12 +138,14 @@ void add_pair_forces(index_t i, const NodeBonds& bonds, const std::uint8_t* bond
 
 void Simulation::add_bond_forces(real* forces) const {
   // Pass 2: pair forces, w_ij s y/|y| on i and -w_ji s y/|y| on j (w_ij = J beta V_j), from the
-  // pressures of pass 1. Ghost particles are skipped (set_ghost_particles).
+  // pressures of pass 1. Ghost particles are skipped (set_ghost_particles), and of a foreign
+  // node only its forward bonds to own nodes are evaluated (set_foreign_nodes).
   const Model& m = *model_;
   const BondSchedule& schedule = m.bond_schedule();
   const PairForceArrays arrays{state_.positions.data(),     m.volumes().data(),       pressure_.data(),
                                m.lps_coefficients().data(), m.pmb_stiffness().data(), forces};
   const std::uint8_t* const ghost = ghost_.empty() ? nullptr : ghost_.data();
+  const std::uint8_t* const foreign = foreign_.empty() ? nullptr : foreign_.data();
 #pragma omp parallel
   for_each_node_in_colours(schedule, [&](index_t i) {
     if (ghost && ghost[m.node_particle()[i]]) return;  // another process's forces
@@ -138,7 +153,14 @@ void Simulation::add_bond_forces(real* forces) const {
     const bool lps = m.materials()[m.node_material()[i]].params.model == ForceModel::lps;
     const bool gathers = schedule.particle_gathers[m.node_particle()[i]];
     const std::uint8_t* const bits = state_.bonds.node(i);
-    if (lps && !gathers) {
+    if (foreign && foreign[i]) {  // its terms on own nodes; own nodes that gather take their own
+      if (gathers || foreign[i] == far_foreign) return;
+      if (lps) {
+        add_pair_forces<true, false, true>(i, bonds, bits, arrays, foreign);
+      } else {
+        add_pair_forces<false, false, true>(i, bonds, bits, arrays, foreign);
+      }
+    } else if (lps && !gathers) {
       add_pair_forces<true, false>(i, bonds, bits, arrays);
     } else if (!gathers) {
       add_pair_forces<false, false>(i, bonds, bits, arrays);
@@ -168,7 +190,11 @@ void Simulation::finish_forces(std::span<const std::array<index_t, 2>> ghost_bre
   contact_.bonds_broke(*model_, state_, std::span(breaks_).subspan(own));
   start_node_forces();
   add_bond_forces(state_.forces.data());  // pass 2
-  broken_bond_copies_ += 2 * breaks_.size();
+  broken_bond_copies_ +=
+      2 * (foreign_.empty()
+               ? breaks_.size()
+               : static_cast<std::size_t>(std::count_if(
+                     breaks_.begin(), breaks_.end(), [&](const auto& pair) { return !foreign_[pair[0]]; })));
   add_contact_forces();
   add_nodal_forces();
   forces_current_ = true;
@@ -180,7 +206,8 @@ void Simulation::sum_dilatation_and_break_bonds() {
   // ends gather, both see bitwise the same stretch and each clears its own). The bonds broken
   // are left in breaks_ for finish_forces, and the anchors they change are taken anew here, so
   // that a step's list positions are settled once it has begun. Ghost particles are skipped
-  // (set_ghost_particles): their breaks come from their owners.
+  // (set_ghost_particles): their breaks come from their owners; of a foreign node only its
+  // forward bonds to own nodes are evaluated (set_foreign_nodes).
   const Model& m = *model_;
   const auto& materials = m.materials();
   const auto& node_material = m.node_material();
@@ -191,6 +218,7 @@ void Simulation::sum_dilatation_and_break_bonds() {
   const real* const volumes = m.volumes().data();
   real* const dilatation_sums = state_.dilatation.data();
   const std::uint8_t* const ghost = ghost_.empty() ? nullptr : ghost_.data();
+  const std::uint8_t* const foreign = foreign_.empty() ? nullptr : foreign_.data();
   std::vector<std::array<index_t, 2>> broken;  // (evaluating node, neighbour)
 #pragma omp parallel
   {
@@ -205,7 +233,16 @@ void Simulation::sum_dilatation_and_break_bonds() {
       const bool breaks = material.params.fracture, gathers = schedule.particle_gathers[m.node_particle()[i]];
       if (ghost && ghost[m.node_particle()[i]]) return;  // another process's bonds
       std::uint8_t* const bits = intact.node(i);
-      if (breaks && !gathers) {
+      if (foreign && foreign[i]) {  // its terms on own nodes; own nodes that gather take their own
+        if (gathers || foreign[i] == far_foreign) return;
+        if (breaks) {
+          add_dilatation_terms<true, false, true>(i, bonds, bits, criterion, positions, volumes,
+                                                  dilatation_sums, broken_here, foreign);
+        } else {
+          add_dilatation_terms<false, false, true>(i, bonds, bits, criterion, positions, volumes,
+                                                   dilatation_sums, broken_here, foreign);
+        }
+      } else if (breaks && !gathers) {
         add_dilatation_terms<true, false>(i, bonds, bits, criterion, positions, volumes, dilatation_sums,
                                           broken_here);
       } else if (!gathers) {

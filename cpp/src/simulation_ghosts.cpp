@@ -1,7 +1,8 @@
 // A distributed run's part in the core (granulate.parallel): the ghosts, the particles another
 // process owns, which this one holds for its own particles' contact (their bonds break where
-// their owner breaks them; their bodies move as their owner measures them), and the numbers
-// its messages give its nodes and particles.
+// their owner breaks them; their bodies move as their owner measures them); the foreign nodes,
+// another process's part of a particle split at node level; and the numbers its messages give
+// its nodes and particles.
 #include <algorithm>
 #include <span>
 #include <sstream>
@@ -23,6 +24,41 @@ void Simulation::set_ghost_particles(const std::vector<index_t>& particles) {
   ghost_ = particles.empty() ? std::vector<std::uint8_t>{} : std::move(ghost);  // empty: none
   contact_.set_ghost_particles(ghost_);
   peridem_damping_.set_ghost_particles(ghost_);
+  mark_others();
+}
+
+void Simulation::set_foreign_nodes(const std::vector<index_t>& nodes) {
+  const index_t n = model_->node_count();
+  if (!nodes.empty() && (contact_.active() || peridem_damping_.active())) {
+    throw InputError(
+        "a particle split at node level runs without contact and PeriDEM's damping for now: its "
+        "bodies' motions are not measured across processes (set contact to None)");
+  }
+  std::vector<std::uint8_t> foreign(n, 0);
+  for (const index_t i : nodes) {
+    if (i >= n || ghost_node(i)) {
+      throw InputError("foreign node " + std::to_string(i) + " is not a node of this process's particles");
+    }
+    foreign[i] = 1;
+  }
+  for (const index_t i : nodes) {  // 2: no bond to an own node, so nothing of it is evaluated
+    const NodeBonds bonds = model_->node_bonds(i);
+    bool reaches_own = false;
+    for (index_t b = 0; b < bonds.count && !reaches_own; ++b) reaches_own = !foreign[bonds.neighbor(b)];
+    if (!reaches_own) foreign[i] = 2;
+  }
+  foreign_ = nodes.empty() ? std::vector<std::uint8_t>{} : std::move(foreign);
+  mark_others();
+}
+
+void Simulation::mark_others() {
+  if (ghost_.empty() && foreign_.empty()) {
+    others_.clear();
+    return;
+  }
+  others_.assign(model_->node_count(), 0);
+  for (index_t i = 0; i < model_->node_count(); ++i)
+    others_[i] = ghost_node(i) || (!foreign_.empty() && foreign_[i]);
 }
 
 void Simulation::set_reported_numbers(std::vector<index_t> nodes, std::vector<index_t> particles) {

@@ -82,6 +82,10 @@ class Simulation {
   /// before ghosts are marked; run and begin_step refuse to start while a step is begun.
   std::vector<std::array<index_t, 2>> begin_step();
   void finish_step(std::span<const std::array<index_t, 2>> ghost_breaks);
+  /// The first half kick, the drift and prescribed motion of a step, which begin_step then
+  /// continues from (pass 1) instead of taking them itself: a run with foreign nodes gives
+  /// them their owners' positions in between (set_foreign_nodes).
+  void move();
 
   /// Recomputes forces (and breaks bonds) at the current positions.
   void compute_forces();
@@ -139,6 +143,18 @@ class Simulation {
   /// ghost bodies their owners' motion (give_ghost_motions), which is all the contact reads of
   /// them; the other ghost nodes stay where they were. InputError for an index out of range.
   void set_ghost_particles(const std::vector<index_t>& particles);
+  /// Marks the nodes of this process's particles that other processes own (a particle split at
+  /// node level, whose bonds cross processes; empty: none). The steps neither move nor check
+  /// them, and the bond passes evaluate of them only their bonds to this process's nodes, so
+  /// that each own node takes the serial run's terms in the serial run's order. The caller
+  /// gives them their owners' state each step: between move and begin_step the positions of
+  /// those bonded to own nodes (the halo, one horizon deep), and between begin_step and finish_step their
+  /// dilatation sums (pass 1's sum_j w r e, before finish_step scales it; LPS only). Their
+  /// dilatation, forces, breaks and measures here are not their own: broken_bonds counts the
+  /// bonds broken at an own node's end. InputError for a node that does not exist or is a
+  /// ghost particle's, and while contact or PeriDEM's damping is on (a body's motion, which
+  /// they read, is not measured across processes yet).
+  void set_foreign_nodes(const std::vector<index_t>& nodes);
   /// Between begin_step and finish_step, on the owner: the rigid-body motion (measure_body) of
   /// every fragment of each of `particles` (this process's own) at the state the contact will
   /// see, named by the fragment's smallest node: what a process holding them as ghosts needs of
@@ -192,8 +208,11 @@ class Simulation {
   void finish_forces(std::span<const std::array<index_t, 2>> ghost_breaks);
   /// The forces at the current state unless they are current (prescribed motion first).
   void evaluate_if_stale();
-  /// The halves of a step (begin_step and finish_step without their checks).
+  /// The halves of a step (begin_step and finish_step without their checks); the first is
+  /// move_nodes (the kick, drift and prescribed motion) and then pass 1.
   void move_and_break_bonds();
+  void move_nodes();
+  void break_bonds_and_measure_travel();
   void finish_step_after_breaks(std::span<const std::array<index_t, 2>> ghost_breaks);
   /// LPS dilatation theta_i and pressure A_i theta_i; each node's force density started with
   /// rho (g - gamma v).
@@ -207,6 +226,10 @@ class Simulation {
   void apply_prescribed_motion(bool positions_too);
   /// Whether node i belongs to a ghost particle (set_ghost_particles).
   bool ghost_node(index_t i) const { return !ghost_.empty() && ghost_[model_->node_particle()[i]]; }
+  /// Whether node i is another process's: a ghost particle's or a foreign node.
+  bool others_node(index_t i) const { return !others_.empty() && others_[i]; }
+  /// others_ from ghost_ and foreign_.
+  void mark_others();
   void check_stability() const;
   std::shared_ptr<Model> model_;
   State state_;
@@ -216,9 +239,12 @@ class Simulation {
   real viscous_damping_ = 0;
   std::vector<PrescribedMotion> motions_;
   std::vector<NodalForce> nodal_forces_;
-  std::vector<real> pressure_;       // A_i theta_i of LPS nodes
-  std::vector<std::uint8_t> ghost_;  // per particle: 1 if another process evaluates it;
-                                     // empty when none is
+  std::vector<real> pressure_;         // A_i theta_i of LPS nodes
+  std::vector<std::uint8_t> ghost_;    // per particle: 1 if another process evaluates it;
+                                       // empty when none is
+  std::vector<std::uint8_t> foreign_;  // per node: 0 own, else another process owns it
+                                       // (set_foreign_nodes): 1 bonded to an own node, 2 not
+  std::vector<std::uint8_t> others_;   // per node: a ghost particle's or foreign; empty if none
   std::vector<index_t> reported_node_, reported_particle_;  // set_reported_numbers; or empty
   real reported_stable_time_step_ = 0;                      // set_reported_stable_time_step
   std::vector<real> travel_origin_;    // positions largest_travel is measured from; or empty
@@ -227,6 +253,7 @@ class Simulation {
   real largest_travel_ = 0;
   std::vector<std::array<index_t, 2>> breaks_;  // the bonds pass 1 (and the owners) broke
   bool step_begun_ = false;                     // begin_step called, finish_step not yet
+  bool moved_ = false;                          // move called, begin_step not yet
   std::uint64_t broken_bond_copies_ = 0;        // both copies of a broken bond count
   ContactModel contact_;
   contact::PeridemDamping peridem_damping_;

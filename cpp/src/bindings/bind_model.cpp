@@ -95,6 +95,12 @@ void bind_contents(nb::class_<Model>& model) {
                      return view(const_cast<std::size_t*>(self.bond_offsets().data()),
                                  self.bond_offsets().size(), 0, nb::find(self));
                    })
+      .def_prop_ro(
+          "particle_gathers",
+          [](const Model& self) { return copy_out(self.bond_schedule().particle_gathers); },
+          nb::rv_policy::move,
+          "Per particle, 1 if its nodes evaluate all their bonds and write only their own sums "
+          "(BondSchedule::particle_gathers), 0 if each bond is evaluated once (a new array).")
       .def(
           "bond_partners",
           [](const Model& self, const std::vector<index_t>& nodes) {

@@ -167,6 +167,10 @@ void bind_loading(nb::class_<Simulation>& cls) {
           "set_contact_skin", [](Simulation& self, real skin) { self.contact().set_skin(skin); }, "skin"_a)
       .def("set_ghost_particles", &Simulation::set_ghost_particles, "particles"_a,
            "Mark the particles whose forces another process evaluates (Simulation::set_ghost_particles).")
+      .def("set_foreign_nodes", &Simulation::set_foreign_nodes, "nodes"_a,
+           "Mark the nodes of this process's particles that other processes own, a particle split at "
+           "node level (Simulation::set_foreign_nodes); [] for none.")
+
       .def(
           "set_inert_contact_nodes",
           [](Simulation& self, const std::vector<index_t>& nodes) {
@@ -263,6 +267,9 @@ void bind_results(nb::class_<Simulation>& cls) {
       .def_prop_ro("walls", [](const Simulation& self) { return self.contact().walls(); })
       .def_prop_ro("contact_statistics", [](const Simulation& self) { return self.contact().statistics(); })
       .def("run", &Simulation::run, "steps"_a, nb::call_guard<nb::gil_scoped_release>())
+      .def("move", &Simulation::move, nb::call_guard<nb::gil_scoped_release>(),
+           "The first half kick, drift and prescribed motion of a step, which begin_step continues "
+           "from (Simulation::move).")
       .def(
           "begin_step",
           [](Simulation& self) {

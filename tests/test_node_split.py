@@ -1,0 +1,160 @@
+"""What a body split at node level rests on (docs/parallel.md, issue 17): a part of a body
+that holds its own nodes and, of the rest, the nodes bonded to them (its halo, one horizon
+deep), computes its own nodes' steps exactly as the whole body does, given each step the halo's
+positions after the drift and, for LPS, the halo's dilatation sums after pass 1 (the two
+exchanges of a step). The core evaluates of a foreign node only its bonds to own nodes
+(core.set_foreign_nodes), so each own node sums the serial run's terms in the serial run's
+order, and a bond across the cut breaks alike on both sides.
+
+Notched plates and strips (2D, LPS and PMB) and a notched block (3D, LPS) stretched until they
+crack
+are run whole and as parts in one process, the parts exchanging as ranks would; every own
+node's position, velocity, force, dilatation and bond states agree bit for bit, for a cut
+across the body and for nodes dealt to the parts at random (a halo of nearly the whole body)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import granulate as gr
+
+RATE = 60.0  # the strain rate [1/s]
+GLASS = dict(density=2500, youngs_modulus=70e9, poisson_ratio=0.22, fracture_energy=8.0)
+
+
+def pulled(shape: str, model: str) -> gr.Simulation:
+    """A notched plate or strip (2D, plane stress) or block (3D) of glass stretched along its
+    length at the strain rate RATE: each node starts at v = RATE (x - c) along it (c its
+    centre) and its ends keep their speed (0.6 m/s for the plate), so it deforms throughout and
+    cracks from the notch within a few hundred steps. The strip stands upright, 10 nodes wide
+    across the lattice's numbering, so that its nodes gather (each evaluates all its bonds;
+    Model.particle_gathers); the plate's and the block's evaluate each bond once."""
+    poisson = {"pmb": 1 / 3, "lps": 0.22}[model]  # PMB's own in plane stress
+    glass = gr.Material(**{**GLASS, "poisson_ratio": poisson}, model=model)
+    axis = 1 if shape == "strip" else 0
+    if shape == "plate":
+        sim = gr.Simulation(dimension=2, plane="stress")
+        notch = gr.Rectangle((9.5e-3, 6e-3), (10.5e-3, 1))
+        sim.add_body(
+            gr.Difference(gr.Rectangle((0, 0), (0.02, 0.01)), notch), glass, mesh_size=0.4e-3
+        )
+        ends = gr.Rectangle((-1, -1), (1e-3, 1)), gr.Rectangle((19e-3, -1), (1, 1))
+    elif shape == "strip":
+        sim = gr.Simulation(dimension=2, plane="stress")
+        notch = gr.Rectangle((2.4e-3, 9.5e-3), (1, 10.5e-3))
+        sim.add_body(
+            gr.Difference(gr.Rectangle((0, 0), (4e-3, 0.02)), notch), glass, mesh_size=0.4e-3
+        )
+        ends = gr.Rectangle((-1, -1), (1, 1e-3)), gr.Rectangle((-1, 19e-3), (1, 1))
+    else:
+        sim = gr.Simulation(dimension=3)
+        notch = gr.Box((4.7e-3, 3e-3, -1), (5.3e-3, 1, 1))
+        sim.add_body(
+            gr.Difference(gr.Box((0, 0, 0), (0.01, 5e-3, 3e-3)), notch), glass, mesh_size=0.5e-3
+        )
+        ends = gr.Box((-1, -1, -1), (0.6e-3, 1, 1)), gr.Box((9.4e-3, -1, -1), (1, 1, 1))
+    sim.contact = None
+    x = sim.reference_positions[:, axis]
+    centre = 0.5 * (x.min() + x.max())
+    for end in ends:
+        nodes = sim.select(end)
+        velocity = np.zeros(sim.dimension)
+        velocity[axis] = RATE * (x[nodes].mean() - centre)
+        sim.prescribe_velocity(nodes, tuple(velocity))
+    sim.core.run(0)
+    sim.core.velocities[:, axis] = RATE * (x - centre)
+    return sim
+
+
+def parts_of(sim: gr.Simulation, parts: int, dealt: str) -> np.ndarray:
+    """Each node's part: slabs across the longest side (a cut through the notch's plane for two
+    parts), or dealt at random."""
+    n = sim.node_count
+    if dealt == "random":
+        return np.random.default_rng(3).integers(0, parts, n)
+    x = sim.reference_positions
+    order = np.argsort(x[:, np.argmax(np.ptp(x, axis=0))], kind="stable")
+    owner = np.empty(n, dtype=np.int64)
+    owner[order] = np.arange(n) * parts // n
+    return owner
+
+
+def step_parts(split: list[gr.Simulation], owner: np.ndarray, halos: list[np.ndarray]) -> None:
+    """One step of every part, with the two exchanges a rank makes: the halo's positions after
+    the drift, its dilatation sums after pass 1 (both from each halo node's owner)."""
+    for part in split:
+        part.core.move()
+    for p, part in enumerate(split):
+        for q, other in enumerate(split):
+            mine = halos[p][owner[halos[p]] == q]
+            part.core.positions[mine] = other.core.positions[mine]
+    for part in split:
+        part.core.begin_step()
+    sums = [np.array(part.core.dilatation) for part in split]
+    for p, part in enumerate(split):
+        part.core.dilatation[halos[p]] = np.choose(owner[halos[p]], [s[halos[p]] for s in sums])
+    for part in split:
+        part.core.finish_step(np.zeros((0, 2), np.uint32))
+
+
+def bond_copies_of(sim: gr.Simulation, nodes: np.ndarray) -> np.ndarray:
+    """The bond copies (positions in core.bond_intact) of these nodes."""
+    offsets = np.asarray(sim.model.bond_offsets, dtype=np.int64)
+    return np.concatenate([np.arange(offsets[i], offsets[i + 1]) for i in nodes])
+
+
+@pytest.mark.parametrize(
+    ("shape", "model", "parts", "dealt"),
+    [
+        ("plate", "lps", 2, "slabs"),
+        ("plate", "pmb", 3, "slabs"),
+        ("plate", "lps", 3, "random"),
+        ("strip", "lps", 2, "slabs"),
+        ("strip", "pmb", 3, "random"),
+        ("block", "lps", 2, "slabs"),
+    ],
+)
+def test_a_split_body_steps_as_the_whole_bit_for_bit(
+    shape: str, model: str, parts: int, dealt: str
+) -> None:
+    steps = 200 if shape == "block" else 300
+    whole = pulled(shape, model)
+    assert list(whole.model.particle_gathers) == [shape == "strip"]
+    owner = parts_of(whole, parts, dealt)
+    split = [pulled(shape, model) for _ in range(parts)]
+    halos = []
+    for p, part in enumerate(split):
+        own = np.flatnonzero(owner == p)
+        part.core.set_foreign_nodes(np.flatnonzero(owner != p).tolist())
+        partners = np.asarray(part.model.bond_partners(own.tolist()), dtype=np.int64)
+        halos.append(partners[owner[partners] != p])
+    whole.core.run(steps)
+    for _ in range(steps):
+        step_parts(split, owner, halos)
+    assert whole.core.broken_bonds() > 100  # it cracked
+    assert sum(part.core.broken_bonds() for part in split) == whole.core.broken_bonds()
+    intact = whole.core.bond_intact
+    for p, part in enumerate(split):
+        own = np.flatnonzero(owner == p)
+        for field in ("positions", "velocities", "forces", "dilatation"):
+            np.testing.assert_array_equal(
+                getattr(part.core, field)[own], getattr(whole.core, field)[own]
+            )
+        copies = bond_copies_of(whole, own)
+        np.testing.assert_array_equal(part.core.bond_intact[copies], intact[copies])
+        assert len(halos[p]) > 0
+
+
+def test_a_split_body_refuses_contact_it_cannot_measure_yet() -> None:
+    sim = gr.Simulation(dimension=2, plane="stress")
+    sim.add_body(gr.Rectangle((0, 0), (0.01, 0.01)), gr.Material(**GLASS), mesh_size=1e-3)
+    sim.core.run(0)
+    with pytest.raises(gr.InputError, match="split at node level runs without contact"):
+        sim.core.set_foreign_nodes([0, 1])
+
+
+def test_foreign_nodes_must_be_this_process_particles() -> None:
+    sim = pulled("plate", "lps")
+    with pytest.raises(gr.InputError, match="foreign node 99999999 is not a node"):
+        sim.core.set_foreign_nodes([99999999])
