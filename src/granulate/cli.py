@@ -318,7 +318,8 @@ def _parser() -> argparse.ArgumentParser:
         "--ranks",
         action="store_true",
         help="a distributed run on the MPI ranks this is launched on (mpirun -n K): per rank "
-        "node-steps/s and communication shares; cases pile3d (default), pile, drum, fine2d",
+        "node-steps/s and communication shares; cases pile3d (default), pile, drum, fine2d, "
+        "shatter",
     )
     bench.add_argument("--steps", type=int, help="with --ranks: timed steps (default 300)")
     bench.add_argument("--grains", type=int, help="with --ranks: grains (default: the case's)")
