@@ -36,13 +36,14 @@ def block() -> gr.Simulation:
         gr.Difference(gr.Box((0, 0, 0), (0.03, 0.015, 0.015)), notch), glass, mesh_size=0.5e-3
     )
     sim.contact = None
-    x = sim.reference_positions[:, 0]
-    centre = 0.5 * (x.min() + x.max())
+    start = np.asarray(sim.reference_positions)
+    centre = 0.5 * (start[:, 0].min() + start[:, 0].max())
+    velocities = np.zeros_like(start)
+    velocities[:, 0] = RATE * (start[:, 0] - centre)
+    sim.start_from(start, velocities)
     for end in (gr.Box((-1, -1, -1), (1e-3, 1, 1)), gr.Box((29e-3, -1, -1), (1, 1, 1))):
         nodes = sim.select(end)
-        sim.prescribe_velocity(nodes, (RATE * (x[nodes].mean() - centre), 0.0, 0.0))
-    sim.core.run(0)
-    sim.core.velocities[:, 0] = RATE * (x - centre)
+        sim.prescribe_velocity(nodes, (RATE * (start[nodes, 0].mean() - centre), 0.0, 0.0))
     return sim
 
 

@@ -229,6 +229,81 @@ def test_a_peridem_deck_with_peridems_damping_runs_on_ranks(tmp_path: Path) -> N
     assert_same_run(tmp_path / "serial", tmp_path / "ranks", 31, searches_within=None)
 
 
+PLATE = Path(__file__).parent / "cases" / "notched_plate_mpi.yaml"
+
+
+@pytest.fixture(scope="module")
+def serial_plate(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The notched plate's serial run (tests/cases/notched_plate_mpi.yaml): its output folder."""
+    folder = tmp_path_factory.mktemp("plate")
+    done = granulate(folder, "--out", "out", case=PLATE)
+    assert done.returncode == 0, done.stderr
+    return folder / "out"
+
+
+def test_one_body_is_cut_at_node_level_and_writes_the_serial_runs_outputs(
+    serial_plate: Path, tmp_path: Path
+) -> None:
+    """The notched plate, one body with nothing to touch (contact: null), on 2 and 3 ranks: its
+    nodes dealt to the ranks (granulate.parallel.node_split; whole grains could not give two
+    ranks one body each), it breaks in two as serially, and every frame (Fragment_ID
+    included), table, checkpoint and history row is the serial run's; cut short on 3 ranks
+    and resumed on 2, and serially and resumed on 3, the same."""
+    assert history(serial_plate)[-1]["fragments"] == "2"
+    for ranks in (2, 3):
+        done = granulate(tmp_path, "--out", f"ranks{ranks}", ranks=ranks, case=PLATE)
+        assert done.returncode == 0, done.stderr
+        assert done.stdout.count("finished at step 2000") == 1
+        assert_same_run(serial_plate, tmp_path / f"ranks{ranks}", row_count=11)
+    for first, second, steps, name in ((3, 2, "1300", "a"), (1, 3, "700", "b")):
+        cut = granulate(tmp_path, "--out", name, "--steps", steps, ranks=first, case=PLATE)
+        assert cut.returncode == 0, cut.stderr
+        resumed = granulate(tmp_path, "--out", name, "--resume", ranks=second, case=PLATE)
+        assert resumed.returncode == 0, resumed.stderr
+        assert f"resuming from step {steps}" in resumed.stdout
+        assert_same_run(serial_plate, tmp_path / name, row_count=11)
+
+
+def test_a_body_cut_at_node_level_writes_frames_in_pieces(
+    serial_plate: Path, tmp_path: Path
+) -> None:
+    """`output: {pieces: true}` on 3 ranks: each piece holds the nodes one rank owns, with
+    their fragment labels from rank 0 (a rank's own bonds cannot tell them), and the pieces
+    joined are the serial run's frames bit for bit."""
+    case = tmp_path / "plate_pieces.yaml"
+    case.write_text(
+        PLATE.read_text().replace("output: {every: 200,", "output: {every: 200, pieces: true,")
+    )
+    done = granulate(tmp_path, "--out", "out", ranks=3, case=case)
+    assert done.returncode == 0, done.stderr
+    for k in range(11):
+        expected = read_vtu_point_data(serial_plate / "frames" / f"frame_{k:06d}.vtu")
+        joined = read_vtu_point_data(tmp_path / "out" / "frames" / f"frame_{k:06d}.pvtu")
+        np.testing.assert_array_equal(joined[0], expected[0])
+        assert joined[1].keys() == expected[1].keys()
+        for field, values in expected[1].items():
+            np.testing.assert_array_equal(joined[1][field], values)
+    pieces = sorted((tmp_path / "out" / "frames" / "frame_000010").iterdir())
+    numbers = [read_vtu_point_data(p)[1]["Node_ID"] for p in pieces]
+    assert [len(n) > 0 for n in numbers] == [True] * 3
+    assert sorted(np.concatenate(numbers)) == list(range(len(expected[0])))
+    assert len(set(expected[1]["Fragment_ID"])) == 2
+
+
+def test_a_body_cut_at_node_level_that_blows_up_ends_every_rank(tmp_path: Path) -> None:
+    """The plate's end yanked at 10 km/s on 3 ranks: the rank owning the node that outruns its
+    mesh size reports the instability once, naming the node as the serial run does, and every
+    rank ends (no hang, no traceback)."""
+    case = tmp_path / "plate_yanked.yaml"
+    text = PLATE.read_text().replace("velocity: [1.0, 0]", "velocity: [1.0e+4, 0]")
+    case.write_text(text.replace("ramp_time: 2.0e-5", "ramp_time: 1.0e-7"))
+    done = granulate(tmp_path, "--out", "out", ranks=3, case=case)
+    assert done.returncode == 1, done.stdout + done.stderr
+    assert done.stderr.count("became unstable at step 2") == 1, done.stderr
+    assert "node 2409 of particle 0" in done.stderr
+    assert "Traceback" not in done.stderr
+
+
 def bench_ranks(*arguments: str, ranks: int = 2) -> subprocess.CompletedProcess[str]:
     """`granulate bench --ranks ...` on `ranks` MPI ranks; a hang fails after 5 minutes."""
     command = [mpiexec(), "-n", str(ranks), sys.executable, "-m", "granulate", "bench"]

@@ -387,7 +387,7 @@ void Simulation::restore(const State& state, const ContactCheckpoint& contact) {
   contact_.check_checkpoint(*model_, contact);  // before anything is replaced
   state_ = state;
   update_kinematic_nodes();  // the contact lists are rebuilt below with the held bodies known
-  broken_bond_copies_ = state_.bonds.broken(model_->bond_offsets(), 0, model_->node_count());
+  count_broken_bond_copies();
   contact_.restore(*model_, state_, contact);
   forces_current_ = true;
 }
@@ -521,13 +521,28 @@ void Simulation::break_bonds(const std::vector<std::array<index_t, 2>>& pairs) {
   forces_current_ = false;
 }
 
+void Simulation::count_broken_bond_copies() {
+  const Model& m = *model_;
+  if (foreign_.empty()) {
+    broken_bond_copies_ = state_.bonds.broken(m.bond_offsets(), 0, m.node_count());
+    return;
+  }
+  std::uint64_t broken = 0;  // bonds broken whose lower end is own, as finish_forces counts them
+  for (index_t i = 0; i < m.node_count(); ++i) {
+    if (foreign_[i]) continue;
+    const NodeBonds bonds = m.node_bonds(i);
+    for (index_t b = bonds.forward; b < bonds.count; ++b) broken += state_.bonds.intact(i, b) ? 0 : 1;
+  }
+  broken_bond_copies_ = 2 * broken;
+}
+
 std::uint64_t Simulation::broken_bonds() const {
   return broken_bond_copies_ / 2;
 }
 
 bool Simulation::assign_bonds(const std::vector<std::uint8_t>& states) {
   if (!state_.bonds.assign_unpacked(model_->bond_offsets(), states)) return false;
-  broken_bond_copies_ = state_.bonds.broken(model_->bond_offsets(), 0, model_->node_count());
+  count_broken_bond_copies();
   return true;
 }
 

@@ -49,6 +49,7 @@ void Simulation::set_foreign_nodes(const std::vector<index_t>& nodes) {
   }
   foreign_ = nodes.empty() ? std::vector<std::uint8_t>{} : std::move(foreign);
   mark_others();
+  count_broken_bond_copies();
 }
 
 void Simulation::mark_others() {

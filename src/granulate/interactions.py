@@ -132,6 +132,16 @@ class Interactions:
         self.walls.append((label, wall))
         return label
 
+    def contact_free(self) -> bool:
+        """Whether nothing touches anything: no wall, no PeriDEM damping and no contact law
+        between the materials of any two bodies (a distributed run may then cut the bodies
+        at node level, granulate.parallel.node_split)."""
+        materials = list(
+            {id(body.material): body.material for body in self._assembly.bodies}.values()
+        )
+        laws = (self.law_between(a, b) for k, a in enumerate(materials) for b in materials[: k + 1])
+        return not self.walls and not self.peridem_damping and all(law is None for law in laws)
+
     def uses_surface_law(self) -> bool:
         """Whether any contact law (the default, or one set per pair of materials) is the
         surface law."""

@@ -54,6 +54,7 @@ from granulate.writers.vtu_frame import FIELDS
 
 if TYPE_CHECKING:
     from granulate.parallel import DistributedRun
+    from granulate.parallel.node_split import NodeSplitRun
 
 __all__ = ["FIELDS", "Body", "Components", "Progress", "Simulation"]
 
@@ -139,7 +140,7 @@ class Simulation(SimulationSetup, SimulationResults):
         self._setup_digest: str | None = None
         self._checkpoint: CheckpointPlan | None = None
         self._comm = comm
-        self._distributed: DistributedRun | None = None
+        self._distributed: DistributedRun | NodeSplitRun | None = None
         self._output_path: Path | None = None  # output's directory, on every rank
         self._dt_warned = False  # a distributed run's parts: said once, by rank 0
         #: Extra text identifying the set-up (a case file's hash), checked by load_checkpoint.
@@ -362,13 +363,19 @@ class Simulation(SimulationSetup, SimulationResults):
             self._output.piece_ranks = self._comm.Get_size()
         return DistributedStepper(self._distributed_run())
 
-    def _distributed_run(self) -> DistributedRun:
+    def _distributed_run(self) -> DistributedRun | NodeSplitRun:
         """The run on the ranks of `comm` (made on first use, by every rank together; its time
-        step checked as validate_time_step checks a serial one)."""
+        step checked as validate_time_step checks a serial one): whole grains per rank, or,
+        when nothing touches, the nodes dealt to the ranks (granulate.parallel.node_split)."""
         if self._distributed is None:
             from granulate.parallel import DistributedRun
 
-            run = DistributedRun(self, self._comm)
+            if self._interactions.contact_free():  # nothing touches: the nodes are dealt
+                from granulate.parallel.node_split import NodeSplitRun
+
+                run: DistributedRun | NodeSplitRun = NodeSplitRun(self, self._comm)
+            else:
+                run = DistributedRun(self, self._comm)
             _check_time_step(run.dt, run.stable_dt)
             if self._comm.Get_rank() == 0 and self._dt is not None:
                 _warn_above_stable(run.dt, run.stable_dt, stacklevel=4)

@@ -151,7 +151,7 @@ class Simulation {
   /// those bonded to own nodes (the halo, one horizon deep), and between begin_step and finish_step their
   /// dilatation sums (pass 1's sum_j w r e, before finish_step scales it; LPS only). Their
   /// dilatation, forces, breaks and measures here are not their own: broken_bonds counts the
-  /// bonds broken at an own node's end. InputError for a node that does not exist or is a
+  /// bonds broken whose lower-numbered end is own. InputError for a node that does not exist or is a
   /// ghost particle's, and while contact or PeriDEM's damping is on (a body's motion, which
   /// they read, is not measured across processes yet).
   void set_foreign_nodes(const std::vector<index_t>& nodes);
@@ -230,6 +230,9 @@ class Simulation {
   bool others_node(index_t i) const { return !others_.empty() && others_[i]; }
   /// others_ from ghost_ and foreign_.
   void mark_others();
+  /// broken_bond_copies_ from the bond states: every broken copy, or with foreign nodes twice
+  /// the bonds broken whose lower-numbered end is own (each bond once over the processes).
+  void count_broken_bond_copies();
   void check_stability() const;
   std::shared_ptr<Model> model_;
   State state_;

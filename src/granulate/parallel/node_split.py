@@ -1,67 +1,97 @@
 """Bodies cut at node level across the ranks of an MPI communicator (issue 17, docs/parallel.md):
-single-body fracture on many processes, bit for bit the serial run.
+one body's fracture on many processes, bit for bit the serial run. Simulation(comm=...) runs a
+model in which nothing touches (no contact law, wall or PeriDEM damping:
+Interactions.contact_free) this way, `mpiexec granulate run case.yaml` included.
 
 The nodes are dealt by recursive coordinate bisection (partition.bisect over the nodes, each
 weighted by its bonds plus one), so a body larger than a subdomain is cut wherever the cuts
 fall and its bonds cross ranks. Each rank evaluates its own nodes (core.set_foreign_nodes) and
-holds, of the others, its halo: the nodes bonded to its own, one horizon deep. A step exchanges
-twice with each neighbouring rank: the halo's positions after the drift (core.move), then, for
-LPS, the halo's dilatation sums after the bonds' stretch and breaking (core.begin_step), before
-the forces (core.finish_step). The core evaluates of a halo node only its bonds to own nodes,
-so every own node sums the serial run's terms in the serial order and a bond across a cut
-breaks alike on both sides (tests/test_node_split.py in one process, tests/test_mpi.py on 2 and
-3 ranks).
+receives, of the others, its halo: the nodes bonded to its own, one horizon deep. A step
+exchanges twice with each neighbouring rank: the halo's positions after the drift (core.move),
+then, for LPS, the halo's dilatation sums after the bonds' stretch and breaking
+(core.begin_step), before the forces (core.finish_step). The core evaluates of a halo node only
+its bonds to own nodes, so every own node sums the serial run's terms in the serial order and a
+bond across a cut breaks alike on both sides (tests/test_node_split.py in one process,
+tests/test_mpi.py on 2 and 3 ranks). The halo is fixed by the bonds, so no node ever needs to
+change hands.
 
-Every rank holds the whole model, as a distributed run's ranks do (engine.py). Contact is not
-split yet (a body's rigid motion, which contact reads, would be a sum across ranks): the model
-must run without contact, walls or PeriDEM's damping (core.set_foreign_nodes refuses them).
-Outputs, checkpoints and Simulation(comm=...) do not run through it yet: `gather` gives rank 0
-a field of every node.
+Every rank holds the whole model, as a distributed run's ranks do (engine.py). For outputs,
+stop criteria and checkpoints rank 0's simulation takes every node's state from its owner
+(collect); the measures (damage, fragments, energies) it then makes of the whole state itself.
+Contact is not split: a body's rigid motion and fragments, which contact reads, would be sums
+across ranks.
 """
 
 from __future__ import annotations
 
+import os
 import time
-from typing import Any
+from dataclasses import replace
+from pathlib import Path
+from types import SimpleNamespace
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
 
+from granulate import checkpoints
 from granulate.errors import InputError
-from granulate.parallel.agreement import RankFailed
+from granulate.evaluation import Evaluation
+from granulate.parallel.agreement import RankFailed, on_root, together
 from granulate.parallel.partition import bisect
+from granulate.writers.vtu_frame import FIELD_TYPES, point_fields, write_piece_rows
+
+if TYPE_CHECKING:
+    from granulate.simulation import Simulation
+    from granulate.writers.outputs import Outputs
 
 _TAG = 23
+_NODE_FIELDS = ("positions", "velocities", "forces", "dilatation")
 
 
 class NodeSplitRun:
-    """`sim` (built alike on every rank of `comm`) stepped with its nodes dealt to the ranks.
+    """`sim` (set up alike on every rank of `comm`, not built) stepped with its nodes dealt to
+    the ranks. Every rank calls the constructor and each method together.
 
-    owner: each node's rank; seconds: "steps" (the core's halves) and "exchange" (the halos'
-    messages, waits included) [s]; halo_nodes: the nodes this rank receives a step.
+    owner: each node's rank; own: this rank's nodes; halo_nodes: the nodes it receives a step;
+    seconds: "steps" (the core's parts of the steps), "exchange" (the halo's messages and the
+    step's one reduction, waits included) and "collect" [s].
     """
 
-    def __init__(self, sim: Any, comm: Any) -> None:
+    def __init__(self, sim: Simulation, comm: Any) -> None:
         from mpi4py import MPI
 
-        self.comm, self.mpi = comm, MPI
-        self.core, model = sim.core, sim.model
-        if comm.Get_size() > sim.node_count:
+        self.comm, self.mpi, self._sim = comm, MPI, sim
+        ranks, nodes = comm.Get_size(), sim.node_count
+        if ranks > nodes:
             raise InputError(
-                f"{comm.Get_size()} ranks for {sim.node_count} nodes: run on at most as many "
-                "ranks as nodes"
+                f"{ranks} ranks for {nodes} nodes: run on at most as many ranks as nodes"
             )
-        self.core.run(0)  # the first evaluation, before the nodes are dealt (its breaks too)
-        bonds = np.diff(np.asarray(model.bond_offsets, dtype=np.int64))
-        points = np.asarray(sim.reference_positions)[:, : sim.dimension]
-        self.owner = bisect(points, bonds + 1.0, comm.Get_size()).owner
+        every = np.arange(len(sim.bodies))
+        self.local: Simulation = together(comm, lambda: _built(sim._subdomain(every)[0]))
+        core, model = self.local.core, self.local.model
+        #: The stable time-step estimate [s]: the serial run's (every rank holds the model).
+        self.stable_dt = float(core.stable_time_step)
+        self._offsets = np.asarray(model.bond_offsets, dtype=np.int64)
+        points = np.asarray(model.reference_positions)[:, : sim.dimension]
+        self.owner = bisect(points, np.diff(self._offsets) + 1.0, ranks).owner
         rank = comm.Get_rank()
         self.own = np.flatnonzero(self.owner == rank)
-        self.core.set_foreign_nodes(np.flatnonzero(self.owner != rank).tolist())
+        core.set_foreign_nodes(np.flatnonzero(self.owner != rank).tolist())
         self._receive, self._send = _halos(model, self.owner, self.own, rank)
-        self._lps = any(body.material.model == "lps" for body in sim.bodies)  # reads θ_j
-        self.halo_nodes = sum(len(nodes) for nodes in self._receive.values())
-        self.seconds = {"steps": 0.0, "exchange": 0.0}
+        self._lps = any(body.material.model == "lps" for body in sim.bodies)  # reads theta_j
+        self.halo_nodes = sum(len(halo) for halo in self._receive.values())
+        self.seconds = dict.fromkeys(("steps", "exchange", "collect"), 0.0)
+
+    @property
+    def dt(self) -> float:
+        """The time step [s], the serial run's."""
+        return float(self.local.core.time_step)
+
+    @property
+    def bond_count(self) -> int:
+        """Every bond, counted once per end (Simulation.bond_count)."""
+        return int(self._offsets[-1])
 
     def run(self, steps: int) -> None:
         """Advance every rank `steps` steps. An error in one rank's step (an instability) ends
@@ -70,65 +100,55 @@ class NodeSplitRun:
             self._step()
 
     def _step(self) -> None:
-        core = self.core
-        failure: Exception | None = None
-        start = time.perf_counter()
-        try:
-            core.move()
-        except Exception as error:  # raised after the step's exchanges, once all agree
-            failure = error
-        moved = time.perf_counter()
+        core, failure = self.local.core, None
+        marks = [time.perf_counter()]
+        failure = _attempt(core.move, failure)
+        marks.append(time.perf_counter())
         self._exchange(core.positions)
-        exchanged = time.perf_counter()
-        if failure is None:
-            try:
-                core.begin_step()
-            except Exception as error:
-                failure = error
-        began = time.perf_counter()
+        marks.append(time.perf_counter())
+        failure = _attempt(core.begin_step, failure)
+        marks.append(time.perf_counter())
         if self._lps:
             self._exchange(core.dilatation)
-        told = time.perf_counter()
-        if failure is None:
-            try:
-                core.finish_step(np.zeros((0, 2), np.uint32))
-            except Exception as error:
-                failure = error
-        stepped = time.perf_counter()
+        marks.append(time.perf_counter())
+        failure = _attempt(lambda: core.finish_step(np.zeros((0, 2), np.uint32)), failure)
+        marks.append(time.perf_counter())
         self._agree(failure)
-        self.seconds["steps"] += (moved - start) + (began - exchanged) + (stepped - told)
-        self.seconds["exchange"] += (
-            (exchanged - moved) + (told - began) + (time.perf_counter() - stepped)
-        )
+        marks.append(time.perf_counter())
+        spans = np.diff(marks)
+        self.seconds["steps"] += float(spans[0::2].sum())
+        self.seconds["exchange"] += float(spans[1::2].sum())
 
     def _exchange(self, field: NDArray[np.float64]) -> None:
         """The halo's rows of `field` (positions, n x 3, or dilatation sums, n) from their
         owners: one message each way per neighbouring rank."""
         width = 1 if field.ndim == 1 else field.shape[1]
-        inbox = {q: np.empty((len(nodes), width)) for q, nodes in self._receive.items()}
+        inbox = {q: np.empty((len(halo), width)) for q, halo in self._receive.items()}
         requests = [self.comm.Irecv(box, source=q, tag=_TAG) for q, box in inbox.items()]
         for q, nodes in self._send.items():
             box = np.ascontiguousarray(field[nodes]).reshape(len(nodes), width)
             requests.append(self.comm.Isend(box, dest=q, tag=_TAG))
         self.mpi.Request.Waitall(requests)
-        for q, nodes in self._receive.items():
-            field[nodes] = inbox[q].reshape(field[nodes].shape)
+        for q, halo in self._receive.items():
+            field[halo] = inbox[q].reshape(field[halo].shape)
 
     def _agree(self, failure: Exception | None) -> None:
-        """One reduction: the first rank whose step failed; it raises its error, the others
+        """One reduction: the first rank whose step failed raises its error, the others
         RankFailed."""
         size = self.comm.Get_size()
-        mine = self.comm.Get_rank() if failure is not None else size
-        first = self.comm.allreduce(mine, op=self.mpi.MIN)
+        first = self.comm.allreduce(self.comm.Get_rank() if failure else size, op=self.mpi.MIN)
         if failure is not None:
             raise failure
         if first < size:
-            raise RankFailed(f"rank {first} failed in step {int(self.core.step)}; every rank stops")
+            step = int(self.local.core.step)
+            raise RankFailed(f"rank {first} failed in step {step}; every rank stops")
 
     def gather(self, field: str, root: int = 0) -> NDArray[np.float64] | None:
-        """core.<field> (positions, velocities, forces, dilatation) of every node on `root`,
+        """core.<field> (positions, velocities, forces or dilatation) of every node on `root`,
         each row from its owner; None on the other ranks."""
-        mine = np.ascontiguousarray(np.asarray(getattr(self.core, field))[self.own])
+        if field not in _NODE_FIELDS:
+            raise ValueError(f"gather: field must be one of {', '.join(_NODE_FIELDS)}: {field!r}")
+        mine = np.asarray(getattr(self.local.core, field))[self.own]
         parts = self.comm.gather(mine, root=root)
         if parts is None:
             return None
@@ -138,8 +158,124 @@ class NodeSplitRun:
         return whole
 
     def broken_bonds(self) -> int:
-        """The bonds broken on every rank, each counted once (by the owner of its lower end)."""
-        return int(self.comm.allreduce(int(self.core.broken_bonds()), op=self.mpi.SUM))
+        """The bonds broken on every rank, each counted once (by the owner of its lower end),
+        on every rank."""
+        return int(self.comm.allreduce(int(self.local.core.broken_bonds()), op=self.mpi.SUM))
+
+    def deepest_contact(self) -> SimpleNamespace:
+        """No contact: nothing overlaps (the contact statistics' names, for the run's check)."""
+        return SimpleNamespace(deepest_overlap=0.0, half_overlap_step=0, full_overlap_step=0)
+
+    def collect(self, measures: bool = True) -> None:
+        """Rank 0's simulation (built whole on the first call) takes every node's position,
+        velocity, force, dilatation and bond states from its owner, the step and time, and an
+        evaluation with no contacts (the most list searches of any rank): its outputs, measures
+        and stop criteria are then the serial run's at this step, which it measures itself
+        (`measures` is for the interface: nothing is measured elsewhere)."""
+        start = time.perf_counter()
+        core = self.local.core
+        intact = np.asarray(core.bond_intact)[_copies_of(self._offsets, self.own)]
+        mine = (*(np.asarray(getattr(core, f))[self.own] for f in _NODE_FIELDS), intact)
+        parts = self.comm.gather(mine, root=0)
+        searches = self.comm.reduce(int(core.contact_statistics.rebuilds), op=self.mpi.MAX, root=0)
+        if parts is not None:
+            self._install(parts, (float(core.time), int(core.step)), int(searches))
+        self.seconds["collect"] += time.perf_counter() - start
+
+    def _install(
+        self, parts: list[tuple[NDArray[Any], ...]], moment: tuple[float, int], searches: int
+    ) -> None:
+        """Rank 0: every rank's nodes (`parts`, in rank order) into its whole simulation."""
+        sim = self._sim
+        core = sim._build()
+        bonds = np.empty(self._offsets[-1], dtype=np.uint8)
+        for q, part in enumerate(parts):
+            nodes = np.flatnonzero(self.owner == q)
+            for field, values in zip(_NODE_FIELDS, part[:-1], strict=True):
+                getattr(core, field)[nodes] = values
+            bonds[_copies_of(self._offsets, nodes)] = part[-1]
+        core.assign_bonds(bonds)
+        core.time, core.step = moment
+        sim.analysis.give(None)
+        sim._gathered = replace(
+            Evaluation.of_core(core, sim.analysis.contact_table()), list_rebuilds=searches
+        )
+
+    def save_checkpoint(self, path: str | os.PathLike[str], outputs: Outputs | None = None) -> Path:
+        """The serial run's checkpoint (granulate.checkpoints, with `outputs`' bookkeeping),
+        written by rank 0 from the whole state (collect); it restarts on any number of ranks,
+        or serially, bit for bit. Rank 0 raises a failure to write, the others RankFailed. The
+        path written, on every rank."""
+        self.collect(measures=False)
+
+        def write() -> Path:
+            self._sim.analysis.forget_fragments()
+            return checkpoints.save(self._sim, path, outputs)
+
+        return Path(self.comm.bcast(on_root(self.comm, write), root=0))
+
+    def load_checkpoint(self, path: str | os.PathLike[str], outputs: Outputs | None = None) -> None:
+        """Continue from a checkpoint of this set-up written by a run on any number of ranks,
+        or serially (else InputError on every rank): rank 0 reads it into its simulation (with
+        `outputs`' bookkeeping) and every rank restores the whole state from it."""
+
+        def read() -> dict[str, Any]:
+            checkpoints.load(self._sim, path, outputs)
+            self._sim._gathered = None  # the evaluation gathered before is not the checkpoint's
+            return dict(self._sim.core.checkpoint())
+
+        start = time.perf_counter()
+        state = self.comm.bcast(on_root(self.comm, read), root=0)
+        together(self.comm, lambda: self.local.core.restore(state), "restoring the checkpoint")
+        self.seconds["collect"] += time.perf_counter() - start
+
+    def write_piece(self, folder: Path, fields: tuple[str, ...]) -> None:
+        """This rank's piece of a frame in pieces (writers/vtu_frame.py): its own nodes now,
+        with `fields`, as folder/piece_<rank>.vtu. The fragment labels come from rank 0, which
+        holds every bond (collect): a rank's own bonds do not tell which piece a node is in."""
+        labels = None
+        if "Fragment_ID" in fields:
+            whole = self._sim.analysis.fragment_labels() if self.comm.Get_rank() == 0 else None
+            mine = (
+                None
+                if whole is None
+                else [whole[self.owner == q] for q in range(self.comm.Get_size())]
+            )
+            labels = self.comm.scatter(mine, root=0)
+        local = [f for f in fields if f != "Fragment_ID"]
+        values = point_fields(self.local, tuple(local), self.local.core.damage())
+        rows = {name: field[self.own] for name, field in values.items()}
+        if labels is not None:
+            rows["Fragment_ID"] = labels
+        path = Path(folder) / f"piece_{self.comm.Get_rank()}.vtu"
+        ordered = {f: rows[f].astype(FIELD_TYPES[f][0]) for f in fields}
+        write_piece_rows(path, self.local.core.positions[self.own], ordered, self.own)
+
+
+def _attempt(action: Any, failure: Exception | None) -> Exception | None:
+    """action() unless a part of the step failed before; the failure, kept for the step's
+    reduction (_agree), so that every rank goes through every exchange."""
+    if failure is not None:
+        return failure
+    try:
+        action()
+    except Exception as error:  # raised after the step's exchanges, once every rank knows
+        return error
+    return None
+
+
+def _built(part: Simulation) -> Simulation:
+    """`part` with its core built and its first forces evaluated (before the nodes are dealt:
+    that evaluation breaks bonds everywhere alike)."""
+    part.core.run(0)
+    return part
+
+
+def _copies_of(offsets: NDArray[np.int64], nodes: NDArray[np.int64]) -> NDArray[np.int64]:
+    """The bond copies of `nodes` (their places in core.bond_intact), node after node."""
+    counts = offsets[nodes + 1] - offsets[nodes]
+    starts = np.repeat(offsets[nodes] - np.cumsum(counts) + counts, counts)
+    return starts + np.arange(int(counts.sum()))
 
 
 def _halos(

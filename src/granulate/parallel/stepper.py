@@ -13,6 +13,7 @@ from granulate.parallel.agreement import on_root, together
 
 if TYPE_CHECKING:
     from granulate.parallel.engine import DistributedRun
+    from granulate.parallel.node_split import NodeSplitRun
     from granulate.simulation import Simulation
     from granulate.writers.outputs import Outputs
 
@@ -22,7 +23,7 @@ T = TypeVar("T")
 class DistributedStepper:
     """The run loop's steps on the ranks of `run` (every method on every rank together)."""
 
-    def __init__(self, run: DistributedRun) -> None:
+    def __init__(self, run: DistributedRun | NodeSplitRun) -> None:
         self.run = run
         self.comm = run.comm
 

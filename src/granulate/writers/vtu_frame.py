@@ -110,15 +110,21 @@ def write_piece(
     values = point_fields(sim, fields, damage or sim.core.damage(), numbering)
     chosen = np.arange(sim.node_count) if nodes is None else nodes
     numbers = chosen if numbering is None else numbering[0][chosen]
+    rows = {name: field[chosen] for name, field in values.items()}
+    write_piece_rows(path, sim.core.positions[chosen], rows, numbers)
+
+
+def write_piece_rows(
+    path: Path,
+    positions: NDArray[np.float64],
+    rows: dict[str, NDArray[np.generic]],
+    numbers: NDArray[np.int64],
+) -> None:
+    """A piece of a frame from its nodes' `positions`, their point fields `rows` (as
+    point_fields makes them, in the order of the frame's fields) and their numbers in the
+    whole run."""
     path.parent.mkdir(parents=True, exist_ok=True)
-    write_vtu(
-        path,
-        sim.core.positions[chosen],
-        {
-            **{name: field[chosen] for name, field in values.items()},
-            NODE_ID: numbers.astype(_NODE_ID_TYPE),
-        },
-    )
+    write_vtu(path, positions, {**rows, NODE_ID: numbers.astype(_NODE_ID_TYPE)})
 
 
 class VtuFrame:
