@@ -39,6 +39,7 @@ import argparse
 import json
 import time
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from granulate._core import points_within
@@ -138,21 +139,27 @@ def node_steps_per_second(nodes_across_radius: int, steps: int = 300) -> tuple[f
     return sim.node_count * steps / seconds, bonds / seconds, ghost_saving
 
 
-def measured_caps(nodes_across_radius: int, depth: float, pair_law: str) -> float:
+def measured_caps(nodes_across_radius: int, depth: float, pair_law: str) -> tuple[float, float]:
     """The engine's caps over this model's layer, measured on the 27 touching spheres after
     320 steps under `pair_law`: for each sphere and each other one, the nodes the engine would
     send of it (as DistributedRun._exchange_caps picks them: list positions within the cutoff
-    plus the default cap margin h/2 of the other's, and what the contact reads of them,
-    contact_reads) over the nodes
-    within `depth` of the other's bounding sphere (exchanged_nodes' layer), summed over the
-    pairs with a node in that layer."""
+    plus the default cap margin h/2 of the other's, and their anchors, contact_reads, each
+    node's x and v; with half a node for each surface normal sent, 3 numbers, of those within
+    the normal reach plus the margin bonded to a node outside the cap, the faces) over the
+    nodes within `depth` of the other's bounding sphere (exchanged_nodes' layer), summed over
+    the pairs with a node in that layer; and what the owner spends computing the faces'
+    normals each step (core.surface_normals, timed) in node-steps of these spheres (timed
+    too) per node of that layer."""
     sim = touching_spheres(nodes_across_radius, pair_law)
-    sim.run(320)
+    sim.run(300)
+    start = time.perf_counter()
+    sim.run(20)
+    node_step = (time.perf_counter() - start) / (20 * sim.node_count)
     core = sim.core
     x, nodes = core.list_positions, core.positions
     margin = 0.5 * RADIUS / nodes_across_radius
     cutoff, normal_reach = core.contact_reach, core.contact_surface_normal_reach
-    capped, layer = 0, 0
+    capped, layer, faces = 0.0, 0, [np.zeros(0, np.int64)]
     for body in sim.bodies:
         mine = np.arange(body.node_slice.start, body.node_slice.stop)
         for other in sim.bodies:
@@ -163,9 +170,24 @@ def measured_caps(nodes_across_radius: int, depth: float, pair_law: str) -> floa
                 continue
             near = mine[points_within(x[mine], x[theirs], cutoff + margin).astype(bool)]
             normal = near[points_within(x[near], x[theirs], normal_reach + margin).astype(bool)]
-            capped += len(contact_reads(core, sim.model, near, normal))
+            cap = contact_reads(core, near)
+            normal = np.asarray(sim.model.bonded_beyond(normal.tolist(), cap.tolist()), np.int64)
+            capped += len(cap) + 0.5 * len(normal)
             layer += int(within.sum())
-    return capped / layer
+            faces.append(normal)
+    return capped / layer, _normals_seconds(core, np.concatenate(faces)) / node_step / layer
+
+
+def _normals_seconds(core: Any, faces: np.ndarray, repeats: int = 20) -> float:
+    """Seconds of one core.surface_normals of `faces`, within a step (after its breaks), as an
+    owner computes them; the mean of `repeats`."""
+    core.begin_step()
+    start = time.perf_counter()
+    for _ in range(repeats):
+        core.surface_normals(faces.tolist())
+    seconds = (time.perf_counter() - start) / repeats
+    core.finish_step(np.zeros((0, 2), np.uint32))
+    return seconds
 
 
 def communication_seconds(
@@ -238,7 +260,7 @@ def as_built(
     rate: float,
     ghost_saving: float,
     args: argparse.Namespace,
-    depths: dict[str, tuple[float, float]],
+    depths: dict[str, tuple[float, float, float]],
 ) -> dict:
     """The engine as built (granulate.parallel.DistributedRun), for the rank with the most ghost
     grains per owned grain: its ghosts are whole grains within the reach plus the margin (the
@@ -249,9 +271,11 @@ def as_built(
     once. Efficiency: its own nodes' compute over its step; the same with the ghosts stepped in
     full, and if ghosts were not stepped at all (not built). "cap_shares": the communication
     share when it receives, instead of whole ghosts, only the ghost nodes within each of
-    `depths` (depth [m], factor) of one of its grains' bounding spheres (exchanged_nodes; the
-    ghosts still held and stepped whole) times the factor, with a second reduction per step
-    (the caps' check within the step)."""
+    `depths` (depth [m], factor, normals) of one of its grains' bounding spheres
+    (exchanged_nodes; the ghosts still held and stepped whole) times the factor, with a second
+    reduction per step (the caps' check within the step), and the owner's computing of the
+    normals it sends (as many node-steps per layer node as `depths` says), counted with the
+    communication."""
     partition = bisect(centres, np.ones(len(centres)), ranks)
     needed = ghosts(partition, pairs)
     owned = np.bincount(partition.owner, minlength=ranks)
@@ -270,9 +294,10 @@ def as_built(
 
     talk = communication(ghost)
     cap_shares = {}
-    for name, (depth, factor) in depths.items():  # caps leave nodes out: a check in the step
+    for name, (depth, factor, faces) in depths.items():  # a check in the step, the normals
         counts = exchanged_nodes(centres, radii, partition.owner, ranks, pairs, unit_nodes, depth)
         capped = communication(round(factor * counts[worst]), reductions=2)
+        capped += faces * counts[worst] / rate
         cap_shares[name] = capped / (stepped + capped)
     return {
         "ranks": ranks,
@@ -324,21 +349,22 @@ CAP_LAYERS = (
 )
 
 
-def cap_depths(args: argparse.Namespace) -> dict[str, tuple[float, float]]:
-    """CAP_LAYERS' (depth [m], factor) at this mesh, the laws' factors measured (measured_caps),
-    printed."""
+def cap_depths(args: argparse.Namespace) -> dict[str, tuple[float, float, float]]:
+    """CAP_LAYERS' (depth [m], factor, the owner's normals in node-steps per layer node) at
+    this mesh, the laws' factors and normals measured (measured_caps), printed."""
     h = RADIUS / args.nodes_across_radius
     depths = {}
     for name, layer, law in CAP_LAYERS:
         depth = layer(args.reach, h)
-        depths[name] = (
-            depth,
-            1.0 if law is None else measured_caps(args.nodes_across_radius, depth, law),
+        measured = (
+            (1.0, 0.0) if law is None else measured_caps(args.nodes_across_radius, depth, law)
         )
+        depths[name] = (depth, *measured)
         if law is not None:
             print(
-                f"{name}: the engine's caps are {depths[name][1]:.2f} times the nodes within "
-                f"{1e3 * depth:.2f} mm of a neighbour's sphere (27 touching spheres, measured)"
+                f"{name}: the engine's caps are {measured[0]:.2f} times the nodes within "
+                f"{1e3 * depth:.2f} mm of a neighbour's sphere (27 touching spheres, measured), "
+                f"their normals {measured[1]:.3f} node-steps of compute per node of that layer"
             )
     return depths
 
@@ -387,7 +413,9 @@ def engine_as_built(
             "\nthe engine with caps: communication % of the step (x, v of the ghost nodes within "
             "a depth of the rank's grains' spheres; ghosts still held and stepped whole)"
         )
-        heads = "".join(f" {f'{n} {1e3 * d:.2f} mm x{f:.2f}':>30}" for n, (d, f) in depths.items())
+        heads = "".join(
+            f" {f'{n} {1e3 * d:.2f} mm x{f:.2f}':>30}" for n, (d, f, _) in depths.items()
+        )
         print(f"{'ranks':>6} {'whole':>8}" + heads)
         for row in rows:
             shares = "".join(f" {100 * share:30.1f}" for share in row["cap_shares"].values())

@@ -119,17 +119,18 @@ def test_a_ghost_grain_needs_only_its_owners_cap_motion_and_breaks(
     """A rank skips its ghosts' bonds and moves (core.set_ghost_particles): between the halves
     of a step (core.begin_step, finish_step) their owners give them the positions and
     velocities of their nodes within reach of the rank's own (the cap: those whose list
-    positions lie within the lists' cutoff of an own node's, their anchors before and after
-    the step's breaks, and the nodes bonded to those within the reach at which the contact
-    reads surface normals, as DistributedRun._exchange_caps and _joining take them), the
-    breaks, and the motion of each
-    of their bodies
-    (core.fragment_motions, core.give_ghost_motions). The tumbling drum run twice, once with
-    grain 1 a ghost given that within each step (node spheres, and the surface law with rolling
-    resistance), its other nodes a little off (1e-9 of their positions and velocities, so that
-    any use of them would show) and out of the contact lists (core.set_inert_contact_nodes,
-    the cap picked anew each step): the other grains' nodes
-    agree bit for bit through 900 steps of contact and breaking, the part breaks the other
+    positions lie within the lists' cutoff of an own node's, and their anchors before and
+    after the step's breaks, as DistributedRun._exchange_caps and _joining take them), the
+    surface normals of those within the reach at which the contact reads them that are
+    bonded to a node outside the cap (sums over their bonds: core.surface_normals,
+    core.give_ghost_surface_normals; the part sums the others' itself), the breaks, and the
+    motion of each of their bodies (core.fragment_motions, core.give_ghost_motions). The
+    tumbling drum run twice, once with grain 1 a ghost given that within each step (node
+    spheres, and the surface law with rolling resistance), its other nodes a little off (1e-9
+    of their positions and velocities, so that any use of them would show) and out of the
+    contact lists (core.set_inert_contact_nodes, the cap picked anew each step): the other
+    grains' nodes agree bit for bit through 900 steps of contact and breaking (and do not
+    without the normals, under the node-sphere law), the part breaks the other
     grains' bonds as the whole run does, and every bond ends the same, and so do the damage, Z
     and strain energy density of its own nodes. The ghost's own forces, dilatation and
     measures are not computed."""
@@ -142,7 +143,7 @@ def test_a_ghost_grain_needs_only_its_owners_cap_motion_and_breaks(
     others = np.ones(part.core.positions.shape[0], dtype=bool)
     others[ghost] = False
     reach, normal_reach = part.core.contact_reach, part.core.contact_surface_normal_reach
-    differed, given, left_out = 0, 0, 0
+    differed, given, left_out, faces = 0, 0, 0, 0
     for _ in range(900):
         broken = np.asarray(whole.core.begin_step()).reshape(-1, 2)
         own = np.asarray(part.core.begin_step()).reshape(-1, 2)
@@ -154,7 +155,6 @@ def test_a_ghost_grain_needs_only_its_owners_cap_motion_and_breaks(
         read = (  # the anchors before and after this step's breaks (_joining's)
             part.core.contact_anchors(near.tolist()),
             whole.core.contact_anchors(near.tolist()),
-            part.model.bond_partners(normal.tolist()),
         )
         cap = np.unique(np.concatenate([near, *(np.asarray(r, np.int64) for r in read)]))
         rest = np.setdiff1d(np.arange(ghost.start, ghost.stop), cap)
@@ -163,6 +163,10 @@ def test_a_ghost_grain_needs_only_its_owners_cap_motion_and_breaks(
             getattr(part.core, field)[cap] = getattr(whole.core, field)[cap]
             getattr(part.core, field)[rest] = getattr(whole.core, field)[rest] * (1 + 1e-9)
         part.core.set_inert_contact_nodes(rest.tolist())  # out of the lists, as on the ranks
+        face = np.asarray(part.model.bonded_beyond(normal.tolist(), cap.tolist()), np.int64)
+        normals = whole.core.surface_normals(face.tolist())  # the rest: from the cap, here
+        part.core.give_ghost_surface_normals(face.astype(np.uint32), normals)
+        faces += len(face)
         nodes, motions = whole.core.fragment_motions([1])
         part.core.give_ghost_motions(
             np.asarray(nodes, np.uint32), np.asarray(motions).reshape(-1, 15)
@@ -176,6 +180,7 @@ def test_a_ghost_grain_needs_only_its_owners_cap_motion_and_breaks(
         differed += int(not np.array_equal(whole.core.forces[ghost], part.core.forces[ghost]))
     assert differed == 900
     assert left_out > 900 * 0.1 * (ghost.stop - ghost.start)  # the caps leave nodes out
+    assert faces > 450  # normals given: of the cap nodes within the normal reach (580-odd a run)
     assert (given > 20) if fracture else (given == 0)
     np.testing.assert_array_equal(whole.core.bond_intact, part.core.bond_intact)
     assert part.broken_bonds() == whole.broken_bonds()

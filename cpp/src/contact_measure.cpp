@@ -77,13 +77,8 @@ BodyMotion measure_body(const Model& model, const State& state, const index_t* n
   return motion;
 }
 
-namespace {
-
-/// Outward unit normal of the surface at node i, in the current configuration: the opposite of
-/// the influence-weighted sum of its intact bonds, sum_j w_ij (y_j - y_i), which points into
-/// the body from a surface node. Zero when that sum is under 10 % of sum_j w_ij |x_j - x_i|
-/// (reference lengths): inside the body, or a node without bonds.
-vec surface_normal(const Model& model, const State& state, index_t i) {
+vec3 ContactModel::surface_normal_at(const Model& model, const State& state, index_t i) const {
+  // The sum points into the body from a surface node.
   const NodeBonds bonds = model.node_bonds(i);
   const real* y = state.positions.data();
   vec sum{0, 0, 0};
@@ -99,8 +94,6 @@ vec surface_normal(const Model& model, const State& state, index_t i) {
   if (!(norm > 0.1 * scale)) return {0, 0, 0};
   return {sum[0] / norm, sum[1] / norm, sum[2] / norm};
 }
-
-}  // namespace
 
 vec3 ContactModel::contact_position(const Model& model, const State& state, index_t i) const {
   if (!centres_.moved(i))
@@ -749,14 +742,17 @@ void ContactModel::check_ghost_motions(const std::vector<std::uint8_t>& measured
 
 void ContactModel::measure_surface_normals(const Model& model, const State& state) {
   // The surface normal of every node in a node pair in contact between two bodies (listed by
-  // measure_contacts, in node order, for the look-ups of pair_surface_normal), in parallel.
+  // measure_contacts, in node order, for the look-ups of pair_surface_normal), in parallel; a
+  // ghost node's as its owner gave it, if it did (give_ghost_surface_normals).
   touching_normals_.resize(touching_nodes_.size());
   release_excess(touching_nodes_);
   release_excess(touching_normals_);
   const std::int64_t count = static_cast<std::int64_t>(touching_nodes_.size());
 #pragma omp parallel for schedule(static)
-  for (std::int64_t k = 0; k < count; ++k)
-    touching_normals_[k] = surface_normal(model, state, touching_nodes_[k]);
+  for (std::int64_t k = 0; k < count; ++k) {
+    const vec3* given = ghosts_.normal(touching_nodes_[k]);
+    touching_normals_[k] = given ? *given : surface_normal_at(model, state, touching_nodes_[k]);
+  }
 }
 
 void ContactModel::release_rested_pairs(const Model& model, const State& state,

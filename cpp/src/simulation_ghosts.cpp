@@ -140,6 +140,27 @@ std::vector<std::pair<index_t, BodyMotion>> Simulation::fragment_motions(
   return motions;
 }
 
+std::vector<real> Simulation::surface_normals(const std::vector<index_t>& nodes) const {
+  std::vector<real> normals;
+  normals.reserve(3 * nodes.size());
+  for (const index_t i : nodes) {
+    if (i >= model_->node_count()) throw InputError("surface_normals: no node " + std::to_string(i));
+    const vec3 n = contact_.surface_normal_at(*model_, state_, i);
+    normals.insert(normals.end(), n.begin(), n.end());
+  }
+  return normals;
+}
+
+void Simulation::give_ghost_surface_normals(std::vector<std::pair<index_t, vec3>> normals) {
+  for (const auto& [node, normal] : normals) {
+    if (node >= model_->node_count() || !ghost_node(node)) {
+      throw InputError("ghost surface normal: node " + std::to_string(node) +
+                       " is not a node of a ghost particle");
+    }
+  }
+  contact_.give_ghost_surface_normals(std::move(normals));
+}
+
 void Simulation::give_ghost_motions(std::vector<std::pair<index_t, BodyMotion>> motions) {
   for (const auto& [node, motion] : motions) {
     if (node >= model_->node_count() || !ghost_node(node)) {

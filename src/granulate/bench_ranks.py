@@ -23,7 +23,8 @@ shatter (400 grains) fracture: the pile's grains, brittle (fracture energy 0.5 J
 Each rank runs one thread unless ``granulate --threads N`` says otherwise. After 20 untimed
 steps (lists built, caches warm) the ranks' clocks start together and run the steps. Rank 0
 prints a table: per rank the grains and nodes it owns at the end, the ghost nodes it holds
-besides and those it received a step on average (the caps), its owned node-steps per second,
+besides and those it received a step on average (the caps), the surface normals it received
+a step on average (of the caps' nodes within the normal reach), its owned node-steps per second,
 and the shares of its wall-clock time spent in the ghost exchange, in the checks (a reduction
 after each step, and one within each step whose caps leave ghost nodes out), in picking the
 caps anew, in migrations and, with
@@ -188,7 +189,7 @@ def measure(
         run = DistributedRun(make(grains), comm)
         run.run(20)  # lists built, caches warm
     migrations, handed = run.migrations, run.handed_over
-    refreshes, received = run.cap_refreshes, run.nodes_received
+    refreshes, received, normals = run.cap_refreshes, run.nodes_received, run.normals_received
     broken = run.broken_bonds()
     wall = _timed(run, steps, collect_every, comm)
     broken = run.broken_bonds() - broken
@@ -197,6 +198,7 @@ def measure(
         "nodes": run.owned_node_count,
         "ghost_nodes": run.ghost_node_count,
         "exchanged_nodes": (run.nodes_received - received) / steps,
+        "exchanged_normals": (run.normals_received - normals) / steps,
         "seconds": wall,
         "node_steps_per_s": run.owned_node_count * steps / wall,
     } | {f"{name}_share": run.seconds[name] / wall for name in SHARES}
@@ -243,15 +245,16 @@ def table(result: dict[str, Any]) -> str:
     lines = [
         f"{result['case']}: {result['grains']} grains, {result['steps']} steps, "
         f"{result['ranks']} ranks, {result['threads']} thread(s) each",
-        "| rank | grains | nodes | ghost nodes | received a step | node-steps/s | exchange % "
-        "| check % | caps % | migrate % | collect % |",
-        "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
+        "| rank | grains | nodes | ghost nodes | received a step | normals a step | node-steps/s "
+        "| exchange % | check % | caps % | migrate % | collect % |",
+        "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
     ]
     for rank, row in enumerate(result["rows"]):
         shares = " | ".join(f"{100 * row[f'{name}_share']:.1f}" for name in SHARES)
         lines.append(
             f"| {rank} | {row['grains']} | {row['nodes']:,} | {row['ghost_nodes']:,} | "
-            f"{row['exchanged_nodes']:,.0f} | {row['node_steps_per_s'] / 1e6:.2f} M | {shares} |"
+            f"{row['exchanged_nodes']:,.0f} | {row['exchanged_normals']:,.0f} | "
+            f"{row['node_steps_per_s'] / 1e6:.2f} M | {shares} |"
         )
     lines.append(
         f"{result['migrations']} migrations, {result['handed_over']} grains handed over in the "

@@ -165,6 +165,15 @@ class Simulation {
   /// otherwise measure them from the ghost nodes held (ContactModel::give_ghost_motions).
   /// InputError for a node that is not a ghost's.
   void give_ghost_motions(std::vector<std::pair<index_t, BodyMotion>> motions);
+  /// On the owner, between begin_step and finish_step: the outward surface normals of `nodes`
+  /// as this step's contact reads them (ContactModel::surface_normal_at: sums over their
+  /// bonds, after this step's breaks), 3 per node. InputError for a node that does not exist.
+  std::vector<real> surface_normals(const std::vector<index_t>& nodes) const;
+  /// Before finish_step, where ghosts are held: the surface normals of ghost nodes from their
+  /// owners' surface_normals, which this step's contact takes in place of its sums over their
+  /// bonds (ContactModel::give_ghost_surface_normals). InputError for a node that is not a
+  /// ghost's.
+  void give_ghost_surface_normals(std::vector<std::pair<index_t, vec3>> normals);
   /// The numbers error messages give this process's nodes and particles (a distributed run's
   /// part names them as the whole run does): one per node and one per particle; empty, their
   /// own indices. InputError for the wrong sizes.

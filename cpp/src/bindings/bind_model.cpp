@@ -116,6 +116,31 @@ void bind_contents(nb::class_<Model>& model) {
             return copy_out(partners);
           },
           "nodes"_a, "The nodes bonded to any of `nodes` (broken bonds too), sorted, each once.")
+      .def(
+          "bonded_beyond",
+          [](const Model& self, const std::vector<index_t>& nodes, const std::vector<index_t>& held) {
+            std::vector<std::uint8_t> in_held(self.node_count(), 0);
+            for (const index_t i : held) {
+              if (i >= self.node_count())
+                throw InputError("bonded_beyond: node " + std::to_string(i) + " does not exist");
+              in_held[i] = 1;
+            }
+            std::vector<index_t> beyond;
+            for (const index_t i : nodes) {
+              if (i >= self.node_count())
+                throw InputError("bonded_beyond: node " + std::to_string(i) + " does not exist");
+              const NodeBonds bonds = self.node_bonds(i);
+              for (index_t b = 0; b < bonds.count; ++b) {
+                if (!in_held[bonds.neighbor(b)]) {
+                  beyond.push_back(i);
+                  break;
+                }
+              }
+            }
+            return copy_out(beyond);
+          },
+          "nodes"_a, "held"_a,
+          "Those of `nodes` (in their order) bonded to a node not in `held` (broken bonds too).")
       .def("bond_neighbors", [](const Model& self) {
         std::vector<index_t> neighbors(self.bond_count());
         for (index_t i = 0; i < self.node_count(); ++i) {

@@ -325,6 +325,30 @@ void bind_results(nb::class_<Simulation>& cls) {
           "nodes"_a, "motions"_a,
           "Before finish_step: the ghost bodies' motions from their owners' fragment_motions "
           "(Simulation::give_ghost_motions), each named by its smallest node here; (k, 15).")
+      .def(
+          "surface_normals",
+          [](const Simulation& self, const std::vector<index_t>& nodes) {
+            return rows_out(self.surface_normals(nodes), 3);
+          },
+          nb::rv_policy::move, "nodes"_a,
+          "Between begin_step and finish_step, on the owner: the outward surface normals of these "
+          "nodes as this step's contact reads them (Simulation::surface_normals), (k, 3).")
+      .def(
+          "give_ghost_surface_normals",
+          [](Simulation& self, nb::ndarray<const std::uint32_t, nb::ndim<1>, nb::c_contig> nodes,
+             nb::ndarray<const double, nb::shape<-1, 3>, nb::c_contig> normals) {
+            if (nodes.shape(0) != normals.shape(0))
+              throw InputError("give_ghost_surface_normals: one node per normal, got " +
+                               std::to_string(nodes.shape(0)) + " nodes and " +
+                               std::to_string(normals.shape(0)) + " normals");
+            std::vector<std::pair<index_t, vec3>> given(nodes.shape(0));
+            for (std::size_t k = 0; k < given.size(); ++k)
+              given[k] = {nodes(k), {normals(k, 0), normals(k, 1), normals(k, 2)}};
+            self.give_ghost_surface_normals(std::move(given));
+          },
+          "nodes"_a, "normals"_a,
+          "Before finish_step: the ghost nodes' surface normals from their owners' surface_normals "
+          "(Simulation::give_ghost_surface_normals); (k,) nodes here and (k, 3) normals.")
       .def("compute_forces", &Simulation::compute_forces, nb::call_guard<nb::gil_scoped_release>())
       .def("kinetic_energy", &Simulation::kinetic_energy)
       .def("strain_energy", &Simulation::strain_energy)

@@ -176,8 +176,10 @@ class DistributedRun:
         self.cap_margin_widenings = 0
         #: How many times the caps were picked anew between distributions (refresh_caps).
         self.cap_refreshes = 0
-        #: The ghost nodes this rank received in all its steps (each step, its caps').
+        #: The ghost nodes this rank received in all its steps (each step, its caps'), and the
+        #: surface normals (of its cap nodes within the normal reach).
         self.nodes_received = 0
+        self.normals_received = 0
         #: The nodes that joined its caps between picks (new anchors of cap nodes; _joining).
         self.nodes_joined = 0
         #: How many of this rank's step messages had a second one for the breaks and bodies'
@@ -386,11 +388,13 @@ class DistributedRun:
         contact centre or the node, core.list_positions) lie within the cutoff plus the cap
         margin of one of this rank's own nodes' list positions, and the nodes those read:
         their anchors (core.contact_anchors; a node that takes new anchors when its bonds
-        break brings them into the cap in that step's message, _joining), and, for those
+        break brings them into the cap in that step's message, _joining); under PeriDEM's
+        damping also every ghost's centre node (the damping reads it). Of the cap's nodes
         within the reach at which the contact reads surface normals (sums over a node's
         bonds: core.contact_surface_normal_reach, none under PeriDEM's node pairs) plus the
-        cap margin, every node bonded to them; under
-        PeriDEM's damping also every ghost's centre node (the damping reads it). No other
+        cap margin, those bonded to a node outside the cap (the faces, _faces) have their
+        normals sent too (core.surface_normals), 3 numbers a node in place of the x and v of
+        the nodes bonded to them; the holder sums the others' itself. No other
         ghost node can come within those reaches of an own node, as the lists see them,
         before the caps are picked again (each node, and each list position of a grain
         another rank holds, moves less than cap_margin/2: core.largest_travel), so a ghost
@@ -411,29 +415,40 @@ class DistributedRun:
         if normal_reach > 0:
             near = ghosts[close[ghosts]]
             normals[near] = points_within(x[near], own, normal_reach + self.cap_margin)
-        caps = {}
+        caps, faces = {}, {}
         for q, nodes in self._receive_whole.items():
             near = nodes[close[nodes]]
-            caps[q] = contact_reads(core, self.local.model, near, near[normals[near]])
+            caps[q] = contact_reads(core, near)
             if self._damped_centres is not None:  # PeriDEM's damping reads ghosts' centres
                 centres = self._node_map[self._damped_centres[self._receive_grains[q]]]
                 caps[q] = np.union1d(caps[q], centres)
+            faces[q] = _faces(self.local.model, near[normals[near]], caps[q])
+        to_global = self._to_global
         requests = [
-            self.comm.isend(self._to_global[cap], dest=q, tag=_CAP_TAG) for q, cap in caps.items()
+            self.comm.isend((to_global[cap], to_global[faces[q]]), dest=q, tag=_CAP_TAG)
+            for q, cap in caps.items()
         ]
-        self._send = {
-            q: self._node_map[self.comm.recv(source=q, tag=_CAP_TAG)] for q in self._send_whole
-        }
+        told = {q: self.comm.recv(source=q, tag=_CAP_TAG) for q in self._send_whole}
         self.mpi.Request.waitall(requests)
+        self._send = {q: self._node_map[cap] for q, (cap, _) in told.items()}
+        self._send_faces = {q: self._node_map[face] for q, (_, face) in told.items()}
         self._in_send = {q: _mask(len(self._to_global), n) for q, n in self._send.items()}
-        self._receive = caps
+        self._receive, self._receive_faces = caps, faces
         outside = [np.setdiff1d(self._receive_whole[q], cap) for q, cap in caps.items()]
         self.local.core.set_inert_contact_nodes(np.concatenate([[], *outside]).astype(int).tolist())
         self._caps_picked_at = int(self.local.core.step)
         #: Whether some rank's caps leave ghost nodes out (else no need to pick them anew).
         self.caps_partial = self.comm.allreduce(any(len(o) for o in outside), op=self.mpi.LOR)
-        self._outbox = {q: _message(len(n), self._rooms_out[q]) for q, n in self._send.items()}
-        self._inbox = {q: _message(len(n), self._rooms_in[q]) for q, n in self._receive.items()}
+        self._outbox = {q: self._message_out(q) for q in self._send}
+        self._inbox = {q: self._message_in(q) for q in self._receive}
+
+    def _message_out(self, q: int) -> NDArray[np.float64]:
+        """A buffer for the largest step message to rank q (_message)."""
+        return _message(len(self._send[q]), len(self._send_faces[q]), self._rooms_out[q])
+
+    def _message_in(self, q: int) -> NDArray[np.float64]:
+        """A buffer for the largest step message from rank q (_message)."""
+        return _message(len(self._receive[q]), len(self._receive_faces[q]), self._rooms_in[q])
 
     def _rooms(self, grains: int) -> NDArray[np.int64]:
         """The rows a step's message about `grains` grains carries of each section: break_slots
@@ -492,6 +507,11 @@ class DistributedRun:
         caps, _exchange_caps)."""
         return sum(len(nodes) for nodes in self._receive.values())
 
+    @property
+    def exchanged_normal_count(self) -> int:
+        """The surface normals this rank receives in each step (of its caps' faces)."""
+        return sum(len(nodes) for nodes in self._receive_faces.values())
+
     def _exchange_state(self) -> None:
         """Owners' positions, velocities and forces to the ranks that hold their grains as
         ghosts (one message per pair of neighbouring ranks): every ghost exact, as its owner's
@@ -509,7 +529,11 @@ class DistributedRun:
 
     def _exchange_within_step(
         self, broken: NDArray[np.uint32] | None
-    ) -> tuple[NDArray[np.uint32], tuple[NDArray[np.uint32], NDArray[np.float64]]]:
+    ) -> tuple[
+        NDArray[np.uint32],
+        tuple[NDArray[np.uint32], NDArray[np.float64]],
+        tuple[NDArray[np.uint32], NDArray[np.float64]],
+    ]:
         """After the first half of a step (the drift and pass 1): each rank sends the ranks that
         hold its grains as ghosts the positions and velocities now (the half-step velocities,
         which the contact uses) of the nodes in their caps (_exchange_caps), the bonds that
@@ -518,9 +542,11 @@ class DistributedRun:
         (core.fragment_motions), and the nodes joining their caps (_joining: number, x, v),
         all in global numbering; it takes the same for its ghosts, overwriting their copies
         (the caps growing by the nodes that joined) and giving the core their bodies' motions.
-        One message per pair of neighbouring ranks (_pack); what it has no room for goes in a
-        second. The ghosts' breaks, as (k, 2) local node pairs, and their bodies' motions
-        (first nodes, local; (k, 15) motions) for core.give_ghost_motions."""
+        The surface normals of the caps' faces (core.surface_normals, after this step's breaks)
+        follow the nodes' x and v. One message per pair of neighbouring ranks (_pack); what it
+        has no room for goes in a second. The ghosts' breaks, as (k, 2) local node pairs, their
+        bodies' motions (first nodes, local; (k, 15) motions) for core.give_ghost_motions, and
+        the faces' normals (nodes, local; (k, 3) normals) for core.give_ghost_surface_normals."""
         core = self.local.core
         x, v = core.positions, core.velocities
         pairs = np.asarray([] if broken is None else broken, dtype=np.int64).reshape(-1, 2)
@@ -534,7 +560,11 @@ class DistributedRun:
             joining = np.hstack([self._to_global[joined[q], None], x[joined[q]], v[joined[q]]])
             box = self._outbox[q]
             sections = [theirs, bodies[rows[q]], joining]
-            used, rest = _pack(box, (x[nodes], v[nodes]), sections, self._rooms_out[q])
+            faces = self._send_faces[q].tolist()
+            normals = (
+                core.surface_normals(faces) if broken is not None else np.zeros((len(faces), 3))
+            )
+            used, rest = _pack(box, (x[nodes], v[nodes], normals), sections, self._rooms_out[q])
             requests.append(self.comm.Isend(box[:used], dest=q, tag=_TAG))
             if len(rest):
                 overflow.append(self.comm.Isend(rest, dest=q, tag=_REST_TAG))
@@ -542,15 +572,29 @@ class DistributedRun:
         self.mpi.Request.Waitall(requests)
         received = {q: self._unpack(q, nodes, (x, v)) for q, nodes in self._receive.items()}
         self.nodes_received += self.exchanged_node_count
+        self.normals_received += self.exchanged_normal_count
         self.mpi.Request.Waitall(overflow)
-        self._grow_caps(joined, {q: joining for q, (_, _, joining) in received.items()})
-        motions = np.concatenate([np.zeros((0, _BODY)), *(m for _, m, _ in received.values())])
+        faces = self._faces_given(received)  # before the caps grow: the joining have none
+        self._grow_caps(joined, {q: joining for q, (_, _, joining, _) in received.items()})
+        motions = np.concatenate([np.zeros((0, _BODY)), *(m for _, m, _, _ in received.values())])
         first = self._node_map[motions[:, 0].astype(np.int64)].astype(np.uint32)
-        breaks = (b for b, _, _ in received.values())
+        breaks = (b for b, _, _, _ in received.values())
         ghost_breaks = np.concatenate([np.zeros((0, 2), np.int64), *breaks])
-        return self._node_map[ghost_breaks].astype(np.uint32), (
-            first,
-            np.ascontiguousarray(motions[:, 1:]),
+        return (
+            self._node_map[ghost_breaks].astype(np.uint32),
+            (first, np.ascontiguousarray(motions[:, 1:])),
+            faces,
+        )
+
+    def _faces_given(
+        self, received: dict[int, tuple[Any, ...]]
+    ) -> tuple[NDArray[np.uint32], NDArray[np.float64]]:
+        """The caps' faces (local nodes) and the normals this step's messages gave them."""
+        nodes = [self._receive_faces[q] for q in received]
+        normals = [normals for _, _, _, normals in received.values()]
+        return (
+            np.concatenate([np.zeros(0, np.int64), *nodes]).astype(np.uint32),
+            np.ascontiguousarray(np.concatenate([np.zeros((0, 3)), *normals])),
         )
 
     def _joining(self, q: int, touched: NDArray[np.int64]) -> NDArray[np.int64]:
@@ -573,11 +617,11 @@ class DistributedRun:
             if len(joined):
                 self._send[q] = np.concatenate([self._send[q], joined])
                 self._in_send[q][joined] = True
-                self._outbox[q] = _message(len(self._send[q]), self._rooms_out[q])
+                self._outbox[q] = self._message_out(q)
         for q, joined in received.items():
             if len(joined):
                 self._receive[q] = np.concatenate([self._receive[q], joined])
-                self._inbox[q] = _message(len(self._receive[q]), self._rooms_in[q])
+                self._inbox[q] = self._message_in(q)
                 self.nodes_joined += len(joined)
 
     def _own_motions(
@@ -598,16 +642,18 @@ class DistributedRun:
 
     def _unpack(
         self, q: int, nodes: NDArray[np.int64], fields: tuple[NDArray[np.float64], ...]
-    ) -> tuple[NDArray[np.int64], NDArray[np.float64], NDArray[np.int64]]:
+    ) -> tuple[NDArray[np.int64], NDArray[np.float64], NDArray[np.int64], NDArray[np.float64]]:
         """Rank q's message of this step into the ghosts' `fields`, and the nodes joining its
         cap (local, their x and v into `fields` too); its breaks, (k, 2) global node pairs,
         bodies' motions, (k, 16) (with what the message had no room for, received now from the
-        second message), and the joining nodes."""
+        second message), the joining nodes, and its faces' normals, (k, 3)."""
         box = self._inbox[q]
         count = 6 * len(nodes)
         motion = box[:count].reshape(-1, 6)
         for k, field in enumerate(fields):
             field[nodes] = motion[:, 3 * k : 3 * k + 3]
+        normals = box[count : count + 3 * len(self._receive_faces[q])].reshape(-1, 3)
+        count += normals.size
         totals = box[count : count + len(_WIDTHS)].astype(np.int64)
         kept = np.minimum(totals, self._rooms_in[q])
         rest = np.empty(int(((totals - kept) * _WIDTHS).sum()))
@@ -617,7 +663,7 @@ class DistributedRun:
         joined = self._node_map[joining[:, 0].astype(np.int64)]
         for k, field in enumerate(fields):
             field[joined] = joining[:, 1 + 3 * k : 4 + 3 * k]
-        return breaks.astype(np.int64), bodies, joined
+        return breaks.astype(np.int64), bodies, joined, normals.copy()
 
     def run(self, steps: int) -> None:
         """Advance every rank `steps` time steps, migrating grains before a step once a node
@@ -662,11 +708,12 @@ class DistributedRun:
         if self.caps_partial:
             self._caps_hold(failure is None)
         checked = time.perf_counter()
-        ghost_breaks, motions = self._exchange_within_step(broken)
+        ghost_breaks, motions, faces = self._exchange_within_step(broken)
         told = time.perf_counter()
         if failure is None:
             try:
                 core.give_ghost_motions(*motions)
+                core.give_ghost_surface_normals(*faces)
                 core.finish_step(ghost_breaks)
             except Exception as error:
                 failure = error
@@ -1026,38 +1073,45 @@ class DistributedRun:
         return whole
 
 
-def contact_reads(
-    core: Any, model: Any, near: NDArray[np.int64], normal: NDArray[np.int64]
-) -> NDArray[np.int64]:
+def contact_reads(core: Any, near: NDArray[np.int64]) -> NDArray[np.int64]:
     """The nodes whose positions and velocities the contact reads of the nodes `near` (within
-    reach of another body, as the lists see them): those, their anchors now
-    (core.contact_anchors), and every node bonded to those of them in `normal` (within the
-    reach at which the contact reads surface normals, sums over a node's bonds;
-    model.bond_partners); sorted, each once. What a cap holds (_exchange_caps)."""
-    read = (near, core.contact_anchors(near.tolist()), model.bond_partners(normal.tolist()))
+    reach of another body, as the lists see them): those and their anchors now
+    (core.contact_anchors); sorted, each once. What a cap holds (_exchange_caps); the surface
+    normals of those within the normal reach, sums over their bonds, travel as normals."""
+    read = (near, core.contact_anchors(near.tolist()))
     return np.unique(np.concatenate([np.asarray(r, dtype=np.int64) for r in read]))
 
 
-def _message(nodes: int, rooms: NDArray[np.int64]) -> NDArray[np.float64]:
-    """A buffer for the largest step message about `nodes` nodes (_pack): their x and v, the
-    sections' counts, and each section's `rooms` rows."""
-    return np.empty(6 * nodes + len(_WIDTHS) + int((rooms * _WIDTHS).sum()))
+def _faces(model: Any, normal: NDArray[np.int64], cap: NDArray[np.int64]) -> NDArray[np.int64]:
+    """Of a cap's nodes within the normal reach, `normal`, those whose surface normals travel:
+    the ones bonded to a node outside the `cap` (Model.bonded_beyond), whose sums over their
+    bonds the holder cannot make; it makes the others'."""
+    return np.asarray(model.bonded_beyond(normal.tolist(), cap.tolist()), dtype=np.int64)
+
+
+def _message(nodes: int, faces: int, rooms: NDArray[np.int64]) -> NDArray[np.float64]:
+    """A buffer for the largest step message about `nodes` nodes and `faces` normals (_pack):
+    their x and v, the normals, the sections' counts, and each section's `rooms` rows."""
+    return np.empty(6 * nodes + 3 * faces + len(_WIDTHS) + int((rooms * _WIDTHS).sum()))
 
 
 def _pack(
     box: NDArray[np.float64],
-    fields: tuple[NDArray[np.float64], ...],
+    fields: tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]],
     sections: list[NDArray[Any]],
     rooms: NDArray[np.int64],
 ) -> tuple[int, NDArray[np.float64]]:
-    """A step's message: the nodes' `fields` (x, v: 6 numbers a node), then each section's row
-    count, then each section's rows (breaks, (k, 2); bodies, (k, 16); nodes joining the cap,
-    (k, 7)), up to its room; the numbers written, and the rows with no room (every section's,
-    flat, in order) for a second message."""
-    count = 6 * len(fields[0])
+    """A step's message: the nodes' x and v (`fields`' first two, 6 numbers a node), the
+    faces' normals (the third, (m, 3)), then each section's row count, then each section's
+    rows (breaks, (k, 2); bodies, (k, 16); nodes joining the cap, (k, 7)), up to its room;
+    the numbers written, and the rows with no room (every section's, flat, in order) for a
+    second message."""
+    x, v, normals = fields
+    count = 6 * len(x)
     motion = box[:count].reshape(-1, 6)
-    for k, field in enumerate(fields):
-        motion[:, 3 * k : 3 * k + 3] = field
+    motion[:, :3], motion[:, 3:] = x, v
+    box[count : count + normals.size] = normals.ravel()
+    count += normals.size
     box[count : count + len(sections)] = [len(rows) for rows in sections]
     start, rest = count + len(sections), []
     for rows, room in zip(sections, rooms, strict=True):

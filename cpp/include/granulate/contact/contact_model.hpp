@@ -193,6 +193,16 @@ class ContactModel {
   void give_ghost_motions(std::vector<std::pair<index_t, BodyMotion>> motions) {
     ghosts_.give(std::move(motions));
   }
+  /// The outward surface normals of ghost nodes (surface_normal_at on their owners, at the
+  /// state of the next evaluation), which that evaluation uses in place of its own sums over
+  /// their bonds (whose far ends this process need not hold) and drops.
+  void give_ghost_surface_normals(std::vector<std::pair<index_t, vec3>> normals) {
+    ghosts_.give_normals(std::move(normals));
+  }
+  /// Node i's outward unit surface normal now, as the contact reads it: the opposite of the
+  /// influence-weighted sum of its intact bonds, sum_j w_ij (y_j - y_i); zero when that sum is
+  /// under 10 % of sum_j w_ij |x_j - x_i| (inside the body, or a node without bonds).
+  vec3 surface_normal_at(const Model& model, const State& state, index_t i) const;
   /// Nodes left out of the lists (per node 1 or 0; empty: none): a distributed run's ghost nodes
   /// outside its caps, which stay where they were and can reach none of its own nodes. Takes
   /// effect at the next evaluation: the nodes whose flag changed are listed again (an inert

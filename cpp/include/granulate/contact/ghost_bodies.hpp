@@ -1,10 +1,13 @@
 // The bodies of ghost particles in a distributed run (granulate.parallel): a process holds
 // another process's particle as a ghost for the contact of its own bodies with it, but only the
 // ghost's nodes within reach of its own are kept current. A ghost body's rigid-body motion,
-// which needs all its nodes, comes from the owner instead, named by the body's smallest node.
+// which needs all its nodes, comes from the owner instead, named by the body's smallest node;
+// so do the surface normals of its nodes near this process's (sums over their bonds, which
+// read nodes farther away).
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <cstdint>
 #include <utility>
 #include <vector>
@@ -34,12 +37,28 @@ class GhostBodies {
                                      [](const auto& entry, index_t node) { return entry.first < node; });
     return it != given_.end() && it->first == first ? &it->second : nullptr;
   }
-  /// Drops the motions given (after the evaluation that used them: they hold for one state).
-  void forget() { given_.clear(); }
+  /// The surface normals of ghost nodes for the next evaluation (sorted here; each node once).
+  void give_normals(std::vector<std::pair<index_t, std::array<real, 3>>> normals) {
+    std::sort(normals.begin(), normals.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    normals_ = std::move(normals);
+  }
+  /// The surface normal given for node i, or null.
+  const std::array<real, 3>* normal(index_t i) const {
+    const auto it = std::lower_bound(normals_.begin(), normals_.end(), i,
+                                     [](const auto& entry, index_t node) { return entry.first < node; });
+    return it != normals_.end() && it->first == i ? &it->second : nullptr;
+  }
+  /// Drops the motions and normals given (after the evaluation that used them: they hold for
+  /// one state).
+  void forget() {
+    given_.clear();
+    normals_.clear();
+  }
 
  private:
   std::vector<std::uint8_t> ghost_;
-  std::vector<std::pair<index_t, BodyMotion>> given_;  // by smallest node
+  std::vector<std::pair<index_t, BodyMotion>> given_;             // by smallest node
+  std::vector<std::pair<index_t, std::array<real, 3>>> normals_;  // by node
 };
 
 }  // namespace granulate
