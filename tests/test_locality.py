@@ -222,6 +222,27 @@ def test_a_ghost_body_in_contact_needs_its_owners_motion(tmp_path: Path) -> None
             part.core.finish_step(np.zeros((0, 2), np.uint32))
 
 
+def test_surface_normals_are_given_to_ghost_nodes_only(tmp_path: Path) -> None:
+    """core.give_ghost_surface_normals refuses a node of a particle the rank owns and a count
+    that does not match the normals; Model.bonded_beyond and core.surface_normals refuse a node
+    that does not exist: each one InputError naming the problem."""
+    sim = tumbling_drum(tmp_path)
+    sim.core.run(0)
+    sim.core.set_ghost_particles([1])
+    first = sim.bodies[1].first_node
+    with pytest.raises(gr.InputError, match="node 0 is not a node of a ghost particle"):
+        sim.core.give_ghost_surface_normals(np.array([0], np.uint32), np.zeros((1, 3)))
+    with pytest.raises(gr.InputError, match="one node per normal, got 2 nodes and 1 normals"):
+        sim.core.give_ghost_surface_normals(
+            np.array([first, first + 1], np.uint32), np.zeros((1, 3))
+        )
+    missing = sim.node_count + 5
+    with pytest.raises(gr.InputError, match=f"bonded_beyond: node {missing} does not exist"):
+        sim.model.bonded_beyond([missing], [])
+    with pytest.raises(gr.InputError, match=f"surface_normals: no node {missing}"):
+        sim.core.surface_normals([missing])
+
+
 def pushed(sim: gr.Simulation, nodes: slice) -> bool:
     """Whether anything but their bonds and gravity acts on `nodes` (gravity: the same force
     density on each, to 1e-9 of the largest force density)."""

@@ -148,12 +148,12 @@ class Simulation {
   /// them, and the bond passes evaluate of them only their bonds to this process's nodes, so
   /// that each own node takes the serial run's terms in the serial run's order. The caller
   /// gives them their owners' state each step: between move and begin_step the positions of
-  /// those bonded to own nodes (the halo, one horizon deep), and between begin_step and finish_step their
-  /// dilatation sums (pass 1's sum_j w r e, before finish_step scales it; LPS only). Their
-  /// dilatation, forces, breaks and measures here are not their own: broken_bonds counts the
-  /// bonds broken whose lower-numbered end is own. InputError for a node that does not exist or is a
-  /// ghost particle's, and while contact or PeriDEM's damping is on (a body's motion, which
-  /// they read, is not measured across processes yet).
+  /// those bonded to own nodes (the halo, one horizon deep), and between begin_step and
+  /// finish_step their dilatation sums (pass 1's sum_j w r e, before finish_step scales it;
+  /// LPS only). Their dilatation, forces, breaks and measures here are not their own:
+  /// broken_bonds counts the bonds broken whose lower-numbered end is own. InputError for a
+  /// node that does not exist or is a ghost particle's, and while contact or PeriDEM's damping
+  /// is on (a body's motion, which they read, is not measured across processes yet).
   void set_foreign_nodes(const std::vector<index_t>& nodes);
   /// Between begin_step and finish_step, on the owner: the rigid-body motion (measure_body) of
   /// every fragment of each of `particles` (this process's own) at the state the contact will

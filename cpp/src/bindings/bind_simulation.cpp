@@ -170,7 +170,6 @@ void bind_loading(nb::class_<Simulation>& cls) {
       .def("set_foreign_nodes", &Simulation::set_foreign_nodes, "nodes"_a,
            "Mark the nodes of this process's particles that other processes own, a particle split at "
            "node level (Simulation::set_foreign_nodes); [] for none.")
-
       .def(
           "set_inert_contact_nodes",
           [](Simulation& self, const std::vector<index_t>& nodes) {

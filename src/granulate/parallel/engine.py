@@ -177,7 +177,7 @@ class DistributedRun:
         #: How many times the caps were picked anew between distributions (refresh_caps).
         self.cap_refreshes = 0
         #: The ghost nodes this rank received in all its steps (each step, its caps'), and the
-        #: surface normals (of its cap nodes within the normal reach).
+        #: surface normals (of its caps' faces, _faces).
         self.nodes_received = 0
         self.normals_received = 0
         #: The nodes that joined its caps between picks (new anchors of cap nodes; _joining).
