@@ -346,6 +346,26 @@ def test_bench_ranks_prints_each_ranks_speed_and_communication() -> None:
         assert row["collect_share"] == 0
 
 
+def test_bench_ranks_measures_one_body_cut_at_node_level() -> None:
+    """`mpiexec -n 2 granulate bench --ranks --case block --quick --json` (the notched block
+    made small): a row per rank with about half the nodes, each receiving the
+    other's nodes bonded to its own (the halo, a part of its own), with its speed and exchange
+    share; --grains refused (one body)."""
+    done = bench_ranks("--case", "block", "--quick", "--json")
+    assert done.returncode == 0, done.stderr
+    result = json.loads(done.stdout)
+    assert (result["case"], result["ranks"], result["steps"]) == ("block", 2, 20)
+    rows = result["rows"]
+    total = sum(row["nodes"] for row in rows)
+    assert len(rows) == 2 and total > 500
+    for row in rows:
+        assert row["nodes"] > 0.4 * total  # bisected by bonds: about half each
+        assert 0 < row["halo_nodes"] < row["nodes"]
+        assert row["node_steps_per_s"] > 0 and 0 <= row["exchange_share"] < 1
+    refused = bench_ranks("--case", "block", "--quick", "--grains", "5")
+    assert refused.returncode == 2 and "--grains does not apply" in refused.stderr
+
+
 def test_bench_ranks_fine_grains_send_caps() -> None:
     """`--case fine2d --quick` (40 discs and hexagons at 16 nodes per radius): each step sends
     each rank less than half the ghost nodes it holds."""

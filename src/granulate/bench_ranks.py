@@ -18,6 +18,11 @@ fine2d  (200 grains, 149,127 nodes) the pile at R/h = 16 (horizon three mesh siz
 shatter (400 grains) fracture: the pile's grains, brittle (fracture energy 0.5 J/m^2), each
         thrown at 8 m/s in a random direction into its neighbours, so that they break from the
         first steps (the bonds broken in the timed steps are counted)
+block   one body cut at node level (granulate.parallel.node_split): a notched LPS block of
+        glass, 60 x 30 x 30 nodes (53,400; 14 x 7 x 7 with --quick), stretched along its length
+        at 60/s from the start until it cracks; nothing touches. Per rank its own and halo
+        nodes, its node-steps/s and the share of its time in the two halo exchanges (waits for
+        the other ranks included); --grains does not apply
 ======  ======================================================================================
 
 Each rank runs one thread unless ``granulate --threads N`` says otherwise. After 20 untimed
@@ -156,6 +161,31 @@ def pile3d(grains: int, comm: Any = None) -> gr.Simulation:
     return sim
 
 
+def block(quick: bool = False) -> gr.Simulation:
+    """A notched glass block, 30 x 15 x 15 mm at h = 0.5 mm (7 x 3.5 x 3.5 mm with `quick`),
+    each node starting at v_x = 60/s (x - c) (c its centre), its ends held at that speed: it
+    deforms throughout and cracks from the notch within a hundred steps. No contact."""
+    glass = gr.Material(density=2500, youngs_modulus=70e9, poisson_ratio=0.22, fracture_energy=8.0)
+    length = 7e-3 if quick else 0.03
+    width = length / 2
+    sim = gr.Simulation(dimension=3)
+    notch = gr.Box((length / 2 - 0.3e-3, 2 / 3 * width, -1), (length / 2 + 0.3e-3, 1, 1))
+    sim.add_body(gr.Difference(gr.Box((0, 0, 0), (length, width, width)), notch), glass, 0.5e-3)
+    sim.contact = None
+    start = np.asarray(sim.reference_positions)
+    centre = 0.5 * length
+    velocities = np.zeros_like(start)
+    velocities[:, 0] = 60.0 * (start[:, 0] - centre)
+    sim.start_from(start, velocities)
+    for end in (gr.Box((-1, -1, -1), (1e-3, 1, 1)), gr.Box((length - 1e-3, -1, -1), (1, 1, 1))):
+        nodes = sim.select(end)
+        sim.prescribe_velocity(nodes, (60.0 * (start[nodes, 0].mean() - centre), 0.0, 0.0))
+    return sim
+
+
+#: Cases of one body cut at node level: name: set-up (quick or not).
+SPLIT_CASES: dict[str, Callable[[bool], gr.Simulation]] = {"block": block}
+
 #: name: (set-up, default grains, grains with --quick)
 CASES: dict[str, tuple[Callable[[int], gr.Simulation], int, int]] = {
     "pile3d": (pile3d, 1000, 200),
@@ -175,8 +205,10 @@ def measure(
     it."""
     from granulate.parallel import DistributedRun
 
+    if case in SPLIT_CASES:
+        return measure_split(case, grains, steps, collect_every, comm, quick)
     if case not in CASES:
-        names = ", ".join(CASES)
+        names = ", ".join([*CASES, *SPLIT_CASES])
         raise InputError(f"unknown distributed benchmark case {case!r}; choose from {names}")
     if steps < 1 or collect_every < 0 or (grains is not None and grains < 1):
         raise InputError(
@@ -224,9 +256,46 @@ def measure(
     }
 
 
+def measure_split(
+    case: str, grains: int | None, steps: int, collect_every: int, comm: Any, quick: bool
+) -> dict[str, Any] | None:
+    """measure for a case of one body cut at node level (SPLIT_CASES; NodeSplitRun): per rank
+    its own and halo nodes, node-steps/s and shares of its time exchanging and collecting."""
+    from granulate.parallel import NodeSplitRun
+
+    if grains is not None:
+        raise InputError(f"bench --ranks: case {case!r} is one body; --grains does not apply")
+    run = NodeSplitRun(SPLIT_CASES[case](quick), comm)
+    run.run(1)  # caches warm
+    broken = run.broken_bonds()
+    wall = _timed(run, steps, collect_every, comm)
+    row = {
+        "nodes": len(run.own),
+        "halo_nodes": run.halo_nodes,
+        "seconds": wall,
+        "node_steps_per_s": len(run.own) * steps / wall,
+        "exchange_share": run.seconds["exchange"] / wall,
+        "collect_share": run.seconds["collect"] / wall,
+    }
+    rows = comm.gather(row, root=0)
+    broken = run.broken_bonds() - broken
+    if rows is None:
+        return None
+    return {
+        "case": case,
+        "steps": steps,
+        "collect_every": collect_every,
+        "ranks": comm.Get_size(),
+        "threads": gr.get_num_threads(),
+        "rows": rows,
+        "bonds_broken": broken,
+    }
+
+
 def _timed(run: Any, steps: int, collect_every: int, comm: Any) -> float:
-    """The wall-clock seconds of `steps` steps of the DistributedRun `run`, gathering the whole
-    state every `collect_every` (0: never); its `seconds` count these steps alone."""
+    """The wall-clock seconds of `steps` steps of `run` (a DistributedRun or NodeSplitRun),
+    gathering the whole state every `collect_every` (0: never); its `seconds` count these steps
+    alone."""
     every = collect_every or steps
     if collect_every:
         run.collect()  # rank 0 builds the whole simulation once, untimed
@@ -242,6 +311,8 @@ def _timed(run: Any, steps: int, collect_every: int, comm: Any) -> float:
 
 def table(result: dict[str, Any]) -> str:
     """The result of `measure` as a Markdown table with a heading and a closing line."""
+    if result["case"] in SPLIT_CASES:
+        return _split_table(result)
     lines = [
         f"{result['case']}: {result['grains']} grains, {result['steps']} steps, "
         f"{result['ranks']} ranks, {result['threads']} thread(s) each",
@@ -263,6 +334,24 @@ def table(result: dict[str, Any]) -> str:
         f"widened {result['cap_margin_widenings']} times), caps picked anew "
         f"{result['cap_refreshes']} times; {result['bonds_broken']:,} bonds broken"
     )
+    return "\n".join(lines)
+
+
+def _split_table(result: dict[str, Any]) -> str:
+    """The result of measure_split as a Markdown table with a heading and a closing line."""
+    lines = [
+        f"{result['case']}: one body cut at node level, {result['steps']} steps, "
+        f"{result['ranks']} ranks, {result['threads']} thread(s) each",
+        "| rank | nodes | halo nodes | node-steps/s | exchange % | collect % |",
+        "|---:|---:|---:|---:|---:|---:|",
+    ]
+    for rank, row in enumerate(result["rows"]):
+        lines.append(
+            f"| {rank} | {row['nodes']:,} | {row['halo_nodes']:,} | "
+            f"{row['node_steps_per_s'] / 1e6:.2f} M | {100 * row['exchange_share']:.1f} | "
+            f"{100 * row['collect_share']:.1f} |"
+        )
+    lines.append(f"{result['bonds_broken']:,} bonds broken")
     return "\n".join(lines)
 
 

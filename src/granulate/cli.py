@@ -319,7 +319,7 @@ def _parser() -> argparse.ArgumentParser:
         action="store_true",
         help="a distributed run on the MPI ranks this is launched on (mpirun -n K): per rank "
         "node-steps/s and communication shares; cases pile3d (default), pile, drum, fine2d, "
-        "shatter",
+        "shatter, block (one body cut at node level)",
     )
     bench.add_argument("--steps", type=int, help="with --ranks: timed steps (default 300)")
     bench.add_argument("--grains", type=int, help="with --ranks: grains (default: the case's)")
