@@ -100,6 +100,9 @@ class NodeSplitRun:
             self._step()
 
     def _step(self) -> None:
+        """One step: the kick and drift, the halo's positions, pass 1, the halo's dilatation
+        sums (LPS), the rest of the step, and the reduction that agrees on failures; every rank
+        goes through every exchange whatever failed."""
         core, failure = self.local.core, None
         marks = [time.perf_counter()]
         failure = _attempt(core.move, failure)
@@ -130,13 +133,14 @@ class NodeSplitRun:
             requests.append(self.comm.Isend(box, dest=q, tag=_TAG))
         self.mpi.Request.Waitall(requests)
         for q, halo in self._receive.items():
-            field[halo] = inbox[q].reshape(field[halo].shape)
+            field[halo] = inbox[q][:, 0] if field.ndim == 1 else inbox[q]
 
     def _agree(self, failure: Exception | None) -> None:
         """One reduction: the first rank whose step failed raises its error, the others
         RankFailed."""
         size = self.comm.Get_size()
-        first = self.comm.allreduce(self.comm.Get_rank() if failure else size, op=self.mpi.MIN)
+        mine = self.comm.Get_rank() if failure is not None else size
+        first = self.comm.allreduce(mine, op=self.mpi.MIN)
         if failure is not None:
             raise failure
         if first < size:
