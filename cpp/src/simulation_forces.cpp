@@ -67,9 +67,6 @@ void for_each_node_in_colours(const BondSchedule& schedule, Body&& body) {
   }
 }
 
-/// Simulation::foreign_ of a foreign node with no bond to an own node (1: it has one).
-constexpr std::uint8_t far_foreign = 2;
-
 /// What the pair-force loop reads and writes, as raw pointers (kept in registers).
 struct PairForceArrays {
   const real* positions;
@@ -141,7 +138,7 @@ void Simulation::add_bond_forces(real* forces) const {
   // pressures of pass 1. Ghost particles are skipped (set_ghost_particles), and of a foreign
   // node only its forward bonds to own nodes are evaluated (set_foreign_nodes).
   const Model& m = *model_;
-  const BondSchedule& schedule = m.bond_schedule();
+  const BondSchedule& schedule = pass_schedule();
   const PairForceArrays arrays{state_.positions.data(),     m.volumes().data(),       pressure_.data(),
                                m.lps_coefficients().data(), m.pmb_stiffness().data(), forces};
   const std::uint8_t* const ghost = ghost_.empty() ? nullptr : ghost_.data();
@@ -213,7 +210,7 @@ void Simulation::sum_dilatation_and_break_bonds() {
   const auto& node_material = m.node_material();
   auto& intact = state_.bonds;
   const std::int64_t n = m.node_count();
-  const BondSchedule& schedule = m.bond_schedule();
+  const BondSchedule& schedule = pass_schedule();
   const real* const positions = state_.positions.data();
   const real* const volumes = m.volumes().data();
   real* const dilatation_sums = state_.dilatation.data();
@@ -279,9 +276,11 @@ void Simulation::start_node_forces() {
   auto& theta = state_.dilatation;
   const std::int64_t n = m.node_count();
   const auto g = body_acceleration_;
+  const std::uint8_t* const foreign = foreign_.empty() ? nullptr : foreign_.data();
 #pragma omp parallel for schedule(static)
   for (std::int64_t ii = 0; ii < n; ++ii) {
     const index_t i = static_cast<index_t>(ii);
+    if (foreign && foreign[i] == far_foreign) continue;  // nothing here reads it
     if (materials[node_material[i]].params.model == ForceModel::lps) {
       theta[i] *= lps_coefficients[i].dilatation_scale;
       pressure_[i] = lps_coefficients[i].dilatation_coupling * theta[i];

@@ -41,15 +41,35 @@ void Simulation::set_foreign_nodes(const std::vector<index_t>& nodes) {
     }
     foreign[i] = 1;
   }
-  for (const index_t i : nodes) {  // 2: no bond to an own node, so nothing of it is evaluated
+  for (const index_t i : nodes) {  // no bond to an own node: nothing of it is evaluated
     const NodeBonds bonds = model_->node_bonds(i);
     bool reaches_own = false;
     for (index_t b = 0; b < bonds.count && !reaches_own; ++b) reaches_own = !foreign[bonds.neighbor(b)];
-    if (!reaches_own) foreign[i] = 2;
+    if (!reaches_own) foreign[i] = far_foreign;
   }
   foreign_ = nodes.empty() ? std::vector<std::uint8_t>{} : std::move(foreign);
   mark_others();
   count_broken_bond_copies();
+  own_schedule_ = foreign_.empty() ? BondSchedule{} : blocks_evaluated_here();
+}
+
+BondSchedule Simulation::blocks_evaluated_here() const {
+  const BondSchedule& all = model_->bond_schedule();
+  BondSchedule here;
+  here.block_starts = all.block_starts;
+  here.particle_gathers = all.particle_gathers;
+  here.colour_offsets.push_back(0);
+  for (std::size_t c = 0; c + 1 < all.colour_offsets.size(); ++c) {
+    for (index_t k = all.colour_offsets[c]; k < all.colour_offsets[c + 1]; ++k) {
+      const index_t block = all.blocks[k];
+      bool evaluates = false;
+      for (index_t i = all.block_starts[block]; i < all.block_starts[block + 1] && !evaluates; ++i)
+        evaluates = foreign_[i] != far_foreign;
+      if (evaluates) here.blocks.push_back(block);
+    }
+    here.colour_offsets.push_back(static_cast<index_t>(here.blocks.size()));
+  }
+  return here;
 }
 
 void Simulation::mark_others() {

@@ -239,6 +239,9 @@ class Simulation {
   bool others_node(index_t i) const { return !others_.empty() && others_[i]; }
   /// others_ from ghost_ and foreign_.
   void mark_others();
+  /// The model's bond schedule with only the blocks holding a node that is own or bonded to
+  /// one (foreign_ set), in the model's colours and order (own_schedule_).
+  BondSchedule blocks_evaluated_here() const;
   /// broken_bond_copies_ from the bond states: every broken copy, or with foreign nodes twice
   /// the bonds broken whose lower-numbered end is own (each bond once over the processes).
   void count_broken_bond_copies();
@@ -255,8 +258,17 @@ class Simulation {
   std::vector<std::uint8_t> ghost_;    // per particle: 1 if another process evaluates it;
                                        // empty when none is
   std::vector<std::uint8_t> foreign_;  // per node: 0 own, else another process owns it
-                                       // (set_foreign_nodes): 1 bonded to an own node, 2 not
-  std::vector<std::uint8_t> others_;   // per node: a ghost particle's or foreign; empty if none
+                                       // (set_foreign_nodes): 1 bonded to an own node,
+                                       // far_foreign not
+  static constexpr std::uint8_t far_foreign = 2;
+  std::vector<std::uint8_t> others_;  // per node: a ghost particle's or foreign; empty if none
+  /// With foreign nodes, the model's bond schedule with only the blocks that hold a node that is
+  /// own or bonded to one, in the same colours and order (so each own node's sums are the
+  /// serial run's); the bond passes walk it (pass_schedule).
+  BondSchedule own_schedule_;
+  const BondSchedule& pass_schedule() const {
+    return foreign_.empty() ? model_->bond_schedule() : own_schedule_;
+  }
   std::vector<index_t> reported_node_, reported_particle_;  // set_reported_numbers; or empty
   real reported_stable_time_step_ = 0;                      // set_reported_stable_time_step
   std::vector<real> travel_origin_;    // positions largest_travel is measured from; or empty
