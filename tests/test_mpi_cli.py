@@ -290,6 +290,17 @@ def test_a_body_cut_at_node_level_writes_frames_in_pieces(
     assert len(set(expected[1]["Fragment_ID"])) == 2
 
 
+def test_one_body_in_contact_on_two_ranks_is_refused_with_the_way_out(tmp_path: Path) -> None:
+    """The notched plate with contact on (so its body cannot be cut at node level) on 2 ranks:
+    one message naming the ranks and grains and what to do, exit code 2, no traceback."""
+    case = tmp_path / "plate_contact.yaml"
+    case.write_text(PLATE.read_text().replace("contact: null", "contact: {restitution: 0.5}"))
+    done = granulate(tmp_path, "--out", "out", ranks=2, case=case)
+    assert done.returncode == 2, done.stdout + done.stderr
+    assert done.stderr.count("2 ranks for 1 grain(s): a run with contact gives each rank") == 1
+    assert "contact: null" in done.stderr and "Traceback" not in done.stderr
+
+
 def test_a_body_cut_at_node_level_that_blows_up_ends_every_rank(tmp_path: Path) -> None:
     """The plate's end yanked at 10 km/s on 3 ranks: the rank owning the node that outruns its
     mesh size reports the instability once, naming the node as the serial run does, and every

@@ -142,6 +142,7 @@ class DistributedRun:
         start = _start_positions(sim)
         centres, radii = _spheres([start[body.node_slice] for body in sim.bodies], sim.dimension)
         self._set_up_damping(sim)
+        _check_grains_for_ranks(len(self._slices), comm.Get_size())
         start_partition = bisect(centres, self._weights, comm.Get_size())
         first = start_partition.grains_of(comm.Get_rank())
         # The cutoff, skin and dt from the first grains and each material's coarsest grain.
@@ -1174,6 +1175,18 @@ def _coarsest_of_each_material(sim: Simulation) -> NDArray[np.int64]:
         if best is None or body.mesh_size > sim.bodies[best].mesh_size:
             coarsest[id(body.material)] = body.index
     return np.array(sorted(coarsest.values()), dtype=np.int64)
+
+
+def _check_grains_for_ranks(grains: int, ranks: int) -> None:
+    """InputError when there are fewer grains than ranks: a run with contact gives each rank
+    whole grains (a body is cut at node level only when nothing touches: node_split)."""
+    if ranks > grains:
+        raise InputError(
+            f"{ranks} ranks for {grains} grain(s): a run with contact gives each rank whole "
+            f"grains, so run it on at most {grains} rank(s); a body is cut across ranks at node "
+            "level only when nothing touches (contact: null, no walls), as contact of a split "
+            "body is not built yet"
+        )
 
 
 def _material_numbers(sim: Simulation) -> dict[int, int]:
