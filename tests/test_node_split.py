@@ -7,10 +7,10 @@ exchanges of a step). The core evaluates of a foreign node only its bonds to own
 order, and a bond across the cut breaks alike on both sides.
 
 Notched plates and strips (2D, LPS and PMB) and a notched block (3D, LPS) stretched until they
-crack
-are run whole and as parts in one process, the parts exchanging as ranks would; every own
+crack are run whole and as parts in one process, the parts exchanging as ranks would; every own
 node's position, velocity, force, dilatation and bond states agree bit for bit, for a cut
-across the body and for nodes dealt to the parts at random (a halo of nearly the whole body)."""
+across the body and for nodes dealt to the parts at random (a halo of nearly the whole body).
+Left out, the positions' exchange changes every case and the dilatations' every LPS case."""
 
 from __future__ import annotations
 
@@ -120,6 +120,8 @@ def bond_copies_of(sim: gr.Simulation, nodes: np.ndarray) -> np.ndarray:
 def test_a_split_body_steps_as_the_whole_bit_for_bit(
     shape: str, model: str, parts: int, dealt: str
 ) -> None:
+    """`parts` parts stepped with their two exchanges against the whole body, `steps` steps
+    into its cracking: own nodes' state and bonds bit for bit, each bond broken counted once."""
     steps = 200 if shape == "block" else 300
     whole = pulled(shape, model)
     assert list(whole.model.particle_gathers) == [shape == "strip"]
