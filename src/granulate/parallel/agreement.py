@@ -21,21 +21,27 @@ class RankFailed(RuntimeError):
 def together(comm: Any, action: Callable[[], T], doing: str = "building its part") -> T:
     """action() on every rank; when it raised on some rank, every rank stops: the first such
     rank with its own error, the others with RankFailed naming it and what it was `doing`
-    (one reduction)."""
-    from mpi4py import MPI
-
+    (one reduction, stop_if_any_failed)."""
     failure, result = None, None
     try:
         result = action()
     except Exception as error:  # re-raised below, once every rank knows
         failure = error
+    stop_if_any_failed(comm, failure, doing)
+    return result  # type: ignore[return-value]
+
+
+def stop_if_any_failed(comm: Any, failure: Exception | None, doing: str) -> None:
+    """One reduction: when some rank's `failure` is set, every rank stops, the first such rank
+    raising its own error, the others RankFailed naming it and what it was `doing`."""
+    from mpi4py import MPI
+
     size = comm.Get_size()
     first = comm.allreduce(comm.Get_rank() if failure is not None else size, op=MPI.MIN)
     if failure is not None:
         raise failure
     if first < size:
         raise RankFailed(f"rank {first} failed while {doing}; every rank stops")
-    return result  # type: ignore[return-value]
 
 
 def on_root(comm: Any, action: Callable[[], T]) -> T | None:

@@ -432,9 +432,14 @@ class DistributedRun:
         told = {q: self.comm.recv(source=q, tag=_CAP_TAG) for q in self._send_whole}
         self.mpi.Request.waitall(requests)
         self._send = {q: self._node_map[cap] for q, (cap, _) in told.items()}
-        self._send_faces = {q: self._node_map[face] for q, (_, face) in told.items()}
+        sent_faces = {q: self._node_map[face] for q, (_, face) in told.items()}
+        # Each step measures every face sent once, and each message takes its rows of them.
+        faces_out = np.unique(np.concatenate([np.zeros(0, np.int64), *sent_faces.values()]))
+        self._faces_out = faces_out.tolist()
+        self._face_rows = {q: np.searchsorted(faces_out, f) for q, f in sent_faces.items()}
         self._in_send = {q: _mask(len(self._to_global), n) for q, n in self._send.items()}
         self._receive, self._receive_faces = caps, faces
+        self._faces_in = np.concatenate([np.zeros(0, np.int64), *faces.values()]).astype(np.uint32)
         outside = [np.setdiff1d(self._receive_whole[q], cap) for q, cap in caps.items()]
         self.local.core.set_inert_contact_nodes(np.concatenate([[], *outside]).astype(int).tolist())
         self._caps_picked_at = int(self.local.core.step)
@@ -445,7 +450,7 @@ class DistributedRun:
 
     def _message_out(self, q: int) -> NDArray[np.float64]:
         """A buffer for the largest step message to rank q (_message)."""
-        return _message(len(self._send[q]), len(self._send_faces[q]), self._rooms_out[q])
+        return _message(len(self._send[q]), len(self._face_rows[q]), self._rooms_out[q])
 
     def _message_in(self, q: int) -> NDArray[np.float64]:
         """A buffer for the largest step message from rank q (_message)."""
@@ -553,6 +558,8 @@ class DistributedRun:
         pairs = np.asarray([] if broken is None else broken, dtype=np.int64).reshape(-1, 2)
         bodies, rows = self._own_motions(broken is not None)
         touched = np.unique(pairs)
+        faces = self._faces_out
+        normals = core.surface_normals(faces) if broken is not None else np.zeros((len(faces), 3))
         requests = [self.comm.Irecv(box, source=q, tag=_TAG) for q, box in self._inbox.items()]
         overflow, joined = [], {}
         for q, nodes in self._send.items():
@@ -561,11 +568,8 @@ class DistributedRun:
             joining = np.hstack([self._to_global[joined[q], None], x[joined[q]], v[joined[q]]])
             box = self._outbox[q]
             sections = [theirs, bodies[rows[q]], joining]
-            faces = self._send_faces[q].tolist()
-            normals = (
-                core.surface_normals(faces) if broken is not None else np.zeros((len(faces), 3))
-            )
-            used, rest = _pack(box, (x[nodes], v[nodes], normals), sections, self._rooms_out[q])
+            fields = (x[nodes], v[nodes], normals[self._face_rows[q]])
+            used, rest = _pack(box, fields, sections, self._rooms_out[q])
             requests.append(self.comm.Isend(box[:used], dest=q, tag=_TAG))
             if len(rest):
                 overflow.append(self.comm.Isend(rest, dest=q, tag=_REST_TAG))
@@ -575,7 +579,7 @@ class DistributedRun:
         self.nodes_received += self.exchanged_node_count
         self.normals_received += self.exchanged_normal_count
         self.mpi.Request.Waitall(overflow)
-        faces = self._faces_given(received)  # before the caps grow: the joining have none
+        given = np.concatenate([np.zeros((0, 3)), *(n for _, _, _, n in received.values())])
         self._grow_caps(joined, {q: joining for q, (_, _, joining, _) in received.items()})
         motions = np.concatenate([np.zeros((0, _BODY)), *(m for _, m, _, _ in received.values())])
         first = self._node_map[motions[:, 0].astype(np.int64)].astype(np.uint32)
@@ -584,18 +588,7 @@ class DistributedRun:
         return (
             self._node_map[ghost_breaks].astype(np.uint32),
             (first, np.ascontiguousarray(motions[:, 1:])),
-            faces,
-        )
-
-    def _faces_given(
-        self, received: dict[int, tuple[Any, ...]]
-    ) -> tuple[NDArray[np.uint32], NDArray[np.float64]]:
-        """The caps' faces (local nodes) and the normals this step's messages gave them."""
-        nodes = [self._receive_faces[q] for q in received]
-        normals = [normals for _, _, _, normals in received.values()]
-        return (
-            np.concatenate([np.zeros(0, np.int64), *nodes]).astype(np.uint32),
-            np.ascontiguousarray(np.concatenate([np.zeros((0, 3)), *normals])),
+            (self._faces_in, given),
         )
 
     def _joining(self, q: int, touched: NDArray[np.int64]) -> NDArray[np.int64]:
@@ -664,7 +657,7 @@ class DistributedRun:
         joined = self._node_map[joining[:, 0].astype(np.int64)]
         for k, field in enumerate(fields):
             field[joined] = joining[:, 1 + 3 * k : 4 + 3 * k]
-        return breaks.astype(np.int64), bodies, joined, normals.copy()
+        return breaks.astype(np.int64), bodies, joined, normals
 
     def run(self, steps: int) -> None:
         """Advance every rank `steps` time steps, migrating grains before a step once a node

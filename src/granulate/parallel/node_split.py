@@ -37,7 +37,7 @@ from numpy.typing import NDArray
 from granulate import checkpoints
 from granulate.errors import InputError
 from granulate.evaluation import Evaluation
-from granulate.parallel.agreement import RankFailed, on_root, together
+from granulate.parallel.agreement import on_root, stop_if_any_failed, together
 from granulate.parallel.partition import bisect
 from granulate.writers.vtu_frame import FIELD_TYPES, point_fields, write_piece_rows
 
@@ -47,13 +47,15 @@ if TYPE_CHECKING:
 
 _TAG = 23
 _NODE_FIELDS = ("positions", "velocities", "forces", "dilatation")
+_NO_BREAKS = np.zeros((0, 2), np.uint32)  # finish_step's ghost breaks: a split body has none
 
 
 class NodeSplitRun:
     """`sim` (set up alike on every rank of `comm`, not built) stepped with its nodes dealt to
     the ranks. Every rank calls the constructor and each method together.
 
-    owner: each node's rank; own: this rank's nodes; halo_nodes: the nodes it receives a step;
+    owner: each node's rank; nodes_of: each rank's nodes (own: this rank's); halo_nodes: the
+    nodes it receives a step;
     seconds: "steps" (the core's parts of the steps), "exchange" (the halo's messages and the
     step's one reduction, waits included) and "collect" [s].
     """
@@ -76,9 +78,15 @@ class NodeSplitRun:
         points = np.asarray(model.reference_positions)[:, : sim.dimension]
         self.owner = bisect(points, np.diff(self._offsets) + 1.0, ranks).owner
         rank = comm.Get_rank()
-        self.own = np.flatnonzero(self.owner == rank)
+        self.nodes_of = [np.flatnonzero(self.owner == q) for q in range(ranks)]
+        self.own = self.nodes_of[rank]
         core.set_foreign_nodes(np.flatnonzero(self.owner != rank).tolist())
         self._receive, self._send = _halos(model, self.owner, self.own, rank)
+        # The halo's messages in, for positions (3 numbers a node) and dilatation sums (1).
+        self._inboxes = {
+            width: {q: np.empty((len(halo), width)) for q, halo in self._receive.items()}
+            for width in (3, 1)
+        }
         self._lps = any(body.material.model == "lps" for body in sim.bodies)  # reads theta_j
         self.halo_nodes = sum(len(halo) for halo in self._receive.values())
         self.seconds = dict.fromkeys(("steps", "exchange", "collect"), 0.0)
@@ -114,9 +122,9 @@ class NodeSplitRun:
         if self._lps:
             self._exchange(core.dilatation)
         marks.append(time.perf_counter())
-        failure = _attempt(lambda: core.finish_step(np.zeros((0, 2), np.uint32)), failure)
+        failure = _attempt(lambda: core.finish_step(_NO_BREAKS), failure)
         marks.append(time.perf_counter())
-        self._agree(failure)
+        stop_if_any_failed(self.comm, failure, f"taking step {int(core.step) + 1}")
         marks.append(time.perf_counter())
         spans = np.diff(marks)
         self.seconds["steps"] += float(spans[0::2].sum())
@@ -126,7 +134,7 @@ class NodeSplitRun:
         """The halo's rows of `field` (positions, n x 3, or dilatation sums, n) from their
         owners: one message each way per neighbouring rank."""
         width = 1 if field.ndim == 1 else field.shape[1]
-        inbox = {q: np.empty((len(halo), width)) for q, halo in self._receive.items()}
+        inbox = self._inboxes[width]
         requests = [self.comm.Irecv(box, source=q, tag=_TAG) for q, box in inbox.items()]
         for q, nodes in self._send.items():
             box = np.ascontiguousarray(field[nodes]).reshape(len(nodes), width)
@@ -134,18 +142,6 @@ class NodeSplitRun:
         self.mpi.Request.Waitall(requests)
         for q, halo in self._receive.items():
             field[halo] = inbox[q][:, 0] if field.ndim == 1 else inbox[q]
-
-    def _agree(self, failure: Exception | None) -> None:
-        """One reduction: the first rank whose step failed raises its error, the others
-        RankFailed."""
-        size = self.comm.Get_size()
-        mine = self.comm.Get_rank() if failure is not None else size
-        first = self.comm.allreduce(mine, op=self.mpi.MIN)
-        if failure is not None:
-            raise failure
-        if first < size:
-            step = int(self.local.core.step)
-            raise RankFailed(f"rank {first} failed in step {step}; every rank stops")
 
     def gather(self, field: str, root: int = 0) -> NDArray[np.float64] | None:
         """core.<field> (positions, velocities, forces or dilatation) of every node on `root`,
@@ -157,8 +153,8 @@ class NodeSplitRun:
         if parts is None:
             return None
         whole = np.empty((len(self.owner), *mine.shape[1:]))
-        for q, part in enumerate(parts):
-            whole[self.owner == q] = part
+        for nodes, part in zip(self.nodes_of, parts, strict=True):
+            whole[nodes] = part
         return whole
 
     def broken_bonds(self) -> int:
@@ -193,8 +189,7 @@ class NodeSplitRun:
         sim = self._sim
         core = sim._build()
         bonds = np.empty(self._offsets[-1], dtype=np.uint8)
-        for q, part in enumerate(parts):
-            nodes = np.flatnonzero(self.owner == q)
+        for nodes, part in zip(self.nodes_of, parts, strict=True):
             for field, values in zip(_NODE_FIELDS, part[:-1], strict=True):
                 getattr(core, field)[nodes] = values
             bonds[_copies_of(self._offsets, nodes)] = part[-1]
@@ -240,11 +235,7 @@ class NodeSplitRun:
         labels = None
         if "Fragment_ID" in fields:
             whole = self._sim.analysis.fragment_labels() if self.comm.Get_rank() == 0 else None
-            mine = (
-                None
-                if whole is None
-                else [whole[self.owner == q] for q in range(self.comm.Get_size())]
-            )
+            mine = None if whole is None else [whole[nodes] for nodes in self.nodes_of]
             labels = self.comm.scatter(mine, root=0)
         local = [f for f in fields if f != "Fragment_ID"]
         values = point_fields(self.local, tuple(local), self.local.core.damage())
@@ -258,7 +249,7 @@ class NodeSplitRun:
 
 def _attempt(action: Any, failure: Exception | None) -> Exception | None:
     """action() unless a part of the step failed before; the failure, kept for the step's
-    reduction (_agree), so that every rank goes through every exchange."""
+    reduction (stop_if_any_failed), so that every rank goes through every exchange."""
     if failure is not None:
         return failure
     try:

@@ -27,27 +27,15 @@ class GhostBodies {
   bool ghost(index_t particle) const { return !ghost_.empty() && ghost_[particle]; }
   /// The motions of ghost bodies for the next evaluation, each named by its smallest node
   /// (sorted here; each node once).
-  void give(std::vector<std::pair<index_t, BodyMotion>> motions) {
-    std::sort(motions.begin(), motions.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
-    given_ = std::move(motions);
-  }
+  void give(std::vector<std::pair<index_t, BodyMotion>> motions) { given_ = sorted(std::move(motions)); }
   /// The motion given for the body whose smallest node is `first`, or null.
-  const BodyMotion* given(index_t first) const {
-    const auto it = std::lower_bound(given_.begin(), given_.end(), first,
-                                     [](const auto& entry, index_t node) { return entry.first < node; });
-    return it != given_.end() && it->first == first ? &it->second : nullptr;
-  }
+  const BodyMotion* given(index_t first) const { return entry(given_, first); }
   /// The surface normals of ghost nodes for the next evaluation (sorted here; each node once).
   void give_normals(std::vector<std::pair<index_t, std::array<real, 3>>> normals) {
-    std::sort(normals.begin(), normals.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
-    normals_ = std::move(normals);
+    normals_ = sorted(std::move(normals));
   }
   /// The surface normal given for node i, or null.
-  const std::array<real, 3>* normal(index_t i) const {
-    const auto it = std::lower_bound(normals_.begin(), normals_.end(), i,
-                                     [](const auto& entry, index_t node) { return entry.first < node; });
-    return it != normals_.end() && it->first == i ? &it->second : nullptr;
-  }
+  const std::array<real, 3>* normal(index_t i) const { return entry(normals_, i); }
   /// Drops the motions and normals given (after the evaluation that used them: they hold for
   /// one state).
   void forget() {
@@ -56,6 +44,19 @@ class GhostBodies {
   }
 
  private:
+  /// `entries` sorted by node.
+  template <class T>
+  static std::vector<std::pair<index_t, T>> sorted(std::vector<std::pair<index_t, T>> entries) {
+    std::sort(entries.begin(), entries.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    return entries;
+  }
+  /// The value of `node` among sorted `entries`, or null.
+  template <class T>
+  static const T* entry(const std::vector<std::pair<index_t, T>>& entries, index_t node) {
+    const auto it = std::lower_bound(entries.begin(), entries.end(), node,
+                                     [](const auto& e, index_t key) { return e.first < key; });
+    return it != entries.end() && it->first == node ? &it->second : nullptr;
+  }
   std::vector<std::uint8_t> ghost_;
   std::vector<std::pair<index_t, BodyMotion>> given_;             // by smallest node
   std::vector<std::pair<index_t, std::array<real, 3>>> normals_;  // by node
