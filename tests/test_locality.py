@@ -128,7 +128,9 @@ def test_a_ghost_grain_needs_only_its_owners_cap_motion_and_breaks(
     tumbling drum run twice, once with grain 1 a ghost given that within each step (node
     spheres, and the surface law with rolling resistance), its other nodes a little off (1e-9
     of their positions and velocities, so that any use of them would show) and out of the
-    contact lists (core.set_inert_contact_nodes, the cap picked anew each step): the other
+    contact lists (core.set_inert_contact_nodes, the cap picked anew each step), and its
+    bond forces evaluated before they are given (core.evaluate_bonds, as the ranks do while
+    the exchange is under way; the whole run's finish_step takes them itself): the other
     grains' nodes agree bit for bit through 900 steps of contact and breaking (and do not
     without the normals, under the node-sphere law), the part breaks the other
     grains' bonds as the whole run does, and every bond ends the same, and so do the damage, Z
@@ -147,6 +149,7 @@ def test_a_ghost_grain_needs_only_its_owners_cap_motion_and_breaks(
     for _ in range(900):
         broken = np.asarray(whole.core.begin_step()).reshape(-1, 2)
         own = np.asarray(part.core.begin_step()).reshape(-1, 2)
+        part.core.evaluate_bonds()  # before the ghosts are given this step's state, as the ranks
         in_ghost = (broken[:, 0] >= ghost.start) & (broken[:, 0] < ghost.stop)
         assert sorted(map(tuple, own)) == sorted(map(tuple, broken[~in_ghost]))
         x = whole.core.list_positions  # where the lists see the nodes: what the caps go by
@@ -281,7 +284,7 @@ def test_ghost_breaks_are_checked(tmp_path: Path) -> None:
     break that is no intact bond of a ghost particle (the step can still be finished), a ghost
     index out of range; and around them: the fragments' motions outside a step or of a ghost,
     a motion given to a node that is no ghost's or without its 15 numbers, reported numbers
-    of the wrong count."""
+    of the wrong count, the bond forces evaluated outside a step."""
     sim = tumbling_drum(tmp_path)
     sim.core.set_ghost_particles([1])
     with pytest.raises(gr.InputError, match="before marking ghost particles"):
@@ -294,6 +297,8 @@ def test_ghost_breaks_are_checked(tmp_path: Path) -> None:
     owned, ghost = sim.bodies[0].first_node, sim.bodies[1].first_node
     with pytest.raises(gr.InputError, match="between begin_step and finish_step"):
         sim.core.fragment_motions([0])
+    with pytest.raises(gr.InputError, match="evaluate_bonds: call it between begin_step"):
+        sim.core.evaluate_bonds()
     sim.core.begin_step()
     with pytest.raises(gr.InputError, match="particle 1 is not one of this process's"):
         sim.core.fragment_motions([0, 1])

@@ -268,6 +268,16 @@ void Simulation::finish_step(std::span<const std::array<index_t, 2>> ghost_break
   finish_step_after_breaks(ghost_breaks);
 }
 
+void Simulation::evaluate_bonds() {
+  if (!step_begun_) throw InputError("evaluate_bonds: call it between begin_step and finish_step");
+  if (bonds_evaluated_) return;
+  const auto start = clock_type::now();
+  start_node_forces();
+  add_bond_forces(state_.forces.data());  // pass 2
+  bonds_evaluated_ = true;
+  phase_times_.peridynamics += seconds_since(start);
+}
+
 void Simulation::move_and_break_bonds() {
   move_nodes();
   break_bonds_and_measure_travel();

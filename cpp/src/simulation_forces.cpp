@@ -182,11 +182,14 @@ void Simulation::compute_forces() {
 }
 
 void Simulation::finish_forces(std::span<const std::array<index_t, 2>> ghost_breaks) {
+  if (!bonds_evaluated_) {
+    start_node_forces();
+    add_bond_forces(state_.forces.data());  // pass 2
+  }
+  bonds_evaluated_ = false;
   const std::size_t own = breaks_.size();
   break_ghost_bonds(ghost_breaks);
   contact_.bonds_broke(*model_, state_, std::span(breaks_).subspan(own));
-  start_node_forces();
-  add_bond_forces(state_.forces.data());  // pass 2
   broken_bond_copies_ +=
       2 * (foreign_.empty()
                ? breaks_.size()

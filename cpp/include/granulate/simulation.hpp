@@ -82,6 +82,12 @@ class Simulation {
   /// before ghosts are marked; run and begin_step refuse to start while a step is begun.
   std::vector<std::array<index_t, 2>> begin_step();
   void finish_step(std::span<const std::array<index_t, 2>> ghost_breaks);
+  /// Between begin_step and finish_step: the LPS pressures, each node's body force and pass 2
+  /// of the bonds, which finish_step otherwise takes itself, first. They read no ghost and
+  /// nothing its owners send (the ghosts' bonds are skipped), so a distributed run of whole
+  /// grains evaluates them while that step's exchange is under way; the forces are the same
+  /// bits either way. Not for foreign nodes, whose halo's dilatation comes before pass 2.
+  void evaluate_bonds();
   /// The first half kick, the drift and prescribed motion of a step, which begin_step then
   /// continues from (pass 1) instead of taking them itself: a run with foreign nodes gives
   /// them their owners' positions in between (set_foreign_nodes).
@@ -212,8 +218,8 @@ class Simulation {
   void check_ghost_breaks(std::span<const std::array<index_t, 2>> pairs) const;
   /// The ghosts' bonds their owners broke (both copies), appended to breaks_.
   void break_ghost_bonds(std::span<const std::array<index_t, 2>> pairs);
-  /// After pass 1: the ghosts' breaks (contact told of them), then the LPS pressures and body
-  /// forces, pass 2, contact forces and nodal loads.
+  /// After pass 1: the LPS pressures and body forces and pass 2 (unless evaluate_bonds took
+  /// them), the ghosts' breaks (contact told of them), contact forces and nodal loads.
   void finish_forces(std::span<const std::array<index_t, 2>> ghost_breaks);
   /// The forces at the current state unless they are current (prescribed motion first).
   void evaluate_if_stale();
@@ -278,6 +284,7 @@ class Simulation {
   std::vector<std::array<index_t, 2>> breaks_;  // the bonds pass 1 (and the owners) broke
   bool step_begun_ = false;                     // begin_step called, finish_step not yet
   bool moved_ = false;                          // move called, begin_step not yet
+  bool bonds_evaluated_ = false;                // evaluate_bonds called, finish_step not yet
   std::uint64_t broken_bond_copies_ = 0;        // both copies of a broken bond count
   ContactModel contact_;
   contact::PeridemDamping peridem_damping_;

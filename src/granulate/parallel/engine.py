@@ -10,7 +10,8 @@ contact and the rest), and between them the owners send the ranks that hold thei
 ghosts the positions and velocities of the nodes within their reach (the caps), the bonds that
 broke in those grains and the rigid-body motion of each of their fragments, which the contact
 takes in place of what the ghost copies would give (a ghost's fragments enter its partners'
-contact too). An owned grain's step needs nothing else (tests/test_locality.py): the owned
+contact too). That exchange is under way while each rank evaluates its bond forces
+(core.evaluate_bonds, which read no ghost), and completed before the contact. An owned grain's step needs nothing else (tests/test_locality.py): the owned
 grains move bit for bit as in the serial run, for any number of ranks (tests/test_mpi.py).
 
 The ghost sets hold while no node has moved more than half the margin from where it was when
@@ -33,7 +34,7 @@ import time
 import warnings
 from pathlib import Path
 from types import SimpleNamespace
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
@@ -61,6 +62,8 @@ from granulate.parallel.whole_state import install, owned_part
 from granulate.writers.vtu_frame import write_piece
 
 if TYPE_CHECKING:
+    from collections.abc import Callable
+
     from granulate.simulation import Simulation
     from granulate.writers.outputs import Outputs
 
@@ -71,6 +74,16 @@ _BODY = 16  # numbers a body's motion takes in a message: its first node, then 1
 _JOINING = 7  # numbers a node joining a cap takes: its global number, x and v
 #: A step message's sections: breaks (node pairs), bodies, nodes joining the cap.
 _WIDTHS = np.array([2, _BODY, _JOINING])
+
+
+class _Exchange(NamedTuple):
+    """A step's exchange under way (_send_within_step): its first messages' requests (the
+    receives, then the sends), the second messages' sends, and the nodes joining each
+    receiving rank's cap."""
+
+    requests: list[Any]
+    overflow: list[Any]
+    joined: dict[int, NDArray[np.int64]]
 
 
 class DistributedRun:
@@ -533,26 +546,18 @@ class DistributedRun:
         for q, nodes in self._receive_whole.items():
             x[nodes], v[nodes], f[nodes] = inbox[q][:, :3], inbox[q][:, 3:6], inbox[q][:, 6:]
 
-    def _exchange_within_step(
-        self, broken: NDArray[np.uint32] | None
-    ) -> tuple[
-        NDArray[np.uint32],
-        tuple[NDArray[np.uint32], NDArray[np.float64]],
-        tuple[NDArray[np.uint32], NDArray[np.float64]],
-    ]:
-        """After the first half of a step (the drift and pass 1): each rank sends the ranks that
-        hold its grains as ghosts the positions and velocities now (the half-step velocities,
-        which the contact uses) of the nodes in their caps (_exchange_caps), the bonds that
-        broke in those grains this step (`broken`: flat (i, j) local node pairs; None when
-        the step failed, and then no bodies either) and the motion of each of their fragments
-        (core.fragment_motions), and the nodes joining their caps (_joining: number, x, v),
-        all in global numbering; it takes the same for its ghosts, overwriting their copies
-        (the caps growing by the nodes that joined) and giving the core their bodies' motions.
-        The surface normals of the caps' faces (core.surface_normals, after this step's breaks)
-        follow the nodes' x and v. One message per pair of neighbouring ranks (_pack); what it
-        has no room for goes in a second. The ghosts' breaks, as (k, 2) local node pairs, their
-        bodies' motions (first nodes, local; (k, 15) motions) for core.give_ghost_motions, and
-        the faces' normals (nodes, local; (k, 3) normals) for core.give_ghost_surface_normals."""
+    def _send_within_step(self, broken: NDArray[np.uint32] | None) -> _Exchange:
+        """After the first half of a step (the drift and pass 1), post the step's exchange:
+        each rank sends the ranks that hold its grains as ghosts the positions and velocities
+        now (the half-step velocities, which the contact uses) of the nodes in their caps
+        (_exchange_caps), the bonds that broke in those grains this step (`broken`: flat (i, j)
+        local node pairs; None when the step failed, and then no bodies either), the motion of
+        each of their fragments (core.fragment_motions), the nodes joining their caps
+        (_joining: number, x, v), all in global numbering, and the surface normals of the
+        caps' faces (core.surface_normals, after this step's breaks). One message per pair of
+        neighbouring ranks (_pack); what it has no room for goes in a second. The receives are
+        posted first; _receive_within_step waits for them, after the rank's bond forces
+        (core.evaluate_bonds), which need nothing of them."""
         core = self.local.core
         x, v = core.positions, core.velocities
         pairs = np.asarray([] if broken is None else broken, dtype=np.int64).reshape(-1, 2)
@@ -574,13 +579,29 @@ class DistributedRun:
             if len(rest):
                 overflow.append(self.comm.Isend(rest, dest=q, tag=_REST_TAG))
                 self.second_messages += 1
-        self.mpi.Request.Waitall(requests)
+        return _Exchange(requests, overflow, joined)
+
+    def _receive_within_step(
+        self, exchange: _Exchange
+    ) -> tuple[
+        NDArray[np.uint32],
+        tuple[NDArray[np.uint32], NDArray[np.float64]],
+        tuple[NDArray[np.uint32], NDArray[np.float64]],
+    ]:
+        """The step's exchange (_send_within_step) completed: the ghosts' copies overwritten
+        with what their owners sent (the caps growing by the nodes that joined). The ghosts'
+        breaks, as (k, 2) local node pairs, their bodies' motions (first nodes, local; (k, 15)
+        motions) for core.give_ghost_motions, and the faces' normals (nodes, local; (k, 3)
+        normals) for core.give_ghost_surface_normals."""
+        core = self.local.core
+        x, v = core.positions, core.velocities
+        self.mpi.Request.Waitall(exchange.requests)
         received = {q: self._unpack(q, nodes, (x, v)) for q, nodes in self._receive.items()}
         self.nodes_received += self.exchanged_node_count
         self.normals_received += self.exchanged_normal_count
-        self.mpi.Request.Waitall(overflow)
+        self.mpi.Request.Waitall(exchange.overflow)
         given = np.concatenate([np.zeros((0, 3)), *(n for _, _, _, n in received.values())])
-        self._grow_caps(joined, {q: joining for q, (_, _, joining, _) in received.items()})
+        self._grow_caps(exchange.joined, {q: joining for q, (_, _, joining, _) in received.items()})
         motions = np.concatenate([np.zeros((0, _BODY)), *(m for _, m, _, _ in received.values())])
         first = self._node_map[motions[:, 0].astype(np.int64)].astype(np.uint32)
         breaks = (b for b, _, _, _ in received.values())
@@ -689,35 +710,44 @@ class DistributedRun:
 
     def _step(self) -> None:
         """One step: its first half (core.begin_step), the exchange of the ghosts' motion and
-        breaks, its second half (core.finish_step) and the check. Every rank goes through the
-        exchange and the check whatever failed, so that none waits for another."""
+        breaks posted, the bond forces (core.evaluate_bonds, which read no ghost) while it is
+        under way, the exchange completed, the rest of the step (core.finish_step: the ghosts'
+        breaks, contact) and the check. Every rank goes through the exchange and the check
+        whatever failed, so that none waits for another."""
         core = self.local.core
-        start = time.perf_counter()
+        times = [time.perf_counter()]
         failure, broken = None, None
         try:
             broken = core.begin_step()
         except Exception as error:  # re-raised by the check, after the ranks agree to stop
             failure = error
-        began = time.perf_counter()
+        times.append(time.perf_counter())
         if self.caps_partial:
             self._caps_hold(failure is None)
-        checked = time.perf_counter()
-        ghost_breaks, motions, faces = self._exchange_within_step(broken)
-        told = time.perf_counter()
+        times.append(time.perf_counter())
+        exchange = self._send_within_step(broken)
+        times.append(time.perf_counter())
         if failure is None:
-            try:
-                core.give_ghost_motions(*motions)
-                core.give_ghost_surface_normals(*faces)
-                core.finish_step(ghost_breaks)
-            except Exception as error:
-                failure = error
-        stepped = time.perf_counter()
+            failure = _attempt(core.evaluate_bonds)
+        times.append(time.perf_counter())
+        ghost_breaks, motions, faces = self._receive_within_step(exchange)
+        times.append(time.perf_counter())
+
+        def finish() -> None:
+            core.give_ghost_motions(*motions)
+            core.give_ghost_surface_normals(*faces)
+            core.finish_step(ghost_breaks)
+
+        if failure is None:
+            failure = _attempt(finish)
+        times.append(time.perf_counter())
         farthest = self._check_step(int(core.step), failure)
         self._loaded_walls = None
         self._migration_due = self._migrates and self._travelled + farthest > 0.25 * self.margin
-        self.seconds["steps"] += (began - start) + (stepped - told)
-        self.seconds["check"] += time.perf_counter() - stepped
-        self.seconds["exchange"] += told - checked
+        spans = np.diff(times)  # begin, caps' check, send, bonds, receive, finish
+        self.seconds["steps"] += spans[0] + spans[3] + spans[5]
+        self.seconds["exchange"] += spans[2] + spans[4]
+        self.seconds["check"] += time.perf_counter() - times[-1]
 
     def _caps_hold(self, moved: bool) -> None:
         """Within a step, once its drift has moved the nodes (`moved`: begin_step did not
@@ -1131,6 +1161,16 @@ def _sections(
         parts.append(np.concatenate(rows).reshape(-1, width))
         here, there = here + n * width, there + m * width
     return parts
+
+
+def _attempt(action: Callable[[], None]) -> Exception | None:
+    """Run `action`: None, or the error it raised (which the step's check re-raises once the
+    ranks agree to stop)."""
+    try:
+        action()
+    except Exception as error:
+        return error
+    return None
 
 
 def _mask(size: int, indices: NDArray[np.int64]) -> NDArray[np.bool_]:
