@@ -18,8 +18,13 @@ dense pile's contact candidates. A step then needs, per rank:
 - one reduction (the stability check's minimum): 2 log2(K) latencies.
 
 The network is an assumption, printed with the table: latency 1.5 us and 0.39 GB/s per rank (a
-100 Gb/s link shared by 32 ranks, every neighbour on another node: the pessimistic case). No
-overlap of communication with computation is assumed.
+100 Gb/s link shared by 32 ranks, every neighbour on another node: the pessimistic case).
+"comm %" assumes no overlap of communication with computation; "hidden %" (and the caps
+table's second figure) what is left exposed with the exchange under way while the rank
+evaluates its bond forces, as DistributedRun does (all but the first of their BOND_PARTS
+parts; their share of a step measured), which assumes the MPI moves a message on between
+its calls (a network's RDMA does; on one machine's shared memory the copy is the CPU's work,
+done within the progress calls).
 
 A second table splits one body at node level (`--block N`: an N^3 simple-cubic block, horizon
 3.015 spacings, LAMMPS' lattice): the same bisection over its nodes, and as halo each rank's
@@ -39,14 +44,14 @@ import argparse
 import json
 import time
 from pathlib import Path
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 from granulate._core import points_within
 
 import granulate as gr
 from granulate.parallel import bisect, ghosts, near_pairs
-from granulate.parallel.engine import contact_reads
+from granulate.parallel.engine import BOND_PARTS, contact_reads
 
 RADIUS = 1e-3
 #: The check after each step (one reduction of the travel the core measures in its last half
@@ -117,11 +122,21 @@ def touching_spheres(nodes_across_radius: int, pair_law: str = "surface") -> gr.
     return sim
 
 
-def node_steps_per_second(nodes_across_radius: int, steps: int = 300) -> tuple[float, float, float]:
+class Measured(NamedTuple):
+    """One core's figures on the 27 touching spheres (node_steps_per_second)."""
+
+    rate: float  # node-steps per second
+    bond_share: float  # the bond passes' share of a step
+    ghost_saving: float  # the share of a step a ghost saves
+    forces: float  # the bond forces' share of a step (bond_force_share)
+
+
+def node_steps_per_second(nodes_across_radius: int, steps: int = 300) -> Measured:
     """One core's node-steps per second on 27 touching spheres in a box under gravity, the
-    share of the bond passes (peridynamics) in the step, and the share a ghost saves: the same
-    steps again from the same state with every sphere a ghost (core.set_ghost_particles: both
-    bond passes skipped), the time saved over the time taken."""
+    share of the bond passes (peridynamics) in the step, the share a ghost saves (the same
+    steps again from the same state with every sphere a ghost, core.set_ghost_particles: both
+    bond passes skipped; the time saved over the time taken), and the share of the bond forces
+    (bond_force_share)."""
     sim = touching_spheres(nodes_across_radius)
     sim.run(20)
     saved = sim.core.checkpoint()
@@ -131,12 +146,30 @@ def node_steps_per_second(nodes_across_radius: int, steps: int = 300) -> tuple[f
     seconds = time.perf_counter() - start
     bonds = sim.summary()["peridynamics_seconds"] - before
     sim.core.restore(saved)
+    forces = bond_force_share(sim)
+    sim.core.restore(saved)
     sim.core.set_ghost_particles(list(range(len(sim.bodies))))
     start = time.perf_counter()
     sim.core.run(steps)
     as_ghosts = time.perf_counter() - start
     ghost_saving = max(0.0, 1.0 - as_ghosts / seconds)
-    return sim.node_count * steps / seconds, bonds / seconds, ghost_saving
+    return Measured(sim.node_count * steps / seconds, bonds / seconds, ghost_saving, forces)
+
+
+def bond_force_share(sim: gr.Simulation, steps: int = 100) -> float:
+    """The share of a step its bond forces take (core.evaluate_bonds: the body forces and pass
+    2 of the bonds), measured over `steps` steps taken in halves: what DistributedRun evaluates
+    while the step's exchange is under way."""
+    core = sim.core
+    inside = 0.0
+    start = time.perf_counter()
+    for _ in range(steps):
+        core.begin_step()
+        began = time.perf_counter()
+        core.evaluate_bonds()
+        inside += time.perf_counter() - began
+        core.finish_step(np.zeros((0, 2), np.uint32))
+    return inside / (time.perf_counter() - start)
 
 
 def measured_caps(nodes_across_radius: int, depth: float, pair_law: str) -> tuple[float, float]:
@@ -230,18 +263,18 @@ def rank_table(
     }
 
 
-def modelled(
-    row: dict, rate: float, bond_share: float, args: argparse.Namespace
-) -> dict[str, float]:
+def modelled(row: dict, measured: Measured, args: argparse.Namespace) -> dict[str, float]:
     """That rank's step: compute, one exchange of its ghost nodes' positions and velocities,
     one reduction; the share of communication in the step, without overlap and with the
-    exchange hidden behind the bond passes (which need no ghost)."""
-    compute = row["owned_nodes"] / rate
+    exchange hidden behind the bond forces, as DistributedRun overlaps them (all but their
+    first of BOND_PARTS parts, measured.forces of a step)."""
+    compute = row["owned_nodes"] / measured.rate
     ghost_bytes = 48.0 * row["ghost_nodes"]
     exchange, reduction = communication_seconds(
         1, row["neighbours_max"], ghost_bytes, row["ranks"], args
     )
-    exposed = max(0.0, exchange - bond_share * compute) + reduction
+    hiding = measured.forces * (1 - 1 / BOND_PARTS) * compute
+    exposed = max(0.0, exchange - hiding) + reduction
     return {
         "ghost_bytes_per_step": ghost_bytes,
         "compute_s": compute,
@@ -257,15 +290,14 @@ def as_built(
     pairs,
     ranks: int,
     unit_nodes: np.ndarray,
-    rate: float,
-    ghost_saving: float,
+    measured: Measured,
     args: argparse.Namespace,
     depths: dict[str, tuple[float, float, float]],
 ) -> dict:
     """The engine as built (granulate.parallel.DistributedRun), for the rank with the most ghost
     grains per owned grain: its ghosts are whole grains within the reach plus the margin (the
     largest bounding radius; `pairs`: near_pairs at that distance), stepped but for their
-    bonds (`ghost_saving` of a step, which the core skips for ghosts); within the step it
+    bonds (measured.ghost_saving of a step, which the core skips for ghosts); within the step it
     receives 48 bytes (x, v) of every ghost node and the bonds broken (one message per
     neighbouring rank), checks after each step (CHECK_SHARE of a step, measured) and reduces
     once. Efficiency: its own nodes' compute over its step; the same with the ghosts stepped in
@@ -275,7 +307,11 @@ def as_built(
     (exchanged_nodes; the ghosts still held and stepped whole) times the factor, with a second
     reduction per step (the caps' check within the step), and the owner's computing of the
     normals it sends (as many node-steps per layer node as `depths` says), counted with the
-    communication."""
+    communication. "cap_exposed": the same with the exchange under way while the rank
+    evaluates its bond forces (DistributedRun._bonds_while_exchanging): hidden but for what
+    outlasts the last BOND_PARTS - 1 parts of them (measured.forces: their share of a step;
+    the MPI is first called on to move the messages after the first part)."""
+    rate, ghost_saving = measured.rate, measured.ghost_saving
     partition = bisect(centres, np.ones(len(centres)), ranks)
     needed = ghosts(partition, pairs)
     owned = np.bincount(partition.owner, minlength=ranks)
@@ -287,18 +323,20 @@ def as_built(
     in_full = (own + ghost) / rate * (1 + CHECK_SHARE)
     lean = useful * (1 + CHECK_SHARE)
 
-    def communication(sent: int, reductions: int = 1) -> float:
+    def communication(sent: int) -> tuple[float, float]:
         # one message per neighbour within a step: x and v of the nodes sent, the bonds broken
-        exchange, reduction = communication_seconds(1, neighbours, 48.0 * sent, ranks, args)
-        return exchange + reductions * reduction
+        return communication_seconds(1, neighbours, 48.0 * sent, ranks, args)
 
-    talk = communication(ghost)
-    cap_shares = {}
+    talk = sum(communication(ghost))
+    hiding = measured.forces * (1 - 1 / BOND_PARTS) * useful
+    cap_shares, cap_exposed = {}, {}
     for name, (depth, factor, faces) in depths.items():  # a check in the step, the normals
         counts = exchanged_nodes(centres, radii, partition.owner, ranks, pairs, unit_nodes, depth)
-        capped = communication(round(factor * counts[worst]), reductions=2)
-        capped += faces * counts[worst] / rate
+        exchange, reduction = communication(round(factor * counts[worst]))
+        rest = 2 * reduction + faces * counts[worst] / rate
+        capped, exposed = exchange + rest, max(0.0, exchange - hiding) + rest
         cap_shares[name] = capped / (stepped + capped)
+        cap_exposed[name] = exposed / (stepped + exposed)
     return {
         "ranks": ranks,
         "ghost_grains_over_owned": len(needed[worst]) / owned[worst],
@@ -309,6 +347,7 @@ def as_built(
         "efficiency_ghosts_in_full": useful / (in_full + talk),
         "efficiency_without_ghost_steps": useful / (lean + talk),
         "cap_shares": cap_shares,
+        "cap_exposed": cap_exposed,
     }
 
 
@@ -372,8 +411,7 @@ def cap_depths(args: argparse.Namespace) -> dict[str, tuple[float, float, float]
 def engine_as_built(
     pack: gr.Packing,
     unit_nodes: np.ndarray,
-    rate: float,
-    ghost_saving: float,
+    measured: Measured,
     args: argparse.Namespace,
 ) -> list[dict]:
     """The table of as_built for 2, 4, ... ranks, and with --caps the table of its
@@ -385,7 +423,7 @@ def engine_as_built(
     depths = cap_depths(args) if args.caps else {}
     print(
         f"\nthe engine as built: whole ghost grains within {1e3 * (args.reach + margin):.2f} mm "
-        f"(reach + margin) stepped but for their bonds ({100 * ghost_saving:.0f} % of a "
+        f"(reach + margin) stepped but for their bonds ({100 * measured.ghost_saving:.0f} % of a "
         "step, measured), x, v of every ghost node and the step's broken bonds exchanged, "
         "the check "
         f"({100 * CHECK_SHARE:.1f} % of a step) and one reduction"
@@ -397,9 +435,7 @@ def engine_as_built(
     rows = []
     ranks = 2
     while ranks <= min(args.largest, args.grains):
-        row = as_built(
-            pack.positions, pack.radii, pairs, ranks, unit_nodes, rate, ghost_saving, args, depths
-        )
+        row = as_built(pack.positions, pack.radii, pairs, ranks, unit_nodes, measured, args, depths)
         rows.append(row)
         print(
             f"{ranks:6d} {row['ghost_grains_over_owned']:9.2f} {row['neighbours']:10d} "
@@ -411,14 +447,19 @@ def engine_as_built(
     if depths:
         print(
             "\nthe engine with caps: communication % of the step (x, v of the ghost nodes within "
-            "a depth of the rank's grains' spheres; ghosts still held and stepped whole)"
+            "a depth of the rank's grains' spheres; ghosts still held and stepped whole), "
+            "without overlap / exposed while the bond forces are evaluated"
         )
         heads = "".join(
             f" {f'{n} {1e3 * d:.2f} mm x{f:.2f}':>30}" for n, (d, f, _) in depths.items()
         )
         print(f"{'ranks':>6} {'whole':>8}" + heads)
         for row in rows:
-            shares = "".join(f" {100 * share:30.1f}" for share in row["cap_shares"].values())
+            exposed = row["cap_exposed"]
+            shares = "".join(
+                f" {f'{100 * share:.1f} / {100 * exposed[name]:.1f}':>30}"
+                for name, share in row["cap_shares"].items()
+            )
             print(f"{row['ranks']:6d} {100 * row['communication_share']:8.1f}" + shares)
     return rows
 
@@ -488,12 +529,14 @@ def main() -> None:
     start = time.perf_counter()
     pack = packing(args.grains)
     unit_nodes = grain_nodes(args.nodes_across_radius)
-    rate, bond_share, ghost_saving = node_steps_per_second(args.nodes_across_radius)
+    measured = node_steps_per_second(args.nodes_across_radius)
+    rate, bond_share = measured.rate, measured.bond_share
     print(
         f"{pack.summary()}; packed in {time.perf_counter() - start:.1f} s\n"
         f"{len(unit_nodes)} nodes per grain (R/h = {args.nodes_across_radius}); one core: "
         f"{rate / 1e6:.2f} M node-steps/s, bond passes {100 * bond_share:.0f} % of the step "
-        f"(a ghost saves {100 * ghost_saving:.0f} %; measured)\n"
+        f"(a ghost saves {100 * measured.ghost_saving:.0f} %, the bond forces take "
+        f"{100 * measured.forces:.0f} %; measured)\n"
         f"network assumed: latency {args.latency * 1e6:.1f} us, "
         f"{args.bandwidth / 1e9:.2f} GB/s per rank"
     )
@@ -509,7 +552,7 @@ def main() -> None:
         began = time.perf_counter()
         row = rank_table(pack.positions, pack.radii, pairs, ranks, unit_nodes, args.reach)
         row["partition_seconds"] = time.perf_counter() - began
-        row |= modelled(row, rate, bond_share, args)
+        row |= modelled(row, measured, args)
         rows.append(row)
         print(
             f"{ranks:6d} {row['grains_per_rank']:11.1f} {row['owned_nodes']:10d} "
@@ -520,14 +563,15 @@ def main() -> None:
         )
         ranks *= 2
     print(f"broad phase: {rows[0]['candidates_per_grain']:.1f} candidate partners per grain")
-    built = engine_as_built(pack, unit_nodes, rate, ghost_saving, args)
+    built = engine_as_built(pack, unit_nodes, measured, args)
     body = single_body(args) if args.block else []
     if args.json is not None:
         settings = vars(args) | {
             "json": None,
             "rate": rate,
             "bond_share": bond_share,
-            "ghost_saving": ghost_saving,
+            "ghost_saving": measured.ghost_saving,
+            "bond_force_share": measured.forces,
         }
         result = {
             "arguments": settings,

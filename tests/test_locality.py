@@ -19,6 +19,7 @@ import pytest
 
 import granulate as gr
 from test_checkpoint import tumbling_drum
+from test_node_split import pulled
 
 RADIUS = 1e-3
 
@@ -276,6 +277,38 @@ def test_inert_nodes_leave_the_lists_and_come_back(tmp_path: Path) -> None:
     assert pushed(sim, grain)
     with pytest.raises(gr.InputError, match="inert contact node 99999 does not exist"):
         sim.core.set_inert_contact_nodes([99999])
+
+
+@pytest.mark.parametrize("case", ["plate", "drum"])
+def test_bond_forces_in_parts_are_the_same_bits(case: str, tmp_path: Path) -> None:
+    """core.evaluate_bonds(share) walks pass 2's blocks in schedule order up to that share of
+    them, from where its last call stopped, and finish_step takes the rest: a distributed run
+    evaluates its bonds in parts while its exchange is under way. Stepped so, with the parts
+    cutting through colours, the notched LPS plate cracking under tension (several colours)
+    and the tumbling drum (grains: one colour, contact) are bit for bit the runs stepped
+    whole. A share outside [0, 1] is refused."""
+    whole, parted = (
+        (pulled("plate", "lps"), pulled("plate", "lps"))
+        if case == "plate"
+        else (tumbling_drum(tmp_path / "a"), tumbling_drum(tmp_path / "b"))
+    )
+    blocks = np.asarray(whole.model.bond_colour_blocks)
+    assert list(blocks) == ([8, 8] if case == "plate" else [2])  # cut at 4, 8, 14; at 1
+    whole.core.run(0)
+    parted.core.run(0)
+    for _ in range(300):
+        whole.core.run(1)
+        parted.core.begin_step()
+        for share in (0.3, 0.3, 0.55, 0.0, 0.9):
+            parted.core.evaluate_bonds(share)
+        parted.core.finish_step(np.zeros((0, 2), np.uint32))
+    for field in ("positions", "velocities", "forces", "bond_intact"):
+        np.testing.assert_array_equal(getattr(whole.core, field), getattr(parted.core, field))
+    assert whole.broken_bonds() > 0
+    parted.core.begin_step()
+    for share in (1.5, -0.1, float("nan")):
+        with pytest.raises(gr.InputError, match="share of the bond blocks must lie in"):
+            parted.core.evaluate_bonds(share)
 
 
 def test_ghost_breaks_are_checked(tmp_path: Path) -> None:

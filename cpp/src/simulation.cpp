@@ -268,14 +268,27 @@ void Simulation::finish_step(std::span<const std::array<index_t, 2>> ghost_break
   finish_step_after_breaks(ghost_breaks);
 }
 
-void Simulation::evaluate_bonds() {
+void Simulation::evaluate_bonds(real share) {
   if (!step_begun_) throw InputError("evaluate_bonds: call it between begin_step and finish_step");
-  if (bonds_evaluated_) return;
+  if (!(share >= 0 && share <= 1)) {
+    throw InputError("evaluate_bonds: the share of the bond blocks must lie in [0, 1], not " +
+                     std::to_string(share));
+  }
   const auto start = clock_type::now();
-  start_node_forces();
-  add_bond_forces(state_.forces.data());  // pass 2
-  bonds_evaluated_ = true;
+  const auto blocks = static_cast<real>(pass_schedule().blocks.size());
+  evaluate_bond_blocks(static_cast<std::int64_t>(share * blocks));
   phase_times_.peridynamics += seconds_since(start);
+}
+
+void Simulation::evaluate_bond_blocks(std::int64_t to) {
+  if (blocks_evaluated_ == forces_not_started) {
+    start_node_forces();
+    blocks_evaluated_ = 0;
+  }
+  to = std::min(to, static_cast<std::int64_t>(pass_schedule().blocks.size()));
+  if (to <= blocks_evaluated_) return;
+  add_bond_forces(state_.forces.data(), blocks_evaluated_, to);  // pass 2
+  blocks_evaluated_ = to;
 }
 
 void Simulation::move_and_break_bonds() {

@@ -5,6 +5,7 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <limits>
 
 #include "bond_extension.hpp"
 #include "granulate/peridynamics/critical_stretch.hpp"
@@ -54,11 +55,16 @@ void add_dilatation_terms(index_t i, const NodeBonds& bonds, std::uint8_t* bond_
 /// omp parallel region). Each bond is evaluated once, at its lower-numbered end, and its terms are
 /// added to both ends; the colours keep concurrent blocks on disjoint nodes (see BondSchedule), so
 /// there are no atomics and the sums do not depend on the thread count. Nodes of a particle that
-/// gathers evaluate all their bonds and write only their own sums.
+/// gathers evaluate all their bonds and write only their own sums. Only the blocks at places
+/// [from, to) of schedule.blocks, when given: the sums do not change when the blocks are walked
+/// in several such calls, in order, since those of one colour never share a node.
 template <class Body>
-void for_each_node_in_colours(const BondSchedule& schedule, Body&& body) {
+void for_each_node_in_colours(const BondSchedule& schedule, Body&& body, std::int64_t from = 0,
+                              std::int64_t to = std::numeric_limits<std::int64_t>::max()) {
   for (std::size_t c = 0; c + 1 < schedule.colour_offsets.size(); ++c) {
-    const std::int64_t first = schedule.colour_offsets[c], last = schedule.colour_offsets[c + 1];
+    const std::int64_t first = std::max<std::int64_t>(schedule.colour_offsets[c], from);
+    const std::int64_t last = std::min<std::int64_t>(schedule.colour_offsets[c + 1], to);
+    if (first >= last) continue;  // the same for every thread
 #pragma omp for schedule(dynamic, 1)
     for (std::int64_t k = first; k < last; ++k) {
       const index_t block = schedule.blocks[k];
@@ -133,7 +139,7 @@ void add_pair_forces(index_t i, const NodeBonds& bonds, const std::uint8_t* bond
 
 }  // namespace
 
-void Simulation::add_bond_forces(real* forces) const {
+void Simulation::add_bond_forces(real* forces, std::int64_t from, std::int64_t to) const {
   // Pass 2: pair forces, w_ij s y/|y| on i and -w_ji s y/|y| on j (w_ij = J beta V_j), from the
   // pressures of pass 1. Ghost particles are skipped (set_ghost_particles), and of a foreign
   // node only its forward bonds to own nodes are evaluated (set_foreign_nodes).
@@ -143,8 +149,7 @@ void Simulation::add_bond_forces(real* forces) const {
                                m.lps_coefficients().data(), m.pmb_stiffness().data(), forces};
   const std::uint8_t* const ghost = ghost_.empty() ? nullptr : ghost_.data();
   const std::uint8_t* const foreign = foreign_.empty() ? nullptr : foreign_.data();
-#pragma omp parallel
-  for_each_node_in_colours(schedule, [&](index_t i) {
+  const auto evaluate = [&](index_t i) {
     if (ghost && ghost[m.node_particle()[i]]) return;  // another process's forces
     const NodeBonds bonds = m.node_bonds(i);
     const bool lps = m.materials()[m.node_material()[i]].params.model == ForceModel::lps;
@@ -166,7 +171,9 @@ void Simulation::add_bond_forces(real* forces) const {
     } else {
       add_pair_forces<false, true>(i, bonds, bits, arrays);
     }
-  });
+  };
+#pragma omp parallel
+  for_each_node_in_colours(schedule, evaluate, from, to);
 }
 
 std::vector<real> Simulation::bond_force_densities() const {
@@ -182,11 +189,8 @@ void Simulation::compute_forces() {
 }
 
 void Simulation::finish_forces(std::span<const std::array<index_t, 2>> ghost_breaks) {
-  if (!bonds_evaluated_) {
-    start_node_forces();
-    add_bond_forces(state_.forces.data());  // pass 2
-  }
-  bonds_evaluated_ = false;
+  evaluate_bond_blocks(std::numeric_limits<std::int64_t>::max());  // what evaluate_bonds left
+  blocks_evaluated_ = forces_not_started;
   const std::size_t own = breaks_.size();
   break_ghost_bonds(ghost_breaks);
   contact_.bonds_broke(*model_, state_, std::span(breaks_).subspan(own));

@@ -82,12 +82,14 @@ class Simulation {
   /// before ghosts are marked; run and begin_step refuse to start while a step is begun.
   std::vector<std::array<index_t, 2>> begin_step();
   void finish_step(std::span<const std::array<index_t, 2>> ghost_breaks);
-  /// Between begin_step and finish_step: the LPS pressures, each node's body force and pass 2
-  /// of the bonds, which finish_step otherwise takes itself, first. They read no ghost and
-  /// nothing its owners send (the ghosts' bonds are skipped), so a distributed run of whole
-  /// grains evaluates them while that step's exchange is under way; the forces are the same
-  /// bits either way. Not for foreign nodes, whose halo's dilatation comes before pass 2.
-  void evaluate_bonds();
+  /// Between begin_step and finish_step: the LPS pressures and each node's body force, then
+  /// pass 2 of the bonds up to `share` (0 to 1) of its blocks in schedule order, continuing
+  /// from where the last call stopped; finish_step takes what is left. None of it reads a ghost
+  /// or anything its owners send (the ghosts' bonds are skipped), so a distributed run of
+  /// whole grains evaluates the bonds while that step's exchange is under way, in parts with
+  /// the MPI progressed in between; the forces are the same bits however the blocks are
+  /// split. Not for foreign nodes, whose halo's dilatation comes before pass 2.
+  void evaluate_bonds(real share = 1);
   /// The first half kick, the drift and prescribed motion of a step, which begin_step then
   /// continues from (pass 1) instead of taking them itself: a run with foreign nodes gives
   /// them their owners' positions in between (set_foreign_nodes).
@@ -218,8 +220,8 @@ class Simulation {
   void check_ghost_breaks(std::span<const std::array<index_t, 2>> pairs) const;
   /// The ghosts' bonds their owners broke (both copies), appended to breaks_.
   void break_ghost_bonds(std::span<const std::array<index_t, 2>> pairs);
-  /// After pass 1: the LPS pressures and body forces and pass 2 (unless evaluate_bonds took
-  /// them), the ghosts' breaks (contact told of them), contact forces and nodal loads.
+  /// After pass 1: what evaluate_bonds left of the LPS pressures, body forces and pass 2, the
+  /// ghosts' breaks (contact told of them), contact forces and nodal loads.
   void finish_forces(std::span<const std::array<index_t, 2>> ghost_breaks);
   /// The forces at the current state unless they are current (prescribed motion first).
   void evaluate_if_stale();
@@ -232,8 +234,13 @@ class Simulation {
   /// LPS dilatation theta_i and pressure A_i theta_i; each node's force density started with
   /// rho (g - gamma v).
   void start_node_forces();
-  /// Adds the bond forces (pass 2) to `forces` (nodes x 3).
-  void add_bond_forces(real* forces) const;
+  /// Adds the bond forces (pass 2) to `forces` (nodes x 3): of the blocks at places [from, to)
+  /// of the pass schedule's, or all.
+  void add_bond_forces(real* forces, std::int64_t from = 0,
+                       std::int64_t to = std::numeric_limits<std::int64_t>::max()) const;
+  /// Within a step: the node forces started (start_node_forces) unless they are, then pass 2's
+  /// blocks from where the last call stopped up to place `to` of the pass schedule's.
+  void evaluate_bond_blocks(std::int64_t to);
   /// Contact (node pairs, walls, dashpots, friction) and PeriDEM's damping, timed.
   void add_contact_forces();
   /// The nodal force densities f(t) b.
@@ -284,8 +291,9 @@ class Simulation {
   std::vector<std::array<index_t, 2>> breaks_;  // the bonds pass 1 (and the owners) broke
   bool step_begun_ = false;                     // begin_step called, finish_step not yet
   bool moved_ = false;                          // move called, begin_step not yet
-  bool bonds_evaluated_ = false;                // evaluate_bonds called, finish_step not yet
-  std::uint64_t broken_bond_copies_ = 0;        // both copies of a broken bond count
+  static constexpr std::int64_t forces_not_started = -1;
+  std::int64_t blocks_evaluated_ = forces_not_started;  // pass 2's blocks done within the step
+  std::uint64_t broken_bond_copies_ = 0;                // both copies of a broken bond count
   ContactModel contact_;
   contact::PeridemDamping peridem_damping_;
   bool forces_current_ = false;

@@ -101,6 +101,17 @@ void bind_contents(nb::class_<Model>& model) {
           nb::rv_policy::move,
           "Per particle, 1 if its nodes evaluate all their bonds and write only their own sums "
           "(BondSchedule::particle_gathers), 0 if each bond is evaluated once (a new array).")
+      .def_prop_ro(
+          "bond_colour_blocks",
+          [](const Model& self) {
+            const auto& offsets = self.bond_schedule().colour_offsets;
+            std::vector<index_t> counts(offsets.size() - 1);
+            for (std::size_t c = 0; c < counts.size(); ++c) counts[c] = offsets[c + 1] - offsets[c];
+            return copy_out(counts);
+          },
+          nb::rv_policy::move,
+          "The bond passes' blocks per colour, in the order they are walked (BondSchedule; a new "
+          "array).")
       .def(
           "bond_partners",
           [](const Model& self, const std::vector<index_t>& nodes) {

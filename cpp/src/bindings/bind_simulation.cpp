@@ -294,9 +294,11 @@ void bind_results(nb::class_<Simulation>& cls) {
           },
           "ghost_breaks"_a,
           "The rest of the step, after breaking the ghosts' bonds their owners broke, (k, 2) node pairs.")
-      .def("evaluate_bonds", &Simulation::evaluate_bonds, nb::call_guard<nb::gil_scoped_release>(),
-           "Between begin_step and finish_step: the body forces and pass 2 of the bonds, which read "
-           "no ghost (Simulation::evaluate_bonds); finish_step then takes the rest.")
+      .def("evaluate_bonds", &Simulation::evaluate_bonds, "share"_a = 1.0,
+           nb::call_guard<nb::gil_scoped_release>(),
+           "Between begin_step and finish_step: the body forces, then pass 2 of the bonds up to this "
+           "share of its blocks, which read no ghost (Simulation::evaluate_bonds); finish_step "
+           "takes what is left.")
       .def(
           "fragment_motions",
           [](const Simulation& self, const std::vector<index_t>& particles) {

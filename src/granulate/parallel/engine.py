@@ -11,8 +11,9 @@ ghosts the positions and velocities of the nodes within their reach (the caps), 
 broke in those grains and the rigid-body motion of each of their fragments, which the contact
 takes in place of what the ghost copies would give (a ghost's fragments enter its partners'
 contact too). That exchange is under way while each rank evaluates its bond forces
-(core.evaluate_bonds, which read no ghost), and completed before the contact. An owned grain's step needs nothing else (tests/test_locality.py): the owned
-grains move bit for bit as in the serial run, for any number of ranks (tests/test_mpi.py).
+(core.evaluate_bonds, which read no ghost), and completed before the contact. An owned grain's
+step needs nothing else (tests/test_locality.py): the owned grains move bit for bit as in the
+serial run, for any number of ranks (tests/test_mpi.py).
 
 The ghost sets hold while no node has moved more than half the margin from where it was when
 the grains were last distributed, since then no pair left out can come within the cutoff; the
@@ -71,6 +72,7 @@ _TAG = 17
 _REST_TAG = 18  # what a step's message has no room for
 _CAP_TAG = 19
 _BODY = 16  # numbers a body's motion takes in a message: its first node, then 15
+BOND_PARTS = 4  # parts of a step's bond forces, the MPI progressed after each
 _JOINING = 7  # numbers a node joining a cap takes: its global number, x and v
 #: A step message's sections: breaks (node pairs), bodies, nodes joining the cap.
 _WIDTHS = np.array([2, _BODY, _JOINING])
@@ -728,7 +730,7 @@ class DistributedRun:
         exchange = self._send_within_step(broken)
         times.append(time.perf_counter())
         if failure is None:
-            failure = _attempt(core.evaluate_bonds)
+            failure = _attempt(lambda: self._bonds_while_exchanging(exchange))
         times.append(time.perf_counter())
         ghost_breaks, motions, faces = self._receive_within_step(exchange)
         times.append(time.perf_counter())
@@ -748,6 +750,16 @@ class DistributedRun:
         self.seconds["steps"] += spans[0] + spans[3] + spans[5]
         self.seconds["exchange"] += spans[2] + spans[4]
         self.seconds["check"] += time.perf_counter() - times[-1]
+
+    def _bonds_while_exchanging(self, exchange: _Exchange) -> None:
+        """The rank's bond forces (core.evaluate_bonds) in BOND_PARTS parts, with the MPI
+        given the chance to move the step's messages along between them (Testall): it
+        progresses a large message only within its own calls, unless it has a progress thread
+        or the network does it."""
+        messages = exchange.requests + exchange.overflow
+        for part in range(1, BOND_PARTS + 1):
+            self.local.core.evaluate_bonds(part / BOND_PARTS)
+            self.mpi.Request.Testall(messages)
 
     def _caps_hold(self, moved: bool) -> None:
         """Within a step, once its drift has moved the nodes (`moved`: begin_step did not
