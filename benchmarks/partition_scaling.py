@@ -21,7 +21,7 @@ The network is an assumption, printed with the table: latency 1.5 us and 0.39 GB
 100 Gb/s link shared by 32 ranks, every neighbour on another node: the pessimistic case).
 "comm %" assumes no overlap of communication with computation; "hidden %" (and the caps
 table's second figure) what is left exposed with the exchange under way while the rank
-evaluates its bond forces, as DistributedRun does (all but the first of their BOND_PARTS
+evaluates its bond forces, as DistributedRun does (all but the first of their PARTS
 parts; their share of a step measured), which assumes the MPI moves a message on between
 its calls (a network's RDMA does; on one machine's shared memory the copy is the CPU's work,
 done within the progress calls).
@@ -51,7 +51,8 @@ from granulate._core import points_within
 
 import granulate as gr
 from granulate.parallel import bisect, ghosts, near_pairs
-from granulate.parallel.engine import BOND_PARTS, contact_reads
+from granulate.parallel.engine import contact_reads
+from granulate.parallel.overlap import PARTS
 
 RADIUS = 1e-3
 #: The check after each step (one reduction of the travel the core measures in its last half
@@ -267,13 +268,13 @@ def modelled(row: dict, measured: Measured, args: argparse.Namespace) -> dict[st
     """That rank's step: compute, one exchange of its ghost nodes' positions and velocities,
     one reduction; the share of communication in the step, without overlap and with the
     exchange hidden behind the bond forces, as DistributedRun overlaps them (all but their
-    first of BOND_PARTS parts, measured.forces of a step)."""
+    first of PARTS parts, measured.forces of a step)."""
     compute = row["owned_nodes"] / measured.rate
     ghost_bytes = 48.0 * row["ghost_nodes"]
     exchange, reduction = communication_seconds(
         1, row["neighbours_max"], ghost_bytes, row["ranks"], args
     )
-    hiding = measured.forces * (1 - 1 / BOND_PARTS) * compute
+    hiding = measured.forces * (1 - 1 / PARTS) * compute
     exposed = max(0.0, exchange - hiding) + reduction
     return {
         "ghost_bytes_per_step": ghost_bytes,
@@ -308,8 +309,8 @@ def as_built(
     reduction per step (the caps' check within the step), and the owner's computing of the
     normals it sends (as many node-steps per layer node as `depths` says), counted with the
     communication. "cap_exposed": the same with the exchange under way while the rank
-    evaluates its bond forces (DistributedRun._bonds_while_exchanging): hidden but for what
-    outlasts the last BOND_PARTS - 1 parts of them (measured.forces: their share of a step;
+    evaluates its bond forces (overlap.while_travelling): hidden but for what
+    outlasts the last PARTS - 1 parts of them (measured.forces: their share of a step;
     the MPI is first called on to move the messages after the first part)."""
     rate, ghost_saving = measured.rate, measured.ghost_saving
     partition = bisect(centres, np.ones(len(centres)), ranks)
@@ -328,7 +329,7 @@ def as_built(
         return communication_seconds(1, neighbours, 48.0 * sent, ranks, args)
 
     talk = sum(communication(ghost))
-    hiding = measured.forces * (1 - 1 / BOND_PARTS) * useful
+    hiding = measured.forces * (1 - 1 / PARTS) * useful
     cap_shares, cap_exposed = {}, {}
     for name, (depth, factor, faces) in depths.items():  # a check in the step, the normals
         counts = exchanged_nodes(centres, radii, partition.owner, ranks, pairs, unit_nodes, depth)

@@ -268,27 +268,40 @@ void Simulation::finish_step(std::span<const std::array<index_t, 2>> ghost_break
   finish_step_after_breaks(ghost_breaks);
 }
 
-void Simulation::evaluate_bonds(real share) {
-  if (!step_begun_) throw InputError("evaluate_bonds: call it between begin_step and finish_step");
+namespace {
+
+/// `share` (0 to 1) of `count` blocks, rounded down; InputError naming `call` outside [0, 1].
+std::int64_t share_of_blocks(real share, std::int64_t count, const char* call) {
   if (!(share >= 0 && share <= 1)) {
-    throw InputError("evaluate_bonds: the share of the bond blocks must lie in [0, 1], not " +
+    throw InputError(std::string(call) + ": the share of the bond blocks must lie in [0, 1], not " +
                      std::to_string(share));
   }
+  return static_cast<std::int64_t>(share * static_cast<real>(count));
+}
+
+}  // namespace
+
+void Simulation::evaluate_dilatation(real share) {
+  if (!moved_) throw InputError("evaluate_dilatation: call it between move and begin_step");
+  const std::int64_t to = share_of_blocks(share, inner_block_count(), "evaluate_dilatation");
   const auto start = clock_type::now();
-  const auto blocks = static_cast<real>(pass_schedule().blocks.size());
-  evaluate_bond_blocks(static_cast<std::int64_t>(share * blocks));
+  sum_dilatation_terms(to);
   phase_times_.peridynamics += seconds_since(start);
 }
 
-void Simulation::evaluate_bond_blocks(std::int64_t to) {
-  if (blocks_evaluated_ == forces_not_started) {
-    start_node_forces();
+void Simulation::evaluate_bonds(real share) {
+  if (!step_begun_) throw InputError("evaluate_bonds: call it between begin_step and finish_step");
+  const std::int64_t to = share_of_blocks(share, inner_block_count(), "evaluate_bonds");
+  const auto start = clock_type::now();
+  if (blocks_evaluated_ == pass_not_begun) {
+    start_node_forces(NodeGroup::own);
     blocks_evaluated_ = 0;
   }
-  to = std::min(to, static_cast<std::int64_t>(pass_schedule().blocks.size()));
-  if (to <= blocks_evaluated_) return;
-  add_bond_forces(state_.forces.data(), blocks_evaluated_, to);  // pass 2
-  blocks_evaluated_ = to;
+  if (to > blocks_evaluated_) {
+    add_bond_forces(state_.forces.data(), blocks_evaluated_, to);  // pass 2
+    blocks_evaluated_ = to;
+  }
+  phase_times_.peridynamics += seconds_since(start);
 }
 
 void Simulation::move_and_break_bonds() {

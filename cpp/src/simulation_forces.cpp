@@ -73,6 +73,16 @@ void for_each_node_in_colours(const BondSchedule& schedule, Body&& body, std::in
   }
 }
 
+/// for_each_node_in_colours over the blocks at places [from, to) of `inner`'s blocks followed
+/// by `outer`'s (inside an omp parallel region).
+template <class Body>
+void for_each_node_in_schedules(const BondSchedule& inner, const BondSchedule& outer, Body&& body,
+                                std::int64_t from, std::int64_t to) {
+  const auto count = static_cast<std::int64_t>(inner.blocks.size());
+  for_each_node_in_colours(inner, body, from, to);
+  if (to > count) for_each_node_in_colours(outer, body, from - count, to - count);
+}
+
 /// What the pair-force loop reads and writes, as raw pointers (kept in registers).
 struct PairForceArrays {
   const real* positions;
@@ -144,7 +154,7 @@ void Simulation::add_bond_forces(real* forces, std::int64_t from, std::int64_t t
   // pressures of pass 1. Ghost particles are skipped (set_ghost_particles), and of a foreign
   // node only its forward bonds to own nodes are evaluated (set_foreign_nodes).
   const Model& m = *model_;
-  const BondSchedule& schedule = pass_schedule();
+  const BondSchedule& schedule = m.bond_schedule();
   const PairForceArrays arrays{state_.positions.data(),     m.volumes().data(),       pressure_.data(),
                                m.lps_coefficients().data(), m.pmb_stiffness().data(), forces};
   const std::uint8_t* const ghost = ghost_.empty() ? nullptr : ghost_.data();
@@ -173,7 +183,7 @@ void Simulation::add_bond_forces(real* forces, std::int64_t from, std::int64_t t
     }
   };
 #pragma omp parallel
-  for_each_node_in_colours(schedule, evaluate, from, to);
+  for_each_node_in_schedules(inner_schedule(), outer_schedule_, evaluate, from, to);
 }
 
 std::vector<real> Simulation::bond_force_densities() const {
@@ -189,8 +199,14 @@ void Simulation::compute_forces() {
 }
 
 void Simulation::finish_forces(std::span<const std::array<index_t, 2>> ghost_breaks) {
-  evaluate_bond_blocks(std::numeric_limits<std::int64_t>::max());  // what evaluate_bonds left
-  blocks_evaluated_ = forces_not_started;
+  if (blocks_evaluated_ == pass_not_begun) {
+    start_node_forces(NodeGroup::both);
+    blocks_evaluated_ = 0;
+  } else {
+    start_node_forces(NodeGroup::halo);  // evaluate_bonds started the own nodes
+  }
+  add_bond_forces(state_.forces.data(), blocks_evaluated_);  // what evaluate_bonds left
+  blocks_evaluated_ = pass_not_begun;
   const std::size_t own = breaks_.size();
   break_ghost_bonds(ghost_breaks);
   contact_.bonds_broke(*model_, state_, std::span(breaks_).subspan(own));
@@ -206,74 +222,88 @@ void Simulation::finish_forces(std::span<const std::array<index_t, 2>> ghost_bre
 
 void Simulation::sum_dilatation_and_break_bonds() {
   // Pass 1: stretch, irreversible breaking, sum_j w r e at both ends. A bond breaks at the end
-  // that evaluates it; its other copy is cleared below, before any loop reads it (when both
-  // ends gather, both see bitwise the same stretch and each clears its own). The bonds broken
-  // are left in breaks_ for finish_forces, and the anchors they change are taken anew here, so
-  // that a step's list positions are settled once it has begun. Ghost particles are skipped
-  // (set_ghost_particles): their breaks come from their owners; of a foreign node only its
-  // forward bonds to own nodes are evaluated (set_foreign_nodes).
+  // that evaluates it; its other copy is cleared here, after every block, before any loop reads
+  // it (when both ends gather, both see bitwise the same stretch and each clears its own). The
+  // bonds broken are left in breaks_ for finish_forces, and the anchors they change are taken
+  // anew here, so that a step's list positions are settled once it has begun.
+  sum_dilatation_terms(std::numeric_limits<std::int64_t>::max());
+  dilatation_blocks_ = pass_not_begun;
+  const Model& m = *model_;
+  for (const auto& [i, j] : breaks_) {
+    const NodeBonds bonds = m.node_bonds(j);
+    BondStates::clear(state_.bonds.node(j), bonds.find(i));
+  }
+  contact_.bonds_broke(m, state_, breaks_);
+}
+
+void Simulation::sum_dilatation_terms(std::int64_t to) {
+  // Ghost particles are skipped (set_ghost_particles): their breaks come from their owners; of
+  // a foreign node only its forward bonds to own nodes are evaluated (set_foreign_nodes).
   const Model& m = *model_;
   const auto& materials = m.materials();
   const auto& node_material = m.node_material();
   auto& intact = state_.bonds;
   const std::int64_t n = m.node_count();
-  const BondSchedule& schedule = pass_schedule();
+  const BondSchedule& schedule = m.bond_schedule();
   const real* const positions = state_.positions.data();
   const real* const volumes = m.volumes().data();
   real* const dilatation_sums = state_.dilatation.data();
   const std::uint8_t* const ghost = ghost_.empty() ? nullptr : ghost_.data();
   const std::uint8_t* const foreign = foreign_.empty() ? nullptr : foreign_.data();
-  std::vector<std::array<index_t, 2>> broken;  // (evaluating node, neighbour)
+  const bool begins = dilatation_blocks_ == pass_not_begun;
+  const std::int64_t from = begins ? 0 : dilatation_blocks_;
+  to = std::min(to, block_count());
+  if (begins) breaks_.clear();  // (evaluating node, neighbour)
+  dilatation_blocks_ = std::max(from, to);
+  if (!begins && to <= from) return;
+  const auto evaluate = [&](index_t i, std::vector<std::array<index_t, 2>>& broken_here) {
+    const Material& material = materials[node_material[i]];
+    const NodeBonds bonds = m.node_bonds(i);
+    const CriticalStretch criterion{m.particles()[m.node_particle()[i]].critical_stretch,
+                                    material.params.break_in_compression};
+    const bool breaks = material.params.fracture, gathers = schedule.particle_gathers[m.node_particle()[i]];
+    if (ghost && ghost[m.node_particle()[i]]) return;  // another process's bonds
+    std::uint8_t* const bits = intact.node(i);
+    if (foreign && foreign[i]) {  // its terms on own nodes; own nodes that gather take their own
+      if (gathers || foreign[i] == far_foreign) return;
+      if (breaks) {
+        add_dilatation_terms<true, false, true>(i, bonds, bits, criterion, positions, volumes,
+                                                dilatation_sums, broken_here, foreign);
+      } else {
+        add_dilatation_terms<false, false, true>(i, bonds, bits, criterion, positions, volumes,
+                                                 dilatation_sums, broken_here, foreign);
+      }
+    } else if (breaks && !gathers) {
+      add_dilatation_terms<true, false>(i, bonds, bits, criterion, positions, volumes, dilatation_sums,
+                                        broken_here);
+    } else if (!gathers) {
+      add_dilatation_terms<false, false>(i, bonds, bits, criterion, positions, volumes, dilatation_sums,
+                                         broken_here);
+    } else if (breaks) {
+      add_dilatation_terms<true, true>(i, bonds, bits, criterion, positions, volumes, dilatation_sums,
+                                       broken_here);
+    } else {
+      add_dilatation_terms<false, true>(i, bonds, bits, criterion, positions, volumes, dilatation_sums,
+                                        broken_here);
+    }
+  };
 #pragma omp parallel
   {
+    if (begins) {
 #pragma omp for schedule(static)
-    for (std::int64_t i = 0; i < n; ++i) dilatation_sums[i] = 0;
+      for (std::int64_t i = 0; i < n; ++i) dilatation_sums[i] = 0;
+    }
     std::vector<std::array<index_t, 2>> broken_here;
-    for_each_node_in_colours(schedule, [&](index_t i) {
-      const Material& material = materials[node_material[i]];
-      const NodeBonds bonds = m.node_bonds(i);
-      const CriticalStretch criterion{m.particles()[m.node_particle()[i]].critical_stretch,
-                                      material.params.break_in_compression};
-      const bool breaks = material.params.fracture, gathers = schedule.particle_gathers[m.node_particle()[i]];
-      if (ghost && ghost[m.node_particle()[i]]) return;  // another process's bonds
-      std::uint8_t* const bits = intact.node(i);
-      if (foreign && foreign[i]) {  // its terms on own nodes; own nodes that gather take their own
-        if (gathers || foreign[i] == far_foreign) return;
-        if (breaks) {
-          add_dilatation_terms<true, false, true>(i, bonds, bits, criterion, positions, volumes,
-                                                  dilatation_sums, broken_here, foreign);
-        } else {
-          add_dilatation_terms<false, false, true>(i, bonds, bits, criterion, positions, volumes,
-                                                   dilatation_sums, broken_here, foreign);
-        }
-      } else if (breaks && !gathers) {
-        add_dilatation_terms<true, false>(i, bonds, bits, criterion, positions, volumes, dilatation_sums,
-                                          broken_here);
-      } else if (!gathers) {
-        add_dilatation_terms<false, false>(i, bonds, bits, criterion, positions, volumes, dilatation_sums,
-                                           broken_here);
-      } else if (breaks) {
-        add_dilatation_terms<true, true>(i, bonds, bits, criterion, positions, volumes, dilatation_sums,
-                                         broken_here);
-      } else {
-        add_dilatation_terms<false, true>(i, bonds, bits, criterion, positions, volumes, dilatation_sums,
-                                          broken_here);
-      }
-    });
+    for_each_node_in_schedules(
+        inner_schedule(), outer_schedule_, [&](index_t i) { evaluate(i, broken_here); }, from, to);
     if (!broken_here.empty()) {
 #pragma omp critical(granulate_broken_bonds)
-      broken.insert(broken.end(), broken_here.begin(), broken_here.end());
+      breaks_.insert(breaks_.end(), broken_here.begin(), broken_here.end());
     }
   }
-  for (const auto& [i, j] : broken) {
-    const NodeBonds bonds = m.node_bonds(j);
-    BondStates::clear(intact.node(j), bonds.find(i));
-  }
-  breaks_ = std::move(broken);
-  contact_.bonds_broke(m, state_, breaks_);
 }
 
-void Simulation::start_node_forces() {
+void Simulation::start_node_forces(NodeGroup group) {
   // Dilatation and pressure of LPS nodes; body forces and damping start each node's sum.
   const Model& m = *model_;
   const auto& materials = m.materials();
@@ -288,6 +318,8 @@ void Simulation::start_node_forces() {
   for (std::int64_t ii = 0; ii < n; ++ii) {
     const index_t i = static_cast<index_t>(ii);
     if (foreign && foreign[i] == far_foreign) continue;  // nothing here reads it
+    const bool halo = foreign && foreign[i];
+    if ((group == NodeGroup::own && halo) || (group == NodeGroup::halo && !halo)) continue;
     if (materials[node_material[i]].params.model == ForceModel::lps) {
       theta[i] *= lps_coefficients[i].dilatation_scale;
       pressure_[i] = lps_coefficients[i].dilatation_coupling * theta[i];

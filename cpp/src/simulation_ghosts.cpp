@@ -50,26 +50,67 @@ void Simulation::set_foreign_nodes(const std::vector<index_t>& nodes) {
   foreign_ = nodes.empty() ? std::vector<std::uint8_t>{} : std::move(foreign);
   mark_others();
   count_broken_bond_copies();
-  own_schedule_ = foreign_.empty() ? BondSchedule{} : blocks_evaluated_here();
+  cut_schedule();
 }
 
-BondSchedule Simulation::blocks_evaluated_here() const {
-  const BondSchedule& all = model_->bond_schedule();
-  BondSchedule here;
-  here.block_starts = all.block_starts;
-  here.particle_gathers = all.particle_gathers;
-  here.colour_offsets.push_back(0);
-  for (std::size_t c = 0; c + 1 < all.colour_offsets.size(); ++c) {
-    for (index_t k = all.colour_offsets[c]; k < all.colour_offsets[c + 1]; ++k) {
-      const index_t block = all.blocks[k];
-      bool evaluates = false;
-      for (index_t i = all.block_starts[block]; i < all.block_starts[block + 1] && !evaluates; ++i)
-        evaluates = foreign_[i] != far_foreign;
-      if (evaluates) here.blocks.push_back(block);
+namespace {
+
+/// The nodes a block's evaluation writes (itself and, unless its particle gathers, its nodes'
+/// forward neighbours), and whether it reads a halo node (foreign[i] == 1): evaluates one (a
+/// foreign node evaluates its bonds to own nodes), or an own node reading one's position or
+/// pressure through a bond it evaluates.
+bool block_reach(const Model& model, index_t first, index_t last, const std::uint8_t* foreign,
+                 std::vector<index_t>& touched) {
+  const bool gathers = model.bond_schedule().particle_gathers[model.node_particle()[first]];
+  bool reads_halo = false;
+  touched.clear();
+  for (index_t i = first; i < last; ++i) {
+    touched.push_back(i);
+    const NodeBonds bonds = model.node_bonds(i);
+    reads_halo = reads_halo || foreign[i] == 1;
+    for (index_t b = gathers ? 0 : bonds.forward; b < bonds.count; ++b) {
+      const index_t j = bonds.neighbor(b);
+      if (!gathers) touched.push_back(j);
+      reads_halo = reads_halo || (!foreign[i] && foreign[j]);
     }
-    here.colour_offsets.push_back(static_cast<index_t>(here.blocks.size()));
   }
-  return here;
+  return reads_halo;
+}
+
+}  // namespace
+
+void Simulation::cut_schedule() {
+  // In colour order: a block is inner unless it reads the halo or touches a node an outer
+  // block of an earlier colour touched (blocks of one colour never share a node), so every
+  // node takes its inner blocks' terms before its outer blocks', as in the model's order.
+  inner_schedule_ = outer_schedule_ = BondSchedule{};
+  if (foreign_.empty()) return;
+  const BondSchedule& all = model_->bond_schedule();
+  for (BondSchedule* part : {&inner_schedule_, &outer_schedule_}) {
+    part->block_starts = all.block_starts;
+    part->particle_gathers = all.particle_gathers;
+    part->colour_offsets.push_back(0);
+  }
+  std::vector<std::uint8_t> outer_touched(model_->node_count(), 0);
+  std::vector<index_t> touched, outer_nodes;
+  for (std::size_t c = 0; c + 1 < all.colour_offsets.size(); ++c) {
+    outer_nodes.clear();
+    for (index_t k = all.colour_offsets[c]; k < all.colour_offsets[c + 1]; ++k) {
+      const index_t block = all.blocks[k], first = all.block_starts[block],
+                    last = all.block_starts[block + 1];
+      if (std::all_of(foreign_.begin() + first, foreign_.begin() + last,
+                      [](std::uint8_t f) { return f == far_foreign; }))
+        continue;  // nothing of it is evaluated here
+      const bool reads_halo = block_reach(*model_, first, last, foreign_.data(), touched);
+      const bool inner = !reads_halo && std::none_of(touched.begin(), touched.end(),
+                                                     [&](index_t i) { return outer_touched[i] != 0; });
+      (inner ? inner_schedule_ : outer_schedule_).blocks.push_back(block);
+      if (!inner) outer_nodes.insert(outer_nodes.end(), touched.begin(), touched.end());
+    }
+    for (const index_t i : outer_nodes) outer_touched[i] = 1;
+    for (BondSchedule* part : {&inner_schedule_, &outer_schedule_})
+      part->colour_offsets.push_back(static_cast<index_t>(part->blocks.size()));
+  }
 }
 
 void Simulation::mark_others() {

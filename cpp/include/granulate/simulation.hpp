@@ -82,18 +82,24 @@ class Simulation {
   /// before ghosts are marked; run and begin_step refuse to start while a step is begun.
   std::vector<std::array<index_t, 2>> begin_step();
   void finish_step(std::span<const std::array<index_t, 2>> ghost_breaks);
-  /// Between begin_step and finish_step: the LPS pressures and each node's body force, then
-  /// pass 2 of the bonds up to `share` (0 to 1) of its blocks in schedule order, continuing
-  /// from where the last call stopped; finish_step takes what is left. None of it reads a ghost
-  /// or anything its owners send (the ghosts' bonds are skipped), so a distributed run of
-  /// whole grains evaluates the bonds while that step's exchange is under way, in parts with
-  /// the MPI progressed in between; the forces are the same bits however the blocks are
-  /// split. Not for foreign nodes, whose halo's dilatation comes before pass 2.
+  /// Between begin_step and finish_step: the LPS pressures and each own node's body force, then
+  /// pass 2 of the inner bond blocks up to `share` (0 to 1) of them in schedule order,
+  /// continuing from where the last call stopped; finish_step takes what is left (the halo's
+  /// pressures, the outer blocks). None of it reads a ghost, the halo or anything other
+  /// processes send in the step (the ghosts' bonds are skipped), so a distributed run
+  /// evaluates it while that step's exchange is under way, in parts with the MPI progressed in
+  /// between; the forces are the same bits however the blocks are split.
   void evaluate_bonds(real share = 1);
   /// The first half kick, the drift and prescribed motion of a step, which begin_step then
   /// continues from (pass 1) instead of taking them itself: a run with foreign nodes gives
   /// them their owners' positions in between (set_foreign_nodes).
   void move();
+  /// Between move and begin_step: pass 1 of the inner bond blocks (those that read nothing of
+  /// the halo; with no foreign node, every block) up to `share` (0 to 1) of them in schedule
+  /// order, continuing from where the last call stopped; begin_step takes the rest. A run with
+  /// foreign nodes evaluates them while the halo's positions travel, in parts with the MPI
+  /// progressed in between; each node's sums are the same bits however the blocks are split.
+  void evaluate_dilatation(real share = 1);
 
   /// Recomputes forces (and breaks bonds) at the current positions.
   void compute_forces();
@@ -213,9 +219,14 @@ class Simulation {
 
  private:
   // The phases of compute_forces, in order.
-  /// Pass 1 of the bonds: each node's dilatation sum; bonds past their critical stretch break
-  /// (both copies), left in breaks_, and contact is told of them (the anchors they change).
+  /// Pass 1 of the bonds (what evaluate_dilatation left of it): each node's dilatation sum;
+  /// bonds past their critical stretch break (both copies), left in breaks_, and contact is
+  /// told of them (the anchors they change).
   void sum_dilatation_and_break_bonds();
+  /// Within a step: the dilatation sums and breaks_ cleared unless pass 1 has begun, then its
+  /// blocks from where the last call stopped up to place `to` (inner_schedule's blocks, then
+  /// outer_schedule_'s), the bonds they break appended to breaks_.
+  void sum_dilatation_terms(std::int64_t to);
   /// InputError unless every pair is an intact bond of a ghost particle.
   void check_ghost_breaks(std::span<const std::array<index_t, 2>> pairs) const;
   /// The ghosts' bonds their owners broke (both copies), appended to breaks_.
@@ -232,15 +243,14 @@ class Simulation {
   void break_bonds_and_measure_travel();
   void finish_step_after_breaks(std::span<const std::array<index_t, 2>> ghost_breaks);
   /// LPS dilatation theta_i and pressure A_i theta_i; each node's force density started with
-  /// rho (g - gamma v).
-  void start_node_forces();
+  /// rho (g - gamma v): of the own nodes (with no foreign node, every node), of the foreign
+  /// nodes bonded to own ones (the halo), or of both.
+  enum class NodeGroup { own, halo, both };
+  void start_node_forces(NodeGroup group);
   /// Adds the bond forces (pass 2) to `forces` (nodes x 3): of the blocks at places [from, to)
-  /// of the pass schedule's, or all.
+  /// of inner_schedule's followed by outer_schedule_'s, or all.
   void add_bond_forces(real* forces, std::int64_t from = 0,
                        std::int64_t to = std::numeric_limits<std::int64_t>::max()) const;
-  /// Within a step: the node forces started (start_node_forces) unless they are, then pass 2's
-  /// blocks from where the last call stopped up to place `to` of the pass schedule's.
-  void evaluate_bond_blocks(std::int64_t to);
   /// Contact (node pairs, walls, dashpots, friction) and PeriDEM's damping, timed.
   void add_contact_forces();
   /// The nodal force densities f(t) b.
@@ -252,9 +262,8 @@ class Simulation {
   bool others_node(index_t i) const { return !others_.empty() && others_[i]; }
   /// others_ from ghost_ and foreign_.
   void mark_others();
-  /// The model's bond schedule with only the blocks holding a node that is own or bonded to
-  /// one (foreign_ set), in the model's colours and order (own_schedule_).
-  BondSchedule blocks_evaluated_here() const;
+  /// inner_schedule_ and outer_schedule_ from the model's schedule and foreign_.
+  void cut_schedule();
   /// broken_bond_copies_ from the bond states: every broken copy, or with foreign nodes twice
   /// the bonds broken whose lower-numbered end is own (each bond once over the processes).
   void count_broken_bond_copies();
@@ -275,12 +284,20 @@ class Simulation {
                                        // far_foreign not
   static constexpr std::uint8_t far_foreign = 2;
   std::vector<std::uint8_t> others_;  // per node: a ghost particle's or foreign; empty if none
-  /// With foreign nodes, the model's bond schedule with only the blocks that hold a node that is
-  /// own or bonded to one, in the same colours and order (so each own node's sums are the
-  /// serial run's); the bond passes walk it (pass_schedule).
-  BondSchedule own_schedule_;
-  const BondSchedule& pass_schedule() const {
-    return foreign_.empty() ? model_->bond_schedule() : own_schedule_;
+  /// With foreign nodes, the blocks of the model's bond schedule that hold a node that is own or
+  /// bonded to one, in two schedules, each in the model's colours and order: the inner blocks,
+  /// which read no halo node's position or pressure and touch no node that an outer block of an
+  /// earlier colour touches, and the outer blocks, the rest. The bond passes walk the inner
+  /// blocks, then the outer ones, so each node still takes its terms in the model's order (the
+  /// serial run's sums). Without foreign nodes, the inner schedule is the model's and the outer
+  /// one is empty.
+  BondSchedule inner_schedule_, outer_schedule_;
+  const BondSchedule& inner_schedule() const {
+    return foreign_.empty() ? model_->bond_schedule() : inner_schedule_;
+  }
+  std::int64_t inner_block_count() const { return static_cast<std::int64_t>(inner_schedule().blocks.size()); }
+  std::int64_t block_count() const {
+    return inner_block_count() + static_cast<std::int64_t>(outer_schedule_.blocks.size());
   }
   std::vector<index_t> reported_node_, reported_particle_;  // set_reported_numbers; or empty
   real reported_stable_time_step_ = 0;                      // set_reported_stable_time_step
@@ -291,9 +308,10 @@ class Simulation {
   std::vector<std::array<index_t, 2>> breaks_;  // the bonds pass 1 (and the owners) broke
   bool step_begun_ = false;                     // begin_step called, finish_step not yet
   bool moved_ = false;                          // move called, begin_step not yet
-  static constexpr std::int64_t forces_not_started = -1;
-  std::int64_t blocks_evaluated_ = forces_not_started;  // pass 2's blocks done within the step
-  std::uint64_t broken_bond_copies_ = 0;                // both copies of a broken bond count
+  static constexpr std::int64_t pass_not_begun = -1;
+  std::int64_t dilatation_blocks_ = pass_not_begun;  // pass 1's blocks done within the step
+  std::int64_t blocks_evaluated_ = pass_not_begun;   // pass 2's blocks done within the step
+  std::uint64_t broken_bond_copies_ = 0;             // both copies of a broken bond count
   ContactModel contact_;
   contact::PeridemDamping peridem_damping_;
   bool forces_current_ = false;

@@ -269,6 +269,11 @@ void bind_results(nb::class_<Simulation>& cls) {
       .def("move", &Simulation::move, nb::call_guard<nb::gil_scoped_release>(),
            "The first half kick, drift and prescribed motion of a step, which begin_step continues "
            "from (Simulation::move).")
+      .def("evaluate_dilatation", &Simulation::evaluate_dilatation, "share"_a = 1.0,
+           nb::call_guard<nb::gil_scoped_release>(),
+           "Between move and begin_step: pass 1 of the inner bond blocks, which read nothing of the "
+           "halo, up to this share of them (Simulation::evaluate_dilatation); begin_step takes the "
+           "rest.")
       .def(
           "begin_step",
           [](Simulation& self) {
@@ -296,9 +301,9 @@ void bind_results(nb::class_<Simulation>& cls) {
           "The rest of the step, after breaking the ghosts' bonds their owners broke, (k, 2) node pairs.")
       .def("evaluate_bonds", &Simulation::evaluate_bonds, "share"_a = 1.0,
            nb::call_guard<nb::gil_scoped_release>(),
-           "Between begin_step and finish_step: the body forces, then pass 2 of the bonds up to this "
-           "share of its blocks, which read no ghost (Simulation::evaluate_bonds); finish_step "
-           "takes what is left.")
+           "Between begin_step and finish_step: the own nodes' body forces, then pass 2 of the inner "
+           "bond blocks, which read no ghost and nothing of the halo, up to this share of them "
+           "(Simulation::evaluate_bonds); finish_step takes what is left.")
       .def(
           "fragment_motions",
           [](const Simulation& self, const std::vector<index_t>& particles) {

@@ -31,6 +31,19 @@ def together(comm: Any, action: Callable[[], T], doing: str = "building its part
     return result  # type: ignore[return-value]
 
 
+def attempt(action: Callable[[], object], failure: Exception | None = None) -> Exception | None:
+    """action() unless a part of the step failed before (`failure`): None, or the error it
+    raised, kept for the step's reduction (stop_if_any_failed), so that every rank goes
+    through every exchange of the step."""
+    if failure is not None:
+        return failure
+    try:
+        action()
+    except Exception as error:  # raised after the step's exchanges, once every rank knows
+        return error
+    return None
+
+
 def stop_if_any_failed(comm: Any, failure: Exception | None, doing: str) -> None:
     """One reduction: when some rank's `failure` is set, every rank stops, the first such rank
     raising its own error, the others RankFailed naming it and what it was `doing`."""

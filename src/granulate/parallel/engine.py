@@ -43,7 +43,8 @@ from numpy.typing import NDArray
 from granulate import checkpoints
 from granulate._core import combined_time_step, points_within
 from granulate.errors import InputError
-from granulate.parallel.agreement import RankFailed, on_root, together
+from granulate.parallel.agreement import RankFailed, attempt, on_root, together
+from granulate.parallel.overlap import while_travelling
 from granulate.parallel.partition import (
     Partition,
     bisect,
@@ -63,8 +64,6 @@ from granulate.parallel.whole_state import install, owned_part
 from granulate.writers.vtu_frame import write_piece
 
 if TYPE_CHECKING:
-    from collections.abc import Callable
-
     from granulate.simulation import Simulation
     from granulate.writers.outputs import Outputs
 
@@ -72,7 +71,6 @@ _TAG = 17
 _REST_TAG = 18  # what a step's message has no room for
 _CAP_TAG = 19
 _BODY = 16  # numbers a body's motion takes in a message: its first node, then 15
-BOND_PARTS = 4  # parts of a step's bond forces, the MPI progressed after each
 _JOINING = 7  # numbers a node joining a cap takes: its global number, x and v
 #: A step message's sections: breaks (node pairs), bodies, nodes joining the cap.
 _WIDTHS = np.array([2, _BODY, _JOINING])
@@ -729,8 +727,8 @@ class DistributedRun:
         times.append(time.perf_counter())
         exchange = self._send_within_step(broken)
         times.append(time.perf_counter())
-        if failure is None:
-            failure = _attempt(lambda: self._bonds_while_exchanging(exchange))
+        messages = exchange.requests + exchange.overflow
+        failure, testing = while_travelling(self.mpi, messages, core.evaluate_bonds, failure)
         times.append(time.perf_counter())
         ghost_breaks, motions, faces = self._receive_within_step(exchange)
         times.append(time.perf_counter())
@@ -740,26 +738,15 @@ class DistributedRun:
             core.give_ghost_surface_normals(*faces)
             core.finish_step(ghost_breaks)
 
-        if failure is None:
-            failure = _attempt(finish)
+        failure = attempt(finish, failure)
         times.append(time.perf_counter())
         farthest = self._check_step(int(core.step), failure)
         self._loaded_walls = None
         self._migration_due = self._migrates and self._travelled + farthest > 0.25 * self.margin
         spans = np.diff(times)  # begin, caps' check, send, bonds, receive, finish
-        self.seconds["steps"] += spans[0] + spans[3] + spans[5]
-        self.seconds["exchange"] += spans[2] + spans[4]
+        self.seconds["steps"] += spans[0] + spans[3] - testing + spans[5]
+        self.seconds["exchange"] += spans[2] + testing + spans[4]
         self.seconds["check"] += time.perf_counter() - times[-1]
-
-    def _bonds_while_exchanging(self, exchange: _Exchange) -> None:
-        """The rank's bond forces (core.evaluate_bonds) in BOND_PARTS parts, with the MPI
-        given the chance to move the step's messages along between them (Testall): it
-        progresses a large message only within its own calls, unless it has a progress thread
-        or the network does it."""
-        messages = exchange.requests + exchange.overflow
-        for part in range(1, BOND_PARTS + 1):
-            self.local.core.evaluate_bonds(part / BOND_PARTS)
-            self.mpi.Request.Testall(messages)
 
     def _caps_hold(self, moved: bool) -> None:
         """Within a step, once its drift has moved the nodes (`moved`: begin_step did not
@@ -1173,16 +1160,6 @@ def _sections(
         parts.append(np.concatenate(rows).reshape(-1, width))
         here, there = here + n * width, there + m * width
     return parts
-
-
-def _attempt(action: Callable[[], None]) -> Exception | None:
-    """Run `action`: None, or the error it raised (which the step's check re-raises once the
-    ranks agree to stop)."""
-    try:
-        action()
-    except Exception as error:
-        return error
-    return None
 
 
 def _mask(size: int, indices: NDArray[np.int64]) -> NDArray[np.bool_]:

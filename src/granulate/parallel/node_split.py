@@ -37,7 +37,8 @@ from numpy.typing import NDArray
 from granulate import checkpoints
 from granulate.errors import InputError
 from granulate.evaluation import Evaluation
-from granulate.parallel.agreement import on_root, stop_if_any_failed, together
+from granulate.parallel.agreement import attempt, on_root, stop_if_any_failed, together
+from granulate.parallel.overlap import while_travelling
 from granulate.parallel.partition import bisect
 from granulate.writers.vtu_frame import FIELD_TYPES, point_fields, write_piece_rows
 
@@ -108,40 +109,46 @@ class NodeSplitRun:
             self._step()
 
     def _step(self) -> None:
-        """One step: the kick and drift, the halo's positions, pass 1, the halo's dilatation
-        sums (LPS), the rest of the step, and the reduction that agrees on failures; every rank
-        goes through every exchange whatever failed."""
-        core, failure = self.local.core, None
-        marks = [time.perf_counter()]
-        failure = _attempt(core.move, failure)
-        marks.append(time.perf_counter())
-        self._exchange(core.positions)
-        marks.append(time.perf_counter())
-        failure = _attempt(core.begin_step, failure)
-        marks.append(time.perf_counter())
+        """One step: the kick and drift; the halo's positions, while pass 1 of the inner bond
+        blocks runs (core.evaluate_dilatation); the rest of pass 1 (core.begin_step); for LPS
+        the halo's dilatation sums, while pass 2 of the inner blocks runs (core.evaluate_bonds);
+        the rest of the step; and the reduction that agrees on failures. Every rank goes
+        through every exchange whatever failed."""
+        core = self.local.core
+        start, exchanged = time.perf_counter(), self.seconds["exchange"]
+        failure = attempt(core.move)
+        failure = self._exchange(core.positions, core.evaluate_dilatation, failure)
+        failure = attempt(core.begin_step, failure)
         if self._lps:
-            self._exchange(core.dilatation)
-        marks.append(time.perf_counter())
-        failure = _attempt(lambda: core.finish_step(_NO_BREAKS), failure)
-        marks.append(time.perf_counter())
+            failure = self._exchange(core.dilatation, core.evaluate_bonds, failure)
+        failure = attempt(lambda: core.finish_step(_NO_BREAKS), failure)
+        reducing = time.perf_counter()
         stop_if_any_failed(self.comm, failure, f"taking step {int(core.step) + 1}")
-        marks.append(time.perf_counter())
-        spans = np.diff(marks)
-        self.seconds["steps"] += float(spans[0::2].sum())
-        self.seconds["exchange"] += float(spans[1::2].sum())
+        end = time.perf_counter()
+        self.seconds["exchange"] += end - reducing
+        self.seconds["steps"] += end - start - (self.seconds["exchange"] - exchanged)
 
-    def _exchange(self, field: NDArray[np.float64]) -> None:
+    def _exchange(
+        self, field: NDArray[np.float64], inner: Any, failure: Exception | None
+    ) -> Exception | None:
         """The halo's rows of `field` (positions, n x 3, or dilatation sums, n) from their
-        owners: one message each way per neighbouring rank."""
+        owners, one message each way per neighbouring rank, while `inner` (core.
+        evaluate_dilatation or evaluate_bonds: the inner blocks, which read nothing of them)
+        runs (overlap.while_travelling). The step's failure so far, or `inner`'s."""
+        start = time.perf_counter()
         width = 1 if field.ndim == 1 else field.shape[1]
         inbox = self._inboxes[width]
         requests = [self.comm.Irecv(box, source=q, tag=_TAG) for q, box in inbox.items()]
-        for q, nodes in self._send.items():
-            box = np.ascontiguousarray(field[nodes]).reshape(len(nodes), width)
-            requests.append(self.comm.Isend(box, dest=q, tag=_TAG))
+        outbox = {q: np.ascontiguousarray(field[nodes]) for q, nodes in self._send.items()}
+        requests += [self.comm.Isend(box, dest=q, tag=_TAG) for q, box in outbox.items()]
+        posted = time.perf_counter()
+        failure, testing = while_travelling(self.mpi, requests, inner, failure)
+        waiting = time.perf_counter()
         self.mpi.Request.Waitall(requests)
         for q, halo in self._receive.items():
             field[halo] = inbox[q][:, 0] if field.ndim == 1 else inbox[q]
+        self.seconds["exchange"] += posted - start + testing + time.perf_counter() - waiting
+        return failure
 
     def gather(self, field: str, root: int = 0) -> NDArray[np.float64] | None:
         """core.<field> (positions, velocities, forces or dilatation) of every node on `root`,
@@ -245,18 +252,6 @@ class NodeSplitRun:
         path = Path(folder) / f"piece_{self.comm.Get_rank()}.vtu"
         ordered = {f: rows[f].astype(FIELD_TYPES[f][0]) for f in fields}
         write_piece_rows(path, self.local.core.positions[self.own], ordered, self.own)
-
-
-def _attempt(action: Any, failure: Exception | None) -> Exception | None:
-    """action() unless a part of the step failed before; the failure, kept for the step's
-    reduction (stop_if_any_failed), so that every rank goes through every exchange."""
-    if failure is not None:
-        return failure
-    try:
-        action()
-    except Exception as error:  # raised after the step's exchanges, once every rank knows
-        return error
-    return None
 
 
 def _built(part: Simulation) -> Simulation:
