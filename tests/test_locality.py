@@ -281,12 +281,13 @@ def test_inert_nodes_leave_the_lists_and_come_back(tmp_path: Path) -> None:
 
 @pytest.mark.parametrize("case", ["plate", "drum"])
 def test_bond_forces_in_parts_are_the_same_bits(case: str, tmp_path: Path) -> None:
-    """core.evaluate_bonds(share) walks pass 2's blocks in schedule order up to that share of
-    them, from where its last call stopped, and finish_step takes the rest: a distributed run
-    evaluates its bonds in parts while its exchange is under way. Stepped so, with the parts
-    cutting through colours, the notched LPS plate cracking under tension (several colours)
-    and the tumbling drum (grains: one colour, contact) are bit for bit the runs stepped
-    whole. A share outside [0, 1] is refused."""
+    """core.evaluate_dilatation(share) and evaluate_bonds(share) walk pass 1's and pass 2's
+    blocks in schedule order up to that share of them (with no foreign node every block is
+    inner), from where their last call stopped, and begin_step and finish_step take the rest:
+    a distributed run evaluates them in parts while its exchanges are under way. Stepped so,
+    with the parts cutting through colours, the notched LPS plate cracking under tension
+    (several colours) and the tumbling drum (grains: one colour, contact) are bit for bit the
+    runs stepped whole. A share outside [0, 1] is refused."""
     whole, parted = (
         (pulled("plate", "lps"), pulled("plate", "lps"))
         if case == "plate"
@@ -298,6 +299,9 @@ def test_bond_forces_in_parts_are_the_same_bits(case: str, tmp_path: Path) -> No
     parted.core.run(0)
     for _ in range(300):
         whole.core.run(1)
+        parted.core.move()
+        for share in (0.3, 0.55, 0.55, 0.9):
+            parted.core.evaluate_dilatation(share)
         parted.core.begin_step()
         for share in (0.3, 0.3, 0.55, 0.0, 0.9):
             parted.core.evaluate_bonds(share)
@@ -305,6 +309,10 @@ def test_bond_forces_in_parts_are_the_same_bits(case: str, tmp_path: Path) -> No
     for field in ("positions", "velocities", "forces", "bond_intact"):
         np.testing.assert_array_equal(getattr(whole.core, field), getattr(parted.core, field))
     assert whole.broken_bonds() > 0
+    parted.core.move()
+    for share in (1.5, -0.1, float("nan")):
+        with pytest.raises(gr.InputError, match="share of the bond blocks must lie in"):
+            parted.core.evaluate_dilatation(share)
     parted.core.begin_step()
     for share in (1.5, -0.1, float("nan")):
         with pytest.raises(gr.InputError, match="share of the bond blocks must lie in"):
@@ -317,7 +325,8 @@ def test_ghost_breaks_are_checked(tmp_path: Path) -> None:
     break that is no intact bond of a ghost particle (the step can still be finished), a ghost
     index out of range; and around them: the fragments' motions outside a step or of a ghost,
     a motion given to a node that is no ghost's or without its 15 numbers, reported numbers
-    of the wrong count, the bond forces evaluated outside a step."""
+    of the wrong count, the bond forces evaluated outside a step, the inner blocks' pass 1
+    outside a move and its step."""
     sim = tumbling_drum(tmp_path)
     sim.core.set_ghost_particles([1])
     with pytest.raises(gr.InputError, match="before marking ghost particles"):
@@ -332,6 +341,8 @@ def test_ghost_breaks_are_checked(tmp_path: Path) -> None:
         sim.core.fragment_motions([0])
     with pytest.raises(gr.InputError, match="evaluate_bonds: call it between begin_step"):
         sim.core.evaluate_bonds()
+    with pytest.raises(gr.InputError, match="evaluate_dilatation: call it between move and begin"):
+        sim.core.evaluate_dilatation()
     sim.core.begin_step()
     with pytest.raises(gr.InputError, match="particle 1 is not one of this process's"):
         sim.core.fragment_motions([0, 1])
