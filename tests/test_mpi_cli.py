@@ -354,6 +354,7 @@ def test_bench_ranks_prints_each_ranks_speed_and_communication() -> None:
         assert row["node_steps_per_s"] > 0
         shares = ("exchange", "check", "caps", "migrate")
         assert all(0 <= row[f"{name}_share"] < 1 for name in shares)
+        assert 0 <= row["wait_share"] <= row["exchange_share"]
         assert row["collect_share"] == 0
 
 
@@ -373,6 +374,7 @@ def test_bench_ranks_measures_one_body_cut_at_node_level() -> None:
         assert row["nodes"] > 0.4 * total  # bisected by bonds: about half each
         assert 0 < row["halo_nodes"] < row["nodes"]
         assert row["node_steps_per_s"] > 0 and 0 <= row["exchange_share"] < 1
+        assert 0 <= row["wait_share"] <= row["exchange_share"]
     refused = bench_ranks("--case", "block", "--quick", "--grains", "5")
     assert refused.returncode == 2 and "--grains does not apply" in refused.stderr
 

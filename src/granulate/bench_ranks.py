@@ -22,7 +22,8 @@ block   one body cut at node level (granulate.parallel.node_split): a notched LP
         glass, 60 x 30 x 30 nodes (53,400; 14 x 7 x 7 with --quick), stretched along its length
         at 60/s from the start until it cracks; nothing touches. Per rank its own and halo
         nodes, its node-steps/s and the share of its time in the two halo exchanges (waits for
-        the other ranks included); --grains does not apply
+        the other ranks included; of that, waiting for the halo after the inner blocks'
+        passes); --grains does not apply
 ======  ======================================================================================
 
 Each rank runs one thread unless ``granulate --threads N`` says otherwise. After 20 untimed
@@ -30,7 +31,9 @@ steps (lists built, caches warm) the ranks' clocks start together and run the st
 prints a table: per rank the grains and nodes it owns at the end, the ghost nodes it holds
 besides and those it received a step on average (the caps), the surface normals it received
 a step on average (of the caps' nodes within the normal reach), its owned node-steps per second,
-and the shares of its wall-clock time spent in the ghost exchange, in the checks (a reduction
+and the shares of its wall-clock time spent in the ghost exchange (and of that, waiting for
+the step's messages after the bond forces it evaluates while they travel: what the overlap
+did not hide), in the checks (a reduction
 after each step, and one within each step whose caps leave ghost nodes out), in picking the
 caps anew, in migrations and, with
 ``--collect-every N``, in gathering the whole state into rank 0's simulation every N steps (as a
@@ -233,6 +236,7 @@ def measure(
         "exchanged_normals": (run.normals_received - normals) / steps,
         "seconds": wall,
         "node_steps_per_s": run.owned_node_count * steps / wall,
+        "wait_share": run.waiting / wall,
     } | {f"{name}_share": run.seconds[name] / wall for name in SHARES}
     rows = comm.gather(row, root=0)
     if rows is None:
@@ -275,6 +279,7 @@ def measure_split(
         "seconds": wall,
         "node_steps_per_s": len(run.own) * steps / wall,
         "exchange_share": run.seconds["exchange"] / wall,
+        "wait_share": run.waiting / wall,
         "collect_share": run.seconds["collect"] / wall,
     }
     rows = comm.gather(row, root=0)
@@ -294,12 +299,13 @@ def measure_split(
 
 def _timed(run: Any, steps: int, collect_every: int, comm: Any) -> float:
     """The wall-clock seconds of `steps` steps of `run` (a DistributedRun or NodeSplitRun),
-    gathering the whole state every `collect_every` (0: never); its `seconds` count these steps
-    alone."""
+    gathering the whole state every `collect_every` (0: never); its `seconds` and `waiting`
+    count these steps alone."""
     every = collect_every or steps
     if collect_every:
         run.collect()  # rank 0 builds the whole simulation once, untimed
     run.seconds = dict.fromkeys(run.seconds, 0.0)
+    run.waiting = 0.0
     comm.Barrier()  # every rank's clock starts together
     start = time.perf_counter()
     for done in range(0, steps, every):
@@ -317,11 +323,13 @@ def table(result: dict[str, Any]) -> str:
         f"{result['case']}: {result['grains']} grains, {result['steps']} steps, "
         f"{result['ranks']} ranks, {result['threads']} thread(s) each",
         "| rank | grains | nodes | ghost nodes | received a step | normals a step | node-steps/s "
-        "| exchange % | check % | caps % | migrate % | collect % |",
-        "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
+        "| exchange % | waiting % | check % | caps % | migrate % | collect % |",
+        "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
     ]
     for rank, row in enumerate(result["rows"]):
-        shares = " | ".join(f"{100 * row[f'{name}_share']:.1f}" for name in SHARES)
+        shares = " | ".join(
+            f"{100 * row[f'{name}_share']:.1f}" for name in (SHARES[0], "wait", *SHARES[1:])
+        )
         lines.append(
             f"| {rank} | {row['grains']} | {row['nodes']:,} | {row['ghost_nodes']:,} | "
             f"{row['exchanged_nodes']:,.0f} | {row['exchanged_normals']:,.0f} | "
@@ -342,14 +350,14 @@ def _split_table(result: dict[str, Any]) -> str:
     lines = [
         f"{result['case']}: one body cut at node level, {result['steps']} steps, "
         f"{result['ranks']} ranks, {result['threads']} thread(s) each",
-        "| rank | nodes | halo nodes | node-steps/s | exchange % | collect % |",
-        "|---:|---:|---:|---:|---:|---:|",
+        "| rank | nodes | halo nodes | node-steps/s | exchange % | waiting % | collect % |",
+        "|---:|---:|---:|---:|---:|---:|---:|",
     ]
     for rank, row in enumerate(result["rows"]):
         lines.append(
             f"| {rank} | {row['nodes']:,} | {row['halo_nodes']:,} | "
             f"{row['node_steps_per_s'] / 1e6:.2f} M | {100 * row['exchange_share']:.1f} | "
-            f"{100 * row['collect_share']:.1f} |"
+            f"{100 * row['wait_share']:.1f} | {100 * row['collect_share']:.1f} |"
         )
     lines.append(f"{result['bonds_broken']:,} bonds broken")
     return "\n".join(lines)

@@ -221,6 +221,9 @@ class DistributedRun:
         self.seconds = dict.fromkeys(
             ("steps", "exchange", "check", "caps", "migrate", "collect"), 0.0
         )
+        #: Of the exchange's seconds, those spent waiting for the step's messages (Waitall,
+        #: after the bond forces): what the overlap did not hide.
+        self.waiting = 0.0
 
     def _stable_time_step(
         self, probe: Simulation, own: NDArray[np.int64], partition: Partition
@@ -595,7 +598,9 @@ class DistributedRun:
         normals) for core.give_ghost_surface_normals."""
         core = self.local.core
         x, v = core.positions, core.velocities
+        start = time.perf_counter()
         self.mpi.Request.Waitall(exchange.requests)
+        self.waiting += time.perf_counter() - start
         received = {q: self._unpack(q, nodes, (x, v)) for q, nodes in self._receive.items()}
         self.nodes_received += self.exchanged_node_count
         self.normals_received += self.exchanged_normal_count

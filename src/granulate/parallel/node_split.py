@@ -91,6 +91,7 @@ class NodeSplitRun:
         self._lps = any(body.material.model == "lps" for body in sim.bodies)  # reads theta_j
         self.halo_nodes = sum(len(halo) for halo in self._receive.values())
         self.seconds = dict.fromkeys(("steps", "exchange", "collect"), 0.0)
+        self.waiting = 0.0  # of the exchange's seconds, those waiting for the halo (Waitall)
 
     @property
     def dt(self) -> float:
@@ -145,6 +146,7 @@ class NodeSplitRun:
         failure, testing = while_travelling(self.mpi, requests, inner, failure)
         waiting = time.perf_counter()
         self.mpi.Request.Waitall(requests)
+        self.waiting += time.perf_counter() - waiting
         for q, halo in self._receive.items():
             field[halo] = inbox[q][:, 0] if field.ndim == 1 else inbox[q]
         self.seconds["exchange"] += posted - start + testing + time.perf_counter() - waiting
