@@ -1,0 +1,72 @@
+"""What each rank of a distributed run holds (issue 17): its memory after the set-up every rank
+makes (the whole Assembly: every grain's nodes), and after its part is built and stepped.
+
+    mpiexec -n K python benchmarks/rank_memory.py [--grains G] [--steps S]
+
+The case is `granulate bench --ranks`' pile3d (G grains in 10 x 10 columns on a floor, each
+meshed at a quarter of its radius, one thread per rank). Rank 0 prints per rank: its resident
+memory [MB] (VmRSS) after the set-up and after `steps` steps of DistributedRun (the peak,
+VmHWM, beside it), its part's core memory (Simulation.core.memory_bytes: bonds and the rest),
+and the whole set-up's node arrays that every rank holds (the Assembly's positions and volumes
+of every grain, 32 bytes a node). Run it with 1 rank too: the serial run holds the same set-up.
+"""
+
+from __future__ import annotations
+
+import argparse
+import warnings
+
+from mpi4py import MPI
+
+from granulate import bench_ranks
+from granulate.parallel import DistributedRun
+from granulate.threads import set_num_threads
+
+
+def resident_mb() -> tuple[float, float]:
+    """(VmRSS, VmHWM) of this process [MB], from /proc/self/status."""
+    fields = {}
+    with open("/proc/self/status") as status:
+        for line in status:
+            name, _, value = line.partition(":")
+            fields[name] = value
+    return tuple(float(fields[name].split()[0]) / 1024 for name in ("VmRSS", "VmHWM"))
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--grains", type=int, default=1000)
+    parser.add_argument("--steps", type=int, default=5)
+    arguments = parser.parse_args()
+    set_num_threads(1, adaptive=False)
+    comm = MPI.COMM_WORLD
+    sim = bench_ranks.pile3d(arguments.grains)
+    assembly = sim._assembly
+    arrays = zip(assembly.positions, assembly.volumes, strict=True)
+    whole = sum(p.nbytes + v.nbytes for p, v in arrays)
+    set_up, _ = resident_mb()
+    with warnings.catch_warnings():
+        warnings.filterwarnings("ignore", message="contact.*bodies pressed")
+        run = DistributedRun(sim, comm)
+        run.run(arguments.steps)
+    stepped, peak = resident_mb()
+    bonds, rest = run.local.core.memory_bytes()
+    row = (run.owned_node_count, set_up, stepped, peak, bonds / 2**20, rest / 2**20, whole / 2**20)
+    rows = comm.gather(row, root=0)
+    if rows is None:
+        return
+    print(
+        f"pile3d: {arguments.grains} grains, {sim.node_count:,} nodes, {comm.Get_size()} ranks, "
+        f"{arguments.steps} steps\n"
+        "| rank | own nodes | set up MB | stepped MB | peak MB | part: bonds MB | part: rest MB "
+        "| whole set-up's node arrays MB |\n|---:|---:|---:|---:|---:|---:|---:|---:|"
+    )
+    for rank, (own, up, now, high, b, r, w) in enumerate(rows):
+        print(
+            f"| {rank} | {own:,} | {up:.0f} | {now:.0f} | {high:.0f} | {b:.1f} | {r:.1f} "
+            f"| {w:.1f} |"
+        )
+
+
+if __name__ == "__main__":
+    main()
