@@ -92,6 +92,25 @@ def test_translated_copies_in_a_subdomain_keep_the_whole_assemblys_bonds() -> No
     assert np.any(alone.core.dilatation[node_map[disc]] != whole.core.dilatation[disc])
 
 
+def test_a_part_keeps_the_outer_layers_of_its_grains_alone() -> None:
+    """A part's scan of the whole assembly for translated copies (every grain, on every rank)
+    compares the surface law's outer layers only of grains whose nodes match an earlier one's
+    and keeps none: the part keeps the outer layers of the grains it builds (session 49: every
+    rank kept every grain's, 32 bytes a node of the whole run). Two rows of discs, the second
+    a size apart: the copies in each row are still found (one shape a row)."""
+    whole = gr.Simulation(2)
+    for k in range(6):
+        radius = 1e-3 if k < 3 else 0.8e-3
+        whole.add_body(gr.Disc((2.2e-3 * k, 0.0), radius), ROCK, 2.5e-4)
+    part, _ = whole._subdomain(np.array([4]))
+    part.core.run(0)
+    kept = ["outer_layer_of" in vars(shape) for shape in whole._assembly.surfaces]
+    assert kept == [False, False, False, True, False, False]  # disc 4 is built from disc 3's
+    assert part.model.shape_count == 1
+    whole.core.run(0)
+    assert whole.model.shape_count == 2
+
+
 def test_a_grains_critical_stretch_does_not_depend_on_the_grains_held_with_it() -> None:
     """Three discs of one material meshed at 0.25, 0.19 and 0.22 mm (each its own horizon, 3
     mesh sizes): each grain's s0 is the material's at its own horizon. It was the material's

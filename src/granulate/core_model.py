@@ -5,6 +5,7 @@ pre-cracks, bonds broken across a plane once the bonds exist."""
 
 from __future__ import annotations
 
+import functools
 import weakref
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -125,7 +126,7 @@ def _translated_copies(assembly: Assembly, outer_layers: bool) -> dict[int, int]
     ):
         if body.reference is not None:
             continue
-        surface_arrays = _surface_arrays(surface, outer_layers)
+        surface_arrays = functools.partial(_surface_arrays, surface, outer_layers, keep=False)
         original = copies.find(positions, volumes, body.mesh_size, surface_arrays)
         if original is None:
             copies.remember(body.index, positions, volumes, body.mesh_size, surface_arrays)
@@ -182,14 +183,18 @@ def _check_material_for(body: Body, horizon: float, dimension: int, plane: str) 
 
 
 def _surface_arrays(
-    reference: ReferenceShape | None, outer_layers: bool
+    reference: ReferenceShape | None, outer_layers: bool, keep: bool = True
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """A shape's surface offsets (flat, 3 per node) and depths for the core; empty arrays where
     it has none (all depths 0: empty too). With ``outer_layers`` (the surface law) a lattice's
-    or conforming discretisation's outer layer, which only that law uses."""
+    or conforming discretisation's outer layer, which only that law uses: kept on the shape
+    (ReferenceShape.outer_layer_of), or with `keep` False computed without keeping it where
+    the shape does not hold it yet (a copy's, compared once)."""
     if reference is None:
         return np.zeros(0), np.zeros(0)
-    layer = reference.outer_layer_of if outer_layers else None
+    layer = None
+    if outer_layers:
+        layer = reference.outer_layer_of if keep else reference.outer_layer_unkept()
     if layer is not None:
         return np.ascontiguousarray(layer[0]).reshape(-1), np.ascontiguousarray(layer[1])
     if reference.surface is None:

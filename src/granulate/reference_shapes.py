@@ -46,6 +46,13 @@ class ReferenceShape:
         (see outer_layer): the unit normals (n, 3) and depths (n,) [m] of its nodes less than h
         deep; None for a mesh or grid (their boundary vertices carry ``surface``). Computed on
         first use: the node-sphere law does not need it."""
+        return self.outer_layer_unkept()
+
+    def outer_layer_unkept(self) -> tuple[NDArray[np.float64], NDArray[np.float64]] | None:
+        """outer_layer_of, computed anew unless the shape holds it already, and not kept: for
+        a shape only compared with others (shape_sharing)."""
+        if "outer_layer_of" in self.__dict__:
+            return self.outer_layer_of
         if self.source is None:
             return None
         shifted = self.positions + np.asarray(self.source_shift)

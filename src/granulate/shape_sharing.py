@@ -21,7 +21,7 @@ differences of the shape's signed distance over h/1000, which round-off leaves e
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from collections.abc import Callable
 
 import numpy as np
 from numpy.typing import NDArray
@@ -32,12 +32,31 @@ TOLERANCE = 1e-10
 OFFSET_TOLERANCE = 1e-8
 
 
-@dataclass(frozen=True)
-class _Known:  # an earlier body's arrays (references, not copies)
-    body: int
-    positions: NDArray[np.float64]
-    volumes: NDArray[np.float64]
-    surface: tuple[NDArray[np.float64], NDArray[np.float64]]
+#: A body's surface data (offsets, depths), computed when asked: only a body whose nodes match
+#: an earlier body's needs it, and a distributed run scans every grain of the whole assembly.
+Surface = Callable[[], tuple[NDArray[np.float64], NDArray[np.float64]]]
+
+
+class _Known:
+    """An earlier body's arrays (references, not copies) and its surface data, computed once
+    when first compared."""
+
+    def __init__(
+        self,
+        body: int,
+        positions: NDArray[np.float64],
+        volumes: NDArray[np.float64],
+        surface: Surface,
+    ) -> None:
+        self.body, self.positions, self.volumes = body, positions, volumes
+        self._surface = surface
+        self._arrays: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None
+
+    def surface(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """The body's surface data (offsets, depths), computed on the first call."""
+        if self._arrays is None:
+            self._arrays = self._surface()
+        return self._arrays
 
 
 class TranslatedShapes:
@@ -51,18 +70,23 @@ class TranslatedShapes:
         positions: NDArray[np.float64],
         volumes: NDArray[np.float64],
         mesh_size: float,
-        surface: tuple[NDArray[np.float64], NDArray[np.float64]],
+        surface: Surface,
     ) -> int | None:
-        """The earlier body these nodes are a translated copy of, or None."""
+        """The earlier body these nodes are a translated copy of, or None. `surface` (this
+        body's surface data) is called only when the nodes and volumes match an earlier
+        body's, at most once."""
         tolerance = TOLERANCE * mesh_size
+        arrays = None
         for known in self._known.get((len(positions), mesh_size), []):
             shift = positions[0] - known.positions[0]
-            if (
+            if not (
                 np.max(np.abs(positions[-1] - known.positions[-1] - shift)) <= tolerance
                 and np.array_equal(known.volumes, volumes)
-                and _same_surface(known.surface, surface, tolerance)
                 and np.max(np.abs(positions - known.positions - shift)) <= tolerance
             ):
+                continue
+            arrays = surface() if arrays is None else arrays
+            if _same_surface(known.surface(), arrays, tolerance):
                 return known.body
         return None
 
@@ -72,9 +96,10 @@ class TranslatedShapes:
         positions: NDArray[np.float64],
         volumes: NDArray[np.float64],
         mesh_size: float,
-        surface: tuple[NDArray[np.float64], NDArray[np.float64]],
+        surface: Surface,
     ) -> None:
-        """Record body number `body` with these nodes."""
+        """Record body number `body` with these nodes (`surface`: its surface data, asked for
+        when a later body's nodes match)."""
         known = _Known(body, positions, volumes, surface)
         self._known.setdefault((len(positions), mesh_size), []).append(known)
 

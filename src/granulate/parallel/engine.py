@@ -153,7 +153,7 @@ class DistributedRun:
         self._node_count = sim._assembly.node_count
         self._weights = np.array([body.node_count for body in sim.bodies], dtype=float)
         start = _start_positions(sim)
-        centres, radii = _spheres([start[body.node_slice] for body in sim.bodies], sim.dimension)
+        centres, radii = _spheres(start, sim.dimension)
         self._set_up_damping(sim)
         _check_grains_for_ranks(len(self._slices), comm.Get_size())
         start_partition = bisect(centres, self._weights, comm.Get_size())
@@ -212,7 +212,7 @@ class DistributedRun:
         self._migration_due = False
         # The wall reactions a loaded checkpoint holds, until the next step evaluates them.
         self._loaded_walls: NDArray[np.float64] | None = None
-        held = self._distribute_whole([start[where] for where in self._slices], centres, radii)
+        held = self._distribute_whole(start, centres, radii)
         together(self.comm, lambda: self._build(held))
         self._exchange_state()
         self._exchange_caps()
@@ -1238,9 +1238,13 @@ def _largest_free_radius(sim: Simulation, radii: NDArray[np.float64]) -> float:
     return float((radii[free] if free else radii).max())
 
 
-def _start_positions(sim: Simulation) -> NDArray[np.float64]:
-    """Every node's position at the start: its start state when one is set."""
-    return sim._start[0] if sim._start is not None else sim._assembly.reference_positions()
+def _start_positions(sim: Simulation) -> list[NDArray[np.float64]]:
+    """Each grain's nodes' positions at the start: its start state when one is set, else the
+    set-up's arrays themselves (not joined into one: that would be 24 bytes a node of the
+    whole run on every rank)."""
+    if sim._start is not None:
+        return [sim._start[0][body.node_slice] for body in sim.bodies]
+    return list(sim._assembly.positions)
 
 
 def _spheres(
