@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 import granulate as gr
+from granulate.shapes import rotation_matrix
 
 ROCK = gr.Material(density=2000, bulk_modulus=1e7, shear_modulus=6e6, fracture_energy=10)
 
@@ -90,6 +91,28 @@ def test_translated_copies_in_a_subdomain_keep_the_whole_assemblys_bonds() -> No
     alone._assembly.parent = None  # the part as if it were a whole assembly of its own
     alone.core.run(0)
     assert np.any(alone.core.dilatation[node_map[disc]] != whole.core.dilatation[disc])
+
+
+def test_placed_particles_hold_no_node_arrays() -> None:
+    """A particle placed from a reference shape keeps its placement, not its nodes
+    (body_nodes.py): the assembly holds node arrays only of the bodies meshed where they stand,
+    and a placed particle's nodes, computed when asked, are x = c + R (s p) (z = 0 in 2D) and
+    V s^d, the same bits at every call and in the built model."""
+    sim = gr.Simulation(2)
+    disc = gr.ReferenceShape.from_shape(gr.Disc((0, 0), 1e-3), 2.5e-4)
+    sim.add_particle(disc, ROCK, position=(1e-3, 2e-3), rotation=0.3, scale=1.2)
+    sim.add_body(gr.Disc((5e-3, 0), 1e-3), ROCK, 2.5e-4)
+    assembly = sim._assembly
+    meshed = assembly.positions[1], assembly.volumes[1]
+    assert [a is b for a, b in zip(assembly.stored_arrays(), meshed, strict=True)] == [True, True]
+    expected = np.array([1e-3, 2e-3, 0.0]) + (1.2 * disc.positions) @ rotation_matrix(0.3, 2).T
+    expected[:, 2] = 0.0
+    np.testing.assert_array_equal(assembly.positions[0], expected)
+    np.testing.assert_array_equal(assembly.positions[0], assembly.positions[0])
+    np.testing.assert_array_equal(assembly.volumes[0], disc.volumes * 1.2**2)
+    sim.core.run(0)
+    nodes = sim.bodies[0].node_slice
+    np.testing.assert_array_equal(sim.model.reference_positions[nodes], expected)
 
 
 def test_a_part_keeps_the_outer_layers_of_its_grains_alone() -> None:

@@ -17,6 +17,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from granulate import _core, reductions
+from granulate.body_nodes import BodyNodes, NodeField, PlacedNodes, StoredNodes
 from granulate.errors import InputError
 from granulate.input_errors import check_number
 from granulate.materials import Material
@@ -83,16 +84,19 @@ def node_ids(nodes: ArrayLike, count: int) -> NDArray[np.uint32]:
 class Assembly:
     """The bodies added so far, in order, with their node arrays.
 
-    ``surfaces[k]``: for a body without a reference shape, the discretised shape its nodes
-    came from (for its surface offsets and depths), or None.
+    ``positions[k]``, ``volumes[k]``: body k's node arrays (a particle placed from a reference
+    shape computes them when asked: body_nodes.py). ``surfaces[k]``: for a body without a
+    reference shape, the discretised shape its nodes came from (for its surface offsets and
+    depths), or None.
     """
 
     def __init__(self, dimension: int) -> None:
         self.dimension = dimension
         self.bodies: list[Body] = []
         self.packings: list[Packing] = []
-        self.positions: list[NDArray[np.float64]] = []
-        self.volumes: list[NDArray[np.float64]] = []
+        self._nodes: list[BodyNodes] = []
+        self.positions = NodeField(self._nodes, "positions")
+        self.volumes = NodeField(self._nodes, "volumes")
         self.surfaces: list[ReferenceShape | None] = []
         self.initial_velocities: list[InitialVelocity] = []
         self._names: dict[str, Body] = {}  # every body by name (adding one is O(1))
@@ -105,11 +109,17 @@ class Assembly:
         last = self.bodies[-1] if self.bodies else None
         return last.first_node + last.node_count if last is not None else 0
 
+    def stored_arrays(self) -> list[NDArray[np.float64]]:
+        """The node arrays the assembly holds (positions and volumes of the bodies not placed
+        from a reference shape, whose nodes are computed when asked)."""
+        stored = [nodes for nodes in self._nodes if isinstance(nodes, StoredNodes)]
+        return [array for nodes in stored for array in (nodes.position_array, nodes.volume_array)]
+
     def reference_positions(self) -> NDArray[np.float64]:
         """(n, 3) reference positions of all nodes added so far [m] (a copy)."""
-        if not self.positions:
+        if not self._nodes:
             return np.zeros((0, 3))
-        return np.concatenate(self.positions)
+        return np.concatenate(list(self.positions))
 
     def vector(self, value: ArrayLike, name: str) -> NDArray[np.float64]:
         return as_vector(value, name, self.dimension)
@@ -185,15 +195,15 @@ class Assembly:
             )
         if not (np.isfinite(scale) and scale > 0):
             raise InputError(f"scale must be positive, got {scale}")
-        placed = (
-            self.vector(position, "position")
-            + (scale * reference.positions) @ rotation_matrix(rotation, self.dimension).T
+        placed = PlacedNodes(
+            reference,
+            self.vector(position, "position"),
+            rotation_matrix(rotation, self.dimension),
+            scale,
+            self.dimension,
         )
-        if self.dimension == 2:
-            placed[:, 2] = 0.0
         return self._add(
             placed,
-            reference.volumes * scale**self.dimension,
             material,
             scale * reference.mesh_size,
             velocity,
@@ -255,12 +265,12 @@ class Assembly:
         check_number("add_body_from_nodes: mesh_size", mesh_size)
         if not (np.isfinite(mesh_size) and mesh_size > 0):
             raise InputError(f"mesh size must be positive, got {mesh_size}")
-        return self._add(p, v, material, mesh_size, velocity, angular_velocity, name, None, 1.0)
+        nodes = StoredNodes(p, v)
+        return self._add(nodes, material, mesh_size, velocity, angular_velocity, name, None, 1.0)
 
     def _add(
         self,
-        p: NDArray[np.float64],
-        v: NDArray[np.float64],
+        nodes: BodyNodes,
         material: Material,
         mesh_size: float,
         velocity: ArrayLike | None,
@@ -280,7 +290,7 @@ class Assembly:
             index,
             name or f"body{index}",
             self.node_count,
-            len(p),
+            nodes.node_count,
             material,
             float(mesh_size),
             reference,
@@ -288,8 +298,12 @@ class Assembly:
         )
         self.bodies.append(body)
         self._names.setdefault(body.name, body)
-        self.positions.append(np.ascontiguousarray(p))
-        self.volumes.append(np.ascontiguousarray(v))
+        if isinstance(nodes, StoredNodes):
+            nodes = StoredNodes(
+                np.ascontiguousarray(nodes.position_array),
+                np.ascontiguousarray(nodes.volume_array),
+            )
+        self._nodes.append(nodes)
         self.surfaces.append(None)
         if velocity is not None or angular_velocity is not None:
             self.initial_velocities.append((body, *self._motion(velocity, angular_velocity)))
@@ -332,8 +346,7 @@ class Assembly:
             node_map[body.node_slice] = copy.first_node + np.arange(body.node_count)
             part.bodies.append(copy)
             part._names[copy.name] = copy
-            part.positions.append(self.positions[g])
-            part.volumes.append(self.volumes[g])
+            part._nodes.append(self._nodes[g])
             part.surfaces.append(self.surfaces[g])
             renamed[int(g)] = copy
         part.initial_velocities = [

@@ -33,6 +33,7 @@ from __future__ import annotations
 import os
 import time
 import warnings
+from collections.abc import Sequence
 from pathlib import Path
 from types import SimpleNamespace
 from typing import TYPE_CHECKING, Any, NamedTuple
@@ -312,7 +313,7 @@ class DistributedRun:
 
     def _distribute_whole(
         self,
-        grains: list[NDArray[np.float64]],
+        grains: Sequence[NDArray[np.float64]],
         centres: NDArray[np.float64],
         radii: NDArray[np.float64],
     ) -> NDArray[np.int64]:
@@ -1238,17 +1239,18 @@ def _largest_free_radius(sim: Simulation, radii: NDArray[np.float64]) -> float:
     return float((radii[free] if free else radii).max())
 
 
-def _start_positions(sim: Simulation) -> list[NDArray[np.float64]]:
+def _start_positions(sim: Simulation) -> Sequence[NDArray[np.float64]]:
     """Each grain's nodes' positions at the start: its start state when one is set, else the
-    set-up's arrays themselves (not joined into one: that would be 24 bytes a node of the
-    whole run on every rank)."""
+    set-up's (Assembly.positions, a placed grain's computed when asked: neither joined into
+    one array nor all kept at once, which would be 24 bytes a node of the whole run on every
+    rank)."""
     if sim._start is not None:
         return [sim._start[0][body.node_slice] for body in sim.bodies]
-    return list(sim._assembly.positions)
+    return sim._assembly.positions
 
 
 def _spheres(
-    grains: list[NDArray[np.float64]], dimension: int
+    grains: Sequence[NDArray[np.float64]], dimension: int
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Per grain (its nodes' positions) the centre of their box (its first `dimension`
     coordinates) and the radius of the sphere about it that holds them [m]."""
