@@ -121,11 +121,10 @@ def _translated_copies(assembly: Assembly, outer_layers: bool) -> dict[int, int]
     if key in known:
         return known[key]
     copies, copy_of = TranslatedShapes(), {}
-    for body, positions, volumes, surface in zip(
-        assembly.bodies, assembly.positions, assembly.volumes, assembly.surfaces, strict=True
-    ):
-        if body.reference is not None:
+    for body, surface in zip(assembly.bodies, assembly.surfaces, strict=True):
+        if body.reference is not None:  # placed: its nodes are not computed here
             continue
+        positions, volumes = assembly.positions[body.index], assembly.volumes[body.index]
         surface_arrays = functools.partial(_surface_arrays, surface, outer_layers, keep=False)
         original = copies.find(positions, volumes, body.mesh_size, surface_arrays)
         if original is None:
