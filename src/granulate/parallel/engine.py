@@ -168,6 +168,7 @@ class DistributedRun:
         #: The stable time-step estimate [s]: the serial run's (_stable_time_step).
         own = np.searchsorted(probed, first)
         self.stable_dt = self._stable_time_step(probe, own, start_partition)
+        del probe  # before the part is built: both at once would double the peak
         self._dt = sim._dt_safety * self.stable_dt if sim._dt is None else float(sim._dt)
         grain = _largest_free_radius(sim, radii)
         self.margin = float(grain if margin is None else margin)
