@@ -16,7 +16,8 @@ from numpy.typing import NDArray
 from granulate.reference_shapes import ReferenceShape
 
 
-@dataclass(frozen=True)
+# eq=False: node arrays are compared by their owners, not as fields of these records.
+@dataclass(frozen=True, eq=False)
 class StoredNodes:
     """A body's node positions (n, 3) [m] and volumes (n,) [m^3; m^2 in 2D], as given."""
 
@@ -34,7 +35,7 @@ class StoredNodes:
         return self.volume_array
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class PlacedNodes:
     """A particle placed from a reference shape: x = c + R (s p) for each node p of the shape
     [m] (z = 0 in 2D), and volumes s^d V; computed anew at each call, to the same bits."""
