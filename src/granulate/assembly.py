@@ -21,6 +21,7 @@ from granulate.body_nodes import BodyNodes, NodeField, PlacedNodes, StoredNodes
 from granulate.errors import InputError
 from granulate.input_errors import check_number
 from granulate.materials import Material
+from granulate.node_map import NodeMap
 from granulate.packing import Grain, Packing, Placements, grains_by_kind
 from granulate.reference_shapes import ReferenceShape
 from granulate.shapes import Shape, rotation_matrix
@@ -322,7 +323,7 @@ class Assembly:
                 spin = self.vector(angular_velocity, "angular_velocity")
         return linear, spin
 
-    def subset(self, grains: ArrayLike) -> tuple[Assembly, NDArray[np.int64]]:
+    def subset(self, grains: ArrayLike) -> tuple[Assembly, NodeMap]:
         """The bodies `grains` (indices, increasing) as an assembly of their own, renumbered in
         that order, with their initial motions; and the map of this assembly's node indices to
         the subset's (-1 for nodes left out). A distributed run's rank holds such a subset: the
@@ -338,12 +339,12 @@ class Assembly:
         part.parent = (
             (self, chosen) if self.parent is None else (self.parent[0], self.parent[1][chosen])
         )
-        node_map = np.full(self.node_count, -1, dtype=np.int64)
+        local = np.full(len(self.bodies), -1, dtype=np.int64)
         renamed: dict[int, Body] = {}
         for g in chosen:
             body = self.bodies[g]
             copy = replace(body, index=len(part.bodies), first_node=part.node_count)
-            node_map[body.node_slice] = copy.first_node + np.arange(body.node_count)
+            local[g] = copy.first_node
             part.bodies.append(copy)
             part._names[copy.name] = copy
             part._nodes.append(self._nodes[g])
@@ -354,7 +355,9 @@ class Assembly:
             for body, linear, spin in self.initial_velocities
             if body.index in renamed
         ]
-        return part, node_map
+        starts = np.array([body.first_node for body in self.bodies], dtype=np.int64)
+        counts = np.array([body.node_count for body in self.bodies], dtype=np.int64)
+        return part, NodeMap(starts, counts, local)
 
     def body(self, body: Body | str) -> Body:
         """A body of this assembly, or the one of that name (InputError otherwise)."""

@@ -14,6 +14,7 @@ from granulate import _core
 from granulate.assembly import Assembly, node_ids
 from granulate.errors import InputError
 from granulate.functions import Constant, Linear, TimeFunction, VelocityRamp
+from granulate.node_map import NodeMap
 
 Components = str  # any of "x", "y", "z", e.g. "xy"
 
@@ -156,7 +157,7 @@ class Loading:
                 held[load.nodes] = True
         return held
 
-    def subset(self, assembly: Assembly, node_map: NDArray[np.int64]) -> Loading:
+    def subset(self, assembly: Assembly, node_map: NodeMap) -> Loading:
         """The loads on `assembly`, a subset of this one's (Assembly.subset and its node map):
         each load on the nodes it keeps, renumbered; loads that keep no node are left out."""
         part = Loading(assembly)

@@ -53,6 +53,7 @@ from granulate.writers.outputs import Outputs
 from granulate.writers.vtu_frame import FIELDS
 
 if TYPE_CHECKING:
+    from granulate.node_map import NodeMap
     from granulate.parallel import DistributedRun
     from granulate.parallel.node_split import NodeSplitRun
 
@@ -223,7 +224,7 @@ class Simulation(SimulationSetup, SimulationResults):
         dt: float | None = None,
         skin: float | None = None,
         initial_motion: bool = True,
-    ) -> tuple[Simulation, NDArray[np.int64]]:
+    ) -> tuple[Simulation, NodeMap]:
         """A new simulation of the bodies `grains` (increasing indices) alone, set up as this
         one is (loads on their nodes, contact, walls, gravity, damping, precracks, start
         state; the initial velocities unless `initial_motion` is False, for a part whose state
@@ -250,7 +251,7 @@ class Simulation(SimulationSetup, SimulationResults):
             part._interactions.set_skin(skin)
         part._precracks = list(self._precracks)
         if self._start is not None:
-            kept = node_map >= 0  # kept nodes keep their order
+            kept = node_map.kept()  # kept nodes keep their order
             part._start = (self._start[0][kept], self._start[1][kept])
             part._start_step = self._start_step
         return part, node_map

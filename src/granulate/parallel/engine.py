@@ -65,6 +65,7 @@ from granulate.parallel.whole_state import install, owned_part
 from granulate.writers.vtu_frame import write_piece
 
 if TYPE_CHECKING:
+    from granulate.node_map import NodeMap
     from granulate.simulation import Simulation
     from granulate.writers.outputs import Outputs
 
@@ -352,7 +353,7 @@ class DistributedRun:
             np.concatenate([none, *(last for _, last in pairs)]),
         )
 
-    def _plan(self, node_map: NDArray[np.int64]) -> None:
+    def _plan(self, node_map: NodeMap) -> None:
         """Which grains go to which rank and come from which, and the positions the nodes'
         travel is measured from (the core measures it in each step). The core skips the
         ghosts' bonds and moves (Simulation::set_ghost_particles): their positions,
@@ -361,7 +362,7 @@ class DistributedRun:
         rank = self.comm.Get_rank()
         owner = self.partition.owner
         self._node_map = node_map
-        self._to_global = np.flatnonzero(node_map >= 0)  # subsets keep the serial order
+        self._to_global = node_map.kept()  # subsets keep the serial order
         self._owned = self.partition.grains_of(rank)
         ghost_particles = np.flatnonzero(owner[self.held] != rank)  # the part's particle order
         self.local.core.set_ghost_particles(ghost_particles.tolist())
@@ -485,7 +486,7 @@ class DistributedRun:
         return slice(first, first + self._slices[grain].stop - self._slices[grain].start)
 
     def _nodes_of(
-        self, grains: NDArray[np.int64], node_map: NDArray[np.int64] | None = None
+        self, grains: NDArray[np.int64], node_map: NodeMap | None = None
     ) -> NDArray[np.int64]:
         """The global indices of the nodes of `grains` in grain order; their local indices
         when `node_map` (global to local) is given."""

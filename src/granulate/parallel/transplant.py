@@ -26,6 +26,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 if TYPE_CHECKING:
+    from granulate.node_map import NodeMap
     from granulate.simulation import Simulation
 
 NO_SPRING = 2**32 - 1  # ContactModel::no_spring: an entry without a friction spring
@@ -194,7 +195,7 @@ def _wall_springs(
 
 
 def restore_grains(
-    core: Any, states: list[GrainState], to_local: NDArray[np.int64], moment: dict[str, Any]
+    core: Any, states: list[GrainState], to_local: NodeMap, moment: dict[str, Any]
 ) -> None:
     """Put `states` (the held grains' states, in the core's grain order) into `core`, a new
     rank part whose global node g is local node to_local[g] (-1: not held): the state, the
@@ -250,9 +251,7 @@ _MOMENT_KEYS = (
 )
 
 
-def _node_bodies(
-    states: list[GrainState], to_local: NDArray[np.int64], broken: bool
-) -> NDArray[np.int64]:
+def _node_bodies(states: list[GrainState], to_local: NodeMap, broken: bool) -> NDArray[np.int64]:
     """Each local node's body as the core numbers them (ContactModel::label_bodies): its
     particle while no bond is broken, else its fragment in the order of their smallest node."""
     if not broken:
@@ -263,7 +262,7 @@ def _node_bodies(
 
 
 def _slots(
-    states: list[GrainState], node_body: NDArray[np.int64], to_local: NDArray[np.int64]
+    states: list[GrainState], node_body: NDArray[np.int64], to_local: NodeMap
 ) -> tuple[NDArray[np.int64], NDArray[np.float64], int]:
     """The collisions between held bodies (and of held bodies with walls) as the core's slots:
     (k, 2) body pairs sorted (p <= q), then (body, wall) pairs sorted; their values; the number
@@ -286,7 +285,7 @@ def _slots(
 
 
 def _give_springs(
-    core: Any, listed: dict[str, Any], states: list[GrainState], to_local: NDArray[np.int64]
+    core: Any, listed: dict[str, Any], states: list[GrainState], to_local: NodeMap
 ) -> None:
     """Each friction spring of `states` to the entry of its pair (or node and wall surface) in
     the freshly searched lists of `listed`, in place. A spring of two held nodes whose pair the
