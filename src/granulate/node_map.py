@@ -24,7 +24,9 @@ class NodeMap:
         if isinstance(nodes, slice):
             nodes = np.arange(*nodes.indices(self._node_count))
         g = np.asarray(nodes, dtype=np.int64)
-        if g.size and (g.min() < 0 or g.max() >= self._node_count):
+        if g.size == 0:  # most steps' breaks and joining nodes: no lookup
+            return np.zeros(g.shape, dtype=np.int64)
+        if g.min() < 0 or g.max() >= self._node_count:
             raise IndexError(f"node index out of range [0, {self._node_count})")
         body = np.searchsorted(self._starts, g, side="right") - 1
         first = self._local[body]
