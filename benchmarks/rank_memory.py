@@ -19,10 +19,8 @@ from __future__ import annotations
 import argparse
 import warnings
 
-import numpy as np
 from mpi4py import MPI
 
-import granulate as gr
 from granulate import bench_ranks
 from granulate.parallel import DistributedRun
 from granulate.threads import set_num_threads
@@ -38,30 +36,6 @@ def resident_mb() -> tuple[float, float]:
     return tuple(float(fields[name].split()[0]) / 1024 for name in ("VmRSS", "VmHWM"))
 
 
-def placed_pile3d(grains: int) -> gr.Simulation:
-    """pile3d's columns with each grain placed from one of two reference shapes: a sphere of
-    radius R and a cube of half-side 0.8 R, meshed at R/4 (bench_ranks' R), scaled to the
-    grain's radius."""
-    radius = bench_ranks.RADIUS
-    rng = np.random.default_rng(3)
-    sim = gr.Simulation(3, gravity=(0, -9.81, 0))
-    sim.contact = gr.Contact(restitution=0.5, friction=0.5)
-    half = 0.8 * radius
-    shapes = (
-        gr.ReferenceShape.from_shape(gr.Box((-half,) * 3, (half,) * 3), radius / 4),
-        gr.ReferenceShape.from_shape(gr.Sphere((0, 0, 0), radius), radius / 4),
-    )
-    for k in range(grains):
-        layer, rest = divmod(k, 100)
-        row, column = divmod(rest, 10)
-        centre = (2 * radius * column, 2 * radius * layer, 2 * radius * row)
-        scale = rng.uniform(0.98, 1.0)
-        shape = shapes[0] if k % 3 == 0 else shapes[1]
-        sim.add_particle(shape, bench_ranks.ROCK, position=centre, scale=scale)
-    sim.add_wall(gr.Wall(gr.Plane((0, -0.99 * radius, 0), (0, 1, 0))), name="floor")
-    return sim
-
-
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--grains", type=int, default=1000)
@@ -70,8 +44,7 @@ def main() -> None:
     arguments = parser.parse_args()
     set_num_threads(1, adaptive=False)
     comm = MPI.COMM_WORLD
-    make = placed_pile3d if arguments.placed else bench_ranks.pile3d
-    sim = make(arguments.grains)
+    sim = bench_ranks.pile3d(arguments.grains, placed=arguments.placed)
     assembly = sim._assembly
     whole = sum(nodes.nbytes for nodes in assembly.stored_arrays())
     set_up, _ = resident_mb()

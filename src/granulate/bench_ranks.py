@@ -143,23 +143,31 @@ def drum(grains: int) -> gr.Simulation:
     return sim
 
 
-def pile3d(grains: int, comm: Any = None) -> gr.Simulation:
+def pile3d(grains: int, comm: Any = None, placed: bool = False) -> gr.Simulation:
     """`grains` grains in 10 x 10 columns on a cubic lattice, on a floor (run on the ranks of
-    `comm`, given one: Simulation's)."""
+    `comm`, given one: Simulation's): every third a cube of half-side 0.8 r, the others
+    spheres of radius r, r within 0.98-1 R, each meshed where it stands at R/4, or with
+    `placed` placed from two reference shapes (a cube and a sphere of R, meshed at R/4) scaled
+    to r, as packings place grains."""
     rng = np.random.default_rng(3)
     sim = gr.Simulation(3, gravity=(0, -9.81, 0), comm=comm)
     sim.contact = gr.Contact(restitution=0.5, friction=0.5)
+    shapes = (gr.Box((-0.8 * RADIUS,) * 3, (0.8 * RADIUS,) * 3), gr.Sphere((0, 0, 0), RADIUS))
+    references = [gr.ReferenceShape.from_shape(s, RADIUS / 4) for s in shapes] if placed else []
     for k in range(grains):
         layer, rest = divmod(k, 100)
         row, column = divmod(rest, 10)
         centre = (2 * RADIUS * column, 2 * RADIUS * layer, 2 * RADIUS * row)
-        radius = RADIUS * rng.uniform(0.98, 1.0)
-        if k % 3 == 0:
+        scale = rng.uniform(0.98, 1.0)
+        radius = RADIUS * scale
+        if placed:
+            sim.add_particle(references[k % 3 != 0], ROCK, position=centre, scale=scale)
+        elif k % 3 == 0:
             half = 0.8 * radius
             shape = gr.Box(tuple(c - half for c in centre), tuple(c + half for c in centre))
+            sim.add_body(shape, ROCK, RADIUS / 4)
         else:
-            shape = gr.Sphere(centre, radius)
-        sim.add_body(shape, ROCK, RADIUS / 4)
+            sim.add_body(gr.Sphere(centre, radius), ROCK, RADIUS / 4)
     sim.add_wall(gr.Wall(gr.Plane((0, -0.99 * RADIUS, 0), (0, 1, 0))), name="floor")
     return sim
 

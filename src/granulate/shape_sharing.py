@@ -21,6 +21,7 @@ differences of the shape's signed distance over h/1000, which round-off leaves e
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Callable
 
 import numpy as np
@@ -50,13 +51,11 @@ class _Known:
     ) -> None:
         self.body, self.positions, self.volumes = body, positions, volumes
         self._surface = surface
-        self._arrays: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None
 
+    @functools.cached_property
     def surface(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        """The body's surface data (offsets, depths), computed on the first call."""
-        if self._arrays is None:
-            self._arrays = self._surface()
-        return self._arrays
+        """The body's surface data (offsets, depths), computed when first read."""
+        return self._surface()
 
 
 class TranslatedShapes:
@@ -86,7 +85,7 @@ class TranslatedShapes:
             ):
                 continue
             arrays = surface() if arrays is None else arrays
-            if _same_surface(known.surface(), arrays, tolerance):
+            if _same_surface(known.surface, arrays, tolerance):
                 return known.body
         return None
 

@@ -83,10 +83,15 @@ class NodeSplitRun:
         self.own = self.nodes_of[rank]
         core.set_foreign_nodes(np.flatnonzero(self.owner != rank).tolist())
         self._receive, self._send = _halos(model, self.owner, self.own, rank)
-        # The halo's messages in, for positions (3 numbers a node) and dilatation sums (1).
+        # The halo's messages in and out, for positions (3 numbers a node) and dilatation sums
+        # (1), made once.
         self._inboxes = {
             width: {q: np.empty((len(halo), width)) for q, halo in self._receive.items()}
             for width in (3, 1)
+        }
+        self._outboxes = {
+            shape: {q: np.empty((len(nodes), *shape)) for q, nodes in self._send.items()}
+            for shape in ((3,), ())
         }
         self._lps = any(body.material.model == "lps" for body in sim.bodies)  # reads theta_j
         self.halo_nodes = sum(len(halo) for halo in self._receive.values())
@@ -140,7 +145,9 @@ class NodeSplitRun:
         width = 1 if field.ndim == 1 else field.shape[1]
         inbox = self._inboxes[width]
         requests = [self.comm.Irecv(box, source=q, tag=_TAG) for q, box in inbox.items()]
-        outbox = {q: np.ascontiguousarray(field[nodes]) for q, nodes in self._send.items()}
+        outbox = self._outboxes[field.shape[1:]]
+        for q, nodes in self._send.items():
+            np.take(field, nodes, axis=0, out=outbox[q])
         requests += [self.comm.Isend(box, dest=q, tag=_TAG) for q, box in outbox.items()]
         posted = time.perf_counter()
         failure, testing = while_travelling(self.mpi, requests, inner, failure)
