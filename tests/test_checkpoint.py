@@ -25,6 +25,7 @@ def tumbling_drum(
     rolling: float = 0.0,
     comm: object | None = None,
     fracture: bool = True,
+    outputs: bool = True,
 ) -> gr.Simulation:
     """Grains breaking in a rotating drum: contact, friction, damping, walls and fracture.
     ``grid``: the fourth grain is a brittle grid-meshed square instead of a lattice triangle:
@@ -33,7 +34,8 @@ def tumbling_drum(
     contact's pair_law ("surface": probes of the grains' smooth surfaces, with their groups
     and the nodes opened by cracks joining the lists). ``rolling``: mu_r, the rolling
     resistance (its springs carried through the checkpoint). ``comm``: run it on MPI ranks
-    (tests/mpi_check.py). ``fracture``: False makes the grains unbreakable."""
+    (tests/mpi_check.py). ``fracture``: False makes the grains unbreakable. ``outputs``: False
+    plans no outputs or checkpoints."""
     rock = gr.Material(
         density=2000, youngs_modulus=1e8, poisson_ratio=0.25, fracture_energy=0.5, fracture=fracture
     )
@@ -55,8 +57,9 @@ def tumbling_drum(
     lifter = gr.PolygonObstacle(((-1e-3, -7.5e-3), (1e-3, -7.5e-3), (0, -5.5e-3)))
     drum = gr.Wall((gr.CircleContainer((0, 0), 7e-3), lifter), motion=gr.Rotation.steady(30.0))
     sim.add_wall(drum, name="drum")
-    sim.output(out, every=250, overwrite=not resume, resume=resume)
-    sim.checkpoint_every(1000)
+    if outputs:
+        sim.output(out, every=250, overwrite=not resume, resume=resume)
+        sim.checkpoint_every(1000)
     return sim
 
 

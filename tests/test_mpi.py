@@ -24,10 +24,13 @@ def mpiexec() -> str:
     return found
 
 
-def run_ranks(ranks: int, *arguments: str) -> subprocess.CompletedProcess[str]:
-    """mpi_check.py on `ranks` ranks; a hang fails the test after 5 minutes."""
+def run_ranks(
+    ranks: int, *arguments: str, script: Path = CHECK
+) -> subprocess.CompletedProcess[str]:
+    """`script` (mpi_check.py) on `ranks` ranks, one thread each; a hang fails the test after 5
+    minutes."""
     environment = {**os.environ, "OMP_NUM_THREADS": "1"}
-    command = [mpiexec(), "-n", str(ranks), sys.executable, str(CHECK), *arguments]
+    command = [mpiexec(), "-n", str(ranks), sys.executable, str(script), *arguments]
     return subprocess.run(command, capture_output=True, text=True, timeout=300, env=environment)
 
 
@@ -225,20 +228,30 @@ def test_a_body_split_at_node_level_is_the_serial_run_bit_for_bit(
     """A notched body cut across the ranks (granulate.parallel.node_split), stretched until it
     cracks: every node's position, velocity, force and dilatation after `steps` steps, and the
     bonds broken, as serially."""
-    environment = {**os.environ, "OMP_NUM_THREADS": "1"}
-    command = [
-        mpiexec(),
-        "-n",
-        str(ranks),
-        sys.executable,
-        str(SPLIT_CHECK),
-        shape,
-        model,
-        str(steps),
-    ]
-    done = subprocess.run(command, capture_output=True, text=True, timeout=300, env=environment)
+    done = run_ranks(ranks, shape, model, str(steps), script=SPLIT_CHECK)
     assert done.returncode == 0, done.stdout + done.stderr
     zero = "{'positions': 0.0, 'velocities': 0.0, 'forces': 0.0, 'dilatation': 0.0}"
     assert f"ranks {ranks}, {shape} {model}, {steps} steps: {zero}" in done.stdout
     broken = done.stdout.split("bonds broken ")[1].split()
     assert int(broken[0]) == int(broken[2]) > 100
+
+
+STOP_CHECK = Path(__file__).with_name("mpi_stop_check.py")
+
+
+@pytest.mark.parametrize(("ranks", "engine", "steps"), [(2, "grains", 600), (3, "split", 400)])
+def test_stop_criteria_read_the_ranks_measures_and_stop_at_the_serial_step(
+    ranks: int, engine: str, steps: int
+) -> None:
+    """The measures the stop criteria read (parallel/run_measures.py), every 100 steps of the
+    drum (whole grains) and of the pulled plate (cut at node level), equal the serial run's to
+    the bit, particles fully broken by hand included (of a body cut among ranks, for the
+    plate); runs with a threshold one float past a serial check's value stop at that check,
+    with the serial reason, and gather the state on rank 0 only at the end."""
+    done = run_ranks(ranks, engine, str(steps), script=STOP_CHECK)
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert f"measures {engine} on {ranks} ranks: equal True" in done.stdout
+    broken = {"grains": "2 particles fully broken by hand (serially 2)", "split": "1 particles"}
+    assert broken[engine] in done.stdout
+    stops = [line for line in done.stdout.splitlines() if line.startswith("stop ")]
+    assert len(stops) == 3 and all("the state gathered 1 times" in line for line in stops)

@@ -457,17 +457,6 @@ void Simulation::check_stability() const {
   }
 }
 
-real Simulation::kinetic_energy() const {
-  const auto& v = state_.velocities;
-  const auto& volume = model_->volumes();
-  real sum = 0;
-  for (index_t i = 0; i < model_->node_count(); ++i) {
-    sum += 0.5 * model_->density(i) * volume[i] *
-           (v[3 * i] * v[3 * i] + v[3 * i + 1] * v[3 * i + 1] + v[3 * i + 2] * v[3 * i + 2]);
-  }
-  return sum;
-}
-
 void Simulation::strain_energy_density(real* out) const {
   const Model& m = *model_;
   const real inverse_dimension = 1.0 / m.lps_dimension();

@@ -38,11 +38,16 @@ bool BondStates::assign_unpacked(const std::vector<std::size_t>& bond_offsets,
 std::uint64_t BondStates::broken(const std::vector<std::size_t>& bond_offsets, index_t first,
                                  index_t last) const {
   std::uint64_t count = 0;
-  for (index_t i = first; i < last; ++i) {
-    const std::uint8_t* bits = node(i);
-    const index_t bonds = static_cast<index_t>(bond_offsets[i + 1] - bond_offsets[i]);
-    for (index_t b = 0; b < bonds; ++b) count += intact(bits, b) ? 0 : 1;
-  }
+  for (index_t i = first; i < last; ++i)
+    count += bond_offsets[i + 1] - bond_offsets[i] - intact_count(bond_offsets, i);
+  return count;
+}
+
+index_t BondStates::intact_count(const std::vector<std::size_t>& bond_offsets, index_t i) const {
+  const std::uint8_t* bits = node(i);
+  const index_t bonds = static_cast<index_t>(bond_offsets[i + 1] - bond_offsets[i]);
+  index_t count = 0;
+  for (index_t b = 0; b < bonds; ++b) count += intact(bits, b) ? 1 : 0;
   return count;
 }
 

@@ -18,6 +18,24 @@ from numpy.typing import ArrayLike, NDArray
 from granulate import _core, fragments, network, particle_table, reductions
 from granulate.assembly import Body
 from granulate.errors import InputError
+from granulate.exact_sum import ExactSum
+
+
+def kinetic_energies(mass: ArrayLike, velocities: ArrayLike) -> NDArray[np.float64]:
+    """Per node 1/2 m_i |v_i|^2 [J; J/m in 2D] for masses m_i = rho_i V_i [kg; kg/m in 2D] and
+    (n, 3) velocities [m/s]: each row's the same bits wherever it is computed."""
+    v = np.asarray(velocities, dtype=np.float64)
+    return 0.5 * np.asarray(mass, dtype=np.float64) * _squared_norms(v)
+
+
+def squared_distances(positions: ArrayLike) -> NDArray[np.float64]:
+    """Per node |x_i|^2 [m^2], its distance from the origin squared."""
+    return _squared_norms(np.asarray(positions, dtype=np.float64))
+
+
+def _squared_norms(rows: NDArray[np.float64]) -> NDArray[np.float64]:
+    """x^2 + y^2 + z^2 of each row, added in that order."""
+    return rows[:, 0] * rows[:, 0] + rows[:, 1] * rows[:, 1] + rows[:, 2] * rows[:, 2]
 
 
 @dataclass(frozen=True)
@@ -68,6 +86,16 @@ class Analysis:
             return given.damage, given.damage_z
         phi, z = self._core.damage()
         return np.asarray(phi), np.asarray(z)
+
+    def kinetic_energy(self) -> float:
+        """sum_i 1/2 m_i |v_i|^2 [J; J/m in 2D], correctly rounded (ExactSum): the same bits
+        however the nodes are dealt to ranks."""
+        mass = np.asarray(self._model.node_density) * np.asarray(self._model.volumes)
+        return ExactSum.of(kinetic_energies(mass, self._core.velocities)).value
+
+    def farthest_node_distance(self) -> float:
+        """max_i |x_i| [m], the largest distance of a node from the origin."""
+        return float(np.sqrt(np.max(squared_distances(self._core.positions))))
 
     def strain_energy(self) -> float:
         """sum_i W_i V_i [J; J/m in 2D] (core.strain_energy)."""

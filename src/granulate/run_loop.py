@@ -22,7 +22,7 @@ import numpy as np
 from granulate import _core, checkpoints, threads
 from granulate.errors import InputError
 from granulate.input_errors import check_number
-from granulate.stopping import StopCriterion
+from granulate.stopping import RunMeasures, StopCriterion
 
 if TYPE_CHECKING:
     from granulate.checkpoints import CheckpointPlan
@@ -87,6 +87,10 @@ class Stepper(Protocol):
     def broken_bonds(self) -> int:
         """The broken bonds of the whole simulation."""
 
+    def measures(self, sim: Simulation) -> RunMeasures:
+        """What the stop criteria read (stopping.RunMeasures): `sim` itself, or the ranks'
+        measures put together on every rank."""
+
     def save_checkpoint(self, sim: Simulation, path: Path, outputs: Outputs | None) -> Path:
         """The checkpoint at `path`; the path written."""
 
@@ -129,6 +133,9 @@ class CoreStepper:
 
     def broken_bonds(self) -> int:
         return int(self.core.broken_bonds())
+
+    def measures(self, sim: Simulation) -> RunMeasures:
+        return sim
 
     def save_checkpoint(self, sim: Simulation, path: Path, outputs: Outputs | None) -> Path:
         return checkpoints.save(sim, path, outputs)
@@ -316,6 +323,21 @@ def write_outputs(
         stepper.on_root(lambda: out.write_final(sim, frame=final) if out is not None else None)
 
 
+def stop_reason(stepper: Stepper, sim: Simulation, criteria: Sequence[StopCriterion]) -> str | None:
+    """The reason of the first of `criteria` met now, or None, on every rank: each reads the
+    stepper's measures, or rank 0's whole simulation when it needs the whole state (its
+    state collected before)."""
+    measured = stepper.measures(sim)
+    for criterion in criteria:
+        if criterion.needs_whole_state:
+            reason = stepper.on_root(lambda c=criterion: c.check(sim))
+        else:
+            reason = criterion.check(measured)
+        if reason is not None:
+            return reason
+    return None
+
+
 class _Chunks:
     """The chunks of one run: each up to the next stopping place, about half a second long (as
     rank 0 measures it, in a distributed run)."""
@@ -351,15 +373,12 @@ class _Chunks:
         checkpoint = parts.checkpoints
         saves = checkpoint is not None and checkpoint.is_due(step)
         writes, saves = stepper.agree((writes, saves))
-        if writes or checks:
+        whole = checks and any(criterion.needs_whole_state for criterion in plan.stop)
+        if writes or whole:
             stepper.collect(measures=writes)
         if writes:
             write_outputs(stepper, sim, out)
-        reason = None
-        if checks:
-            reason = stepper.on_root(
-                lambda: next((r for c in plan.stop if (r := c.check(sim)) is not None), None)
-            )
+        reason = stop_reason(stepper, sim, plan.stop) if checks else None
         if saves and checkpoint is not None:
             stepper.save_checkpoint(sim, checkpoint.path, out)
             checkpoint.saved()

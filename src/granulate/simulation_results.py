@@ -124,8 +124,12 @@ class SimulationResults:
         return self._build().step
 
     def kinetic_energy(self) -> float:
-        """sum 1/2 rho V |v|^2 [J; J/m in 2D]."""
-        return self._build().kinetic_energy()
+        """sum 1/2 rho V |v|^2 [J; J/m in 2D], correctly rounded (granulate.exact_sum)."""
+        return self.analysis.kinetic_energy()
+
+    def farthest_node_distance(self) -> float:
+        """The largest distance of a node from the origin [m]."""
+        return self.analysis.farthest_node_distance()
 
     def strain_energy(self) -> float:
         """sum W_i V_i over intact bonds [J; J/m in 2D]."""

@@ -10,34 +10,65 @@ of the first one met, or None when it ran to the end.
 - ``ParticlesBroken(count)``: at least ``count`` particles have lost every bond.
 - ``BrokenBonds(count)``: at least ``count`` bonds are broken.
 - ``NodeDistance(distance)``: a node is farther than ``distance`` [m] from the origin.
+
+Each reads the run through the measures of ``RunMeasures``, which a Simulation has and which a
+distributed run makes on every rank with one reduction each (parallel/run_measures.py), the
+same values to the bit: its ranks need not send rank 0 their nodes to check them. A criterion
+of your own that reads more of the simulation sets ``needs_whole_state = True``; a distributed
+run then gathers the whole state on rank 0 and checks it there.
 """
 
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import ClassVar, Protocol
 
 import numpy as np
 
 from granulate.errors import InputError
 from granulate.input_errors import checked_arguments
 
-if TYPE_CHECKING:
-    from granulate.simulation import Simulation
+
+class RunMeasures(Protocol):
+    """What the built-in criteria read of a run: a Simulation, or on every rank of a
+    distributed run its ranks' measures put together (the same bits)."""
+
+    @property
+    def time(self) -> float: ...
+
+    def kinetic_energy(self) -> float: ...
+
+    def wall_displacement(self, name: str) -> float: ...
+
+    def fully_broken_particles(self) -> int: ...
+
+    def broken_bonds(self) -> int: ...
+
+    def farthest_node_distance(self) -> float: ...
 
 
 class StopCriterion(ABC):
     """A condition checked during a run (see the module docstring)."""
 
+    #: False: ``check`` reads only RunMeasures. True: it is given the whole Simulation (in a
+    #: distributed run, rank 0's, after the ranks sent it their state).
+    needs_whole_state: ClassVar[bool] = True
+
     @abstractmethod
-    def check(self, sim: Simulation) -> str | None:
+    def check(self, run: RunMeasures) -> str | None:
         """The reason to stop, or None."""
+
+
+class _MeasuredCriterion(StopCriterion):
+    """A built-in criterion: it reads RunMeasures only."""
+
+    needs_whole_state: ClassVar[bool] = False
 
 
 @checked_arguments
 @dataclass(frozen=True)
-class KineticEnergyBelow(StopCriterion):
+class KineticEnergyBelow(_MeasuredCriterion):
     """Stop when the kinetic energy [J; J/m in 2D] is below ``energy``, from simulated time
     ``after`` [s] on. A run that starts at rest is below any threshold at its first check:
     give ``after`` (say, the time a grain takes to fall onto the pile) so that it stops when
@@ -50,10 +81,10 @@ class KineticEnergyBelow(StopCriterion):
         if not (self.energy > 0 and np.isfinite(self.energy)):
             raise InputError(f"KineticEnergyBelow needs a positive energy, got {self.energy}")
 
-    def check(self, sim: Simulation) -> str | None:
-        if sim.time < self.after:
+    def check(self, run: RunMeasures) -> str | None:
+        if run.time < self.after:
             return None
-        energy = sim.kinetic_energy()
+        energy = run.kinetic_energy()
         return (
             f"kinetic energy {energy:.4g} below {self.energy:.4g}" if energy < self.energy else None
         )
@@ -61,7 +92,7 @@ class KineticEnergyBelow(StopCriterion):
 
 @checked_arguments
 @dataclass(frozen=True)
-class WallDisplacement(StopCriterion):
+class WallDisplacement(_MeasuredCriterion):
     wall: str
     distance: float
 
@@ -69,8 +100,8 @@ class WallDisplacement(StopCriterion):
         if not (self.distance > 0 and np.isfinite(self.distance)):
             raise InputError(f"WallDisplacement needs a positive distance, got {self.distance}")
 
-    def check(self, sim: Simulation) -> str | None:
-        moved = sim.wall_displacement(self.wall)
+    def check(self, run: RunMeasures) -> str | None:
+        moved = run.wall_displacement(self.wall)
         if moved >= self.distance:
             return f"wall {self.wall!r} moved {moved:.4g} m (limit {self.distance:.4g} m)"
         return None
@@ -78,15 +109,15 @@ class WallDisplacement(StopCriterion):
 
 @checked_arguments
 @dataclass(frozen=True)
-class ParticlesBroken(StopCriterion):
+class ParticlesBroken(_MeasuredCriterion):
     count: int
 
     def __post_init__(self) -> None:
         if not (isinstance(self.count, int) and self.count > 0):
             raise InputError(f"ParticlesBroken needs a positive count, got {self.count!r}")
 
-    def check(self, sim: Simulation) -> str | None:
-        broken = sim.fully_broken_particles()
+    def check(self, run: RunMeasures) -> str | None:
+        broken = run.fully_broken_particles()
         if broken >= self.count:
             return f"{broken} particles have lost every bond (limit {self.count})"
         return None
@@ -94,21 +125,21 @@ class ParticlesBroken(StopCriterion):
 
 @checked_arguments
 @dataclass(frozen=True)
-class BrokenBonds(StopCriterion):
+class BrokenBonds(_MeasuredCriterion):
     count: int
 
     def __post_init__(self) -> None:
         if not (isinstance(self.count, int) and self.count > 0):
             raise InputError(f"BrokenBonds needs a positive count, got {self.count!r}")
 
-    def check(self, sim: Simulation) -> str | None:
-        broken = sim.broken_bonds()
+    def check(self, run: RunMeasures) -> str | None:
+        broken = run.broken_bonds()
         return f"{broken} bonds broken (limit {self.count})" if broken >= self.count else None
 
 
 @checked_arguments
 @dataclass(frozen=True)
-class NodeDistance(StopCriterion):
+class NodeDistance(_MeasuredCriterion):
     """A node is farther than ``distance`` [m] from the origin (a particle escaped the domain;
     PeriDEM's ``Output_Criteria: max_node_dist``)."""
 
@@ -118,8 +149,8 @@ class NodeDistance(StopCriterion):
         if not (self.distance > 0 and np.isfinite(self.distance)):
             raise InputError(f"NodeDistance needs a positive distance, got {self.distance}")
 
-    def check(self, sim: Simulation) -> str | None:
-        farthest = float(np.sqrt(np.max(np.einsum("ij,ij->i", sim.positions, sim.positions))))
+    def check(self, run: RunMeasures) -> str | None:
+        farthest = run.farthest_node_distance()
         if farthest > self.distance:
             return f"a node is {farthest:.4g} m from the origin (limit {self.distance:.4g} m)"
         return None

@@ -105,8 +105,7 @@ class Simulation {
   void compute_forces();
 
   // Diagnostics (computed on demand; sums in a fixed order, so identical for any thread count).
-  real kinetic_energy() const;  ///< sum 1/2 rho V |v|^2 [J; J/m in 2D]
-  real strain_energy() const;   ///< sum W_i V_i [J; J/m in 2D] (volume_weighted_total)
+  real strain_energy() const;  ///< sum W_i V_i [J; J/m in 2D] (volume_weighted_total)
   /// sum_i W_i V_i in node order [J; J/m in 2D]: strain_energy's sum of the energy densities W
   /// [J/m^3] (strain_energy_density), which a distributed run's rank 0 takes of the densities
   /// the ranks measured of their grains, to the serial run's bits.

@@ -29,6 +29,8 @@ class BondStates {
   bool assign_unpacked(const std::vector<std::size_t>& bond_offsets, const std::vector<std::uint8_t>& states);
   /// Broken copies among the bonds of nodes first .. last-1.
   std::uint64_t broken(const std::vector<std::size_t>& bond_offsets, index_t first, index_t last) const;
+  /// Intact copies among the bonds of node i.
+  index_t intact_count(const std::vector<std::size_t>& bond_offsets, index_t i) const;
   std::size_t bit_bytes() const { return bits_.capacity(); }  ///< 1/8 per bond
   std::size_t offset_bytes() const { return byte_offsets_.capacity() * sizeof(std::size_t); }  ///< 8 per node
 

@@ -359,7 +359,6 @@ void bind_results(nb::class_<Simulation>& cls) {
           "Before finish_step: the ghost nodes' surface normals from their owners' surface_normals "
           "(Simulation::give_ghost_surface_normals); (k,) nodes here and (k, 3) normals.")
       .def("compute_forces", &Simulation::compute_forces, nb::call_guard<nb::gil_scoped_release>())
-      .def("kinetic_energy", &Simulation::kinetic_energy)
       .def("strain_energy", &Simulation::strain_energy)
       .def("contact_energy", &Simulation::contact_energy)
       .def(
@@ -433,6 +432,20 @@ void bind_state(nb::class_<Simulation>& cls) {
             return self.state().bonds.broken(self.model().bond_offsets(), first, last);
           },
           "first"_a, "last"_a, "The broken bond copies (two per bond) of nodes first .. last-1.")
+      .def(
+          "intact_bond_copies",
+          [](const Simulation& self, nb::ndarray<const std::int64_t, nb::ndim<1>, nb::c_contig> nodes) {
+            const auto& offsets = self.model().bond_offsets();
+            const auto count = static_cast<std::int64_t>(self.model().node_count());
+            std::vector<index_t> counts(nodes.shape(0));
+            for (std::size_t k = 0; k < counts.size(); ++k) {
+              const std::int64_t i = nodes.data()[k];
+              if (i < 0 || i >= count) throw InputError("intact_bond_copies: nodes out of range");
+              counts[k] = self.state().bonds.intact_count(offsets, static_cast<index_t>(i));
+            }
+            return copy_out(counts);
+          },
+          "nodes"_a, "Each of these nodes' intact bond copies.")
       .def_prop_ro("bond_intact",
                    [](Simulation& self) {  // a read-only copy, 1 byte per bond (stored as bits)
                      nb::object array =

@@ -54,6 +54,7 @@ from granulate.parallel.partition import (
     near_pairs,
     near_pairs_with_large,
 )
+from granulate.parallel.run_measures import RankMeasures
 from granulate.parallel.transplant import (
     GrainState,
     body_first_nodes,
@@ -1070,6 +1071,10 @@ class DistributedRun:
         return SimpleNamespace(
             deepest_overlap=-float(least[0]), half_overlap_step=half, full_overlap_step=full
         )
+
+    def measures(self) -> RankMeasures:
+        """What the stop criteria read (stopping.RunMeasures), from each rank's own grains."""
+        return RankMeasures(self.comm, self.local, self._owned_nodes, self.held, self.broken_bonds)
 
     @property
     def bond_count(self) -> int:

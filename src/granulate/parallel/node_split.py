@@ -40,6 +40,7 @@ from granulate.evaluation import Evaluation
 from granulate.parallel.agreement import attempt, on_root, stop_if_any_failed, together
 from granulate.parallel.overlap import while_travelling
 from granulate.parallel.partition import bisect
+from granulate.parallel.run_measures import RankMeasures
 from granulate.writers.vtu_frame import FIELD_TYPES, point_fields, write_piece_rows
 
 if TYPE_CHECKING:
@@ -177,6 +178,11 @@ class NodeSplitRun:
         """The bonds broken on every rank, each counted once (by the owner of its lower end),
         on every rank."""
         return int(self.comm.allreduce(int(self.local.core.broken_bonds()), op=self.mpi.SUM))
+
+    def measures(self) -> RankMeasures:
+        """What the stop criteria read (stopping.RunMeasures), from each rank's own nodes."""
+        every = np.arange(len(self._sim.bodies))
+        return RankMeasures(self.comm, self.local, self.own, every, self.broken_bonds)
 
     def deepest_contact(self) -> SimpleNamespace:
         """No contact: nothing overlaps (the contact statistics' names, for the run's check)."""

@@ -1,7 +1,8 @@
 """Simulation.run's loop on the ranks of a distributed run (granulate.run_loop.Stepper): every
 rank takes the steps of the chunks rank 0 decides, rank 0's simulation takes the whole state
-(DistributedRun.collect) before rank 0 writes outputs or checks stop criteria, and rank 0's
-decisions and errors reach every rank."""
+(DistributedRun.collect) before rank 0 writes outputs, the stop criteria read the ranks'
+measures put together (run_measures.py), and rank 0's decisions and errors reach every
+rank."""
 
 from __future__ import annotations
 
@@ -15,6 +16,7 @@ if TYPE_CHECKING:
     from granulate.parallel.engine import DistributedRun
     from granulate.parallel.node_split import NodeSplitRun
     from granulate.simulation import Simulation
+    from granulate.stopping import RunMeasures
     from granulate.writers.outputs import Outputs
 
 T = TypeVar("T")
@@ -55,6 +57,9 @@ class DistributedStepper:
 
     def broken_bonds(self) -> int:
         return self.run.broken_bonds()
+
+    def measures(self, sim: Simulation) -> RunMeasures:
+        return self.run.measures()
 
     def save_checkpoint(self, sim: Simulation, path: Path, outputs: Outputs | None) -> Path:
         return self.run.save_checkpoint(path, outputs)

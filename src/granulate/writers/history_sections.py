@@ -33,7 +33,7 @@ class Energies:
         sim = data.simulation
         core = sim.core
         evaluation = data.evaluation
-        kinetic, strain = core.kinetic_energy(), sim.strain_energy()
+        kinetic, strain = sim.kinetic_energy(), sim.strain_energy()
         gravity, contact = sim.gravity_energy(), evaluation.contact_energy
         return {
             "step": core.step,

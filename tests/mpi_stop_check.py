@@ -1,0 +1,162 @@
+"""Run under `mpiexec -n K python tests/mpi_stop_check.py ENGINE STEPS` (tests/test_mpi.py
+does): the stop criteria's measures of a distributed run (parallel/run_measures.py) against
+the serial run's, bit for bit, and runs that stop on them at the serial run's step.
+
+ENGINE `grains` is the tumbling drum with a grid-meshed brittle grain (tests/test_checkpoint.py,
+whole grains per rank); `split` the notched plate pulled apart (tests/test_node_split.py, its
+one body cut at node level). Rank 0 prints one line per part and the exit status is non-zero
+on any difference:
+- measures: every 100 steps, the ranks' kinetic energy, farthest node, broken bonds, particles
+  that lost every bond and wall displacement, then the same with every bond of the first and
+  third bodies broken by hand (the counts of a body cut among ranks included), against the
+  serial simulation's;
+- stops: Simulation(comm=...).run with a stop criterion whose threshold lies one float past the
+  serial run's value at a check (so a value one bit off stops elsewhere), for each criterion
+  in turn: the reason and step, and how many times the ranks sent rank 0 their state (once,
+  at the end: the checks gather nothing).
+"""
+
+from __future__ import annotations
+
+import sys
+import warnings
+from pathlib import Path
+
+import numpy as np
+from mpi4py import MPI
+
+sys.path.insert(0, str(Path(__file__).parent))
+import granulate as gr
+from granulate.parallel import DistributedRun
+from granulate.parallel.node_split import NodeSplitRun
+from test_checkpoint import tumbling_drum
+from test_node_split import pulled
+
+CHECK_EVERY = 100
+MEASURES = (
+    "kinetic_energy",
+    "farthest_node_distance",
+    "broken_bonds",
+    "fully_broken_particles",
+)
+
+
+def set_up(engine: str, comm: MPI.Comm | None = None) -> gr.Simulation:
+    """The engine's case, with no outputs, on the ranks of `comm` when given."""
+    if engine == "grains":
+        return tumbling_drum(Path("unused"), grid=True, comm=comm, outputs=False)
+    return pulled("plate", "lps", comm)
+
+
+def values(measured: gr.stopping.RunMeasures, wall: str | None) -> tuple[float, ...]:
+    """Every measure the criteria read, in MEASURES order, then the wall's displacement."""
+    row = [float(getattr(measured, name)()) for name in MEASURES]
+    return (*row, measured.wall_displacement(wall) if wall else 0.0)
+
+
+def check_measures(engine: str, steps: int, comm: MPI.Comm) -> tuple[bool, list[tuple[float, ...]]]:
+    """The ranks' measures every CHECK_EVERY steps and after breaking bodies 0 and 2 by hand,
+    against the serial run's; rank 0 prints them. Whether they agree, and the serial run's
+    at each check (rank 0's; none elsewhere)."""
+    engines = {"grains": DistributedRun, "split": NodeSplitRun}
+    run = engines[engine](set_up(engine), comm)
+    held = run.held if isinstance(run, DistributedRun) else np.arange(len(run.local.bodies))
+    serial = set_up(engine) if comm.Get_rank() == 0 else None
+    wall = "drum" if engine == "grains" else None
+    rows: list[tuple[tuple[float, ...], tuple[float, ...]]] = []
+    for _ in range(steps // CHECK_EVERY):
+        run.run(CHECK_EVERY)
+        mine = values(run.measures(), wall)
+        if serial is not None:
+            serial.core.run(CHECK_EVERY)
+            rows.append((mine, values(serial, wall)))
+    chosen = [0, 2] if engine == "grains" else [0]
+    _break(run.local, [np.flatnonzero(held == b) for b in chosen])
+    mine = values(run.measures(), wall)
+    if serial is None:
+        return True, []
+    _break(serial, [np.array([b]) for b in chosen])
+    rows.append((mine, values(serial, wall)))
+    same = all(a == b for a, b in rows)
+    print(
+        f"measures {engine} on {comm.Get_size()} ranks: equal {same}; at the end "
+        f"{dict(zip(MEASURES, rows[-2][0], strict=False))}; "
+        f"{rows[-1][0][3]:.0f} particles fully broken by hand (serially {rows[-1][1][3]:.0f})"
+    )
+    return same, [row[1] for row in rows[:-1]]
+
+
+def _break(sim: gr.Simulation, bodies: list[np.ndarray]) -> None:
+    """Every bond copy of the nodes of the local `bodies` of `sim` broken."""
+    core, offsets = sim.core, np.asarray(sim.model.bond_offsets)
+    intact = np.asarray(core.bond_intact).copy()
+    for body in np.concatenate(bodies).astype(int):
+        nodes = sim.bodies[body].node_slice
+        intact[offsets[nodes.start] : offsets[nodes.stop]] = 0
+    core.assign_bonds(intact)
+
+
+def check_stops(engine: str, steps: int, seen: list[tuple[float, ...]], comm: MPI.Comm) -> bool:
+    """For each criterion, its threshold one float past the serial run's value at a check:
+    the run on the ranks stops where the serial run does, with its reason, gathering the
+    state on rank 0 once (at the end)."""
+    thresholds = comm.bcast(_thresholds(seen) if comm.Get_rank() == 0 else None, root=0)
+    owner = DistributedRun if engine == "grains" else NodeSplitRun
+    collect, gathered = owner.collect, [0]
+
+    def counted(run: DistributedRun | NodeSplitRun, measures: bool = True) -> None:
+        gathered[0] += 1
+        collect(run, measures)  # type: ignore[arg-type]
+
+    same = True
+    for criterion in thresholds:
+        expected = None
+        if comm.Get_rank() == 0:
+            serial = set_up(engine)
+            expected = (serial.run(steps, stop=[criterion], check_every=CHECK_EVERY), serial.step)
+        gathered[0] = 0
+        owner.collect = counted  # type: ignore[method-assign]
+        try:
+            sim = set_up(engine, comm)
+            got = (sim.run(steps, stop=[criterion], check_every=CHECK_EVERY), sim.step)
+        finally:
+            owner.collect = collect  # type: ignore[method-assign]
+        if expected is not None:
+            print(
+                f"stop {engine} on {comm.Get_size()} ranks, {criterion}: {got} "
+                f"(serially {expected}), the state gathered {gathered[0]} times"
+            )
+            same = same and got == expected and got[0] is not None and gathered[0] == 1
+    return same
+
+
+def _thresholds(seen: list[tuple[float, ...]]) -> list[gr.stopping.StopCriterion]:
+    """Criteria met first at a check of the serial run whose measures at each check were
+    `seen`: each threshold one float past the value there."""
+    energy = _new_extreme([-row[0] for row in seen])
+    farthest = _new_extreme([row[1] for row in seen])
+    broken = _new_extreme([row[2] for row in seen])
+    return [
+        gr.stopping.KineticEnergyBelow(float(np.nextafter(-energy, np.inf))),
+        gr.stopping.NodeDistance(float(np.nextafter(farthest, -np.inf))),
+        gr.stopping.BrokenBonds(int(broken)),
+    ]
+
+
+def _new_extreme(row: list[float]) -> float:
+    """Of the values above every one before them, the one nearest the middle of `row`."""
+    news = [k for k, value in enumerate(row) if all(value > before for before in row[:k])]
+    return row[min(news, key=lambda k: abs(k - len(row) // 2))]
+
+
+def main() -> int:
+    warnings.filterwarnings("ignore", message="contact.*bodies pressed")
+    engine, steps = sys.argv[1], int(sys.argv[2])
+    comm = MPI.COMM_WORLD
+    measured, seen = check_measures(engine, steps, comm)
+    stopped = check_stops(engine, steps, seen, comm)
+    return 0 if comm.bcast(measured and stopped, root=0) else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,65 @@
+"""ExactSum: the correctly rounded sum of any floats, the same bits however they are split,
+ordered or merged (granulate.exact_sum)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from granulate.exact_sum import ExactSum
+
+
+def _wide(rng: np.random.Generator, n: int) -> np.ndarray:
+    """Floats of both signs over 600 binary orders of magnitude, subnormals and cancelling
+    pairs among them: sums that naive addition gets wrong in many bits."""
+    x = rng.standard_normal(n) * np.exp2(rng.integers(-300, 300, n))
+    x[: n // 10] = rng.standard_normal(n // 10) * 5e-324 * 2**20  # subnormal
+    x[n // 10 : n // 5] = -x[n // 5 : n // 5 + n // 10]  # cancel others exactly
+    return x
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_is_the_correctly_rounded_sum(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    x = _wide(rng, 5_000)
+    assert ExactSum.of(x).value == math.fsum(x)
+    energies = rng.random(10_000) * 1e-6  # like node kinetic energies
+    assert ExactSum.of(energies).value == math.fsum(energies)
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_parts_in_any_order_give_the_same_bits(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    for x in (_wide(rng, 4_000), rng.random(4_000)):
+        whole = ExactSum.of(x).value
+        shuffled = rng.permutation(x)
+        pieces = np.split(shuffled, np.sort(rng.integers(0, len(x), 6)))
+        parts = [ExactSum.of(piece) for piece in pieces]
+        assert sum(reversed(parts), ExactSum()).value == whole
+        assert sum(parts, ExactSum()).value == whole
+        assert sum(x[::-1].tolist()) != whole or sum(x.tolist()) != whole  # order matters
+
+
+def test_chunks_of_the_bincount_are_joined_exactly(monkeypatch: pytest.MonkeyPatch) -> None:
+    import granulate.exact_sum as exact
+
+    rng = np.random.default_rng(7)
+    x = _wide(rng, 1_000)
+    monkeypatch.setattr(exact, "_CHUNK", 7)
+    assert ExactSum.of(x).value == math.fsum(x)
+
+
+def test_extremes() -> None:
+    largest = np.finfo(np.float64).max
+    assert ExactSum.of([]).value == 0.0
+    assert ExactSum.of([5e-324, 5e-324]).value == 1e-323
+    assert ExactSum.of([largest, -largest, 1.0]).value == 1.0
+    assert ExactSum.of([1e308, 1e308]).value == math.inf  # as float addition overflows
+    assert ExactSum.of([-1e308, -1e308]).value == -math.inf
+    assert ExactSum.of([1.0, math.inf]).value == math.inf
+    assert math.isnan(ExactSum.of([math.inf, 1.0, -math.inf]).value)
+    assert math.isnan((ExactSum.of([math.inf]) + ExactSum.of([-math.inf])).value)
+    assert math.isnan((ExactSum.of([1.0]) + ExactSum.of([math.nan])).value)
+    assert ExactSum.of(np.ones((3, 4))).value == 12.0
