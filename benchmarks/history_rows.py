@@ -1,14 +1,18 @@
-"""What a history row costs rank 0 of a distributed run: the gathering of the state into its
-simulation (DistributedRun.collect, with the ranks' measures of their grains) and the row's
-sections (energies, breakage, granular measures) computed from it, at one fixed state.
+"""What a history row costs a distributed run: (a) made of what the ranks measure of their own
+grains (DistributedRun.step_data: parallel/step_parts.py, no node array on rank 0), and (b) the
+whole state gathered into rank 0's simulation (DistributedRun.collect, with the ranks' measures
+of their grains) and the row computed from it, as every output step did before session 50 (and
+still does for a frame of every node), each followed by the row's sections (energies,
+breakage, granular measures), at one fixed state.
 
     mpiexec -n 2 python benchmarks/history_rows.py CASE [--peridem-compat] [--steps 10]
         [--repeats 40]
 
 CASE is a case file or a PeriDEM deck (the paper's n500_circ_hex deck, say). The run takes
-`--steps` steps, then gathers and computes the row `--repeats` times, the ranks starting each
-together (a barrier); rank 0 prints the medians in ms. One thread per rank unless
-OMP_NUM_THREADS says otherwise. Run two installs alternating for an A/B.
+`--steps` steps, then makes the row both ways, alternating, `--repeats` times, the ranks
+starting each together (a barrier); rank 0 prints the medians in ms, its resident memory
+(VmRSS, MB) before the first gathering and after, and whether both rows are equal. One thread
+per rank unless OMP_NUM_THREADS says otherwise.
 """
 
 from __future__ import annotations
@@ -44,27 +48,48 @@ def main() -> None:
     sim = load_case(args.case, peridem_compat=args.peridem_compat).build(outputs=False)
     run = DistributedRun(sim, comm)
     run.run(args.steps)
-    run.collect()  # rank 0 builds its whole simulation once, untimed
     outputs = SimpleNamespace(tracked=())
-    gathering, rows = [], []
+    measured, gathered = [], []
+    rows: list[list[dict[str, float | int]]] = [[], []]
+    before = resident_mb()
     for _ in range(args.repeats):
         comm.Barrier()
         start = time.perf_counter()
+        data = run.step_data(())
+        if data is not None:
+            rows[0].append(row(data, outputs))
+        measured.append(time.perf_counter() - start)
+        comm.Barrier()
+        start = time.perf_counter()
         run.collect()
-        gathered = time.perf_counter()
         if comm.Get_rank() == 0:
-            data = StepData.of(sim)
-            for section in SECTIONS:
-                section.columns(data, outputs)
-        gathering.append(gathered - start)
-        rows.append(time.perf_counter() - gathered)
+            rows[1].append(row(StepData.of(sim), outputs))
+        gathered.append(time.perf_counter() - start)
     if comm.Get_rank() == 0:
-        together = np.add(gathering, rows)
         print(
-            f"{comm.Get_size()} ranks, {sim.node_count:,} nodes: rank 0 per row "
-            f"{1e3 * np.median(together):.1f} ms (gathering {1e3 * np.median(gathering):.1f} "
-            f"ms, the row {1e3 * np.median(rows):.1f} ms), median of {args.repeats}"
+            f"{comm.Get_size()} ranks, {sim.node_count:,} nodes, per row (median of "
+            f"{args.repeats}): from the ranks' measures {1e3 * np.median(measured):.1f} ms; "
+            f"through the gathered state {1e3 * np.median(gathered):.1f} ms; rank 0 "
+            f"{before:.0f} MB before the first gathering, {resident_mb():.0f} MB after; rows "
+            f"equal {rows[0] == rows[1]}"
         )
+
+
+def row(data: StepData, outputs: SimpleNamespace) -> dict[str, float | int]:
+    """The row's sections' columns (SECTIONS)."""
+    columns: dict[str, float | int] = {}
+    for section in SECTIONS:
+        columns.update(section.columns(data, outputs))  # type: ignore[arg-type]
+    return columns
+
+
+def resident_mb() -> float:
+    """VmRSS of this process [MB], from /proc/self/status."""
+    with open("/proc/self/status") as status:
+        for line in status:
+            if line.startswith("VmRSS:"):
+                return float(line.split()[1]) / 1024
+    return float("nan")
 
 
 if __name__ == "__main__":

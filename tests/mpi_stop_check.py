@@ -13,13 +13,21 @@ on any difference:
 - stops: Simulation(comm=...).run with a stop criterion whose threshold lies one float past the
   serial run's value at a check (so a value one bit off stops elsewhere), for each criterion
   in turn: the reason and step, and how many times the ranks sent rank 0 their state (once,
-  at the end: the checks gather nothing).
+  at the end: the checks gather nothing);
+- outputs (`grains` only): the drum with frames in pieces and a tracked grain, every 100 steps:
+  every file but the frames' pieces and run.json as the serial run's (history.csv but its
+  list searches), the state gathered once (at the end: each output step is made of the
+  ranks' measures, parallel/step_parts.py).
 """
 
 from __future__ import annotations
 
+import shutil
 import sys
+import tempfile
 import warnings
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
@@ -29,6 +37,7 @@ sys.path.insert(0, str(Path(__file__).parent))
 import granulate as gr
 from granulate.parallel import DistributedRun
 from granulate.parallel.node_split import NodeSplitRun
+from run_folders import SEARCHES, history, outputs
 from test_checkpoint import tumbling_drum
 from test_node_split import pulled
 
@@ -102,25 +111,15 @@ def check_stops(engine: str, steps: int, seen: list[tuple[float, ...]], comm: MP
     state on rank 0 once (at the end)."""
     thresholds = comm.bcast(_thresholds(seen) if comm.Get_rank() == 0 else None, root=0)
     owner = DistributedRun if engine == "grains" else NodeSplitRun
-    collect, gathered = owner.collect, [0]
-
-    def counted(run: DistributedRun | NodeSplitRun, measures: bool = True) -> None:
-        gathered[0] += 1
-        collect(run, measures)  # type: ignore[arg-type]
-
     same = True
     for criterion in thresholds:
         expected = None
         if comm.Get_rank() == 0:
             serial = set_up(engine)
             expected = (serial.run(steps, stop=[criterion], check_every=CHECK_EVERY), serial.step)
-        gathered[0] = 0
-        owner.collect = counted  # type: ignore[method-assign]
-        try:
+        with counting(owner) as gathered:
             sim = set_up(engine, comm)
             got = (sim.run(steps, stop=[criterion], check_every=CHECK_EVERY), sim.step)
-        finally:
-            owner.collect = collect  # type: ignore[method-assign]
         if expected is not None:
             print(
                 f"stop {engine} on {comm.Get_size()} ranks, {criterion}: {got} "
@@ -128,6 +127,58 @@ def check_stops(engine: str, steps: int, seen: list[tuple[float, ...]], comm: MP
             )
             same = same and got == expected and got[0] is not None and gathered[0] == 1
     return same
+
+
+@contextmanager
+def counting(owner: type[DistributedRun] | type[NodeSplitRun]) -> Iterator[list[int]]:
+    """[how many times] the ranks sent rank 0 their whole state (owner.collect) within."""
+    collect, gathered = owner.collect, [0]
+
+    def counted(run: DistributedRun | NodeSplitRun, measures: bool = True) -> None:
+        gathered[0] += 1
+        collect(run, measures)  # type: ignore[arg-type]
+
+    owner.collect = counted  # type: ignore[method-assign]
+    try:
+        yield gathered
+    finally:
+        owner.collect = collect  # type: ignore[method-assign]
+
+
+def check_outputs(steps: int, comm: MPI.Comm) -> bool:
+    """The drum's outputs in pieces on the ranks against the serial run's (the module
+    docstring); rank 0 prints what differs."""
+    root = Path(comm.bcast(tempfile.mkdtemp() if comm.Get_rank() == 0 else None, root=0))
+    with counting(DistributedRun) as gathered:
+        for name, ranks in (("serial", None), ("ranks", comm)):
+            if ranks is None and comm.Get_rank() != 0:
+                continue
+            sim = set_up("grains", ranks)
+            sim.output(root / name, every=CHECK_EVERY, pieces=True, track=[sim.bodies[3]])
+            sim.run(steps)
+            gathered[0] = 0 if ranks is None else gathered[0]
+    if comm.Get_rank() != 0:
+        return True
+    found = {name: outputs(root / name) for name in ("serial", "ranks")}
+    kept = {
+        name: {k: v for k, v in files.items() if "/frame_" not in k}
+        for name, files in found.items()
+    }
+    differ = sorted(
+        k
+        for k in kept["serial"].keys() | kept["ranks"].keys()
+        if kept["serial"].get(k) != kept["ranks"].get(k)
+    )
+    rows = [history(root / name) for name in ("serial", "ranks")]
+    for row in (*rows[0], *rows[1]):
+        del row[SEARCHES]
+    shutil.rmtree(root)
+    print(
+        f"outputs grains on {comm.Get_size()} ranks: {len(kept['serial'])} files but frames, "
+        f"differing {differ}; history equal but list searches {rows[0] == rows[1]} "
+        f"({len(rows[0])} rows, {len(rows[0][0])} columns); the state gathered {gathered[0]} times"
+    )
+    return not differ and rows[0] == rows[1] and gathered[0] == 1
 
 
 def _thresholds(seen: list[tuple[float, ...]]) -> list[gr.stopping.StopCriterion]:
@@ -155,7 +206,8 @@ def main() -> int:
     comm = MPI.COMM_WORLD
     measured, seen = check_measures(engine, steps, comm)
     stopped = check_stops(engine, steps, seen, comm)
-    return 0 if comm.bcast(measured and stopped, root=0) else 1
+    written = check_outputs(steps, comm) if engine == "grains" else True
+    return 0 if comm.bcast(measured and stopped and written, root=0) else 1
 
 
 if __name__ == "__main__":

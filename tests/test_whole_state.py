@@ -1,9 +1,10 @@
 """What rank 0 of a distributed run relies on from the core when it takes the ranks' grains
 (granulate.parallel.whole_state), checked serially: per-node contact terms that sum to the
-core's totals in node order, and bonds assigned whole."""
+core's totals, and bonds assigned whole."""
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import numpy as np
@@ -19,9 +20,10 @@ def test_the_per_node_contact_terms_sum_to_the_cores_totals(
     options: dict[str, object], tmp_path: Path
 ) -> None:
     """What a distributed run sums on rank 0 (core.node_contact_terms): per node the contact
-    energy, whose sum in node order is the core's contact_energy to the bit, and the node pairs
-    (counted at the smaller node, a probe at its node) and wall contacts, which sum to the
-    statistics; in the tumbling drum, with pairs and walls touching at these steps."""
+    energy, whose sum in node order is the core's contact_energy to the bit and whose correctly
+    rounded sum the outputs give (Evaluation), and the node pairs (counted at the smaller node,
+    a probe at its node) and wall contacts, which sum to the statistics; in the tumbling drum,
+    with pairs and walls touching at these steps."""
     sim = tumbling_drum(tmp_path, **options)  # type: ignore[arg-type]
     touched = 0
     for _ in range(6):
@@ -29,6 +31,7 @@ def test_the_per_node_contact_terms_sum_to_the_cores_totals(
         energy, pairs, walls = (np.asarray(a) for a in sim.core.node_contact_terms())
         statistics = sim.core.contact_statistics
         assert np.add.accumulate(energy)[-1] == sim.core.contact_energy()
+        assert sim.evaluation().contact_energy == math.fsum(energy)
         assert (pairs.sum(), walls.sum()) == (statistics.node_contacts, statistics.wall_contacts)
         touched += int(pairs.sum() > 0) + int(walls.sum() > 0)
     assert touched >= 6
@@ -47,17 +50,17 @@ def test_bonds_assigned_whole_set_the_broken_count(tmp_path: Path) -> None:
         fresh.core.assign_bonds(np.ones(3, dtype=np.uint8))
 
 
-def test_the_strain_energy_sums_its_densities_in_node_order(tmp_path: Path) -> None:
-    """What rank 0 sums of the densities the ranks measure (_core.volume_weighted_total):
-    the core's strain energy to the bit, in the tumbling drum as it breaks."""
+def test_the_strain_energy_is_the_correctly_rounded_sum_of_its_densities(tmp_path: Path) -> None:
+    """What rank 0 sums of the densities the ranks measure: sum_i W_i V_i rounded once (as
+    math.fsum rounds it), within 1e-12 of the core's sum in node order, in the tumbling drum as
+    it breaks."""
     sim = tumbling_drum(tmp_path)
     for _ in range(3):
         sim.core.run(300)
         density = np.asarray(sim.core.strain_energy_density())
-        total = gr._core.volume_weighted_total(density, np.asarray(sim.model.volumes))
-        assert total == sim.core.strain_energy() > 0
-    with pytest.raises(gr.InputError, match="one density per node volume"):
-        gr._core.volume_weighted_total(density[1:], np.asarray(sim.model.volumes))
+        terms = density * np.asarray(sim.model.volumes)
+        assert sim.strain_energy() == math.fsum(terms) > 0
+        assert sim.strain_energy() == pytest.approx(sim.core.strain_energy(), rel=1e-12)
 
 
 def test_given_measures_stand_for_the_cores_until_the_state_changes(tmp_path: Path) -> None:
@@ -75,11 +78,12 @@ def test_given_measures_stand_for_the_cores_until_the_state_changes(tmp_path: Pa
     )
     sim.analysis.give(given)
     assert np.all(sim.damage == 0.25) and np.all(sim.damage_z == 0.5)
-    assert sim.strain_energy() == 2.0 * np.add.accumulate(np.asarray(sim.model.volumes))[-1]
+    assert sim.strain_energy() == math.fsum(2.0 * np.asarray(sim.model.volumes))
     assert len(sim.fragment_table()["fragment"]) == 1  # every node labelled 0
     assert np.all(sim.particle_table()["vx"] == 7.0)
     sim.analysis.give(None)
-    assert sim.strain_energy() == sim.core.strain_energy()
+    core_density = np.asarray(sim.core.strain_energy_density())
+    assert sim.strain_energy() == math.fsum(core_density * np.asarray(sim.model.volumes)) > 0
     sim.analysis.give(given)
     sim.core.run(1)
     assert np.array_equal(sim.damage, sim.core.damage()[0])

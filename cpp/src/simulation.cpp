@@ -490,12 +490,7 @@ void Simulation::strain_energy_density(real* out) const {
 real Simulation::strain_energy() const {
   std::vector<real> density(model_->node_count());
   strain_energy_density(density.data());
-  return volume_weighted_total(density, model_->volumes());
-}
-
-real Simulation::volume_weighted_total(std::span<const real> density, std::span<const real> volumes) {
-  if (density.size() != volumes.size())
-    throw InputError("volume_weighted_total: one density per node volume");
+  const auto& volumes = model_->volumes();
   real total = 0;
   for (std::size_t i = 0; i < density.size(); ++i) total += density[i] * volumes[i];
   return total;

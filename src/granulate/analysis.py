@@ -15,7 +15,7 @@ from typing import Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from granulate import _core, fragments, network, particle_table, reductions
+from granulate import _core, fragments, network, particle_table
 from granulate.assembly import Body
 from granulate.errors import InputError
 from granulate.exact_sum import ExactSum
@@ -26,6 +26,44 @@ def kinetic_energies(mass: ArrayLike, velocities: ArrayLike) -> NDArray[np.float
     (n, 3) velocities [m/s]: each row's the same bits wherever it is computed."""
     v = np.asarray(velocities, dtype=np.float64)
     return 0.5 * np.asarray(mass, dtype=np.float64) * _squared_norms(v)
+
+
+def gravity_energies(
+    mass: ArrayLike, positions: ArrayLike, gravity: ArrayLike
+) -> NDArray[np.float64]:
+    """Per node -m_i g . x_i [J; J/m in 2D] for gravity g [m/s^2] (zero at the origin)."""
+    x, g = np.asarray(positions, dtype=np.float64), np.asarray(gravity, dtype=np.float64)
+    return -np.asarray(mass, dtype=np.float64) * (x[:, 0] * g[0] + x[:, 1] * g[1] + x[:, 2] * g[2])
+
+
+def mean_damage(damage: ArrayLike, volumes: ArrayLike) -> float:
+    """sum_i V_i phi_i / sum_i V_i, the volume-weighted mean damage, of correctly rounded sums."""
+    v = np.asarray(volumes, dtype=np.float64)
+    return ExactSum.of(v * np.asarray(damage, dtype=np.float64)).value / ExactSum.of(v).value
+
+
+def complete_particle_table(
+    motion: particle_table.Table,
+    volumes: NDArray[np.float64],
+    damage: NDArray[np.float64],
+    contacts: network.Table,
+    time: float,
+    dimension: int,
+) -> tuple[particle_table.Table, NDArray[np.float64]]:
+    """The particle table of particles with these motion columns (particle_table.motion),
+    volumes [m^3; m^2 in 2D] and volume-weighted damage, at `time` [s], and their Love-Weber
+    stresses (N, D, D) [Pa] from `contacts`: the motion columns then particle, time, damage,
+    coordination and the stresses (granulate.particle_table)."""
+    count = len(volumes)
+    table = dict(motion)
+    table["particle"] = np.arange(count)
+    table["time"] = np.full(count, time)
+    table["damage"] = damage
+    table["coordination"] = network.coordination(contacts, count)
+    centres = np.column_stack([table[axis] for axis in "xyz"])
+    stresses = network.love_weber_stresses(contacts, centres, volumes, dimension)
+    particle_table.add_stresses(table, stresses, dimension)
+    return table, stresses
 
 
 def squared_distances(positions: ArrayLike) -> NDArray[np.float64]:
@@ -97,12 +135,17 @@ class Analysis:
         """max_i |x_i| [m], the largest distance of a node from the origin."""
         return float(np.sqrt(np.max(squared_distances(self._core.positions))))
 
-    def strain_energy(self) -> float:
-        """sum_i W_i V_i [J; J/m in 2D] (core.strain_energy)."""
+    def strain_energy_densities(self) -> NDArray[np.float64]:
+        """Per node the strain energy density W_i [J/m^3] (core.strain_energy_density)."""
         given = self._given_now()
-        if given is None:
-            return float(self._core.strain_energy())
-        return _core.volume_weighted_total(given.strain_energy_density, self._model.volumes)
+        if given is not None:
+            return given.strain_energy_density
+        return np.asarray(self._core.strain_energy_density())
+
+    def strain_energy(self) -> float:
+        """sum_i W_i V_i [J; J/m in 2D], correctly rounded (ExactSum)."""
+        volumes = np.asarray(self._model.volumes)
+        return ExactSum.of(self.strain_energy_densities() * volumes).value
 
     def fragment_labels(self) -> NDArray[np.uint32]:
         """Each node's piece: its smallest node (computed once per step and bond count)."""
@@ -157,11 +200,10 @@ class Analysis:
         return count
 
     def gravity_energy(self, gravity: NDArray[np.float64]) -> float:
-        """-sum m_i g . x_i [J; J/m in 2D], zero at the origin."""
+        """-sum m_i g . x_i [J; J/m in 2D], zero at the origin, correctly rounded."""
         model = self._model
         mass = np.asarray(model.node_density) * np.asarray(model.volumes)
-        moment = reductions.weighted_sum(mass, self._core.positions)  # sum_i m_i x_i
-        return -reductions.dot(moment, gravity)
+        return ExactSum.of(gravity_energies(mass, self._core.positions, gravity)).value
 
     def contact_table(self) -> network.Table:
         """One row per contact of the last force evaluation (granulate.network)."""
@@ -174,16 +216,13 @@ class Analysis:
         volumes [m^3; m^2 in 2D]: what a frame's table and a history row both need. `damage`:
         phi per node (the core's, when None)."""
         core, count = self._core, self._particles
-        owner, volumes, table = self._motion()
+        owner, volumes, motion = self._motion()
         phi = self.damage()[0] if damage is None else np.asarray(damage)
         particle_volume = np.bincount(owner, volumes, count)
-        table["particle"] = np.arange(count)
-        table["time"] = np.full(count, float(core.time))
-        table["damage"] = np.bincount(owner, volumes * phi, count) / particle_volume
-        table["coordination"] = network.coordination(contacts, count)
-        centres = np.column_stack([table[axis] for axis in "xyz"])
-        stresses = network.love_weber_stresses(contacts, centres, particle_volume, self._dimension)
-        particle_table.add_stresses(table, stresses, self._dimension)
+        mean_damage = np.bincount(owner, volumes * phi, count) / particle_volume
+        table, stresses = complete_particle_table(
+            motion, particle_volume, mean_damage, contacts, float(core.time), self._dimension
+        )
         return table, stresses, particle_volume
 
     def _motion(self) -> tuple[NDArray, NDArray, particle_table.Table]:

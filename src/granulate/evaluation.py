@@ -16,6 +16,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from granulate import network
+from granulate.exact_sum import ExactSum
 
 
 @dataclass(frozen=True)
@@ -23,7 +24,7 @@ class Evaluation:
     """The last force evaluation's contacts, energies, counts and wall reactions."""
 
     contacts: network.Table  #: one row per contact (granulate.network.COLUMNS)
-    contact_energy: float  #: the normal springs' energy [J; J/m in 2D]
+    contact_energy: float  #: the normal springs' energy [J; J/m in 2D], correctly rounded
     node_contacts: int  #: node pairs in contact (each once)
     wall_contacts: int  #: node-wall contacts
     list_rebuilds: int  #: neighbour-list searches so far (distributed: the most of any rank)
@@ -33,9 +34,10 @@ class Evaluation:
     def of_core(cls, core: Any, contacts: network.Table) -> Evaluation:
         """A serial simulation's, read from its core, with its contact table (Analysis's)."""
         statistics = core.contact_statistics
+        energy = np.asarray(core.node_contact_terms()[0])  # per node
         return cls(
             contacts,
-            float(core.contact_energy()),
+            ExactSum.of(energy).value,
             int(statistics.node_contacts),
             int(statistics.wall_contacts),
             int(statistics.rebuilds),

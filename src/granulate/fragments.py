@@ -91,20 +91,19 @@ def fragment_table(
     return table
 
 
-def summary(table: Table, damage: ArrayLike, volumes: ArrayLike) -> dict[str, float | int]:
+def summary(table: Table, mean_damage: float) -> dict[str, float | int]:
     """The history columns of a fragment table: fragments (pieces of two nodes or more),
     debris_nodes, debris_mass, particles_split (particles in two pieces or more; not the stop
-    criterion's particles that lost every bond) and the volume-weighted mean damage of all
-    nodes."""
+    criterion's particles that lost every bond), and `mean_damage`, the volume-weighted mean
+    damage of all nodes (analysis.mean_damage)."""
     debris = table["debris"] == 1
     pieces = np.bincount(table["particle"])
-    v = np.asarray(volumes, dtype=np.float64)
     return {
         "fragments": int(np.count_nonzero(~debris)),
         "debris_nodes": int(np.count_nonzero(debris)),
         "debris_mass": float(table["mass"][debris].sum()),
         "particles_split": int(np.count_nonzero(pieces > 1)),
-        "mean_damage": reductions.dot(v, damage) / float(v.sum()),
+        "mean_damage": mean_damage,
     }
 
 

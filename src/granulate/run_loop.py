@@ -28,6 +28,7 @@ if TYPE_CHECKING:
     from granulate.checkpoints import CheckpointPlan
     from granulate.simulation import Simulation
     from granulate.writers.outputs import Outputs
+    from granulate.writers.step_data import StepData
 
 
 @dataclass(frozen=True)
@@ -91,6 +92,13 @@ class Stepper(Protocol):
         """What the stop criteria read (stopping.RunMeasures): `sim` itself, or the ranks'
         measures put together on every rank."""
 
+    def step_data(self, sim: Simulation, tracked: tuple[int, ...], whole: bool) -> StepData | None:
+        """The current output step made of the ranks' measures of their own grains, with the
+        sums of the `tracked` bodies, on rank 0 (None elsewhere); or None once `sim` holds
+        the whole state (collect), which the outputs then read: always serially, and on ranks
+        when `whole` (the outputs read the whole simulation) or the bodies are cut at node
+        level."""
+
     def save_checkpoint(self, sim: Simulation, path: Path, outputs: Outputs | None) -> Path:
         """The checkpoint at `path`; the path written."""
 
@@ -136,6 +144,9 @@ class CoreStepper:
 
     def measures(self, sim: Simulation) -> RunMeasures:
         return sim
+
+    def step_data(self, sim: Simulation, tracked: tuple[int, ...], whole: bool) -> StepData | None:
+        return None
 
     def save_checkpoint(self, sim: Simulation, path: Path, outputs: Outputs | None) -> Path:
         return checkpoints.save(sim, path, outputs)
@@ -274,7 +285,6 @@ def advance(sim: Simulation, plan: RunPlan, parts: LoopParts) -> str | None:
     stepper, out = parts.stepper, parts.outputs
     if stepper.agree(out is not None and out.frames == 0):
         stepper.first_forces()  # the forces of step 0 (prescribed motion, contact), for the frame
-        stepper.collect()
         write_outputs(stepper, sim, out)
     target = stepper.step + plan.steps
     first_step = stepper.step
@@ -301,16 +311,31 @@ def advance(sim: Simulation, plan: RunPlan, parts: LoopParts) -> str | None:
         parts.record.wall_seconds += wallclock.perf_counter() - start
         parts.record.steps_run += stepper.step - first_step
     stepper.collect()  # the end state in the simulation (rank 0's, in a distributed run)
-    write_outputs(stepper, sim, out, final=plan.write_final or reason is not None)
+    write_outputs(stepper, sim, out, final=plan.write_final or reason is not None, collected=True)
     return reason
 
 
 def write_outputs(
-    stepper: Stepper, sim: Simulation, out: Outputs | None, final: bool | None = None
+    stepper: Stepper,
+    sim: Simulation,
+    out: Outputs | None,
+    final: bool | None = None,
+    collected: bool = False,
 ) -> None:
     """The current step's outputs, written by rank 0 (Outputs.write_step; with `final`,
     write_final with that frame flag) once every rank has written its piece of the frame
-    they write, when the frames go in pieces written by the ranks."""
+    they write, when the frames go in pieces written by the ranks. They read the step made of
+    the ranks' measures (stepper.step_data) or, when `collected` or that cannot be, the
+    whole state collected into `sim`."""
+    data = None
+    if not collected:
+        planned = None  # rank 0's: the tracked bodies, and whether the outputs read the whole
+        if out is not None:
+            tracked = tuple(body.index for body in out.tracked)
+            planned = (tracked, out.needs_whole_state(stepper.step, final))
+        agreed = stepper.agree(planned)
+        if agreed is not None:  # the step made of the ranks' measures, or the state collected
+            data = stepper.step_data(sim, *agreed)
     mine = None  # rank 0's: where the pieces go and their fields, when the frame has pieces
     if out is not None and (folder := out.piece_folder(stepper.step, final)) is not None:
         mine = (folder, out.fields)
@@ -318,9 +343,11 @@ def write_outputs(
     if pieces is not None:
         stepper.write_pieces(*pieces)
     if final is None:
-        stepper.on_root(lambda: out.write_step(sim) if out is not None else None)
+        stepper.on_root(lambda: out.write_step(sim, data) if out is not None else None)
     else:
-        stepper.on_root(lambda: out.write_final(sim, frame=final) if out is not None else None)
+        stepper.on_root(
+            lambda: out.write_final(sim, frame=final, data=data) if out is not None else None
+        )
 
 
 def stop_reason(stepper: Stepper, sim: Simulation, criteria: Sequence[StopCriterion]) -> str | None:
@@ -374,10 +401,10 @@ class _Chunks:
         saves = checkpoint is not None and checkpoint.is_due(step)
         writes, saves = stepper.agree((writes, saves))
         whole = checks and any(criterion.needs_whole_state for criterion in plan.stop)
-        if writes or whole:
+        if whole:
             stepper.collect(measures=writes)
         if writes:
-            write_outputs(stepper, sim, out)
+            write_outputs(stepper, sim, out, collected=whole)
         reason = stop_reason(stepper, sim, plan.stop) if checks else None
         if saves and checkpoint is not None:
             stepper.save_checkpoint(sim, checkpoint.path, out)

@@ -213,19 +213,23 @@ class SimulationResults:
         """Counts, time step and timings of the run so far: ``steps`` is the current step,
         ``steps_run`` and ``wall_seconds`` the steps advanced and the wall time taken by this
         process's runs (after a resume, only the resumed part)."""
-        core = self._build()
-        # A distributed run's timings are rank 0's part's (its simulation steps no grain).
-        timed = core if self._distributed is None else self._distributed.local.core
-        phases = timed.phase_times
+        # A distributed run's step, time and timings are rank 0's part's (every part steps
+        # with the serial run's time step): rank 0's whole simulation is built only when the
+        # whole state is gathered.
+        run = self._distributed
+        core = self._build() if run is None else run.local.core
+        bonds = self.bond_count if run is None else run.bond_count
+        stable = core.stable_time_step if run is None else run.stable_dt
+        phases = core.phase_times
         return {
             "granulate": __version__,
             "case_fingerprint": self.case_fingerprint,
             "dimension": self.dimension,
             "bodies": len(self.bodies),
             "nodes": self.node_count,
-            "bonds": self.bond_count,
+            "bonds": bonds,
             "dt": core.time_step,
-            "stable_dt": core.stable_time_step,
+            "stable_dt": stable,
             "steps": core.step,
             "time": core.time,
             "ranks": 1 if self._comm is None else int(self._comm.Get_size()),
@@ -238,7 +242,7 @@ class SimulationResults:
             "integration_seconds": phases.integration,
             "loading_seconds": phases.loading,
             "contact_seconds": phases.contact,
-            "neighbor_list_rebuilds": timed.contact_statistics.rebuilds,
+            "neighbor_list_rebuilds": core.contact_statistics.rebuilds,
         }
 
     @property

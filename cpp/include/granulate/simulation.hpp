@@ -105,11 +105,7 @@ class Simulation {
   void compute_forces();
 
   // Diagnostics (computed on demand; sums in a fixed order, so identical for any thread count).
-  real strain_energy() const;  ///< sum W_i V_i [J; J/m in 2D] (volume_weighted_total)
-  /// sum_i W_i V_i in node order [J; J/m in 2D]: strain_energy's sum of the energy densities W
-  /// [J/m^3] (strain_energy_density), which a distributed run's rank 0 takes of the densities
-  /// the ranks measured of their grains, to the serial run's bits.
-  static real volume_weighted_total(std::span<const real> density, std::span<const real> volumes);
+  real strain_energy() const;  ///< sum W_i V_i in node order [J; J/m in 2D]
   real contact_energy() const { return contact_.spring_energy(*model_, state_); }  ///< [J; J/m]
   /// W_i per node [J/m^3, also in 2D]: LPS and PMB energy densities (see the evaluators); 0
   /// on ghost particles (set_ghost_particles: their owners measure them).

@@ -23,15 +23,6 @@ void bind_contact(nb::module_& m) {
       .def_rw("surface", &contact::Law::surface);
   m.def("combined_time_step", &Simulation::combined_time_step, "peridynamic"_a, "contact"_a,
         "1 / sqrt(1/dt_pd^2 + 1/dt_contact^2) [s] (dt_pd for an infinite dt_contact).");
-  m.def(
-      "volume_weighted_total",
-      [](nb::ndarray<const real, nb::ndim<1>, nb::c_contig> density,
-         nb::ndarray<const real, nb::ndim<1>, nb::c_contig> volumes) {
-        return Simulation::volume_weighted_total({density.data(), density.shape(0)},
-                                                 {volumes.data(), volumes.shape(0)});
-      },
-      "density"_a, "volumes"_a,
-      "sum_i W_i V_i in node order (Simulation::strain_energy's sum of strain_energy_density).");
   m.def("damping_ratio_from_restitution", &contact::damping_ratio_from_restitution, "restitution"_a);
   m.def("power_law_restitution", &contact::power_law_restitution, "damping_ratio"_a, "exponent"_a);
   m.def("power_law_damping_ratio", &contact::power_law_damping_ratio, "restitution"_a, "exponent"_a,

@@ -55,6 +55,7 @@ from granulate.parallel.partition import (
     near_pairs_with_large,
 )
 from granulate.parallel.run_measures import RankMeasures
+from granulate.parallel.step_parts import step_data, step_part
 from granulate.parallel.transplant import (
     GrainState,
     body_first_nodes,
@@ -69,6 +70,7 @@ if TYPE_CHECKING:
     from granulate.node_map import NodeMap
     from granulate.simulation import Simulation
     from granulate.writers.outputs import Outputs
+    from granulate.writers.step_data import StepData
 
 _TAG = 17
 _REST_TAG = 18  # what a step's message has no room for
@@ -220,6 +222,7 @@ class DistributedRun:
         together(self.comm, lambda: self._build(held))
         self._exchange_state()
         self._exchange_caps()
+        self._bond_count = self._count_bonds()
         #: Wall-clock seconds of this rank in its steps, ghost exchanges, partition checks,
         #: migrations and collections of the whole state on rank 0 (collect).
         self.seconds = dict.fromkeys(
@@ -481,7 +484,7 @@ class DistributedRun:
         breaks, one body per grain plus body_slots, and joining_slots nodes joining the cap."""
         return np.array([self.break_slots, grains + self.body_slots, self.joining_slots])
 
-    def _local_slice(self, grain: int) -> slice:
+    def local_slice(self, grain: int) -> slice:
         """The local nodes of a held grain."""
         first = int(self._node_map[self._slices[grain].start])
         return slice(first, first + self._slices[grain].stop - self._slices[grain].start)
@@ -512,7 +515,7 @@ class DistributedRun:
 
     def owned_slices(self) -> list[slice]:
         """The local node slice of each owned grain, in grain order."""
-        return [self._local_slice(g) for g in self._owned]
+        return [self.local_slice(g) for g in self._owned]
 
     def is_owned_node(self, local: NDArray[np.int64]) -> NDArray[np.bool_]:
         """Whether each of these local nodes belongs to an owned grain."""
@@ -827,7 +830,7 @@ class DistributedRun:
             centres,
             radii,
             {
-                int(g): positions[self._local_slice(g)]
+                int(g): positions[self.local_slice(g)]
                 for g in np.intersect1d(self._large, self._owned)
             },
         )
@@ -894,7 +897,7 @@ class DistributedRun:
         node is (else None), from its owner (one allgather)."""
         positions = self.local.core.positions
         dimension = self._sim.dimension
-        mine = _spheres([positions[self._local_slice(g)] for g in self._owned], dimension)
+        mine = _spheres([positions[self.local_slice(g)] for g in self._owned], dimension)
         points = None
         if self._damped_centres is not None:
             points = positions[self._node_map[self._damped_centres[self._owned]], :dimension]
@@ -915,7 +918,7 @@ class DistributedRun:
         core = self.local.core
         giving = np.unique(np.concatenate(wanted))
         saved = dict(core.checkpoint()) if renew or len(giving) else {}
-        owned = {int(g): self._local_slice(g) for g in giving}
+        owned = {int(g): self.local_slice(g) for g in giving}
         states = grain_states(self.local, saved, self._to_global, owned) if owned else {}
         outgoing = [{int(g): states[int(g)] for g in grains} for grains in wanted]
         received: dict[int, GrainState] = {}
@@ -954,7 +957,7 @@ class DistributedRun:
             [deepest.deepest_overlap, deepest.half_overlap_step, deepest.full_overlap_step],
             dtype=float,
         )
-        owned = {int(g): self._local_slice(g) for g in self._owned}
+        owned = {int(g): self.local_slice(g) for g in self._owned}
         parts = self.comm.gather(grain_states(self.local, saved, self._to_global, owned), root=0)
 
         def write() -> Path:
@@ -1037,6 +1040,19 @@ class DistributedRun:
             total = _sum_wall_terms(parts, len(core.wall_reactions()))
         return self.comm.bcast(total, root=0)
 
+    def step_data(self, tracked: tuple[int, ...]) -> StepData | None:
+        """Every rank: the current output step made of what each rank measures of its own
+        grains (step_parts.py), with the sums of the `tracked` grains; on rank 0 (None on the
+        others), with no node array: rank 0's simulation is not built for it."""
+        start = time.perf_counter()
+        walls = self.wall_reactions()
+        broken = self.broken_bonds()
+        part = together(self.comm, lambda: step_part(self, tracked), "measuring its grains")
+        parts = self.comm.gather(part, root=0)
+        data = on_root(self.comm, lambda: step_data(self._sim, self, parts, broken, walls))
+        self.seconds["collect"] += time.perf_counter() - start
+        return data
+
     def collect(self, measures: bool = True) -> None:
         """Every rank: rank 0's simulation (the one the run was made of, built whole on the
         first call) takes every grain's state and the last step's contacts, contact energy
@@ -1078,7 +1094,12 @@ class DistributedRun:
 
     @property
     def bond_count(self) -> int:
-        """Every grain's bonds, counted once per end (Simulation.bond_count), on every rank."""
+        """Every grain's bonds, counted once per end (Simulation.bond_count), on every rank
+        (counted when the run was made: bonds break, they never go)."""
+        return self._bond_count
+
+    def _count_bonds(self) -> int:
+        """Every grain's bonds, counted once per end (one reduction)."""
         offsets = np.asarray(self.local.model.bond_offsets, dtype=np.int64)
         mine = sum(int(offsets[s.stop] - offsets[s.start]) for s in self.owned_slices())
         return int(self.comm.allreduce(mine))

@@ -1,8 +1,9 @@
 """Simulation.run's loop on the ranks of a distributed run (granulate.run_loop.Stepper): every
-rank takes the steps of the chunks rank 0 decides, rank 0's simulation takes the whole state
-(DistributedRun.collect) before rank 0 writes outputs, the stop criteria read the ranks'
-measures put together (run_measures.py), and rank 0's decisions and errors reach every
-rank."""
+rank takes the steps of the chunks rank 0 decides; rank 0 writes the outputs of the step its
+ranks measured of their grains (step_parts.py), or of the whole state its simulation takes
+(DistributedRun.collect) for a frame of every node, writers of users' own or bodies cut at node
+level; the stop criteria read the ranks' measures put together (run_measures.py); rank 0's
+decisions and errors reach every rank."""
 
 from __future__ import annotations
 
@@ -11,13 +12,14 @@ from pathlib import Path
 from typing import TYPE_CHECKING, TypeVar
 
 from granulate.parallel.agreement import on_root, together
+from granulate.parallel.engine import DistributedRun
 
 if TYPE_CHECKING:
-    from granulate.parallel.engine import DistributedRun
     from granulate.parallel.node_split import NodeSplitRun
     from granulate.simulation import Simulation
     from granulate.stopping import RunMeasures
     from granulate.writers.outputs import Outputs
+    from granulate.writers.step_data import StepData
 
 T = TypeVar("T")
 
@@ -60,6 +62,12 @@ class DistributedStepper:
 
     def measures(self, sim: Simulation) -> RunMeasures:
         return self.run.measures()
+
+    def step_data(self, sim: Simulation, tracked: tuple[int, ...], whole: bool) -> StepData | None:
+        if whole or not isinstance(self.run, DistributedRun):  # a node split's pieces span ranks
+            self.run.collect(measures=True)
+            return None
+        return self.run.step_data(tracked)
 
     def save_checkpoint(self, sim: Simulation, path: Path, outputs: Outputs | None) -> Path:
         return self.run.save_checkpoint(path, outputs)

@@ -1,4 +1,6 @@
-"""The whole state of a distributed run on rank 0, for its outputs, stop criteria and measures.
+"""The whole state of a distributed run on rank 0, for a frame of every node, a checkpoint, the
+end of a run and outputs of writers from outside the package (an output step of the built-in
+writers is made of the ranks' measures instead: step_parts.py).
 
 Each rank sends its own grains' nodes (positions, velocities, forces, dilatation) and bonds, and
 what its last force evaluation left for them: the contacts whose first body it owns (the
@@ -6,9 +8,9 @@ network's rows, in global numbering), its nodes' contact energy and contact coun
 (ContactModel::node_contact_terms) and its neighbour-list searches. Rank 0 puts the nodes and
 bonds into its simulation, built whole once, and the evaluation in the serial order: contact rows
 sorted as the serial core's slots (pairs of bodies by their smallest nodes, then bodies and walls),
-the energy summed node by node in node order as the serial core sums it. Every value is then the
-serial run's at that step, bit for bit, except the number of list searches, which each rank
-makes for its own part (the largest over the ranks is given).
+the energy's correctly rounded sum (granulate.exact_sum), as the serial Evaluation gives it.
+Every value is then the serial run's at that step, bit for bit, except the number of list
+searches, which each rank makes for its own part (the largest over the ranks is given).
 
 The measures that read every bond or sum over every node (the damage, the fragment labels, the
 strain energy densities and the particles' motion: analysis.GivenMeasures) each rank makes of
@@ -31,6 +33,7 @@ from numpy.typing import NDArray
 from granulate import network, particle_table
 from granulate.analysis import GivenMeasures
 from granulate.evaluation import Evaluation
+from granulate.exact_sum import ExactSum
 
 if TYPE_CHECKING:
     from granulate.parallel.engine import DistributedRun
@@ -76,7 +79,7 @@ def owned_part(run: DistributedRun, measures: bool = True) -> OwnedPart:
         core.forces[nodes],
         np.asarray(core.dilatation)[nodes],
         np.concatenate(bond_rows) if bond_rows else np.zeros(0, np.uint8),
-        _owned_contacts(run, core.contact_network()),
+        owned_contacts(run, core.contact_network()),
         energy[nodes],
         int(pairs[nodes].sum()),
         int(walls[nodes].sum()),
@@ -104,7 +107,7 @@ def _owned_measures(run: DistributedRun) -> GivenMeasures:
     return GivenMeasures(phi, z, labels, density, motion)
 
 
-def _owned_contacts(run: DistributedRun, local: dict[str, Any]) -> dict[str, NDArray[Any]]:
+def owned_contacts(run: DistributedRun, local: dict[str, Any]) -> dict[str, NDArray[Any]]:
     """The rows of a rank's contact network (ContactNetwork) whose first body it owns, in
     global numbering: grains for particles, global nodes for the bodies' smallest nodes."""
     every = {key: np.asarray(local[key]).astype(np.int64) for key in _ROW_KEYS}
@@ -159,8 +162,8 @@ def install(
     core.time, core.step = moment
     sim.analysis.give(given if len(measured) == len(parts) else None)
     sim._gathered = Evaluation(
-        network.contact_table(_serial_order([part.contacts for part in parts])),
-        float(np.add.accumulate(energy)[-1]) if len(energy) else 0.0,  # the core's order
+        network.contact_table(serial_order([part.contacts for part in parts])),
+        ExactSum.of(energy).value,
         sum(part.node_contacts for part in parts),
         sum(part.wall_contacts for part in parts),
         max(part.searches for part in parts),
@@ -208,7 +211,7 @@ def _place(
         at = mine.stop
 
 
-def _serial_order(pieces: list[dict[str, NDArray[Any]]]) -> dict[str, NDArray[Any]]:
+def serial_order(pieces: list[dict[str, NDArray[Any]]]) -> dict[str, NDArray[Any]]:
     """The ranks' contact rows as one network in the serial core's slot order: pairs of bodies
     sorted by their smallest nodes, then bodies and walls sorted by body and wall."""
     rows = {key: np.concatenate([piece[key] for piece in pieces]) for key in pieces[0]}

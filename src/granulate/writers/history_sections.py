@@ -7,7 +7,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from granulate import fragments, network, reductions
+from granulate import fragments, network
 
 if TYPE_CHECKING:
     from granulate.writers.outputs import Outputs
@@ -30,20 +30,18 @@ class Energies:
     """step, time, the energies [J; J/m in 2D], broken bonds, contact counts, list rebuilds."""
 
     def columns(self, data: StepData, outputs: Outputs) -> dict[str, float | int]:
-        sim = data.simulation
-        core = sim.core
-        evaluation = data.evaluation
-        kinetic, strain = sim.kinetic_energy(), sim.strain_energy()
-        gravity, contact = sim.gravity_energy(), evaluation.contact_energy
+        totals, evaluation = data.totals, data.evaluation
+        kinetic, strain = totals.kinetic.value, totals.strain.value
+        gravity, contact = totals.gravity.value, totals.contact.value
         return {
-            "step": core.step,
-            "time": core.time,
+            "step": data.step,
+            "time": data.time,
             "kinetic_energy": kinetic,
             "strain_energy": strain,
             "gravity_energy": gravity,
             "contact_energy": contact,
             "total_energy": kinetic + strain + gravity + contact,
-            "broken_bonds": core.broken_bonds(),
+            "broken_bonds": data.broken_bonds,
             "node_contacts": evaluation.node_contacts,
             "wall_contacts": evaluation.wall_contacts,
             "list_rebuilds": evaluation.list_rebuilds,
@@ -54,23 +52,23 @@ class Breakage:
     """Fragments, debris, particles split, mean damage (granulate.fragments.summary)."""
 
     def columns(self, data: StepData, outputs: Outputs) -> dict[str, float | int]:
-        return fragments.summary(data.fragments, data.damage, data.simulation.model.volumes)
+        return fragments.summary(data.fragments, data.mean_damage)
 
 
 class GranularMeasures:
     """Particle contacts, mean coordination, assembly stress [Pa] and fabric tensor."""
 
     def columns(self, data: StepData, outputs: Outputs) -> dict[str, float | int]:
-        sim = data.simulation
+        particles = len(data.particles["particle"])
         row: dict[str, float | int] = {
             "contacts": len(network.coordination_pairs(data.contacts)),
-            "coordination": network.mean_coordination(data.contacts, len(sim.bodies)),
+            "coordination": network.mean_coordination(data.contacts, particles),
         }
         solid = network.assembly_stress(*data.stresses)
-        fabric = network.fabric_tensor(data.contacts, sim.dimension)
-        for name, (i, j) in STRESS_COMPONENTS[sim.dimension]:
+        fabric = network.fabric_tensor(data.contacts, data.dimension)
+        for name, (i, j) in STRESS_COMPONENTS[data.dimension]:
             row[f"stress_{name}"] = float(solid[i, j])
-        for name, (i, j) in STRESS_COMPONENTS[sim.dimension]:
+        for name, (i, j) in STRESS_COMPONENTS[data.dimension]:
             row[f"fabric_{name}"] = float(fabric[i, j])
         return row
 
@@ -80,43 +78,29 @@ class WallLoads:
     its stress."""
 
     def columns(self, data: StepData, outputs: Outputs) -> dict[str, float | int]:
-        sim = data.simulation
-        core = sim.core
         row: dict[str, float | int] = {}
-        for (name, spec), reaction, wall in zip(
-            sim.walls, data.evaluation.wall_reactions, core.walls, strict=True
+        for (name, spec), reaction, moved in zip(
+            data.walls, data.evaluation.wall_reactions, data.wall_displacements, strict=True
         ):
-            for c in _WALL_COMPONENTS[sim.dimension]:
+            for c in _WALL_COMPONENTS[data.dimension]:
                 row[f"{name}_{c}"] = float(reaction[_WALL_INDEX[c]])
-            row[f"{name}_displacement"] = wall.displacement(core.time)
+            row[f"{name}_displacement"] = moved
             if spec.area is not None:
-                row[f"{name}_stress"] = float(np.linalg.norm(reaction[: sim.dimension])) / spec.area
+                row[f"{name}_stress"] = (
+                    float(np.linalg.norm(reaction[: data.dimension])) / spec.area
+                )
         return row
 
 
 class TrackedBodies:
     """Per tracked body: the resultant of its forces other than gravity [N; N/m in 2D], its
-    mean displacement [m] and, given an area, its stress [Pa]."""
+    mean displacement [m] and, given an area, its stress [Pa] (granulate.step_totals)."""
 
     def columns(self, data: StepData, outputs: Outputs) -> dict[str, float | int]:
         row: dict[str, float | int] = {}
-        if not outputs.tracked:
-            return row
-        sim = data.simulation
-        model = sim.model
-        forces, positions, reference = (
-            sim.core.forces,
-            sim.core.positions,
-            model.reference_positions,
-        )
-        volumes, density, gravity = model.volumes, model.node_density, sim.gravity
-        axes = "xyz"[: sim.dimension]
-        for body in outputs.tracked:
-            nodes = body.node_slice
-            v = volumes[nodes]
-            weight = reductions.dot(v, density[nodes]) * gravity
-            resultant = reductions.weighted_sum(v, forces[nodes]) - weight
-            mean = (positions[nodes] - reference[nodes]).mean(axis=0)
+        axes = "xyz"[: data.dimension]
+        for body, sums in zip(outputs.tracked, data.totals.tracked, strict=True):
+            resultant, mean = sums.load(data.gravity)
             for k, axis in enumerate(axes):
                 row[f"{body.name}_f{axis}"] = float(resultant[k])
             for k, axis in enumerate(axes):

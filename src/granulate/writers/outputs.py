@@ -105,6 +105,12 @@ class Outputs:
             return step % self.every == 0 or self.frames == 0
         return final and self.frame_step != step
 
+    def needs_whole_state(self, step: int, final: bool | None = None) -> bool:
+        """Whether the outputs of `step` (write_step's, or write_final's) read the whole
+        simulation: a frame of every node, or a writer registered from outside the package.
+        Otherwise a distributed run makes them of its ranks' measures (StepData)."""
+        return (self.frame_due(step, final) and not self.pieces) or not registry.only_built_in()
+
     def piece_folder(self, step: int, final: bool | None = None) -> Path | None:
         """The folder of the pieces the ranks write of the frame `step`'s outputs write
         (frame_due), or None when there is none or it is not written by ranks."""
@@ -112,39 +118,44 @@ class Outputs:
             return None
         return self.directory / "frames" / f"frame_{self.frames:06d}"
 
-    def write_step(self, sim: Simulation) -> None:
+    def write_step(self, sim: Simulation, data: StepData | None = None) -> None:
         """The frame (at a frame step, or the first) and the history row (at a history step,
-        or the first) of the current step."""
-        step = int(sim.core.step)
+        or the first) of the current step, from `data` (a distributed run's, made of its
+        ranks' measures) or from `sim`'s whole state."""
+        step = sim.step
         self.write(
             sim,
             self.frame_due(step),
             step % self.history_every == 0 or self.history is None,
+            data,
         )
 
-    def write_final(self, sim: Simulation, frame: bool) -> None:
+    def write_final(self, sim: Simulation, frame: bool, data: StepData | None = None) -> None:
         """The end of a run: with ``frame``, the frame and history row of the last step when
         it was not an output step."""
-        step = int(sim.core.step)
-        self.write(sim, self.frame_due(step, frame), frame and self.history_step != step)
+        step = sim.step
+        self.write(sim, self.frame_due(step, frame), frame and self.history_step != step, data)
 
-    def write(self, sim: Simulation, frame: bool, history: bool) -> None:
-        """The frame and the history row of the current step, as asked, from one StepData."""
+    def write(
+        self, sim: Simulation, frame: bool, history: bool, data: StepData | None = None
+    ) -> None:
+        """The frame and the history row of the current step, as asked, from one StepData
+        (`data`, or made of `sim`'s whole state)."""
         if not (frame or history):
             return
         start = wallclock.perf_counter()
         try:
-            self._write(sim, frame, history)
+            self._write(sim, frame, history, data)
         finally:
             self.seconds += wallclock.perf_counter() - start
 
-    def _write(self, sim: Simulation, frame: bool, history: bool) -> None:
-        data = StepData.of(sim)
+    def _write(self, sim: Simulation, frame: bool, history: bool, data: StepData | None) -> None:
+        data = data or StepData.of(sim, self.tracked)
         if frame:
             for writer in registry.FRAME_WRITERS:
                 writer.write(data, self)
             self.frames += 1
-            self.frame_step = int(sim.core.step)
+            self.frame_step = data.step
             self.write_run_record(sim)
         if history:
             row: dict[str, float | int] = {}
@@ -153,7 +164,7 @@ class Outputs:
             if self.history is None:
                 self.history = HistoryWriter(self.directory / "history.csv", list(row))
             self.history.write(row)
-            self.history_step = int(sim.core.step)
+            self.history_step = data.step
 
     def resume(self, frames: int, pvd: list[tuple[float, str]], step: int) -> None:
         """Continue the outputs of a checkpoint at `step`: its frame count and PVD entries,

@@ -34,6 +34,26 @@ HISTORY_SECTIONS: list[HistorySection] = [
 ]
 
 
+_BUILT_IN = (
+    VtuFrame,
+    ParticleTables,
+    FragmentTables,
+    ContactNetwork,
+    Energies,
+    Breakage,
+    GranularMeasures,
+    WallLoads,
+    TrackedBodies,
+)
+
+
+def only_built_in() -> bool:
+    """Whether every registered writer and section is the package's own: these read StepData's
+    values alone (one registered from outside may read its simulation, which a distributed
+    run's step data made of its ranks' measures lacks)."""
+    return all(isinstance(w, _BUILT_IN) for w in [*FRAME_WRITERS, *HISTORY_SECTIONS])
+
+
 def register_frame_writer(writer: FrameWriter) -> None:
     """Every run's frames from now on also call ``writer.write``."""
     FRAME_WRITERS.append(writer)

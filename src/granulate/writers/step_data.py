@@ -1,5 +1,6 @@
 """What every writer of one output step reads, computed once for the frame and the history row
-of that step."""
+of that step: from a simulation's whole state (StepData.of), or in a distributed run from what
+its ranks measured of their own grains (parallel/step_parts.py), with no node array."""
 
 from __future__ import annotations
 
@@ -11,31 +12,97 @@ from numpy.typing import NDArray
 
 from granulate import fragments, network, particle_table
 from granulate.evaluation import Evaluation
+from granulate.step_totals import StepTotals, TrackedSums, node_totals
 
 if TYPE_CHECKING:
+    from granulate.assembly import Body
     from granulate.simulation import Simulation
+    from granulate.walls import Wall
 
 
 @dataclass(frozen=True)
 class StepData:
-    """The current step of `simulation`: damage, fragments, the last force evaluation
-    (contacts, contact energy and counts, wall reactions) and particles."""
+    """The current step: its time, sums over the nodes (StepTotals), broken bonds, fragment
+    table, the last force evaluation (contacts, contact counts, wall reactions), the particles
+    and the walls' displacements; and, when made of the whole state, the simulation and its
+    damage per node (for a frame of every node)."""
 
-    simulation: Simulation
-    damage: NDArray[np.float64]  #: phi per node
-    damage_z: NDArray[np.float64]  #: PeriDEM's Damage_Z per node
+    step: int
+    time: float  #: [s]
+    totals: StepTotals
+    broken_bonds: int
     fragments: fragments.Table
     evaluation: Evaluation
-    contacts: network.Table
     particles: particle_table.Table
     #: the particles' Love-Weber stresses (N, D, D) [Pa] and volumes [m^3; m^2 in 2D]
     stresses: tuple[NDArray[np.float64], NDArray[np.float64]]
+    walls: tuple[tuple[str, Wall], ...]  #: the walls' names and set-ups, in order
+    wall_displacements: tuple[float, ...]  #: [m or rad], in the walls' order
+    gravity: NDArray[np.float64]  #: (3,) [m/s^2]
+    dimension: int
+    #: the whole simulation and its damage phi and PeriDEM's Z per node; None when made of the
+    #: ranks' measures (a frame in pieces, written by the ranks)
+    simulation: Simulation | None = None
+    damage: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None
+
+    @property
+    def contacts(self) -> network.Table:
+        return self.evaluation.contacts
+
+    @property
+    def mean_damage(self) -> float:
+        return self.totals.mean_damage
 
     @classmethod
-    def of(cls, simulation: Simulation) -> StepData:
-        phi, z = simulation.analysis.damage()
-        table = simulation.fragment_table()
-        evaluation = simulation.evaluation()
-        contacts = evaluation.contacts
-        particles, stresses, volumes = simulation.analysis.particles(contacts, phi)
-        return cls(simulation, phi, z, table, evaluation, contacts, particles, (stresses, volumes))
+    def of(cls, simulation: Simulation, tracked: tuple[Body, ...] = ()) -> StepData:
+        """The step of `simulation`'s whole state, with the sums of the `tracked` bodies."""
+        sim = simulation
+        phi, z = sim.analysis.damage()
+        evaluation = sim.evaluation()
+        particles, stresses, volumes = sim.analysis.particles(evaluation.contacts, phi)
+        core = sim.core
+        return cls(
+            int(core.step),
+            float(core.time),
+            whole_totals(sim, phi, tracked),
+            int(core.broken_bonds()),
+            sim.fragment_table(),
+            evaluation,
+            particles,
+            (stresses, volumes),
+            sim.walls,
+            tuple(float(wall.displacement(core.time)) for wall in core.walls),
+            np.asarray(sim.gravity, dtype=np.float64),
+            sim.dimension,
+            sim,
+            (phi, z),
+        )
+
+
+def whole_totals(
+    sim: Simulation, damage: NDArray[np.float64], tracked: tuple[Body, ...]
+) -> StepTotals:
+    """StepTotals of every node of `sim` (its strain energy densities, contact energies and
+    `damage` phi), with the sums of the `tracked` bodies."""
+    model, core = sim.model, sim.core
+    volumes = np.asarray(model.volumes)
+    mass = np.asarray(model.node_density) * volumes
+    density = sim.analysis.strain_energy_densities()
+    contact = [sim.evaluation().contact_energy]  # a correctly rounded sum already
+    totals = node_totals(
+        mass, volumes, core.velocities, core.positions, sim.gravity, density, contact, damage
+    )
+    sums = tuple(
+        TrackedSums.of(
+            mass[body.node_slice],
+            volumes[body.node_slice],
+            core.forces[body.node_slice],
+            core.positions[body.node_slice],
+            model.reference_positions[body.node_slice],
+        )
+        for body in tracked
+    )
+    return StepTotals(*(getattr(totals, f) for f in _ENERGY_FIELDS), tracked=sums)
+
+
+_ENERGY_FIELDS = ("kinetic", "strain", "gravity", "contact", "damaged_volume", "volume")

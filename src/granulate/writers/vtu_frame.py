@@ -132,16 +132,17 @@ class VtuFrame:
     file or in pieces (module docstring)."""
 
     def write(self, data: StepData, outputs: Outputs) -> None:
-        sim = data.simulation
+        sim, damage = data.simulation, data.damage
         name = f"frame_{outputs.frames:06d}"
         frames = outputs.directory / "frames"
-        damage = (data.damage, data.damage_z)
         if not outputs.pieces:
+            assert sim is not None and damage is not None  # a frame of every node
             values = point_fields(sim, outputs.fields, damage)
             write_vtu(frames / f"{name}.vtu", sim.core.positions, values)
-            outputs.pvd.add(sim.core.time, Path("frames") / f"{name}.vtu")
+            outputs.pvd.add(data.time, Path("frames") / f"{name}.vtu")
             return
         if not outputs.piece_ranks:  # a serial run's one piece; else the ranks wrote theirs
+            assert sim is not None and damage is not None
             write_piece(frames / name / "piece_0.vtu", sim, outputs.fields, damage=damage)
         count = outputs.piece_ranks or 1
         pieces = [f"piece_{r}.vtu" for r in range(count)]
@@ -151,7 +152,7 @@ class VtuFrame:
                 stale.unlink()
         arrays = [(f, *FIELD_TYPES[f]) for f in outputs.fields] + [(NODE_ID, _NODE_ID_TYPE, 1)]
         write_pvtu(frames / f"{name}.pvtu", [f"{name}/{piece}" for piece in pieces], arrays)
-        outputs.pvd.add(sim.core.time, Path("frames") / f"{name}.pvtu")
+        outputs.pvd.add(data.time, Path("frames") / f"{name}.pvtu")
 
 
 def _check_pieces(folder: Path, pieces: list[str]) -> None:

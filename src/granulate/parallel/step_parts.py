@@ -1,0 +1,172 @@
+"""A distributed run's output step made of what each rank measures of its own grains, with no
+node array on rank 0 (writers/step_data.py's StepData without a simulation): the history row,
+the particle, fragment and contact tables, and a frame in pieces (each rank writes its own).
+
+Each rank sends rank 0 (StepPart):
+- its nodes' sums (step_totals.StepTotals: the energies, the damaged volume, the tracked bodies
+  it owns), exact, so that rank 0's totals are the serial run's correctly rounded sums;
+- the fragment table of its grains' pieces (fragments.fragment_table over its nodes, labelled by
+  their smallest node in the whole run): a piece lies in one grain, and its sums run over its
+  nodes in node order wherever they are made, so each row is the serial row to the bit;
+- per grain its motion (particle_table.motion), volume and volume-weighted damage, summed over
+  its nodes in node order as the serial Analysis sums them;
+- the contacts whose first body it owns and its contact counts (whole_state's).
+Rank 0 puts the fragment rows in the serial order (by id), the grains' rows in grain order, the
+contacts in the serial slot order, and completes the particle table from them
+(analysis.complete_particle_table): every column is the serial run's.
+
+A frame of every node (output without pieces), a writer registered from outside the package and
+a body cut at node level (NodeSplitRun, whose pieces span ranks) still need the whole state on
+rank 0 (DistributedRun.collect).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from granulate import fragments, network, particle_table
+from granulate.analysis import complete_particle_table
+from granulate.evaluation import Evaluation
+from granulate.parallel.whole_state import owned_contacts, serial_order
+from granulate.step_totals import StepTotals, TrackedSums, node_totals
+from granulate.writers.step_data import StepData
+
+if TYPE_CHECKING:
+    from granulate.parallel.engine import DistributedRun
+    from granulate.simulation import Simulation
+
+
+@dataclass(frozen=True)
+class StepPart:
+    """What one rank sends rank 0 for an output step (the module docstring)."""
+
+    totals: StepTotals
+    fragments: fragments.Table
+    grains: NDArray[np.int64]  #: the grains it owns, sorted
+    motion: particle_table.Table  #: per owned grain
+    volumes: NDArray[np.float64]  #: per owned grain [m^3; m^2 in 2D]
+    damage: NDArray[np.float64]  #: per owned grain, volume-weighted
+    contacts: dict[str, NDArray[Any]]
+    node_contacts: int
+    wall_contacts: int
+    searches: int
+
+
+def step_part(run: DistributedRun, tracked: tuple[int, ...]) -> StepPart:
+    """This rank's StepPart, with the sums of the `tracked` grains it owns (others' empty)."""
+    local, nodes = run.local, run.owned_nodes
+    core, model = local.core, local.model
+    volumes = np.asarray(model.volumes)[nodes]
+    mass = np.asarray(model.node_density)[nodes] * volumes
+    phi = np.asarray(core.damage()[0])[nodes]
+    energy, pairs, walls = (np.asarray(a) for a in core.node_contact_terms())
+    density = np.asarray(core.strain_energy_density())[nodes]
+    x, v = core.positions[nodes], core.velocities[nodes]
+    totals = node_totals(mass, volumes, v, x, local.gravity, density, energy[nodes], phi)
+    sums = tuple(_tracked_sums(run, grain) for grain in tracked)
+    grain = np.searchsorted(run.owned, run.held[np.asarray(model.node_particle)[nodes]])
+    count = len(run.owned)
+    # Each piece labelled by its smallest node's place among the own nodes (the part numbers
+    # a grain's nodes in the whole run's order), then by that node's number in the whole run.
+    place = np.searchsorted(nodes, np.asarray(core.fragments())[nodes])
+    table = fragments.fragment_table(
+        place,
+        run.owned[grain],
+        x,
+        v,
+        volumes,
+        np.asarray(model.node_density)[nodes],
+        local.dimension,
+    )
+    table["fragment"] = run.global_nodes(nodes[table["fragment"]]).astype(np.int64)
+    grain_volumes = np.bincount(grain, volumes, count)
+    return StepPart(
+        StepTotals(*(getattr(totals, f) for f in _NODE_FIELDS), tracked=sums),
+        table,
+        run.owned,
+        particle_table.motion(grain, mass, x, v, count),
+        grain_volumes,
+        np.bincount(grain, volumes * phi, count) / grain_volumes,
+        owned_contacts(run, core.contact_network()),
+        int(pairs[nodes].sum()),
+        int(walls[nodes].sum()),
+        int(core.contact_statistics.rebuilds),
+    )
+
+
+def step_data(
+    sim: Simulation,
+    run: DistributedRun,
+    parts: list[StepPart],
+    broken: int,
+    wall_reactions: NDArray[np.float64],
+) -> StepData:
+    """Rank 0: the output step of `sim` (its set-up: walls, gravity, bodies) from every rank's
+    part, with `broken` bonds in all and the walls' reactions."""
+    core, grains = run.local.core, len(sim.bodies)
+    totals = sum((part.totals for part in parts), StepTotals())
+    table = _merged_fragments([part.fragments for part in parts])
+    motion: particle_table.Table = {}
+    volumes, damage = np.empty(grains), np.empty(grains)
+    for part in parts:
+        for column, values in part.motion.items():
+            motion.setdefault(column, np.empty(grains))[part.grains] = values
+        volumes[part.grains] = part.volumes
+        damage[part.grains] = part.damage
+    contacts = network.contact_table(serial_order([part.contacts for part in parts]))
+    evaluation = Evaluation(
+        contacts,
+        totals.contact.value,
+        sum(part.node_contacts for part in parts),
+        sum(part.wall_contacts for part in parts),
+        max(part.searches for part in parts),
+        wall_reactions,
+    )
+    time = float(core.time)
+    particles, stresses = complete_particle_table(
+        motion, volumes, damage, contacts, time, sim.dimension
+    )
+    return StepData(
+        int(core.step),
+        time,
+        totals,
+        broken,
+        table,
+        evaluation,
+        particles,
+        (stresses, volumes),
+        sim.walls,
+        tuple(float(wall.displacement(core.time)) for wall in core.walls),
+        np.asarray(sim.gravity, dtype=np.float64),
+        sim.dimension,
+    )
+
+
+_NODE_FIELDS = ("kinetic", "strain", "gravity", "contact", "damaged_volume", "volume")
+
+
+def _tracked_sums(run: DistributedRun, grain: int) -> TrackedSums:
+    """The sums of a tracked grain's nodes on the rank that owns it; empty elsewhere."""
+    if not np.isin(grain, run.owned):
+        return TrackedSums()
+    local, nodes = run.local, run.local_slice(grain)
+    model, core = local.model, local.core
+    volumes = np.asarray(model.volumes)[nodes]
+    return TrackedSums.of(
+        np.asarray(model.node_density)[nodes] * volumes,
+        volumes,
+        core.forces[nodes],
+        core.positions[nodes],
+        np.asarray(model.reference_positions)[nodes],
+    )
+
+
+def _merged_fragments(tables: list[fragments.Table]) -> fragments.Table:
+    """The ranks' fragment rows as one table in the serial order (by fragment id)."""
+    merged = {column: np.concatenate([t[column] for t in tables]) for column in tables[0]}
+    order = np.argsort(merged["fragment"], kind="stable")
+    return {column: values[order] for column, values in merged.items()}
