@@ -60,6 +60,7 @@ from granulate.parallel.transplant import (
     GrainState,
     body_first_nodes,
     grain_states,
+    moment_of,
     restore_grains,
     wall_lists,
 )
@@ -324,7 +325,17 @@ class DistributedRun:
         radii: NDArray[np.float64],
     ) -> NDArray[np.int64]:
         """_distribute from every grain's node positions (`grains`), which every rank has at
-        the start and from a checkpoint, and their bounding spheres (_spheres)."""
+        the start, and their bounding spheres (_spheres)."""
+        return self._distribute(*self._layout(grains, centres, radii))
+
+    def _layout(
+        self,
+        grains: Sequence[NDArray[np.float64]],
+        centres: NDArray[np.float64],
+        radii: NDArray[np.float64],
+    ) -> tuple[Any, ...]:
+        """What _distribute reads of every grain's node positions (`grains`) and bounding
+        spheres: those, PeriDEM's damped centres' positions and the large bodies' pairs."""
         damped = None
         if self._damped_centres is not None:
             starts = [where.start for where in self._slices]
@@ -338,7 +349,7 @@ class DistributedRun:
                 ]
             )
         large = self._pairs_of_large(centres, radii, {int(g): grains[g] for g in self._large})
-        return self._distribute(centres, radii, damped, large)
+        return centres, radii, damped, large
 
     def _pairs_of_large(
         self,
@@ -976,22 +987,33 @@ class DistributedRun:
     def load_checkpoint(self, path: str | os.PathLike[str], outputs: Outputs | None = None) -> None:
         """Continue from a checkpoint of this set-up written by a run on any number of ranks, or
         by a serial run (else InputError on every rank): rank 0 reads it into its simulation
-        (with `outputs`' bookkeeping, granulate.checkpoints.load), the grains are cut anew where
-        it has them and each rank builds its part from their states. Every rank calls it."""
+        (with `outputs`' bookkeeping, granulate.checkpoints.load) and tells every rank where
+        the grains are (their bounding spheres); the grains are cut anew there, and rank 0
+        sends each rank the states of the grains it holds, of which it builds its part. Every
+        rank calls it."""
+        states: dict[int, GrainState] = {}
 
-        def read() -> tuple[dict[int, GrainState], dict[str, Any]]:
+        def read() -> tuple[tuple[Any, ...], dict[str, Any]]:
             sim = self._sim
             checkpoints.load(sim, path, outputs)
             sim._gathered = None  # the evaluation gathered before is not the checkpoint's
             saved = dict(sim.core.checkpoint())
             every = {g: self._slices[g] for g in range(len(self._slices))}
-            return grain_states(sim, saved, np.arange(self._node_count), every), saved
+            states.update(grain_states(sim, saved, np.arange(self._node_count), every))
+            grains = [states[g].positions for g in range(len(self._slices))]
+            layout = self._layout(grains, *_spheres(grains, self._sim.dimension))
+            return layout, moment_of(saved)
 
         start = time.perf_counter()
-        states, moment = self.comm.bcast(on_root(self.comm, read), root=0)
-        grains = [states[g].positions for g in range(len(self._slices))]
-        held = self._distribute_whole(grains, *_spheres(grains, self._sim.dimension))
-        together(self.comm, lambda: self._rebuild(held, states, moment))
+        layout, moment = self.comm.bcast(on_root(self.comm, read), root=0)
+        held = self._distribute(*layout)
+        every_held = self.comm.gather(held, root=0)
+        mine = self.comm.scatter(
+            None if every_held is None else [{int(g): states[g] for g in h} for h in every_held],
+            root=0,
+        )
+        states.clear()
+        together(self.comm, lambda: self._rebuild(held, mine, moment))
         self._exchange_caps()
         self._loaded_walls = np.asarray(moment["contact_wall_reactions"]).reshape(-1, 6)
         self._migration_due = False

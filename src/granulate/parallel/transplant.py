@@ -239,6 +239,12 @@ def restore_grains(
 
 # The entries of a checkpoint that are the same on every rank at a step, or that the receiving
 # rank keeps as its own (its counters, its walls' last reactions: recomputed by the next step).
+def moment_of(saved: dict[str, Any]) -> dict[str, Any]:
+    """Of a core checkpoint (core.checkpoint()), what restore_grains reads besides the grains'
+    states: the time, step and contact scalars."""
+    return {key: saved[key] for key in _MOMENT_KEYS}
+
+
 _MOMENT_KEYS = (
     "time",
     "step",
