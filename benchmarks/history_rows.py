@@ -24,6 +24,7 @@ from types import SimpleNamespace
 
 import numpy as np
 from mpi4py import MPI
+from process_memory import resident_mb
 
 from granulate.case import load_case
 from granulate.parallel import DistributedRun
@@ -81,15 +82,6 @@ def row(data: StepData, outputs: SimpleNamespace) -> dict[str, float | int]:
     for section in SECTIONS:
         columns.update(section.columns(data, outputs))  # type: ignore[arg-type]
     return columns
-
-
-def resident_mb() -> float:
-    """VmRSS of this process [MB], from /proc/self/status."""
-    with open("/proc/self/status") as status:
-        for line in status:
-            if line.startswith("VmRSS:"):
-                return float(line.split()[1]) / 1024
-    return float("nan")
 
 
 if __name__ == "__main__":

@@ -20,20 +20,11 @@ import argparse
 import warnings
 
 from mpi4py import MPI
+from process_memory import status_mb
 
 from granulate import bench_ranks
 from granulate.parallel import DistributedRun
 from granulate.threads import set_num_threads
-
-
-def resident_mb() -> tuple[float, float]:
-    """(VmRSS, VmHWM) of this process [MB], from /proc/self/status."""
-    fields = {}
-    with open("/proc/self/status") as status:
-        for line in status:
-            name, _, value = line.partition(":")
-            fields[name] = value
-    return tuple(float(fields[name].split()[0]) / 1024 for name in ("VmRSS", "VmHWM"))
 
 
 def main() -> None:
@@ -47,12 +38,12 @@ def main() -> None:
     sim = bench_ranks.pile3d(arguments.grains, placed=arguments.placed)
     assembly = sim._assembly
     whole = sum(nodes.nbytes for nodes in assembly.stored_arrays())
-    set_up, _ = resident_mb()
+    set_up, _ = status_mb("VmRSS", "VmHWM")
     with warnings.catch_warnings():
         warnings.filterwarnings("ignore", message="contact.*bodies pressed")
         run = DistributedRun(sim, comm)
         run.run(arguments.steps)
-    stepped, peak = resident_mb()
+    stepped, peak = status_mb("VmRSS", "VmHWM")
     bonds, rest = run.local.core.memory_bytes()
     row = (run.owned_node_count, set_up, stepped, peak, bonds / 2**20, rest / 2**20, whole / 2**20)
     rows = comm.gather(row, root=0)

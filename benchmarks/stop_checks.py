@@ -21,6 +21,7 @@ import time
 import warnings
 
 from mpi4py import MPI
+from process_memory import resident_mb
 
 from granulate import bench_ranks
 from granulate.parallel import DistributedRun
@@ -32,15 +33,6 @@ CRITERIA = (
     "broken_bonds",
     "fully_broken_particles",
 )
-
-
-def resident_mb() -> float:
-    """VmRSS of this process [MB], from /proc/self/status."""
-    with open("/proc/self/status") as status:
-        for line in status:
-            if line.startswith("VmRSS:"):
-                return float(line.split()[1]) / 1024
-    return float("nan")
 
 
 def measured(run: DistributedRun) -> tuple[float, ...]:

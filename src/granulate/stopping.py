@@ -14,8 +14,9 @@ of the first one met, or None when it ran to the end.
 Each reads the run through the measures of ``RunMeasures``, which a Simulation has and which a
 distributed run makes on every rank with one reduction each (parallel/run_measures.py), the
 same values to the bit: its ranks need not send rank 0 their nodes to check them. A criterion
-of your own that reads more of the simulation sets ``needs_whole_state = True``; a distributed
-run then gathers the whole state on rank 0 and checks it there.
+of your own (a StopCriterion subclass) is given the Simulation: a distributed run gathers the
+whole state on rank 0 and checks it there, unless its class sets ``needs_whole_state = False``
+because it reads only RunMeasures.
 """
 
 from __future__ import annotations

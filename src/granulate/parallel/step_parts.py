@@ -22,7 +22,7 @@ rank 0 (DistributedRun.collect).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -33,7 +33,7 @@ from granulate.analysis import complete_particle_table
 from granulate.evaluation import Evaluation
 from granulate.parallel.whole_state import owned_contacts, serial_order
 from granulate.step_totals import StepTotals, TrackedSums, node_totals
-from granulate.writers.step_data import StepData
+from granulate.writers.step_data import StepData, set_up_fields
 
 if TYPE_CHECKING:
     from granulate.parallel.engine import DistributedRun
@@ -85,7 +85,7 @@ def step_part(run: DistributedRun, tracked: tuple[int, ...]) -> StepPart:
     table["fragment"] = run.global_nodes(nodes[table["fragment"]]).astype(np.int64)
     grain_volumes = np.bincount(grain, volumes, count)
     return StepPart(
-        StepTotals(*(getattr(totals, f) for f in _NODE_FIELDS), tracked=sums),
+        replace(totals, tracked=sums),
         table,
         run.owned,
         particle_table.motion(grain, mass, x, v, count),
@@ -139,14 +139,8 @@ def step_data(
         evaluation,
         particles,
         (stresses, volumes),
-        sim.walls,
-        tuple(float(wall.displacement(core.time)) for wall in core.walls),
-        np.asarray(sim.gravity, dtype=np.float64),
-        sim.dimension,
+        *set_up_fields(sim, core),
     )
-
-
-_NODE_FIELDS = ("kinetic", "strain", "gravity", "contact", "damaged_volume", "volume")
 
 
 def _tracked_sums(run: DistributedRun, grain: int) -> TrackedSums:

@@ -4,8 +4,8 @@ its ranks measured of their own grains (parallel/step_parts.py), with no node ar
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from dataclasses import dataclass, replace
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -70,13 +70,21 @@ class StepData:
             evaluation,
             particles,
             (stresses, volumes),
-            sim.walls,
-            tuple(float(wall.displacement(core.time)) for wall in core.walls),
-            np.asarray(sim.gravity, dtype=np.float64),
-            sim.dimension,
+            *set_up_fields(sim, core),
             sim,
             (phi, z),
         )
+
+
+def set_up_fields(sim: Simulation, core: Any) -> tuple[Any, ...]:
+    """StepData's walls, wall displacements, gravity and dimension: of `sim`'s set-up, the
+    walls displaced to `core`'s time (its walls: the whole core's, or a part's)."""
+    return (
+        sim.walls,
+        tuple(float(wall.displacement(core.time)) for wall in core.walls),
+        np.asarray(sim.gravity, dtype=np.float64),
+        sim.dimension,
+    )
 
 
 def whole_totals(
@@ -102,7 +110,4 @@ def whole_totals(
         )
         for body in tracked
     )
-    return StepTotals(*(getattr(totals, f) for f in _ENERGY_FIELDS), tracked=sums)
-
-
-_ENERGY_FIELDS = ("kinetic", "strain", "gravity", "contact", "damaged_volume", "volume")
+    return replace(totals, tracked=sums)
