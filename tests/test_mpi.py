@@ -255,3 +255,22 @@ def test_stop_criteria_read_the_ranks_measures_and_stop_at_the_serial_step(
     assert broken[engine] in done.stdout
     stops = [line for line in done.stdout.splitlines() if line.startswith("stop ")]
     assert len(stops) == 3 and all("the state gathered 1 times" in line for line in stops)
+
+
+THREADS_CHECK = Path(__file__).with_name("mpi_threads_check.py")
+
+
+@pytest.mark.parametrize("given", [None, "2"])
+def test_each_rank_takes_its_share_of_the_cores_unless_told(given: str | None) -> None:
+    """Ranks on one machine left at OpenMP's default thread count each use their share of the
+    CPUs (parallel/rank_threads.py: at least 1); OMP_NUM_THREADS is used as given."""
+    environment = {k: v for k, v in os.environ.items() if k != "OMP_NUM_THREADS"}
+    if given is not None:
+        environment["OMP_NUM_THREADS"] = given
+    command = [mpiexec(), "-n", "2", sys.executable, str(THREADS_CHECK)]
+    done = subprocess.run(command, capture_output=True, text=True, timeout=300, env=environment)
+    assert done.returncode == 0, done.stdout + done.stderr
+    rows = done.stdout.split("threads and CPUs per rank [")[1].split("]")[0]
+    pairs = [tuple(map(int, pair.strip("() ").split(","))) for pair in rows.split("), (")]
+    expected = int(given) if given else max(1, pairs[0][1] // 2)
+    assert [threads for threads, _ in pairs] == [expected, expected]

@@ -54,6 +54,7 @@ from granulate.parallel.partition import (
     near_pairs,
     near_pairs_with_large,
 )
+from granulate.parallel.rank_threads import share_of_cores
 from granulate.parallel.run_measures import RankMeasures
 from granulate.parallel.step_parts import step_data, step_part
 from granulate.parallel.transplant import (
@@ -155,6 +156,7 @@ class DistributedRun:
         self.mpi = MPI
         self.comm = comm
         self._sim = sim
+        share_of_cores(comm)
         self._slices = [body.node_slice for body in sim.bodies]  # each grain's global nodes
         self._node_count = sim._assembly.node_count
         self._weights = np.array([body.node_count for body in sim.bodies], dtype=float)

@@ -40,6 +40,7 @@ from granulate.evaluation import Evaluation
 from granulate.parallel.agreement import attempt, on_root, stop_if_any_failed, together
 from granulate.parallel.overlap import while_travelling
 from granulate.parallel.partition import bisect
+from granulate.parallel.rank_threads import share_of_cores
 from granulate.parallel.run_measures import RankMeasures
 from granulate.writers.vtu_frame import FIELD_TYPES, point_fields, write_piece_rows
 
@@ -66,6 +67,7 @@ class NodeSplitRun:
         from mpi4py import MPI
 
         self.comm, self.mpi, self._sim = comm, MPI, sim
+        share_of_cores(comm)
         ranks, nodes = comm.Get_size(), sim.node_count
         if ranks > nodes:
             raise InputError(
