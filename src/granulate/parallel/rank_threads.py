@@ -3,11 +3,12 @@
 Every rank of a distributed run runs its own OpenMP threads. Left at OpenMP's default (every CPU
 the process may use), K ranks on one machine start K times as many threads as it has cores, and
 threads spinning at their barriers while another rank holds their core slow a run down by up to
-two orders of magnitude (the drum of tests/mpi_stop_check.py, 600 steps of a bare DistributedRun
-on 2 ranks of 2 cores: 59-62 s with 2 threads each, 0.07-0.08 s with 1). So, unless the user set a thread count
-(OMP_NUM_THREADS, granulate.set_num_threads, ``granulate --threads``: granulate.threads), a
-rank uses at most its share: the CPUs it may use over the ranks on its machine
-(MPI.COMM_TYPE_SHARED), at least 1. Simulation.run's thread tuner then adapts below that.
+three orders of magnitude (the drum of tests/mpi_stop_check.py, 600 steps of a bare
+DistributedRun on 2 ranks of 2 cores: 59-62 s with 2 threads each, 0.07-0.08 s with 1). So,
+unless the user set a thread count (OMP_NUM_THREADS, granulate.set_num_threads, ``granulate
+--threads``: granulate.threads), a rank uses at most its share: the CPUs it may use over the
+ranks on its machine (MPI.COMM_TYPE_SHARED), at least 1. Simulation.run's thread tuner then
+adapts below that.
 """
 
 from __future__ import annotations

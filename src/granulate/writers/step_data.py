@@ -64,7 +64,7 @@ class StepData:
         return cls(
             int(core.step),
             float(core.time),
-            whole_totals(sim, phi, tracked),
+            whole_totals(sim, phi, evaluation.contact_energy, tracked),
             int(core.broken_bonds()),
             sim.fragment_table(),
             evaluation,
@@ -88,17 +88,17 @@ def set_up_fields(sim: Simulation, core: Any) -> tuple[Any, ...]:
 
 
 def whole_totals(
-    sim: Simulation, damage: NDArray[np.float64], tracked: tuple[Body, ...]
+    sim: Simulation, damage: NDArray[np.float64], contact: float, tracked: tuple[Body, ...]
 ) -> StepTotals:
-    """StepTotals of every node of `sim` (its strain energy densities, contact energies and
-    `damage` phi), with the sums of the `tracked` bodies."""
+    """StepTotals of every node of `sim` (its strain energy densities and `damage` phi), its
+    `contact` energy (Evaluation's, a correctly rounded sum already), with the sums of the
+    `tracked` bodies."""
     model, core = sim.model, sim.core
     volumes = np.asarray(model.volumes)
     mass = np.asarray(model.node_density) * volumes
     density = sim.analysis.strain_energy_densities()
-    contact = [sim.evaluation().contact_energy]  # a correctly rounded sum already
     totals = node_totals(
-        mass, volumes, core.velocities, core.positions, sim.gravity, density, contact, damage
+        mass, volumes, core.velocities, core.positions, sim.gravity, density, [contact], damage
     )
     sums = tuple(
         TrackedSums.of(
