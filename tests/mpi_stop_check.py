@@ -17,7 +17,8 @@ on any difference:
 - outputs (`grains` only): the drum with frames in pieces and a tracked grain, every 100 steps:
   every file but the frames' pieces and run.json as the serial run's (history.csv but its
   list searches), the state gathered once (at the end: each output step is made of the
-  ranks' measures, parallel/step_parts.py).
+  ranks' measures, parallel/step_parts.py); and again with a history section of a user's own
+  that reads the simulation's velocities (LargestSpeed), whose every output step gathers it.
 """
 
 from __future__ import annotations
@@ -37,6 +38,8 @@ sys.path.insert(0, str(Path(__file__).parent))
 import granulate as gr
 from granulate.parallel import DistributedRun
 from granulate.parallel.node_split import NodeSplitRun
+from granulate.writers import registry
+from granulate.writers.step_data import StepData
 from run_folders import SEARCHES, history, outputs
 from test_checkpoint import tumbling_drum
 from test_node_split import pulled
@@ -145,10 +148,23 @@ def counting(owner: type[DistributedRun] | type[NodeSplitRun]) -> Iterator[list[
         owner.collect = collect  # type: ignore[method-assign]
 
 
-def check_outputs(steps: int, comm: MPI.Comm) -> bool:
+class LargestSpeed:
+    """A history section of a user's own: it reads the simulation's node velocities, so a
+    distributed run gathers the whole state on rank 0 for every output step."""
+
+    def columns(self, data: StepData, outputs: object) -> dict[str, float | int]:
+        assert data.simulation is not None
+        speeds = np.linalg.norm(data.simulation.velocities, axis=1)
+        return {"largest_speed": float(speeds.max())}
+
+
+def check_outputs(steps: int, comm: MPI.Comm, own_section: bool = False) -> bool:
     """The drum's outputs in pieces on the ranks against the serial run's (the module
-    docstring); rank 0 prints what differs."""
+    docstring), with LargestSpeed registered when `own_section`; rank 0 prints what differs."""
     root = Path(comm.bcast(tempfile.mkdtemp() if comm.Get_rank() == 0 else None, root=0))
+    sections = list(registry.HISTORY_SECTIONS)
+    if own_section:
+        registry.register_history_section(LargestSpeed())
     with counting(DistributedRun) as gathered:
         for name, ranks in (("serial", None), ("ranks", comm)):
             if ranks is None and comm.Get_rank() != 0:
@@ -157,6 +173,7 @@ def check_outputs(steps: int, comm: MPI.Comm) -> bool:
             sim.output(root / name, every=CHECK_EVERY, pieces=True, track=[sim.bodies[3]])
             sim.run(steps)
             gathered[0] = 0 if ranks is None else gathered[0]
+    registry.HISTORY_SECTIONS[:] = sections
     if comm.Get_rank() != 0:
         return True
     found = {name: outputs(root / name) for name in ("serial", "ranks")}
@@ -173,12 +190,14 @@ def check_outputs(steps: int, comm: MPI.Comm) -> bool:
     for row in (*rows[0], *rows[1]):
         del row[SEARCHES]
     shutil.rmtree(root)
+    kind = "with a section of its own" if own_section else "grains"
     print(
-        f"outputs grains on {comm.Get_size()} ranks: {len(kept['serial'])} files but frames, "
+        f"outputs {kind} on {comm.Get_size()} ranks: {len(kept['serial'])} files but frames, "
         f"differing {differ}; history equal but list searches {rows[0] == rows[1]} "
         f"({len(rows[0])} rows, {len(rows[0][0])} columns); the state gathered {gathered[0]} times"
     )
-    return not differ and rows[0] == rows[1] and gathered[0] == 1
+    once_each = len(rows[0]) + 1 if own_section else 1  # every output step, and the end
+    return not differ and rows[0] == rows[1] and gathered[0] == once_each
 
 
 def _thresholds(seen: list[tuple[float, ...]]) -> list[gr.stopping.StopCriterion]:
@@ -206,7 +225,9 @@ def main() -> int:
     comm = MPI.COMM_WORLD
     measured, seen = check_measures(engine, steps, comm)
     stopped = check_stops(engine, steps, seen, comm)
-    written = check_outputs(steps, comm) if engine == "grains" else True
+    written = engine != "grains" or (
+        check_outputs(steps, comm) and check_outputs(steps, comm, own_section=True)
+    )
     return 0 if comm.bcast(measured and stopped and written, root=0) else 1
 
 
