@@ -247,7 +247,10 @@ def test_stop_criteria_read_the_ranks_measures_and_stop_at_the_serial_step(
     drum (whole grains) and of the pulled plate (cut at node level), equal the serial run's to
     the bit, particles fully broken by hand included (of a body cut among ranks, for the
     plate); runs with a threshold one float past a serial check's value stop at that check,
-    with the serial reason, and gather the state on rank 0 only at the end."""
+    with the serial reason, and gather the state on rank 0 only at the end. The drum's outputs
+    in pieces (a tracked grain's columns among them) are the serial run's, every output step
+    made of the ranks' measures (the state gathered only at the end), and with a history
+    section of a user's own that reads the simulation, every output step gathers it."""
     done = run_ranks(ranks, engine, str(steps), script=STOP_CHECK)
     assert done.returncode == 0, done.stdout + done.stderr
     assert f"measures {engine} on {ranks} ranks: equal True" in done.stdout
@@ -255,6 +258,16 @@ def test_stop_criteria_read_the_ranks_measures_and_stop_at_the_serial_step(
     assert broken[engine] in done.stdout
     stops = [line for line in done.stdout.splitlines() if line.startswith("stop ")]
     assert len(stops) == 3 and all("the state gathered 1 times" in line for line in stops)
+    if engine == "grains":
+        assert (
+            f"outputs grains on {ranks} ranks: 30 files but frames, differing []; history equal "
+            "but list searches True (7 rows, 31 columns); the state gathered 1 times"
+        ) in done.stdout
+        assert (
+            f"outputs with a section of its own on {ranks} ranks: 30 files but frames, "
+            "differing []; history equal but list searches True (7 rows, 32 columns); the state "
+            "gathered 8 times"
+        ) in done.stdout
 
 
 THREADS_CHECK = Path(__file__).with_name("mpi_threads_check.py")
