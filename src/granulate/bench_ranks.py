@@ -36,9 +36,11 @@ the step's messages after the bond forces it evaluates while they travel: what t
 did not hide), in the checks (a reduction
 after each step, and one within each step whose caps leave ghost nodes out), in picking the
 caps anew, in migrations and, with
-``--collect-every N``, in gathering the whole state into rank 0's simulation every N steps (as a
-run with outputs every N steps does, DistributedRun.collect, the ranks measuring their grains
-for the outputs too; nothing is written, and the row rank 0 would compute is not); then the
+``--collect-every N``, in making an output step every N steps: of whole grains, the step made
+of the ranks' measures of their grains (DistributedRun.step_data, as a run with frames in pieces
+or no frames does at its output steps); of a body cut at node level, the whole state gathered
+into rank 0's simulation (NodeSplitRun.collect, as its outputs do); nothing is written, and
+no row is computed from it; then the
 migrations and grains handed over, the ghost and cap margins and how often the caps were
 picked anew. With ``--json``, one JSON object instead. On fewer cores
 than ranks (oversubscribed) the shares include waiting for the other ranks and are an upper
@@ -307,11 +309,14 @@ def measure_split(
 
 def _timed(run: Any, steps: int, collect_every: int, comm: Any) -> float:
     """The wall-clock seconds of `steps` steps of `run` (a DistributedRun or NodeSplitRun),
-    gathering the whole state every `collect_every` (0: never); its `seconds` and `waiting`
-    count these steps alone."""
+    making an output step every `collect_every` (0: never; module docstring); its `seconds`
+    and `waiting` count these steps alone."""
+    from granulate.parallel import DistributedRun
+
     every = collect_every or steps
+    output = (lambda: run.step_data(())) if isinstance(run, DistributedRun) else run.collect
     if collect_every:
-        run.collect()  # rank 0 builds the whole simulation once, untimed
+        output()  # once untimed (NodeSplitRun: rank 0 builds its whole simulation)
     run.seconds = dict.fromkeys(run.seconds, 0.0)
     run.waiting = 0.0
     comm.Barrier()  # every rank's clock starts together
@@ -319,7 +324,7 @@ def _timed(run: Any, steps: int, collect_every: int, comm: Any) -> float:
     for done in range(0, steps, every):
         run.run(min(every, steps - done))
         if collect_every:
-            run.collect()
+            output()
     return time.perf_counter() - start
 
 
