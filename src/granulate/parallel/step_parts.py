@@ -15,9 +15,9 @@ Rank 0 puts the fragment rows in the serial order (by id), the grains' rows in g
 contacts in the serial slot order, and completes the particle table from them
 (analysis.complete_particle_table): every column is the serial run's.
 
-A frame of every node (output without pieces), a writer registered from outside the package and
-a body cut at node level (NodeSplitRun, whose pieces span ranks) still need the whole state on
-rank 0 (DistributedRun.collect).
+A frame of every node (output without pieces), a writer registered from outside the package, a
+checkpoint, the end of a run and a body cut at node level (NodeSplitRun, whose pieces span
+ranks) still take the whole state on rank 0 (DistributedRun.collect).
 """
 
 from __future__ import annotations
@@ -70,23 +70,10 @@ def step_part(run: DistributedRun, tracked: tuple[int, ...]) -> StepPart:
     sums = tuple(_tracked_sums(run, grain) for grain in tracked)
     grain = np.searchsorted(run.owned, run.held[np.asarray(model.node_particle)[nodes]])
     count = len(run.owned)
-    # Each piece labelled by its smallest node's place among the own nodes (the part numbers
-    # a grain's nodes in the whole run's order), then by that node's number in the whole run.
-    place = np.searchsorted(nodes, np.asarray(core.fragments())[nodes])
-    table = fragments.fragment_table(
-        place,
-        run.owned[grain],
-        x,
-        v,
-        volumes,
-        np.asarray(model.node_density)[nodes],
-        local.dimension,
-    )
-    table["fragment"] = run.global_nodes(nodes[table["fragment"]]).astype(np.int64)
     grain_volumes = np.bincount(grain, volumes, count)
     return StepPart(
         replace(totals, tracked=sums),
-        table,
+        _own_fragments(run, run.owned[grain]),
         run.owned,
         particle_table.motion(grain, mass, x, v, count),
         grain_volumes,
@@ -141,6 +128,20 @@ def step_data(
         (stresses, volumes),
         *set_up_fields(sim, core),
     )
+
+
+def _own_fragments(run: DistributedRun, grains: NDArray[np.int64]) -> fragments.Table:
+    """The fragment rows of the rank's own nodes (whose grains these are), each piece labelled
+    by its smallest node in the whole run's numbering. The part numbers a grain's nodes in the
+    whole run's order, so that node is the piece's smallest here too."""
+    local, nodes = run.local, run.owned_nodes
+    core, model = local.core, local.model
+    place = np.searchsorted(nodes, np.asarray(core.fragments())[nodes])  # among the own nodes
+    volumes, density = (np.asarray(a)[nodes] for a in (model.volumes, model.node_density))
+    x, v = core.positions[nodes], core.velocities[nodes]
+    table = fragments.fragment_table(place, grains, x, v, volumes, density, local.dimension)
+    table["fragment"] = run.global_nodes(nodes[table["fragment"]]).astype(np.int64)
+    return table
 
 
 def _tracked_sums(run: DistributedRun, grain: int) -> TrackedSums:
