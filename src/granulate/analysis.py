@@ -36,12 +36,6 @@ def gravity_energies(
     return -np.asarray(mass, dtype=np.float64) * (x[:, 0] * g[0] + x[:, 1] * g[1] + x[:, 2] * g[2])
 
 
-def mean_damage(damage: ArrayLike, volumes: ArrayLike) -> float:
-    """sum_i V_i phi_i / sum_i V_i, the volume-weighted mean damage, of correctly rounded sums."""
-    v = np.asarray(volumes, dtype=np.float64)
-    return ExactSum.of(v * np.asarray(damage, dtype=np.float64)).value / ExactSum.of(v).value
-
-
 def complete_particle_table(
     motion: particle_table.Table,
     volumes: NDArray[np.float64],

@@ -95,7 +95,7 @@ def summary(table: Table, mean_damage: float) -> dict[str, float | int]:
     """The history columns of a fragment table: fragments (pieces of two nodes or more),
     debris_nodes, debris_mass, particles_split (particles in two pieces or more; not the stop
     criterion's particles that lost every bond), and `mean_damage`, the volume-weighted mean
-    damage of all nodes (analysis.mean_damage)."""
+    damage of all nodes (step_totals.StepTotals.mean_damage)."""
     debris = table["debris"] == 1
     pieces = np.bincount(table["particle"])
     return {
