@@ -13,7 +13,8 @@ on any difference:
 - stops: Simulation(comm=...).run with a stop criterion whose threshold lies one float past the
   serial run's value at a check (so a value one bit off stops elsewhere), for each criterion
   in turn: the reason and step, and how many times the ranks sent rank 0 their state (once,
-  at the end: the checks gather nothing);
+  at the end: the checks gather nothing); and a criterion of a user's own reading the
+  simulation's velocities (LargestSpeedAt), whose every check gathers it;
 - outputs (`grains` only): the drum with frames in pieces and a tracked grain, every 100 steps:
   every file but the frames' pieces and run.json as the serial run's (history.csv but its
   list searches), the state gathered once (at the end: each output step is made of the
@@ -29,6 +30,7 @@ import tempfile
 import warnings
 from collections.abc import Iterator
 from contextlib import contextmanager
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -128,8 +130,26 @@ def check_stops(engine: str, steps: int, seen: list[tuple[float, ...]], comm: MP
                 f"stop {engine} on {comm.Get_size()} ranks, {criterion}: {got} "
                 f"(serially {expected}), the state gathered {gathered[0]} times"
             )
-            same = same and got == expected and got[0] is not None and gathered[0] == 1
+            checks = got[1] // CHECK_EVERY  # a criterion of one's own gathers at each, and the end
+            once = checks + 1 if criterion.needs_whole_state else 1
+            same = same and got == expected and got[0] is not None and gathered[0] == once
     return same
+
+
+@dataclass(frozen=True)
+class LargestSpeedAt(gr.stopping.StopCriterion):
+    """A stop criterion of a user's own: at `step`, stop and give the largest node speed read
+    from the simulation's velocities (so a distributed run gathers the whole state for it)."""
+
+    step: int
+
+    def check(self, run: gr.stopping.RunMeasures) -> str | None:
+        sim = run
+        assert isinstance(sim, gr.Simulation)
+        if sim.step < self.step:
+            return None
+        speed = float(np.linalg.norm(sim.velocities, axis=1).max())
+        return f"largest speed {speed!r} m/s at step {sim.step}"
 
 
 @contextmanager
@@ -210,6 +230,7 @@ def _thresholds(seen: list[tuple[float, ...]]) -> list[gr.stopping.StopCriterion
         gr.stopping.KineticEnergyBelow(float(np.nextafter(-energy, np.inf))),
         gr.stopping.NodeDistance(float(np.nextafter(farthest, -np.inf))),
         gr.stopping.BrokenBonds(int(broken)),
+        LargestSpeedAt(3 * CHECK_EVERY),
     ]
 
 

@@ -247,7 +247,9 @@ def test_stop_criteria_read_the_ranks_measures_and_stop_at_the_serial_step(
     drum (whole grains) and of the pulled plate (cut at node level), equal the serial run's to
     the bit, particles fully broken by hand included (of a body cut among ranks, for the
     plate); runs with a threshold one float past a serial check's value stop at that check,
-    with the serial reason, and gather the state on rank 0 only at the end. The drum's outputs
+    with the serial reason, and gather the state on rank 0 only at the end; a criterion of a
+    user's own that reads the simulation stops with the serial reason, its every check
+    gathering the state. The drum's outputs
     in pieces (a tracked grain's columns among them) are the serial run's, every output step
     made of the ranks' measures (the state gathered only at the end), and with a history
     section of a user's own that reads the simulation, every output step gathers it."""
@@ -257,7 +259,8 @@ def test_stop_criteria_read_the_ranks_measures_and_stop_at_the_serial_step(
     broken = {"grains": "2 particles fully broken by hand (serially 2)", "split": "1 particles"}
     assert broken[engine] in done.stdout
     stops = [line for line in done.stdout.splitlines() if line.startswith("stop ")]
-    assert len(stops) == 3 and all("the state gathered 1 times" in line for line in stops)
+    assert len(stops) == 4 and all("the state gathered 1 times" in line for line in stops[:3])
+    assert "LargestSpeedAt(step=300)" in stops[3] and "the state gathered 4 times" in stops[3]
     if engine == "grains":
         assert (
             f"outputs grains on {ranks} ranks: 30 files but frames, differing []; history equal "
