@@ -7,6 +7,8 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from granulate.exact_sum import ExactSum
 
@@ -63,3 +65,22 @@ def test_extremes() -> None:
     assert math.isnan((ExactSum.of([math.inf]) + ExactSum.of([-math.inf])).value)
     assert math.isnan((ExactSum.of([1.0]) + ExactSum.of([math.nan])).value)
     assert ExactSum.of(np.ones((3, 4))).value == 12.0
+
+
+@settings(max_examples=300, deadline=None, derandomize=True)
+@given(
+    st.lists(st.floats(allow_nan=False, allow_infinity=False), max_size=60),
+    st.integers(min_value=0, max_value=60),
+)
+def test_any_floats_split_anywhere_sum_as_fsum(terms: list[float], cut: int) -> None:
+    """Hypothesis' floats (subnormals, the largest, signed zeros), cut in two anywhere: the
+    parts added give math.fsum's bits, or infinity where the exact sum is beyond the largest
+    float (fsum raises there)."""
+    parts = ExactSum.of(terms[:cut]) + ExactSum.of(terms[cut:])
+    try:
+        expected = math.fsum(terms)
+    except OverflowError:
+        assert math.isinf(parts.value)
+        return
+    assert parts.value == expected
+    assert ExactSum.of(terms).value == expected

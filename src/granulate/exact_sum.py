@@ -44,7 +44,8 @@ class ExactSum:
         x = np.asarray(terms, dtype=np.float64).ravel()
         finite = np.isfinite(x)
         if not finite.all():
-            return cls(0, float(np.sum(x[~finite])))
+            with np.errstate(invalid="ignore"):  # inf - inf: nan, as float addition gives
+                return cls(0, float(np.sum(x[~finite])))
         scaled = 0
         for start in range(0, len(x), _CHUNK):
             scaled += _scaled_chunk(x[start : start + _CHUNK])
