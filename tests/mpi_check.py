@@ -32,7 +32,9 @@ margin [m], without migrating grains (or with), expecting every rank to stop wit
 InputError that says the grains moved too far for it;
 `... DIMENSION STEPS fail` blows up one rank's step and expects every rank to stop;
 `... DIMENSION STEPS fail-start` (`fail-migration`) makes the last rank fail to build its part
-at the start (in a migration) and expects every rank to stop."""
+at the start (in a migration) and expects every rank to stop; `... DIMENSION STEPS fail-whole`
+leaves rank 0 too little memory to build its whole simulation when the ranks first gather the
+state into it, and expects every rank to stop with rank 0's InputError."""
 
 from __future__ import annotations
 
@@ -50,7 +52,7 @@ from mpi4py import MPI
 
 sys.path.insert(0, str(Path(__file__).parent))
 import granulate as gr
-from granulate import checkpoints
+from granulate import checkpoints, resources
 from granulate.parallel import DistributedRun
 from run_folders import SEARCHES, differing, history
 from test_checkpoint import tumbling_drum
@@ -141,6 +143,8 @@ def main() -> int:
     dimension, steps = int(sys.argv[1]), int(sys.argv[2])
     if len(sys.argv) > 3 and sys.argv[3] == "fail":
         return check_failure(dimension, steps, comm)
+    if len(sys.argv) > 3 and sys.argv[3] == "fail-whole":
+        return check_whole_failure(dimension, steps, comm)
     if len(sys.argv) > 3 and sys.argv[3] in ("fail-start", "fail-migration"):
         return check_build_failure(dimension, sys.argv[3].removeprefix("fail-"), comm)
     if len(sys.argv) > 4 and sys.argv[4] == "compare":
@@ -387,6 +391,22 @@ def check_build_failure(dimension: int, during: str, comm: MPI.Comm) -> int:
     print(during, messages)
     others = all(f"rank {last} failed while building" in m for m in messages[:last])
     return 0 if others and messages[last] == "InputError: an injected failure" else 1
+
+
+def check_whole_failure(dimension: int, steps: int, comm: MPI.Comm) -> int:
+    """0 when rank 0, with too little memory left for its whole simulation (the memory check
+    of core_model), fails to take the gathered state, and every rank stops with its
+    InputError rather than waiting for it."""
+    run = DistributedRun(set_up(dimension), comm)
+    run.run(steps)
+    if comm.Get_rank() == 0:
+        resources.available_memory = lambda: 1000
+    messages = stop_messages(run.collect, comm)
+    if messages is None:
+        return 0
+    print("whole", messages)
+    same = len(set(messages)) == 1 and messages[0].startswith("InputError")
+    return 0 if same and "of memory" in messages[0] else 1
 
 
 if __name__ == "__main__":

@@ -208,6 +208,14 @@ def test_a_blow_up_on_one_rank_ends_every_rank_without_a_hang() -> None:
     assert "rank 2 failed" in done.stdout and "InstabilityError" in done.stdout
 
 
+def test_rank_0_failing_to_take_the_whole_state_ends_every_rank_without_a_hang() -> None:
+    """Rank 0's whole simulation too large for the memory left (the memory check, forced): every
+    rank stops with rank 0's InputError when the state is gathered, none waits for it."""
+    done = run_ranks(2, "2", "10", "fail-whole")
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert "whole ['InputError: " in done.stdout and "of memory" in done.stdout
+
+
 @pytest.mark.parametrize("during", ["start", "migration"])
 def test_a_failure_building_one_ranks_part_ends_every_rank_without_a_hang(during: str) -> None:
     done = run_ranks(3, "2", "0", f"fail-{during}")

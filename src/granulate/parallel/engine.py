@@ -1083,13 +1083,15 @@ class DistributedRun:
         and counts and wall reactions, in the serial order (whole_state.py): its outputs,
         measures and stop criteria are then the serial run's at this step. With `measures`
         (for outputs), each rank also measures its grains (damage, fragments, strain energy,
-        motion: analysis.GivenMeasures), which rank 0's analysis then takes."""
+        motion: analysis.GivenMeasures), which rank 0's analysis then takes. An error on
+        any rank (rank 0's whole simulation too large for its memory, say) ends every rank:
+        InputError with the same message, else that rank's error and RankFailed."""
         start = time.perf_counter()
         walls = self.wall_reactions()
-        parts = self.comm.gather(owned_part(self, measures), root=0)
-        if parts is not None:
-            core = self.local.core
-            install(self._sim, parts, (float(core.time), int(core.step)), walls)
+        part = together(self.comm, lambda: owned_part(self, measures), "measuring its grains")
+        parts = self.comm.gather(part, root=0)
+        moment = (float(self.local.core.time), int(self.local.core.step))
+        on_root(self.comm, lambda: install(self._sim, parts, moment, walls))
         self.seconds["collect"] += time.perf_counter() - start
 
     def deepest_contact(self) -> SimpleNamespace:

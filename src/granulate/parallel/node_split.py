@@ -195,15 +195,17 @@ class NodeSplitRun:
         velocity, force, dilatation and bond states from its owner, the step and time, and an
         evaluation with no contacts (the most list searches of any rank): its outputs, measures
         and stop criteria are then the serial run's at this step, which it measures itself
-        (`measures` is for the interface: nothing is measured elsewhere)."""
+        (`measures` is for the interface: nothing is measured elsewhere). An error on rank 0
+        (its whole simulation too large for its memory, say) ends every rank: InputError with
+        the same message, else rank 0's error and RankFailed."""
         start = time.perf_counter()
         core = self.local.core
         intact = np.asarray(core.bond_intact)[_copies_of(self._offsets, self.own)]
         mine = (*(np.asarray(getattr(core, f))[self.own] for f in _NODE_FIELDS), intact)
         parts = self.comm.gather(mine, root=0)
         searches = self.comm.reduce(int(core.contact_statistics.rebuilds), op=self.mpi.MAX, root=0)
-        if parts is not None:
-            self._install(parts, (float(core.time), int(core.step)), int(searches))
+        moment = (float(core.time), int(core.step))
+        on_root(self.comm, lambda: self._install(parts, moment, int(searches)))
         self.seconds["collect"] += time.perf_counter() - start
 
     def _install(
