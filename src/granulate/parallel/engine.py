@@ -1059,9 +1059,8 @@ class DistributedRun:
             ),
             root=0,
         )
-        total = None
-        if parts is not None:
-            total = _sum_wall_terms(parts, len(core.wall_reactions()))
+        walls = len(core.wall_reactions())
+        total = on_root(self.comm, lambda: _sum_wall_terms(parts, walls))
         return self.comm.bcast(total, root=0)
 
     def step_data(self, tracked: tuple[int, ...]) -> StepData | None:

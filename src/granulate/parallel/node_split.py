@@ -260,7 +260,7 @@ class NodeSplitRun:
         holds every bond (collect): a rank's own bonds do not tell which piece a node is in."""
         labels = None
         if "Fragment_ID" in fields:
-            whole = self._sim.analysis.fragment_labels() if self.comm.Get_rank() == 0 else None
+            whole = on_root(self.comm, lambda: self._sim.analysis.fragment_labels())
             mine = None if whole is None else [whole[nodes] for nodes in self.nodes_of]
             labels = self.comm.scatter(mine, root=0)
         local = [f for f in fields if f != "Fragment_ID"]
