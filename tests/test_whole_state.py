@@ -12,6 +12,7 @@ import pytest
 
 import granulate as gr
 from granulate.analysis import GivenMeasures
+from granulate.parallel.whole_state import require_room
 from test_checkpoint import tumbling_drum
 
 
@@ -88,3 +89,18 @@ def test_given_measures_stand_for_the_cores_until_the_state_changes(tmp_path: Pa
     sim.core.run(1)
     assert np.array_equal(sim.damage, sim.core.damage()[0])
     assert np.all(sim.particle_table()["vx"] != 7.0)
+
+
+def test_rank_0_is_told_at_the_start_when_the_whole_model_will_not_fit(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """whole_state.require_room (every distributed run's rank 0, once its part is built): the
+    model's memory check on the whole assembly, without building it; its message says why
+    rank 0 needs the whole model and what to do."""
+    sim = tumbling_drum(tmp_path, outputs=False)
+    require_room(sim)  # this machine holds the drum
+    assert sim._core is None  # nothing was built
+    monkeypatch.setattr(gr.resources, "available_memory", lambda: 1000)
+    with pytest.raises(gr.InputError, match=r"would need about .* of memory") as refused:
+        require_room(sim)
+    assert "rank 0 holds the whole model at checkpoints" in str(refused.value)

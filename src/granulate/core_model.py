@@ -135,6 +135,12 @@ def _translated_copies(assembly: Assembly, outer_layers: bool) -> dict[int, int]
     return copy_of
 
 
+def require_memory_for(assembly: Assembly, plane: str, outer_layers: bool) -> None:
+    """build_model's memory check of `assembly`'s model, without building it (InputError when
+    it would not fit in the memory free now)."""
+    _require_memory_for_model(assembly, plane, _translated_copies(assembly, outer_layers))
+
+
 def _require_memory_for_model(assembly: Assembly, plane: str, shapes: Mapping[int, int]) -> None:
     """InputError before the bonds are built when the model would not fit in memory: every
     node's state, and one bond family per reference shape and horizon ratio (particles placed

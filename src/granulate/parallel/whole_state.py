@@ -30,8 +30,9 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
-from granulate import network, particle_table
+from granulate import core_model, network, particle_table
 from granulate.analysis import GivenMeasures
+from granulate.errors import InputError
 from granulate.evaluation import Evaluation
 from granulate.exact_sum import ExactSum
 
@@ -42,6 +43,21 @@ if TYPE_CHECKING:
 _NO_NODE = 2**32 - 1  # ContactNetwork's node_b of a wall contact
 _ROW_KEYS = ("particle_a", "node_a", "particle_b", "node_b", "wall")
 _VECTOR_KEYS = ("point", "normal", "force")
+
+
+def require_room(sim: Simulation) -> None:
+    """Rank 0, at the start: InputError when its whole simulation, which it builds the first
+    time the ranks send it their state, would not fit in the memory free now (build_model's
+    check), rather than when it first needs it, maybe hours into the run."""
+    try:
+        outer_layers = sim._interactions.uses_surface_law()
+        core_model.require_memory_for(sim._assembly, sim.plane, outer_layers)
+    except InputError as error:
+        raise InputError(
+            f"{error}. On MPI ranks, rank 0 holds the whole model at checkpoints, frames of every "
+            "node and the end of a run: give it a machine with that much memory free (fewer "
+            "ranks beside it)"
+        ) from None
 
 
 @dataclass
