@@ -34,7 +34,10 @@ InputError that says the grains moved too far for it;
 `... DIMENSION STEPS fail-start` (`fail-migration`) makes the last rank fail to build its part
 at the start (in a migration) and expects every rank to stop; `... DIMENSION STEPS fail-whole`
 leaves rank 0 too little memory to build its whole simulation when the ranks first gather the
-state into it, and expects every rank to stop with rank 0's InputError."""
+state into it, and expects every rank to stop with rank 0's InputError; `... DIMENSION STEPS
+fail-room` makes rank 0's memory check of the whole model fail when the drum set up with
+Simulation(comm=...) starts its run, and expects every rank to stop with its InputError before
+the first step."""
 
 from __future__ import annotations
 
@@ -52,7 +55,7 @@ from mpi4py import MPI
 
 sys.path.insert(0, str(Path(__file__).parent))
 import granulate as gr
-from granulate import checkpoints, resources
+from granulate import checkpoints, core_model, resources
 from granulate.parallel import DistributedRun
 from run_folders import SEARCHES, differing, history
 from test_checkpoint import tumbling_drum
@@ -143,6 +146,8 @@ def main() -> int:
     dimension, steps = int(sys.argv[1]), int(sys.argv[2])
     if len(sys.argv) > 3 and sys.argv[3] == "fail":
         return check_failure(dimension, steps, comm)
+    if len(sys.argv) > 3 and sys.argv[3] == "fail-room":
+        return check_room_failure(steps, comm)
     if len(sys.argv) > 3 and sys.argv[3] == "fail-whole":
         return check_whole_failure(dimension, steps, comm)
     if len(sys.argv) > 3 and sys.argv[3] in ("fail-start", "fail-migration"):
@@ -407,6 +412,25 @@ def check_whole_failure(dimension: int, steps: int, comm: MPI.Comm) -> int:
     print("whole", messages)
     same = len(set(messages)) == 1 and messages[0].startswith("InputError")
     return 0 if same and "of memory" in messages[0] else 1
+
+
+def check_room_failure(steps: int, comm: MPI.Comm) -> int:
+    """0 when rank 0's memory check of the whole model (whole_state.require_room), failing on
+    rank 0 alone, stops every rank with its InputError before the drum's run (Simulation(comm=
+    ...)) takes a step."""
+    sim = tumbling_drum(Path("unused"), comm=comm, outputs=False)
+    if comm.Get_rank() == 0:
+
+        def full(*_: object) -> None:
+            raise gr.InputError("the model would need about 9 TB of memory")
+
+        core_model.require_memory_for = full
+    messages = stop_messages(lambda: sim.run(steps), comm)
+    if messages is None:
+        return 0
+    print("room", messages)
+    reason = "rank 0 holds the whole model at checkpoints"
+    return 0 if len(set(messages)) == 1 and reason in messages[0] else 1
 
 
 if __name__ == "__main__":

@@ -216,6 +216,14 @@ def test_rank_0_failing_to_take_the_whole_state_ends_every_rank_without_a_hang()
     assert "whole ['InputError: " in done.stdout and "of memory" in done.stdout
 
 
+def test_rank_0_without_room_for_the_whole_model_stops_every_rank_at_the_start() -> None:
+    """Rank 0's memory check of the whole model failing (forced) when Simulation(comm=...)
+    starts its run: every rank stops with its InputError, which says why, before a step."""
+    done = run_ranks(2, "2", "10", "fail-room")
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert "room ['InputError: the model would need about 9 TB" in done.stdout
+
+
 @pytest.mark.parametrize("during", ["start", "migration"])
 def test_a_failure_building_one_ranks_part_ends_every_rank_without_a_hang(during: str) -> None:
     done = run_ranks(3, "2", "0", f"fail-{during}")

@@ -370,6 +370,8 @@ class Simulation(SimulationSetup, SimulationResults):
         when nothing touches, the nodes dealt to the ranks (granulate.parallel.node_split)."""
         if self._distributed is None:
             from granulate.parallel import DistributedRun
+            from granulate.parallel.agreement import on_root
+            from granulate.parallel.whole_state import require_room
 
             if self._interactions.contact_free():  # nothing touches: the nodes are dealt
                 from granulate.parallel.node_split import NodeSplitRun
@@ -378,6 +380,9 @@ class Simulation(SimulationSetup, SimulationResults):
             else:
                 run = DistributedRun(self, self._comm)
             _check_time_step(run.dt, run.stable_dt)
+            # Rank 0 takes the whole state at checkpoints and the end of each run: refuse now
+            # a model it cannot hold, rather than then.
+            on_root(self._comm, lambda: require_room(self))
             if self._comm.Get_rank() == 0 and self._dt is not None:
                 _warn_above_stable(run.dt, run.stable_dt, stacklevel=4)
             self._dt_warned = True  # rank 0's whole simulation, built later, is quiet

@@ -65,7 +65,7 @@ from granulate.parallel.transplant import (
     restore_grains,
     wall_lists,
 )
-from granulate.parallel.whole_state import install, owned_part, require_room
+from granulate.parallel.whole_state import install, owned_part
 from granulate.writers.vtu_frame import write_piece
 
 if TYPE_CHECKING:
@@ -223,7 +223,6 @@ class DistributedRun:
         self._loaded_walls: NDArray[np.float64] | None = None
         held = self._distribute_whole(start, centres, radii)
         together(self.comm, lambda: self._build(held))
-        on_root(self.comm, lambda: require_room(sim))
         self._exchange_state()
         self._exchange_caps()
         self._bond_count = self._count_bonds()

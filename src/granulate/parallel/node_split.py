@@ -42,7 +42,6 @@ from granulate.parallel.overlap import while_travelling
 from granulate.parallel.partition import bisect
 from granulate.parallel.rank_threads import share_of_cores
 from granulate.parallel.run_measures import RankMeasures
-from granulate.parallel.whole_state import require_room
 from granulate.writers.vtu_frame import FIELD_TYPES, point_fields, write_piece_rows
 
 if TYPE_CHECKING:
@@ -76,7 +75,6 @@ class NodeSplitRun:
             )
         every = np.arange(len(sim.bodies))
         self.local: Simulation = together(comm, lambda: _built(sim._subdomain(every)[0]))
-        on_root(comm, lambda: require_room(sim))
         core, model = self.local.core, self.local.model
         #: The stable time-step estimate [s]: the serial run's (every rank holds the model).
         self.stable_dt = float(core.stable_time_step)
