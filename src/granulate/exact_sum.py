@@ -11,7 +11,7 @@ even on a tie): the correctly rounded sum of every term, as math.fsum gives it.
 The terms are added in NumPy: the mantissas are split into two halves of 26 and 27 bits and each
 half summed per exponent by np.bincount, whose float64 sums of integers stay exact while they
 are below 2^53 (chunks of 2^25 terms); the few exponents present are then put together in Python
-ints. About 30 ns a term.
+ints. About 35 ns a term (math.fsum: 46 ns).
 
 A non-finite term (inf, nan) makes the sum non-finite as float addition would: inf, -inf or nan,
 whatever the order.

@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import functools
 from collections.abc import Callable
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
@@ -38,24 +39,20 @@ OFFSET_TOLERANCE = 1e-8
 Surface = Callable[[], tuple[NDArray[np.float64], NDArray[np.float64]]]
 
 
+@dataclass(eq=False)
 class _Known:
     """An earlier body's arrays (references, not copies) and its surface data, computed once
     when first compared."""
 
-    def __init__(
-        self,
-        body: int,
-        positions: NDArray[np.float64],
-        volumes: NDArray[np.float64],
-        surface: Surface,
-    ) -> None:
-        self.body, self.positions, self.volumes = body, positions, volumes
-        self._surface = surface
+    body: int
+    positions: NDArray[np.float64]
+    volumes: NDArray[np.float64]
+    compute_surface: Surface
 
     @functools.cached_property
     def surface(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """The body's surface data (offsets, depths), computed when first read."""
-        return self._surface()
+        return self.compute_surface()
 
 
 class TranslatedShapes:

@@ -83,8 +83,6 @@ class StepTotals:
     tracked: tuple[TrackedSums, ...] = field(default_factory=tuple)
 
     def __add__(self, other: StepTotals) -> StepTotals:
-        tracked = self.tracked or tuple(TrackedSums() for _ in other.tracked)
-        others = other.tracked or tuple(TrackedSums() for _ in self.tracked)
         return StepTotals(
             self.kinetic + other.kinetic,
             self.strain + other.strain,
@@ -92,7 +90,7 @@ class StepTotals:
             self.contact + other.contact,
             self.damaged_volume + other.damaged_volume,
             self.volume + other.volume,
-            tuple(a + b for a, b in zip(tracked, others, strict=True)),
+            tuple(a + b for a, b in zip(self.tracked, other.tracked, strict=True)),
         )
 
     @property
@@ -108,17 +106,16 @@ def node_totals(
     positions: ArrayLike,
     gravity: ArrayLike,
     strain_density: ArrayLike,
-    contact_energy: ArrayLike,
     damage: ArrayLike,
 ) -> StepTotals:
-    """The energies' and the damage's sums over the nodes whose per-node arrays these are (no
+    """The kinetic, strain and gravity energies' and the damage's sums over the nodes whose
+    per-node arrays these are (no contact energy, which the force evaluation sums, and no
     tracked body's)."""
     v = np.asarray(volumes, dtype=np.float64)
     return StepTotals(
-        ExactSum.of(kinetic_energies(mass, velocities)),
-        ExactSum.of(np.asarray(strain_density, dtype=np.float64) * v),
-        ExactSum.of(gravity_energies(mass, positions, gravity)),
-        ExactSum.of(contact_energy),
-        ExactSum.of(v * np.asarray(damage, dtype=np.float64)),
-        ExactSum.of(v),
+        kinetic=ExactSum.of(kinetic_energies(mass, velocities)),
+        strain=ExactSum.of(np.asarray(strain_density, dtype=np.float64) * v),
+        gravity=ExactSum.of(gravity_energies(mass, positions, gravity)),
+        damaged_volume=ExactSum.of(v * np.asarray(damage, dtype=np.float64)),
+        volume=ExactSum.of(v),
     )

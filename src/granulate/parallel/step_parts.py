@@ -10,7 +10,8 @@ Each rank sends rank 0 (StepPart):
   nodes in node order wherever they are made, so each row is the serial row to the bit;
 - per grain its motion (particle_table.motion), volume and volume-weighted damage, summed over
   its nodes in node order as the serial Analysis sums them;
-- the contacts whose first body it owns and its contact counts (whole_state's).
+- what the last force evaluation left of its grains (whole_state.OwnEvaluation, as for the
+  whole state).
 Rank 0 puts the fragment rows in the serial order (by id), the grains' rows in grain order, the
 contacts in the serial slot order, and completes the particle table from them
 (analysis.complete_particle_table): every column is the serial run's.
@@ -22,16 +23,17 @@ ranks) still take the whole state on rank 0 (DistributedRun.collect).
 
 from __future__ import annotations
 
+import functools
+import operator
 from dataclasses import dataclass, replace
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
 
-from granulate import fragments, network, particle_table
+from granulate import fragments, particle_table
 from granulate.analysis import complete_particle_table
-from granulate.evaluation import Evaluation
-from granulate.parallel.whole_state import owned_contacts, serial_order
+from granulate.parallel.whole_state import OwnEvaluation, merged_evaluation, own_grain_places
 from granulate.step_totals import StepTotals, TrackedSums, node_totals
 from granulate.writers.step_data import StepData, set_up_fields
 
@@ -50,10 +52,7 @@ class StepPart:
     motion: particle_table.Table  #: per owned grain
     volumes: NDArray[np.float64]  #: per owned grain [m^3; m^2 in 2D]
     damage: NDArray[np.float64]  #: per owned grain, volume-weighted
-    contacts: dict[str, NDArray[Any]]
-    node_contacts: int
-    wall_contacts: int
-    searches: int
+    evaluation: OwnEvaluation
 
 
 def step_part(run: DistributedRun, tracked: tuple[int, ...]) -> StepPart:
@@ -63,25 +62,21 @@ def step_part(run: DistributedRun, tracked: tuple[int, ...]) -> StepPart:
     volumes = np.asarray(model.volumes)[nodes]
     mass = np.asarray(model.node_density)[nodes] * volumes
     phi = np.asarray(core.damage()[0])[nodes]
-    energy, pairs, walls = (np.asarray(a) for a in core.node_contact_terms())
     density = np.asarray(core.strain_energy_density())[nodes]
     x, v = core.positions[nodes], core.velocities[nodes]
-    totals = node_totals(mass, volumes, v, x, local.gravity, density, energy[nodes], phi)
+    evaluation = OwnEvaluation.of(run)
+    totals = node_totals(mass, volumes, v, x, local.gravity, density, phi)
     sums = tuple(_tracked_sums(run, grain) for grain in tracked)
-    grain = np.searchsorted(run.owned, run.held[np.asarray(model.node_particle)[nodes]])
-    count = len(run.owned)
+    grain, count = own_grain_places(run), len(run.owned)
     grain_volumes = np.bincount(grain, volumes, count)
     return StepPart(
-        replace(totals, tracked=sums),
+        replace(totals, contact=evaluation.contact_energy, tracked=sums),
         _own_fragments(run, run.owned[grain]),
         run.owned,
         particle_table.motion(grain, mass, x, v, count),
         grain_volumes,
         np.bincount(grain, volumes * phi, count) / grain_volumes,
-        owned_contacts(run, core.contact_network()),
-        int(pairs[nodes].sum()),
-        int(walls[nodes].sum()),
-        int(core.contact_statistics.rebuilds),
+        evaluation,
     )
 
 
@@ -95,7 +90,7 @@ def step_data(
     """Rank 0: the output step of `sim` (its set-up: walls, gravity, bodies) from every rank's
     part, with `broken` bonds in all and the walls' reactions."""
     core, grains = run.local.core, len(sim.bodies)
-    totals = sum((part.totals for part in parts), StepTotals())
+    totals = functools.reduce(operator.add, (part.totals for part in parts))
     table = _merged_fragments([part.fragments for part in parts])
     motion: particle_table.Table = {}
     volumes, damage = np.empty(grains), np.empty(grains)
@@ -104,18 +99,10 @@ def step_data(
             motion.setdefault(column, np.empty(grains))[part.grains] = values
         volumes[part.grains] = part.volumes
         damage[part.grains] = part.damage
-    contacts = network.contact_table(serial_order([part.contacts for part in parts]))
-    evaluation = Evaluation(
-        contacts,
-        totals.contact.value,
-        sum(part.node_contacts for part in parts),
-        sum(part.wall_contacts for part in parts),
-        max(part.searches for part in parts),
-        wall_reactions,
-    )
+    evaluation = merged_evaluation([part.evaluation for part in parts], wall_reactions)
     time = float(core.time)
     particles, stresses = complete_particle_table(
-        motion, volumes, damage, contacts, time, sim.dimension
+        motion, volumes, damage, evaluation.contacts, time, sim.dimension
     )
     return StepData(
         int(core.step),

@@ -73,13 +73,51 @@ class OwnedPart:
     forces: NDArray[np.float64]  # (n, 3) [N/m^3]
     dilatation: NDArray[np.float64]  # (n,)
     bonds: NDArray[np.uint8]  # the grains' bond copies, in the model's order
-    contacts: dict[str, NDArray[Any]]  # the network's rows whose first body is owned
-    contact_energy: NDArray[np.float64]  # (n,) per node [J; J/m in 2D]
+    evaluation: OwnEvaluation
+    #: of the grains' nodes and of the grains (labels: global nodes), when asked for
+    measures: GivenMeasures | None
+
+
+@dataclass(frozen=True)
+class OwnEvaluation:
+    """What the last force evaluation left of a rank's own grains: the network's rows whose
+    first body it owns (in global numbering), its nodes' contact energy (an exact sum,
+    ContactModel::node_contact_terms), their node pair and wall contacts, and its part's
+    neighbour-list searches."""
+
+    contacts: dict[str, NDArray[Any]]
+    contact_energy: ExactSum  # [J; J/m in 2D]
     node_contacts: int
     wall_contacts: int
     searches: int
-    #: of the grains' nodes and of the grains (labels: global nodes), when asked for
-    measures: GivenMeasures | None
+
+    @classmethod
+    def of(cls, run: DistributedRun) -> OwnEvaluation:
+        core, nodes = run.local.core, run.owned_nodes
+        energy, pairs, walls = (np.asarray(a)[nodes] for a in core.node_contact_terms())
+        return cls(
+            owned_contacts(run, core.contact_network()),
+            ExactSum.of(energy),
+            int(pairs.sum()),
+            int(walls.sum()),
+            int(core.contact_statistics.rebuilds),
+        )
+
+
+def merged_evaluation(
+    parts: list[OwnEvaluation], wall_reactions: NDArray[np.float64]
+) -> Evaluation:
+    """Rank 0: the whole run's evaluation (Evaluation) from every rank's, in the serial order:
+    contact rows sorted as the serial slots, the energy's correctly rounded sum, the counts,
+    the most list searches of any rank, and the walls' reactions."""
+    return Evaluation(
+        network.contact_table(serial_order([part.contacts for part in parts])),
+        sum((part.contact_energy for part in parts), ExactSum()).value,
+        sum(part.node_contacts for part in parts),
+        sum(part.wall_contacts for part in parts),
+        max(part.searches for part in parts),
+        wall_reactions,
+    )
 
 
 def owned_part(run: DistributedRun, measures: bool = True) -> OwnedPart:
@@ -89,7 +127,6 @@ def owned_part(run: DistributedRun, measures: bool = True) -> OwnedPart:
     offsets = np.asarray(run.local.model.bond_offsets, dtype=np.int64)
     intact = np.asarray(core.bond_intact)
     bond_rows = [intact[offsets[s.start] : offsets[s.stop]] for s in run.owned_slices()]
-    energy, pairs, walls = (np.asarray(a) for a in core.node_contact_terms())
     return OwnedPart(
         run.owned,
         core.positions[nodes],
@@ -97,11 +134,7 @@ def owned_part(run: DistributedRun, measures: bool = True) -> OwnedPart:
         core.forces[nodes],
         np.asarray(core.dilatation)[nodes],
         np.concatenate(bond_rows) if bond_rows else np.zeros(0, np.uint8),
-        owned_contacts(run, core.contact_network()),
-        energy[nodes],
-        int(pairs[nodes].sum()),
-        int(walls[nodes].sum()),
-        int(core.contact_statistics.rebuilds),
+        OwnEvaluation.of(run),
         _owned_measures(run) if measures else None,
     )
 
@@ -116,13 +149,17 @@ def _owned_measures(run: DistributedRun) -> GivenMeasures:
     core, model = local.core, local.model
     phi, z = (np.asarray(a)[nodes] for a in core.damage())
     labels = run.global_nodes(np.asarray(core.fragments())[nodes]).astype(np.uint32)
-    grain = np.searchsorted(run.owned, run.held[np.asarray(model.node_particle)[nodes]])
     mass = (np.asarray(model.node_density) * np.asarray(model.volumes))[nodes]
-    motion = particle_table.motion(
-        grain, mass, core.positions[nodes], core.velocities[nodes], len(run.owned)
-    )
+    x, v = core.positions[nodes], core.velocities[nodes]
+    motion = particle_table.motion(own_grain_places(run), mass, x, v, len(run.owned))
     density = np.asarray(core.strain_energy_density())[nodes]
     return GivenMeasures(phi, z, labels, density, motion)
+
+
+def own_grain_places(run: DistributedRun) -> NDArray[np.int64]:
+    """Per own node (in grain order), its grain's place among the grains the rank owns."""
+    particle = np.asarray(run.local.model.node_particle)[run.owned_nodes]
+    return np.searchsorted(run.owned, run.held[particle])
 
 
 def owned_contacts(run: DistributedRun, local: dict[str, Any]) -> dict[str, NDArray[Any]]:
@@ -158,7 +195,6 @@ def install(
     starts = np.array([body.first_node for body in sim.bodies] + [sim.node_count])
     bond_starts = np.asarray(sim.model.bond_offsets, dtype=np.int64)[starts]
     bonds = np.empty(bond_starts[-1], dtype=np.uint8)
-    energy = np.zeros(sim.node_count)
     measured = [part.measures for part in parts if part.measures is not None]
     given = _empty_measures(measured[0], sim.node_count, len(sim.bodies)) if measured else None
     x, v, f, dilatation = core.positions, core.velocities, core.forces, core.dilatation
@@ -168,7 +204,6 @@ def install(
             (v, part.velocities),
             (f, part.forces),
             (dilatation, part.dilatation),
-            (energy, part.contact_energy),
         ]
         if given is not None and part.measures is not None:
             rows += _measured_rows(given, part.measures)
@@ -179,14 +214,7 @@ def install(
     core.assign_bonds(bonds)
     core.time, core.step = moment
     sim.analysis.give(given if len(measured) == len(parts) else None)
-    sim._gathered = Evaluation(
-        network.contact_table(serial_order([part.contacts for part in parts])),
-        ExactSum.of(energy).value,
-        sum(part.node_contacts for part in parts),
-        sum(part.wall_contacts for part in parts),
-        max(part.searches for part in parts),
-        wall_reactions,
-    )
+    sim._gathered = merged_evaluation([part.evaluation for part in parts], wall_reactions)
 
 
 def _empty_measures(like: GivenMeasures, nodes: int, grains: int) -> GivenMeasures:

@@ -1,5 +1,9 @@
 """What a writer of a run's outputs is: a frame writer writes files at each frame; a history
-section adds columns to each history.csv row. Both read the step's StepData."""
+section adds columns to each history.csv row. Both read the step's StepData.
+
+A writer whose class sets ``needs_whole_state = False`` reads only StepData's values, which a
+distributed run makes of its ranks' measures; one without it (False is not assumed) may read
+``data.simulation``, for which rank 0 of a distributed run first takes the whole state."""
 
 from __future__ import annotations
 

@@ -16,6 +16,8 @@ if TYPE_CHECKING:
 
 
 class ContactNetwork:
+    needs_whole_state = False  # reads StepData's values (base.py)
+
     def write(self, data: StepData, outputs: Outputs) -> None:
         frames, frame = outputs.directory / "frames", outputs.frames
         network.write_table(frames / f"contacts_{frame:06d}.csv", data.contacts)

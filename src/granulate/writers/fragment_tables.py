@@ -12,6 +12,8 @@ if TYPE_CHECKING:
 
 
 class FragmentTables:
+    needs_whole_state = False  # reads StepData's values (base.py)
+
     def write(self, data: StepData, outputs: Outputs) -> None:
         path = outputs.directory / "frames" / f"fragments_{outputs.frames:06d}.csv"
         fragments.write_table(path, data.fragments)

@@ -29,6 +29,8 @@ _WALL_INDEX = {"fx": 0, "fy": 1, "fz": 2, "tx": 3, "ty": 4, "tz": 5}
 class Energies:
     """step, time, the energies [J; J/m in 2D], broken bonds, contact counts, list rebuilds."""
 
+    needs_whole_state = False  # reads StepData's values (base.py)
+
     def columns(self, data: StepData, outputs: Outputs) -> dict[str, float | int]:
         totals, evaluation = data.totals, data.evaluation
         kinetic, strain = totals.kinetic.value, totals.strain.value
@@ -51,12 +53,16 @@ class Energies:
 class Breakage:
     """Fragments, debris, particles split, mean damage (granulate.fragments.summary)."""
 
+    needs_whole_state = False  # reads StepData's values (base.py)
+
     def columns(self, data: StepData, outputs: Outputs) -> dict[str, float | int]:
         return fragments.summary(data.fragments, data.mean_damage)
 
 
 class GranularMeasures:
     """Particle contacts, mean coordination, assembly stress [Pa] and fabric tensor."""
+
+    needs_whole_state = False  # reads StepData's values (base.py)
 
     def columns(self, data: StepData, outputs: Outputs) -> dict[str, float | int]:
         particles = len(data.particles["particle"])
@@ -77,6 +83,8 @@ class WallLoads:
     """Per wall: the particles' force and torque on it, its displacement, and with an area
     its stress."""
 
+    needs_whole_state = False  # reads StepData's values (base.py)
+
     def columns(self, data: StepData, outputs: Outputs) -> dict[str, float | int]:
         row: dict[str, float | int] = {}
         for (name, spec), reaction, moved in zip(
@@ -95,6 +103,8 @@ class WallLoads:
 class TrackedBodies:
     """Per tracked body: the resultant of its forces other than gravity [N; N/m in 2D], its
     mean displacement [m] and, given an area, its stress [Pa] (granulate.step_totals)."""
+
+    needs_whole_state = False  # reads StepData's values (base.py)
 
     def columns(self, data: StepData, outputs: Outputs) -> dict[str, float | int]:
         row: dict[str, float | int] = {}

@@ -107,9 +107,9 @@ class Outputs:
 
     def needs_whole_state(self, step: int, final: bool | None = None) -> bool:
         """Whether the outputs of `step` (write_step's, or write_final's) read the whole
-        simulation: a frame of every node, or a writer registered from outside the package.
+        simulation: a frame of every node, or a writer that may read it (base.py).
         Otherwise a distributed run makes them of its ranks' measures (StepData)."""
-        return (self.frame_due(step, final) and not self.pieces) or not registry.only_built_in()
+        return (self.frame_due(step, final) and not self.pieces) or not registry.reads_values_only()
 
     def piece_folder(self, step: int, final: bool | None = None) -> Path | None:
         """The folder of the pieces the ranks write of the frame `step`'s outputs write

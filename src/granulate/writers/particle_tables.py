@@ -12,6 +12,8 @@ if TYPE_CHECKING:
 
 
 class ParticleTables:
+    needs_whole_state = False  # reads StepData's values (base.py)
+
     def write(self, data: StepData, outputs: Outputs) -> None:
         path = outputs.directory / "frames" / f"particles_{outputs.frames:06d}.csv"
         particle_table.write_table(path, data.particles)

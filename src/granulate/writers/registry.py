@@ -34,24 +34,12 @@ HISTORY_SECTIONS: list[HistorySection] = [
 ]
 
 
-_BUILT_IN = (
-    VtuFrame,
-    ParticleTables,
-    FragmentTables,
-    ContactNetwork,
-    Energies,
-    Breakage,
-    GranularMeasures,
-    WallLoads,
-    TrackedBodies,
-)
-
-
-def only_built_in() -> bool:
-    """Whether every registered writer and section is the package's own: these read StepData's
-    values alone (one registered from outside may read its simulation, which a distributed
-    run's step data made of its ranks' measures lacks)."""
-    return all(isinstance(w, _BUILT_IN) for w in [*FRAME_WRITERS, *HISTORY_SECTIONS])
+def reads_values_only() -> bool:
+    """Whether every registered writer and section reads StepData's values alone (its class
+    sets needs_whole_state = False, base.py): then a distributed run's step data made of its
+    ranks' measures, which has no simulation, serves them all."""
+    writers = [*FRAME_WRITERS, *HISTORY_SECTIONS]
+    return not any(getattr(writer, "needs_whole_state", True) for writer in writers)
 
 
 def register_frame_writer(writer: FrameWriter) -> None:

@@ -12,6 +12,7 @@ from numpy.typing import NDArray
 
 from granulate import fragments, network, particle_table
 from granulate.evaluation import Evaluation
+from granulate.exact_sum import ExactSum
 from granulate.step_totals import StepTotals, TrackedSums, node_totals
 
 if TYPE_CHECKING:
@@ -98,7 +99,7 @@ def whole_totals(
     mass = np.asarray(model.node_density) * volumes
     density = sim.analysis.strain_energy_densities()
     totals = node_totals(
-        mass, volumes, core.velocities, core.positions, sim.gravity, density, [contact], damage
+        mass, volumes, core.velocities, core.positions, sim.gravity, density, damage
     )
     sums = tuple(
         TrackedSums.of(
@@ -110,4 +111,4 @@ def whole_totals(
         )
         for body in tracked
     )
-    return replace(totals, tracked=sums)
+    return replace(totals, contact=ExactSum.of([contact]), tracked=sums)

@@ -131,6 +131,10 @@ class VtuFrame:
     """The node frame: positions and the fields of ``Simulation.output(fields=...)``, in one
     file or in pieces (module docstring)."""
 
+    # In pieces it reads StepData's values; a frame of every node reads the simulation, for
+    # which Outputs.needs_whole_state asks.
+    needs_whole_state = False
+
     def write(self, data: StepData, outputs: Outputs) -> None:
         sim, damage = data.simulation, data.damage
         name = f"frame_{outputs.frames:06d}"
