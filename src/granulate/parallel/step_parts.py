@@ -16,9 +16,9 @@ Rank 0 puts the fragment rows in the serial order (by id), the grains' rows in g
 contacts in the serial slot order, and completes the particle table from them
 (analysis.complete_particle_table): every column is the serial run's.
 
-A frame of every node (output without pieces), a writer registered from outside the package, a
-checkpoint, the end of a run and a body cut at node level (NodeSplitRun, whose pieces span
-ranks) still take the whole state on rank 0 (DistributedRun.collect).
+A frame of every node (output without pieces), a writer that may read the simulation
+(writers/base.py), a checkpoint, the end of a run and a body cut at node level (NodeSplitRun,
+whose pieces span ranks) still take the whole state on rank 0 (DistributedRun.collect).
 """
 
 from __future__ import annotations

@@ -1,8 +1,8 @@
 """Simulation.run's loop on the ranks of a distributed run (granulate.run_loop.Stepper): every
 rank takes the steps of the chunks rank 0 decides; rank 0 writes the outputs of the step its
 ranks measured of their grains (step_parts.py), or of the whole state its simulation takes
-(DistributedRun.collect) for a frame of every node, writers of users' own or bodies cut at node
-level; the stop criteria read the ranks' measures put together (run_measures.py); rank 0's
+(DistributedRun.collect) for a frame of every node, writers that may read the simulation or
+bodies cut at node level; the stop criteria read the ranks' measures put together (run_measures.py); rank 0's
 decisions and errors reach every rank."""
 
 from __future__ import annotations
