@@ -2,8 +2,8 @@
 rank takes the steps of the chunks rank 0 decides; rank 0 writes the outputs of the step its
 ranks measured of their grains (step_parts.py), or of the whole state its simulation takes
 (DistributedRun.collect) for a frame of every node, writers that may read the simulation or
-bodies cut at node level; the stop criteria read the ranks' measures put together (run_measures.py); rank 0's
-decisions and errors reach every rank."""
+bodies cut at node level; the stop criteria read the ranks' measures put together
+(run_measures.py); rank 0's decisions and errors reach every rank."""
 
 from __future__ import annotations
 
