@@ -32,12 +32,12 @@ margin [m], without migrating grains (or with), expecting every rank to stop wit
 InputError that says the grains moved too far for it;
 `... DIMENSION STEPS fail` blows up one rank's step and expects every rank to stop;
 `... DIMENSION STEPS fail-start` (`fail-migration`) makes the last rank fail to build its part
-at the start (in a migration) and expects every rank to stop; `... DIMENSION STEPS fail-whole`
-leaves rank 0 too little memory to build its whole simulation when the ranks first gather the
-state into it, and expects every rank to stop with rank 0's InputError; `... DIMENSION STEPS
-fail-room` makes rank 0's memory check of the whole model fail when the drum set up with
-Simulation(comm=...) starts its run, and expects every rank to stop with its InputError before
-the first step."""
+at the start with a user's error (in a migration with a bug) and expects every rank to stop;
+`... DIMENSION STEPS fail-whole` leaves rank 0 too little memory to build its whole simulation
+when the ranks first gather the state into it, and expects every rank to stop with rank 0's
+InputError; `... DIMENSION STEPS fail-room` makes rank 0's memory check of the whole model
+fail when the drum set up with Simulation(comm=...) starts its run, and expects every rank to
+stop with its InputError before the first step."""
 
 from __future__ import annotations
 
@@ -372,13 +372,17 @@ def check_failure(dimension: int, steps: int, comm: MPI.Comm) -> int:
 
 
 def check_build_failure(dimension: int, during: str, comm: MPI.Comm) -> int:
-    """0 when an error while the last rank builds its part (at the start, or in a migration)
-    ends every rank: it with its own InputError, the others with the RuntimeError naming it."""
+    """0 when an error while the last rank builds its part ends every rank: at the start a
+    user's error (InputError), which every rank raises with its message (rank 0 reports it);
+    in a migration a bug (RuntimeError), which that rank raises, the others RankFailed naming
+    it."""
     last = comm.Get_size() - 1
     sim = set_up(dimension)
 
     def broken(*_: object, **__: object) -> None:
-        raise gr.InputError("an injected failure")
+        if during == "start":
+            raise gr.InputError("an injected failure")
+        raise RuntimeError("an injected bug")
 
     def build_and_migrate() -> None:
         if during == "start" and comm.Get_rank() == last:
@@ -394,8 +398,10 @@ def check_build_failure(dimension: int, during: str, comm: MPI.Comm) -> int:
     if messages is None:
         return 0
     print(during, messages)
+    if during == "start":
+        return 0 if set(messages) == {"InputError: an injected failure"} else 1
     others = all(f"rank {last} failed while building" in m for m in messages[:last])
-    return 0 if others and messages[last] == "InputError: an injected failure" else 1
+    return 0 if others and messages[last] == "RuntimeError: an injected bug" else 1
 
 
 def check_whole_failure(dimension: int, steps: int, comm: MPI.Comm) -> int:

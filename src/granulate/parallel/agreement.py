@@ -19,9 +19,9 @@ class RankFailed(RuntimeError):
 
 
 def together(comm: Any, action: Callable[[], T], doing: str = "building its part") -> T:
-    """action() on every rank; when it raised on some rank, every rank stops: the first such
-    rank with its own error, the others with RankFailed naming it and what it was `doing`
-    (one reduction, stop_if_any_failed)."""
+    """action() on every rank; when it raised on some rank, every rank stops
+    (stop_if_any_failed: a user's error with its message on every rank, else the first failing
+    rank with its own error, the others with RankFailed naming it and what it was `doing`)."""
     failure, result = None, None
     try:
         result = action()
@@ -45,16 +45,24 @@ def attempt(action: Callable[[], object], failure: Exception | None = None) -> E
 
 
 def stop_if_any_failed(comm: Any, failure: Exception | None, doing: str) -> None:
-    """One reduction: when some rank's `failure` is set, every rank stops, the first such rank
-    raising its own error, the others RankFailed naming it and what it was `doing`."""
+    """One reduction: when some rank's `failure` is set, every rank stops. When the first such
+    rank's is an InputError (a user's error: a missing file, a model too large), every rank
+    raises it with its message (one broadcast), so that rank 0 reports it; else that rank
+    raises its own error, the others RankFailed naming it and what it was `doing`. Another
+    failing rank raises its own error."""
     from mpi4py import MPI
 
     size = comm.Get_size()
     first = comm.allreduce(comm.Get_rank() if failure is not None else size, op=MPI.MIN)
-    if failure is not None:
+    if first == size:
+        return
+    mine = str(failure) if isinstance(failure, InputError) else None
+    shared = comm.bcast(mine, root=first)
+    if failure is not None and (shared is None or comm.Get_rank() == first):
         raise failure
-    if first < size:
-        raise RankFailed(f"rank {first} failed while {doing}; every rank stops")
+    if shared is not None:
+        raise InputError(shared)
+    raise RankFailed(f"rank {first} failed while {doing}; every rank stops")
 
 
 def on_root(comm: Any, action: Callable[[], T]) -> T | None:
