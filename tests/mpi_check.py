@@ -435,7 +435,7 @@ def check_room_failure(steps: int, comm: MPI.Comm) -> int:
     if messages is None:
         return 0
     print("room", messages)
-    reason = "rank 0 holds the whole model at checkpoints"
+    reason = "rank 0 holds the whole model at the end of a run"
     return 0 if len(set(messages)) == 1 and reason in messages[0] else 1
 
 

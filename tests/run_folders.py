@@ -6,9 +6,14 @@ from __future__ import annotations
 import csv
 from pathlib import Path
 
+from granulate.io.run_folder import CHECKPOINT_PIECES
+
 #: What a distributed run's folder may hold differently: its timings (run.json), and its
-#: checkpoint (the same state, with neighbour lists searched anew: it restarts bit for bit).
+#: checkpoint (the same state in the ranks' pieces, with neighbour lists searched anew: it
+#: restarts bit for bit).
 DIFFERENT = {"run.json", "checkpoint.npz"}
+#: The folder of a distributed run's checkpoint pieces.
+PIECES = CHECKPOINT_PIECES
 #: history.csv's count of neighbour-list searches, which each rank makes for its own part (the
 #: largest over the ranks is written): a diagnostic of the run, not of its physics.
 SEARCHES = "list_rebuilds"
@@ -20,7 +25,10 @@ def outputs(directory: Path) -> dict[str, bytes]:
     return {
         str(p.relative_to(directory)): p.read_bytes()
         for p in sorted(directory.rglob("*"))
-        if p.is_file() and p.name not in DIFFERENT and p.name != "history.csv"
+        if p.is_file()
+        and p.name not in DIFFERENT
+        and p.name != "history.csv"
+        and PIECES not in p.relative_to(directory).parts
     }
 
 

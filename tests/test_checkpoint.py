@@ -252,9 +252,10 @@ def test_stop_criteria_end_the_run_at_a_fixed_step(tmp_path: Path) -> None:
 def test_checkpoints_of_the_earlier_contact_model_are_refused(tmp_path: Path) -> None:
     """Formats 1 (before friction springs and per-node contact radii), 2 (before the damping
     fitted to each collision's force law), 3 (before contact against the particles' smooth
-    surfaces) and 4 (before the turned collision forces fade out in lasting contacts) cannot
-    continue the same trajectory: they are refused with the reason and the fix, and the file
-    is left alone."""
+    surfaces), 4 (before the turned collision forces fade out in lasting contacts) and 5
+    (before the rest overlaps of nodes opened by cracks) cannot continue the same trajectory,
+    and format 6 fingerprints the set-up otherwise: they are refused with the reason and the
+    fix, and the file is left alone."""
     import json
 
     sim = tumbling_drum(tmp_path / "a")
@@ -263,7 +264,7 @@ def test_checkpoints_of_the_earlier_contact_model_are_refused(tmp_path: Path) ->
     with np.load(checkpoint) as archive:
         data = {name: archive[name] for name in archive.files}
     header = json.loads(bytes(data["__header__"]).decode())
-    for format_ in (1, 2, 3, 4):
+    for format_ in (1, 2, 3, 4, 5, 6):
         header["format"] = format_
         data["__header__"] = np.frombuffer(json.dumps(header).encode(), np.uint8)
         old = tmp_path / f"old{format_}.npz"

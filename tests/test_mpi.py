@@ -173,6 +173,33 @@ def test_a_distributed_checkpoint_restarts_on_fewer_ranks_bit_for_bit(ranks: int
     assert "serially: {'positions': 0.0, 'velocities': 0.0, 'forces': 0.0}" in done.stdout
 
 
+CHECKPOINT_CHECK = Path(__file__).with_name("mpi_checkpoint_check.py")
+
+
+@pytest.mark.parametrize("ranks", [2, 3])
+def test_a_distributed_checkpoint_is_a_header_and_a_piece_per_rank(ranks: int) -> None:
+    """Each rank writes its own grains' states and reads some pieces back; rank 0 never builds
+    the whole simulation; the next checkpoint at the path leaves only its own pieces."""
+    done = run_ranks(ranks, "pieces", script=CHECKPOINT_CHECK)
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert "rank 0 built the whole: False" in done.stdout
+
+
+def test_a_checkpoint_missing_a_piece_or_with_a_foreign_one_is_refused_on_every_rank() -> None:
+    """One InputError on every rank naming the piece; history.csv is left as it was."""
+    done = run_ranks(2, "damaged", script=CHECKPOINT_CHECK)
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert "is missing its piece" in done.stdout and "history.csv kept True" in done.stdout
+
+
+def test_a_rank_failing_to_write_its_piece_leaves_the_last_checkpoint_whole() -> None:
+    """The last of 3 ranks cannot write (a full disk): every rank stops, the checkpoint before
+    keeps its header and pieces, and a run continues from it."""
+    done = run_ranks(3, "write-fail", script=CHECKPOINT_CHECK)
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert "No space left on device" in done.stdout and "checkpoint kept True" in done.stdout
+
+
 @pytest.mark.parametrize(("ranks", "variant"), [(3, "surface"), (2, "rolling")])
 def test_a_simulation_given_a_communicator_writes_the_serial_outputs(
     ranks: int, variant: str

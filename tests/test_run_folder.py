@@ -63,7 +63,7 @@ def test_overwrite_followed_by_an_input_error_keeps_the_old_run(
 ) -> None:
     """--overwrite deleted the old frames at once, so an error found after (here --steps 0)
     left a PVD listing frames that no longer existed. The old run is now replaced only when the
-    new one starts writing."""
+    new one starts writing, with the pieces of a distributed run's checkpoint."""
     out = tmp_path / "run"
     assert main(["run", str(BASE), "--out", str(out), "--quiet"]) == 0
     before = {p.name: p.read_bytes() for p in (out / "frames").iterdir()}
@@ -74,10 +74,13 @@ def test_overwrite_followed_by_an_input_error_keeps_the_old_run(
     assert "--steps must be positive" in capsys.readouterr().err
     assert {p.name: p.read_bytes() for p in (out / "frames").iterdir()} == before
     assert (out / "simulation.pvd").read_bytes() == pvd
+    stale = out / "checkpoint.npz.pieces" / "100-0a1b2c3d"  # a distributed run's checkpoint
+    stale.mkdir(parents=True)
     assert (
         main(["run", str(BASE), "--out", str(out), "--quiet", "--overwrite", "--steps", "30"]) == 0
     )
     assert len(listed_frames(out)) < len(before) // 2  # replaced by the shorter run
+    assert not (out / "checkpoint.npz.pieces").exists()
 
 
 def plate(out: Path, **output) -> gr.Simulation:

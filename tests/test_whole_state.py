@@ -103,4 +103,4 @@ def test_rank_0_is_told_at_the_start_when_the_whole_model_will_not_fit(
     monkeypatch.setattr(gr.resources, "available_memory", lambda: 1000)
     with pytest.raises(gr.InputError, match=r"would need about .* of memory") as refused:
         require_room(sim)
-    assert "rank 0 holds the whole model at checkpoints" in str(refused.value)
+    assert "rank 0 holds the whole model at the end of a run" in str(refused.value)

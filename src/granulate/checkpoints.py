@@ -6,12 +6,15 @@ are those of an uninterrupted one. The file format is granulate.io.checkpoint's.
 
 from __future__ import annotations
 
+import hashlib
+import shutil
 import time as wallclock
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 from granulate import resources
 from granulate._version import __version__
@@ -19,6 +22,7 @@ from granulate.errors import InputError
 from granulate.io import checkpoint as checkpoint_file
 
 if TYPE_CHECKING:
+    from granulate.materials import Material
     from granulate.simulation import Simulation
     from granulate.writers.outputs import Outputs
 
@@ -91,14 +95,68 @@ class CheckpointPlan:
         self.last_wall_time = wallclock.perf_counter()
 
 
-def save(sim: Simulation, path: str | Path, outputs: Outputs | None) -> Path:
-    """Write sim's state and the bookkeeping of its `outputs` to `path` atomically."""
-    core = sim.core
-    header = {
+def grain_digest(
+    reference: NDArray[np.float64], volumes: NDArray[np.float64], bond_offsets: NDArray[Any]
+) -> bytes:
+    """SHA-256 of one grain's reference positions, node volumes and bonds per node (from its
+    nodes' `bond_offsets`, one more than nodes): what a checkpoint's set-up fingerprint holds of
+    each grain, the same whether the grain's rank holds the whole model or only its grains."""
+    digest = hashlib.sha256()
+    for values in (reference, volumes, np.diff(np.asarray(bond_offsets, dtype=np.int64))):
+        digest.update(np.ascontiguousarray(values).tobytes())
+    return digest.digest()
+
+
+def model_grain_digests(model: Any, slices: list[slice]) -> bytes:
+    """grain_digest of each grain (its node slice in `model`, a core Model), in order."""
+    reference, volumes = model.reference_positions, model.volumes
+    offsets = np.asarray(model.bond_offsets)
+    return b"".join(
+        grain_digest(reference[s], volumes[s], offsets[s.start : s.stop + 1]) for s in slices
+    )
+
+
+def set_up_digest(sim: Simulation, grain_digests: bytes) -> str:
+    """The part of sim's fingerprint fixed when it is set up: its grains (`grain_digests`, one
+    grain_digest per body in order), loading, walls and contact, with materials named by the
+    order in which the bodies first use them (the core's order), so that it is the same in
+    every process and needs no whole model."""
+    return checkpoint_file.fingerprint(
+        grain_digests,
+        *sim._loading.fingerprint_parts(),
+        *sim._interactions.fingerprint_parts(_materials_in_core_order(sim)),
+    )
+
+
+def fingerprint(sim: Simulation, setup: str, time_step: float) -> str:
+    """Identifies the set-up a checkpoint belongs to: the `setup` digest (set_up_digest), the
+    time step [s], gravity, damping and sim's case_fingerprint."""
+    return checkpoint_file.fingerprint(
+        setup,
+        float(time_step),
+        repr(sim.gravity.tolist()),
+        sim._viscous_damping,
+        sim.case_fingerprint,
+    )
+
+
+def _materials_in_core_order(sim: Simulation) -> list[Material]:
+    """sim's materials in the order its bodies first use them, as core_model.build_model adds
+    them to the core."""
+    materials: dict[int, Material] = {}
+    for body in sim.bodies:
+        materials.setdefault(id(body.material), body.material)
+    return list(materials.values())
+
+
+def header_of(step: int, time: float, fingerprint: str, outputs: Outputs | None) -> dict[str, Any]:
+    """A checkpoint's header at `step` and `time` [s]: granulate's version, the set-up's
+    `fingerprint` and the bookkeeping of `outputs` (frames written, intervals, PVD series)."""
+    return {
         "granulate": __version__,
-        "fingerprint": sim.fingerprint(),
-        "step": int(core.step),
-        "time": float(core.time),
+        "fingerprint": fingerprint,
+        "step": int(step),
+        "time": float(time),
         "output": None
         if outputs is None
         else {
@@ -108,25 +166,64 @@ def save(sim: Simulation, path: str | Path, outputs: Outputs | None) -> Path:
             "pvd": outputs.pvd.entries,
         },
     }
+
+
+def save(
+    sim: Simulation, path: str | Path, outputs: Outputs | None, fingerprint: str | None = None
+) -> Path:
+    """Write sim's whole state and the bookkeeping of its `outputs` to `path` atomically, then
+    remove the pieces of a distributed run's checkpoint there before (pieces_folder).
+    `fingerprint`: sim's, when already known."""
+    core = sim.core
+    header = header_of(core.step, core.time, fingerprint or sim.fingerprint(), outputs)
     target = Path(path)
     target.parent.mkdir(parents=True, exist_ok=True)
     checkpoint_file.save(target, core.checkpoint(), header)
+    shutil.rmtree(pieces_folder(target), ignore_errors=True)
     return target
 
 
-def load(sim: Simulation, path: str | Path, outputs: Outputs | None) -> None:
-    """Continue sim from a checkpoint of its same set-up (else InputError): the state and,
-    when `outputs` are set, their frame count, PVD series and history.csv up to the
-    checkpoint's step."""
-    core = sim.core
+def pieces_folder(path: str | Path) -> Path:
+    """Where a distributed run's checkpoint at `path` keeps its ranks' pieces: path.pieces."""
+    target = Path(path)
+    return target.with_name(f"{target.name}.pieces")
+
+
+def read(path: str | Path, fingerprint: str) -> tuple[dict[str, Any], dict[str, Any]]:
+    """The checkpoint at `path` (granulate.io.checkpoint.load: its arrays and header), refused
+    (InputError) unless it belongs to the set-up with this `fingerprint`."""
     state, header = checkpoint_file.load(path)
-    if header.get("fingerprint") != sim.fingerprint():
+    if header.get("fingerprint") != fingerprint:
         raise InputError(
             f"checkpoint {path} belongs to a different set-up (other nodes, loading, walls, "
             "time step or case file); run without --resume, or restore the original case"
         )
-    core.restore(state)
+    return state, header
+
+
+def load(
+    sim: Simulation, path: str | Path, outputs: Outputs | None, fingerprint: str | None = None
+) -> None:
+    """Continue sim from a checkpoint of its same set-up (else InputError), whole or in a
+    distributed run's pieces (parallel/checkpoint_pieces.py): the state and, when `outputs` are
+    set, their frame count, PVD series and history.csv up to the checkpoint's step.
+    `fingerprint`: sim's, when already known."""
+    state, header = read(path, fingerprint or sim.fingerprint())
+    core = sim.core
+    if "pieces" in header:
+        from granulate.parallel import checkpoint_pieces
+
+        checkpoint_pieces.restore_whole(core, path, state, header, sim.node_count)
+    else:
+        core.restore(state)
     sim.analysis.forget_fragments()  # the labels of the bonds before the restore
+    resume_outputs(path, header, outputs)
+
+
+def resume_outputs(path: str | Path, header: dict[str, Any], outputs: Outputs | None) -> None:
+    """The bookkeeping of `outputs` (when set) as the checkpoint at `path` with `header` left
+    it: frames written, PVD series, history.csv up to its step; InputError when it was written
+    with other output settings."""
     saved = header.get("output")
     if outputs is None:
         return
@@ -139,7 +236,7 @@ def load(sim: Simulation, path: str | Path, outputs: Outputs | None) -> None:
             f"checkpoint {path} was written with other output settings; keep the "
             "output interval of the original run"
         )
-    outputs.resume(int(saved["frames"]), saved["pvd"], int(core.step))
+    outputs.resume(int(saved["frames"]), saved["pvd"], int(header["step"]))
 
 
 def interrupt_path(plan: CheckpointPlan | None, outputs: Outputs | None) -> Path | None:

@@ -41,7 +41,6 @@ from granulate.errors import GranulateWarning, InputError
 from granulate.evaluation import Evaluation
 from granulate.input_errors import check_number, unknown_name
 from granulate.interactions import Interactions
-from granulate.io import checkpoint as checkpoint_file
 from granulate.loading import Components, Loading
 from granulate.materials import Material
 from granulate.run_loop import LoopParts, Progress, RunPlan, RunRecord
@@ -380,7 +379,7 @@ class Simulation(SimulationSetup, SimulationResults):
             else:
                 run = DistributedRun(self, self._comm)
             _check_time_step(run.dt, run.stable_dt)
-            # Rank 0 takes the whole state at checkpoints and the end of each run: refuse now
+            # Rank 0 takes the whole state at the end of each run: refuse now
             # a model it cannot hold, rather than then.
             on_root(self._comm, lambda: require_room(self))
             if self._comm.Get_rank() == 0 and self._dt is not None:
@@ -466,27 +465,19 @@ class Simulation(SimulationSetup, SimulationResults):
             self._checkpoint.require_budget(steps, self.node_count, bonds)
 
     def fingerprint(self) -> str:
-        """Identifies the set-up a checkpoint belongs to: nodes, volumes, bonds, loading,
-        walls, contact (frozen once built: hashed once), time step, body force, damping and
-        ``case_fingerprint``. Materials are named by their order, not by object identity, so
-        the fingerprint is the same in every process."""
+        """Identifies the set-up a checkpoint belongs to: each body's nodes, volumes and bonds,
+        loading, walls, contact (frozen once built: hashed once), time step, body force,
+        damping and ``case_fingerprint`` (granulate.checkpoints.fingerprint). Materials are
+        named by their order, not by object identity, so the fingerprint is the same in every
+        process. In a distributed run every rank calls it; each hashes its own grains."""
+        if self._comm is not None:
+            return self._distributed_run().fingerprint()
         core = self._build()
         if self._setup_digest is None:
-            model = self.model
-            self._setup_digest = checkpoint_file.fingerprint(
-                np.ascontiguousarray(model.reference_positions).tobytes(),
-                np.ascontiguousarray(model.volumes).tobytes(),
-                np.ascontiguousarray(model.bond_offsets).tobytes(),
-                *self._loading.fingerprint_parts(),
-                *self._interactions.fingerprint_parts(self._core_materials),
-            )
-        return checkpoint_file.fingerprint(
-            self._setup_digest,
-            float(core.time_step),
-            repr(self.gravity.tolist()),
-            self._viscous_damping,
-            self.case_fingerprint,
-        )
+            slices = [body.node_slice for body in self.bodies]
+            grains = checkpoints.model_grain_digests(self.model, slices)
+            self._setup_digest = checkpoints.set_up_digest(self, grains)
+        return checkpoints.fingerprint(self, self._setup_digest, core.time_step)
 
     def save_checkpoint(self, path: str | Path) -> Path:
         """Write the state (positions, velocities, forces, bond states, contact history, time,

@@ -26,8 +26,9 @@ from granulate.io.atomic import atomic_write
 # 2: per-contact friction springs and per-node contact radii; 3: each collision's force-law
 # exponent (the damping that gives the requested restitution); 4: contact against the
 # particles' smooth surfaces; 5: the turned collision forces fading out in lasting contacts;
-# 6: the rest overlaps of nodes opened by cracks
-FORMAT = 6
+# 6: the rest overlaps of nodes opened by cracks; 7: the set-up fingerprinted grain by grain (a
+# distributed run's checkpoint in pieces has no rank holding the whole model)
+FORMAT = 7
 HEADER = "__header__"
 
 
@@ -81,8 +82,8 @@ def load(path: str | Path) -> tuple[dict[str, Any], dict[str, Any]]:
             "per-node contact radii, format 2 the damping fitted to each collision's force law, "
             "format 3 contact against the particles' smooth surfaces, format 4 the turned "
             "collision forces fading out in lasting contacts, format 5 the rest overlaps of "
-            "nodes that cracks open; their trajectories differ); run "
-            "without --resume to start over"
+            "nodes that cracks open: their trajectories differ; format 6 fingerprints the "
+            "set-up as a whole, not grain by grain); run without --resume to start over"
         )
     checksum = header.get("checksum")
     if checksum is not None and checksum != content_checksum(data):

@@ -16,6 +16,8 @@ from granulate.resources import size_text
 LOCK = ".granulate.lock"
 #: What a run writes (replaced together with --overwrite).
 RUN_FILES = ("simulation.pvd", "contacts.pvd", "history.csv", "run.json", "checkpoint.npz")
+#: The pieces of a distributed run's checkpoint.npz (granulate.checkpoints.pieces_folder).
+CHECKPOINT_PIECES = "checkpoint.npz.pieces"
 FRAME_PATTERNS = ("frame_*.vtu", "frame_*.pvtu", "particles_*.csv")
 
 
@@ -128,6 +130,8 @@ class RunFolder:
             for pieces in (self.path / "frames").glob("frame_*"):  # frames written in pieces
                 if pieces.is_dir():
                     shutil.rmtree(pieces)
+            if (self.path / CHECKPOINT_PIECES).is_dir():
+                shutil.rmtree(self.path / CHECKPOINT_PIECES)
             self.clean_temporaries()
 
     def stop_writing(self) -> None:

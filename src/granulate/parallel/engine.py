@@ -33,7 +33,7 @@ from __future__ import annotations
 import os
 import time
 import warnings
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from types import SimpleNamespace
 from typing import TYPE_CHECKING, Any, NamedTuple
@@ -44,7 +44,9 @@ from numpy.typing import NDArray
 from granulate import checkpoints
 from granulate._core import combined_time_step, points_within
 from granulate.errors import InputError
+from granulate.parallel import checkpoint_pieces
 from granulate.parallel.agreement import RankFailed, attempt, on_root, together
+from granulate.parallel.checkpoint_pieces import read_pieces
 from granulate.parallel.overlap import while_travelling
 from granulate.parallel.partition import (
     Partition,
@@ -221,6 +223,7 @@ class DistributedRun:
         self._migration_due = False
         # The wall reactions a loaded checkpoint holds, until the next step evaluates them.
         self._loaded_walls: NDArray[np.float64] | None = None
+        self._setup_digest: str | None = None  # of the set-up's fingerprint, made once
         held = self._distribute_whole(start, centres, radii)
         together(self.comm, lambda: self._build(held))
         self._exchange_state()
@@ -837,19 +840,9 @@ class DistributedRun:
         self._widen_margin()
         self._exchange_state()
         before, owners_before = self._held_by_rank(), self.partition.owner
-        centres, radii, damped = self._current_spheres()
         positions = self.local.core.positions
-        mine = self._pairs_of_large(  # each large body's owner finds its pairs
-            centres,
-            radii,
-            {
-                int(g): positions[self.local_slice(g)]
-                for g in np.intersect1d(self._large, self._owned)
-            },
-        )
-        everyone = self.comm.allgather(mine)
-        large = tuple(np.concatenate([pairs[k] for pairs in everyone]) for k in (0, 1))
-        held = self._distribute(centres, radii, damped, large)
+        layout = self._gathered_layout(self._owned, lambda g: positions[self.local_slice(g)])
+        held = self._distribute(*layout)
         self.handed_over += int(np.count_nonzero(self.partition.owner != owners_before))
         after = self._held_by_rank()
         owner = self.partition.owner
@@ -903,25 +896,32 @@ class DistributedRun:
             for q in range(self.comm.Get_size())
         ]
 
-    def _current_spheres(
-        self,
-    ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64] | None]:
-        """Every grain's bounding sphere now and, with PeriDEM's damping, where its centre
-        node is (else None), from its owner (one allgather)."""
-        positions = self.local.core.positions
+    def _gathered_layout(
+        self, grains: NDArray[np.int64], nodes_of: Callable[[int], NDArray[np.float64]]
+    ) -> tuple[Any, ...]:
+        """What _distribute reads (_layout), on every rank: each grain measured by the one
+        rank that has it among its `grains` (nodes_of(g): grain g's nodes' positions now),
+        its bounding sphere and, with PeriDEM's damping, where its centre node is; then each
+        large body's pairs found by that rank (two allgathers)."""
         dimension = self._sim.dimension
-        mine = _spheres([positions[self.local_slice(g)] for g in self._owned], dimension)
+        mine = _spheres([nodes_of(int(g)) for g in grains], dimension)
         points = None
         if self._damped_centres is not None:
-            points = positions[self._node_map[self._damped_centres[self._owned]], :dimension]
+            points = [
+                nodes_of(int(g))[self._damped_centres[g] - self._slices[g].start, :dimension]
+                for g in grains
+            ]
         centres = np.empty((len(self._slices), dimension))
         radii = np.empty(len(self._slices))
         damped = None if points is None else np.empty((len(self._slices), dimension))
-        for grains, spheres, their_points in self.comm.allgather((self._owned, mine, points)):
-            centres[grains], radii[grains] = spheres
-            if damped is not None:
-                damped[grains] = their_points
-        return centres, radii, damped
+        for theirs, spheres, their_points in self.comm.allgather((grains, mine, points)):
+            centres[theirs], radii[theirs] = spheres
+            if damped is not None and len(theirs):
+                damped[theirs] = their_points
+        large = {int(g): nodes_of(int(g)) for g in np.intersect1d(self._large, grains)}
+        everyone = self.comm.allgather(self._pairs_of_large(centres, radii, large))
+        pairs = tuple(np.concatenate([theirs[k] for theirs in everyone]) for k in (0, 1))
+        return centres, radii, damped, pairs
 
     def _hand_over(
         self, held: NDArray[np.int64], wanted: list[NDArray[np.int64]], renew: bool
@@ -957,12 +957,34 @@ class DistributedRun:
         self.local, self.held = local, held
         self._plan(node_map)
 
-    def save_checkpoint(self, path: str | os.PathLike[str], outputs: Outputs | None = None) -> Path:
-        """Write the run's checkpoint at `path`, the serial run's format (granulate.checkpoints,
-        with the bookkeeping of `outputs`): every grain's state is gathered into rank 0's
-        simulation, which writes it. It restarts on any number of ranks (load_checkpoint), or
-        serially, bit for bit. Every rank calls it; rank 0 raises a failure to write, the others
-        RankFailed. The path written, on every rank."""
+    def fingerprint(self) -> str:
+        """The set-up's fingerprint (Simulation.fingerprint), on every rank: each rank hashes
+        the grains it owns (checkpoints.grain_digest; one gather, once per run), rank 0 puts
+        the digests together in grain order."""
+        if self._setup_digest is None:
+            local = self.local.model
+            offsets = np.asarray(local.bond_offsets)
+            mine = {
+                int(g): checkpoints.grain_digest(
+                    local.reference_positions[s], local.volumes[s], offsets[s.start : s.stop + 1]
+                )
+                for g, s in ((g, self.local_slice(g)) for g in self._owned)
+            }
+            parts = self.comm.gather(mine, root=0)
+
+            def digest() -> str:
+                assert parts is not None
+                every = {g: d for part in parts for g, d in part.items()}
+                grains = b"".join(every[g] for g in range(len(self._slices)))
+                return checkpoints.set_up_digest(self._sim, grains)
+
+            self._setup_digest = str(self.comm.bcast(on_root(self.comm, digest), root=0))
+        return checkpoints.fingerprint(self._sim, self._setup_digest, self.dt)
+
+    def checkpoint_part(self) -> tuple[dict[str, Any], dict[int, GrainState]]:
+        """This rank's part of a checkpoint now (every rank together): the moment (the time,
+        step and contact scalars, transplant.moment_of, with the whole run's wall reactions and
+        deepest overlaps) and the states of the grains it owns."""
         saved = dict(self.local.core.checkpoint())
         saved["contact_wall_reactions"] = self.wall_reactions().ravel()  # the whole run's
         deepest = self.deepest_contact()
@@ -971,51 +993,62 @@ class DistributedRun:
             dtype=float,
         )
         owned = {int(g): self.local_slice(g) for g in self._owned}
-        parts = self.comm.gather(grain_states(self.local, saved, self._to_global, owned), root=0)
+        return moment_of(saved), grain_states(self.local, saved, self._to_global, owned)
 
-        def write() -> Path:
-            assert parts is not None
-            states = {grain: state for part in parts for grain, state in part.items()}
-            sim = self._sim
-            every = [states[g] for g in range(len(self._slices))]
-            with warnings.catch_warnings():  # the start checks were made when the run was set up
-                warnings.simplefilter("ignore")
-                restore_grains(sim._build(), every, np.arange(self._node_count), saved)
-            sim.analysis.forget_fragments()
-            return checkpoints.save(sim, path, outputs)
-
-        return Path(self.comm.bcast(on_root(self.comm, write), root=0))
+    def save_checkpoint(self, path: str | os.PathLike[str], outputs: Outputs | None = None) -> Path:
+        """Write the run's checkpoint at `path` in pieces (checkpoint_pieces.py, with the
+        bookkeeping of `outputs`): each rank its own grains' states, rank 0 the header. It
+        restarts on any number of ranks (load_checkpoint), or serially, bit for bit. Every rank
+        calls it; an error on one rank ends every rank. The path written, on every rank."""
+        return checkpoint_pieces.save(self, path, outputs)
 
     def load_checkpoint(self, path: str | os.PathLike[str], outputs: Outputs | None = None) -> None:
         """Continue from a checkpoint of this set-up written by a run on any number of ranks, or
-        by a serial run (else InputError on every rank): rank 0 reads it into its simulation
-        (with `outputs`' bookkeeping, granulate.checkpoints.load) and tells every rank where
-        the grains are (their bounding spheres); the grains are cut anew there, and rank 0
-        sends each rank the states of the grains it holds, of which it builds its part. Every
-        rank calls it."""
+        by a serial run (else InputError on every rank). Rank 0 reads its header; of a
+        checkpoint in pieces each rank reads some pieces, of a whole one (a serial run's) rank
+        0 reads every grain. The grains are cut anew where they are, each goes to the ranks
+        that hold it, and each rank builds its part of them; rank 0 then takes `outputs`'
+        bookkeeping from it. Every rank calls it."""
+        fingerprint = self.fingerprint()
+        start = time.perf_counter()
         states: dict[int, GrainState] = {}
 
-        def read() -> tuple[tuple[Any, ...], dict[str, Any]]:
+        def read() -> tuple[dict[str, Any], dict[str, Any], NDArray[np.int64] | None]:
+            state, header = checkpoints.read(path, fingerprint)
+            if "pieces" in header:
+                return header, moment_of(state), np.asarray(state["piece_of_grain"])
             sim = self._sim
-            checkpoints.load(sim, path, outputs)
+            with warnings.catch_warnings():  # the start checks were made when the run was set up
+                warnings.simplefilter("ignore")
+                sim.core.restore(state)
+            sim.analysis.forget_fragments()
             sim._gathered = None  # the evaluation gathered before is not the checkpoint's
             saved = dict(sim.core.checkpoint())
             every = {g: self._slices[g] for g in range(len(self._slices))}
             states.update(grain_states(sim, saved, np.arange(self._node_count), every))
-            grains = [states[g].positions for g in range(len(self._slices))]
-            layout = self._layout(grains, *_spheres(grains, self._sim.dimension))
-            return layout, moment_of(saved)
+            return header, moment_of(saved), None
 
-        start = time.perf_counter()
-        layout, moment = self.comm.bcast(on_root(self.comm, read), root=0)
-        held = self._distribute(*layout)
-        every_held = self.comm.gather(held, root=0)
-        mine = self.comm.scatter(
-            None if every_held is None else [{int(g): states[g] for g in h} for h in every_held],
-            root=0,
-        )
+        header, moment, piece_of_grain = self.comm.bcast(on_root(self.comm, read), root=0)
+        if piece_of_grain is not None:
+            ranks, rank = self.comm.Get_size(), self.comm.Get_rank()
+            mine = list(range(rank, header["pieces"]["count"], ranks))
+            together(
+                self.comm,
+                lambda: states.update(read_pieces(path, header, piece_of_grain, mine)),
+                "reading its pieces of the checkpoint",
+            )
+        grains = np.array(sorted(states), dtype=np.int64)
+        held = self._distribute(*self._gathered_layout(grains, lambda g: states[g].positions))
+        outgoing = [
+            {int(g): states[int(g)] for g in np.intersect1d(held_there, grains)}
+            for held_there in self._held_by_rank()
+        ]
         states.clear()
-        together(self.comm, lambda: self._rebuild(held, mine, moment))
+        received: dict[int, GrainState] = {}
+        for box in self.comm.alltoall(outgoing):
+            received |= box
+        together(self.comm, lambda: self._rebuild(held, received, moment))
+        on_root(self.comm, lambda: checkpoints.resume_outputs(path, header, outputs))
         self._exchange_caps()
         self._loaded_walls = np.asarray(moment["contact_wall_reactions"]).reshape(-1, 6)
         self._migration_due = False

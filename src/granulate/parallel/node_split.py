@@ -100,6 +100,7 @@ class NodeSplitRun:
         self.halo_nodes = sum(len(halo) for halo in self._receive.values())
         self.seconds = dict.fromkeys(("steps", "exchange", "collect"), 0.0)
         self.waiting = 0.0  # of the exchange's seconds, those waiting for the halo (Waitall)
+        self._setup_digest: str | None = None  # of the set-up's fingerprint, made once
 
     @property
     def dt(self) -> float:
@@ -226,6 +227,15 @@ class NodeSplitRun:
             Evaluation.of_core(core, sim.analysis.contact_table()), list_rebuilds=searches
         )
 
+    def fingerprint(self) -> str:
+        """The set-up's fingerprint (Simulation.fingerprint), on every rank from the whole
+        model it holds (no message)."""
+        if self._setup_digest is None:
+            slices = [body.node_slice for body in self._sim.bodies]
+            grains = checkpoints.model_grain_digests(self.local.model, slices)
+            self._setup_digest = checkpoints.set_up_digest(self._sim, grains)
+        return checkpoints.fingerprint(self._sim, self._setup_digest, self.dt)
+
     def save_checkpoint(self, path: str | os.PathLike[str], outputs: Outputs | None = None) -> Path:
         """The serial run's checkpoint (granulate.checkpoints, with `outputs`' bookkeeping),
         written by rank 0 from the whole state (collect); it restarts on any number of ranks,
@@ -235,7 +245,7 @@ class NodeSplitRun:
 
         def write() -> Path:
             self._sim.analysis.forget_fragments()
-            return checkpoints.save(self._sim, path, outputs)
+            return checkpoints.save(self._sim, path, outputs, self.fingerprint())
 
         return Path(self.comm.bcast(on_root(self.comm, write), root=0))
 
@@ -245,7 +255,7 @@ class NodeSplitRun:
         `outputs`' bookkeeping) and every rank restores the whole state from it."""
 
         def read() -> dict[str, Any]:
-            checkpoints.load(self._sim, path, outputs)
+            checkpoints.load(self._sim, path, outputs, self.fingerprint())
             self._sim._gathered = None  # the evaluation gathered before is not the checkpoint's
             return dict(self._sim.core.checkpoint())
 

@@ -47,18 +47,18 @@ _VECTOR_KEYS = ("point", "normal", "force")
 
 def require_room(sim: Simulation) -> None:
     """Rank 0 of Simulation(comm=...)'s run, at its start: InputError when its whole
-    simulation, which it builds the first time the ranks send it their state (a checkpoint, a
-    frame of every node, the end of a run), would not fit in the memory free now
-    (build_model's check), rather than when it first needs it, maybe hours in. A bare
+    simulation, which it builds the first time the ranks send it their state (a frame of every
+    node, a writer that reads the simulation, the end of a run), would not fit in the memory
+    free now (build_model's check), rather than when it first needs it, maybe hours in. A bare
     DistributedRun that never gathers (bench --ranks) is not checked."""
     try:
         outer_layers = sim._interactions.uses_surface_law()
         core_model.require_memory_for(sim._assembly, sim.plane, outer_layers)
     except InputError as error:
         raise InputError(
-            f"{error}. On MPI ranks, rank 0 holds the whole model at checkpoints, frames of every "
-            "node and the end of a run: give it a machine with that much memory free (fewer "
-            "ranks beside it)"
+            f"{error}. On MPI ranks, rank 0 holds the whole model at the end of a run (and for "
+            "frames of every node): give it a machine with that much memory free (fewer ranks "
+            "beside it)"
         ) from None
 
 

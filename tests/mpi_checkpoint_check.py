@@ -1,0 +1,159 @@
+"""Run under `mpiexec -n K python tests/mpi_checkpoint_check.py CASE` (tests/test_mpi.py does):
+a distributed run's checkpoint in pieces (granulate/parallel/checkpoint_pieces.py) on the
+checkpoint tests' tumbling drum (tests/test_checkpoint.py). Rank 0 prints one line; the exit
+status is non-zero when the check fails.
+
+`pieces`: a checkpoint of 600 steps is a header and one piece per rank, written and read again
+on the ranks without rank 0 ever building the whole simulation, and a second checkpoint at the
+same path leaves only its own pieces.
+
+`damaged`: a checkpoint missing a piece, or holding a piece of another checkpoint, is refused on
+every rank with one InputError naming the piece, and the run's history.csv is left as it was.
+
+`write-fail`: the last rank failing to write its piece (a full disk) ends every rank; the
+checkpoint written before is left whole (its header's bytes, its pieces) and a run continues
+from it.
+"""
+
+from __future__ import annotations
+
+import shutil
+import sys
+import tempfile
+import warnings
+from pathlib import Path
+
+from mpi4py import MPI
+
+sys.path.insert(0, str(Path(__file__).parent))
+import granulate as gr
+from granulate import checkpoints
+from granulate.parallel import DistributedRun, checkpoint_pieces
+from test_checkpoint import tumbling_drum
+
+
+def pieces_of(path: Path) -> list[str]:
+    """The files in the pieces folder of the checkpoint at `path`, as folder/file."""
+    folder = checkpoints.pieces_folder(path)
+    return sorted(str(p.relative_to(folder)) for p in folder.rglob("*") if p.is_file())
+
+
+def messages_of(action: object, comm: MPI.Comm) -> list[str] | None:
+    """action() on every rank; on rank 0 each rank's "ErrorType: message" (empty if it
+    finished), None on the others."""
+    try:
+        action()  # type: ignore[operator]
+        message = ""
+    except (gr.InputError, RuntimeError, OSError) as error:
+        message = f"{type(error).__name__}: {error}"
+    return comm.gather(message, root=0)
+
+
+def check_pieces(folder: Path, comm: MPI.Comm) -> int:
+    """0 when a checkpoint of the ranks is a header and a piece per rank, written and loaded
+    with rank 0's simulation never built, and a second one replaces the first's pieces."""
+    path = folder / "checkpoint.npz"
+    first = DistributedRun(tumbling_drum(folder, outputs=False), comm)
+    first.run(600)
+    first.save_checkpoint(path)
+    after_first = pieces_of(path) if comm.Get_rank() == 0 else []
+    second = DistributedRun(tumbling_drum(folder, outputs=False), comm)
+    second.load_checkpoint(path)
+    second.run(100)
+    second.save_checkpoint(path)
+    built = comm.gather(first._sim._core is not None or second._sim._core is not None, root=0)
+    if comm.Get_rank() != 0:
+        return 0
+    after_second = pieces_of(path)
+    print(f"first {after_first}; second {after_second}; rank 0 built the whole: {built[0]}")
+    names = {f"piece_{r}.npz" for r in range(comm.Get_size())}
+    one_folder = [
+        len({f.split("/")[0] for f in files}) == 1 and {f.split("/")[1] for f in files} == names
+        for files in (after_first, after_second)
+    ]
+    steps = [files[0].split("-")[0] for files in (after_first, after_second)]
+    return 0 if all(one_folder) and steps == ["600", "700"] and not any(built) else 1
+
+
+def check_damaged(folder: Path, comm: MPI.Comm) -> int:
+    """0 when a checkpoint with a piece missing, or a piece of another checkpoint, is refused
+    with the same InputError on every rank, and history.csv is left as it was."""
+    sim = tumbling_drum(folder, comm=comm)
+    sim.run(600)  # checkpoints every 1,000 steps: the one below is the folder's
+    path = sim.save_checkpoint(folder / "checkpoint.npz")
+    other = sim.save_checkpoint(folder / "other.npz")  # the same step: another token
+    rank, history = comm.Get_rank(), folder / "history.csv"
+    before = history.read_bytes() if rank == 0 else b""
+    found = []
+    for damage in ("missing", "foreign"):
+        if rank == 0:
+            piece = next(checkpoints.pieces_folder(path).glob("*/piece_1.npz"))
+            kept = piece.read_bytes()
+            piece.unlink()
+            if damage == "foreign":
+                shutil.copy(next(checkpoints.pieces_folder(other).glob("*/piece_0.npz")), piece)
+        comm.Barrier()
+        resumed = tumbling_drum(folder, comm=comm, resume=True)
+        found.append(messages_of(lambda: resumed.load_checkpoint(path), comm))  # noqa: B023
+        if rank == 0:
+            piece.write_bytes(kept)
+    if rank != 0:
+        return 0
+    same_history = history.read_bytes() == before
+    print(f"missing: {found[0]}; foreign: {found[1]}; history.csv kept {same_history}")
+    refused = all(
+        len(set(messages)) == 1 and messages[0].startswith("InputError") and expected in messages[0]
+        for messages, expected in zip(found, ("missing its piece", "does not belong"), strict=True)
+    )
+    return 0 if refused and same_history else 1
+
+
+def check_write_failure(folder: Path, comm: MPI.Comm) -> int:
+    """0 when the last rank failing to write its piece ends every rank, the checkpoint written
+    before is left whole, and a run continues from it."""
+    path = folder / "checkpoint.npz"
+    run = DistributedRun(tumbling_drum(folder, outputs=False), comm)
+    run.run(300)
+    run.save_checkpoint(path)
+    rank, last = comm.Get_rank(), comm.Get_size() - 1
+    header = path.read_bytes() if rank == 0 else b""
+    pieces = pieces_of(path) if rank == 0 else []
+    run.run(300)
+    if rank == last:
+
+        def full_disk(*_: object) -> object:
+            raise OSError(28, "No space left on device")
+
+        checkpoint_pieces.pack = full_disk  # type: ignore[assignment]
+    messages = messages_of(lambda: run.save_checkpoint(path), comm)
+    resumed = DistributedRun(tumbling_drum(folder, outputs=False), comm)
+    resumed.load_checkpoint(path)
+    resumed.run(10)
+    step = int(resumed.local.core.step)
+    if rank != 0:
+        return 0
+    kept = path.read_bytes() == header and pieces_of(path) == pieces
+    print(f"messages {messages}; checkpoint kept {kept}; continued to step {step}")
+    failed = messages[last].startswith("OSError") and all(
+        f"rank {last} failed" in m for m in messages[:last]
+    )
+    return 0 if failed and kept and step == 310 else 1
+
+
+CASES = {"pieces": check_pieces, "damaged": check_damaged, "write-fail": check_write_failure}
+
+
+def main() -> int:
+    comm = MPI.COMM_WORLD
+    warnings.filterwarnings("ignore", message="contact.*bodies pressed")
+    folder = Path(comm.bcast(tempfile.mkdtemp() if comm.Get_rank() == 0 else None, root=0))
+    try:
+        return CASES[sys.argv[1]](folder, comm)
+    finally:
+        comm.Barrier()
+        if comm.Get_rank() == 0:
+            shutil.rmtree(folder)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
