@@ -19,7 +19,10 @@ on any difference:
   every file but the frames' pieces and run.json as the serial run's (history.csv but its
   list searches), the state gathered once (at the end: each output step is made of the
   ranks' measures, parallel/step_parts.py); and again with a history section of a user's own
-  that reads the simulation's velocities (LargestSpeed), whose every output step gathers it.
+  that reads the simulation's velocities (LargestSpeed), whose every output step gathers it;
+  and run with gather=False, which never gathers it, nor checks rank 0's memory for it (the
+  check made to fail): rank 0's simulation refuses to give the nodes after, and
+  sim.measures() gives the serial run's kinetic energy and broken bonds.
 """
 
 from __future__ import annotations
@@ -38,6 +41,7 @@ from mpi4py import MPI
 
 sys.path.insert(0, str(Path(__file__).parent))
 import granulate as gr
+from granulate import core_model
 from granulate.parallel import DistributedRun
 from granulate.parallel.node_split import NodeSplitRun
 from granulate.writers import registry
@@ -168,6 +172,23 @@ def counting(owner: type[DistributedRun] | type[NodeSplitRun]) -> Iterator[list[
         owner.collect = collect  # type: ignore[method-assign]
 
 
+@contextmanager
+def no_room_on_root(comm: MPI.Comm, active: bool) -> Iterator[None]:
+    """Within, when `active`: rank 0's memory check of the whole model always fails, as for a
+    model larger than its memory (a run that never gathers the state does not need it)."""
+    check = core_model.require_memory_for
+
+    def full(*_: object) -> None:
+        raise gr.InputError("the model would need about 9 TB of memory")
+
+    if active and comm.Get_rank() == 0:
+        core_model.require_memory_for = full
+    try:
+        yield
+    finally:
+        core_model.require_memory_for = check
+
+
 class LargestSpeed:
     """A history section of a user's own: it reads the simulation's node velocities, so a
     distributed run gathers the whole state on rank 0 for every output step."""
@@ -178,22 +199,27 @@ class LargestSpeed:
         return {"largest_speed": float(speeds.max())}
 
 
-def check_outputs(steps: int, comm: MPI.Comm, own_section: bool = False) -> bool:
+def check_outputs(
+    steps: int, comm: MPI.Comm, own_section: bool = False, gather: bool = True
+) -> bool:
     """The drum's outputs in pieces on the ranks against the serial run's (the module
-    docstring), with LargestSpeed registered when `own_section`; rank 0 prints what differs."""
+    docstring), with LargestSpeed registered when `own_section`, run with `gather`; rank 0
+    prints what differs."""
     root = Path(comm.bcast(tempfile.mkdtemp() if comm.Get_rank() == 0 else None, root=0))
     sections = list(registry.HISTORY_SECTIONS)
     if own_section:
         registry.register_history_section(LargestSpeed())
-    with counting(DistributedRun) as gathered:
+    made: dict[str, gr.Simulation] = {}
+    with counting(DistributedRun) as gathered, no_room_on_root(comm, not gather):
         for name, ranks in (("serial", None), ("ranks", comm)):
             if ranks is None and comm.Get_rank() != 0:
                 continue
-            sim = set_up("grains", ranks)
+            sim = made[name] = set_up("grains", ranks)
             sim.output(root / name, every=CHECK_EVERY, pieces=True, track=[sim.bodies[3]])
-            sim.run(steps)
+            sim.run(steps, gather=gather)
             gathered[0] = 0 if ranks is None else gathered[0]
     registry.HISTORY_SECTIONS[:] = sections
+    after = None if gather else without_gathering(made["ranks"], made.get("serial"))
     if comm.Get_rank() != 0:
         return True
     found = {name: outputs(root / name) for name in ("serial", "ranks")}
@@ -211,13 +237,34 @@ def check_outputs(steps: int, comm: MPI.Comm, own_section: bool = False) -> bool
         del row[SEARCHES]
     shutil.rmtree(root)
     kind = "with a section of its own" if own_section else "grains"
+    kind += "" if gather else " without gathering"
     print(
         f"outputs {kind} on {comm.Get_size()} ranks: {len(kept['serial'])} files but frames, "
         f"differing {differ}; history equal but list searches {rows[0] == rows[1]} "
-        f"({len(rows[0])} rows, {len(rows[0][0])} columns); the state gathered {gathered[0]} times"
+        f"({len(rows[0])} rows, {len(rows[0][0])} columns); the state gathered {gathered[0]} "
+        f"times{'' if after is None else '; ' + after}"
     )
-    once_each = len(rows[0]) + 1 if own_section else 1  # every output step, and the end
-    return not differ and rows[0] == rows[1] and gathered[0] == once_each
+    once_each = len(rows[0]) + 1 if own_section else int(gather)  # every output step, the end
+    ok_after = after is None or after.endswith("measured as serially True")
+    return not differ and rows[0] == rows[1] and gathered[0] == once_each and ok_after
+
+
+def without_gathering(sim: gr.Simulation, serial: gr.Simulation | None) -> str | None:
+    """After sim.run(..., gather=False) on every rank: on rank 0, what its simulation says
+    when asked for the nodes (it holds no state of the run), and whether sim.measures()
+    (every rank together) gives the serial run's kinetic energy and broken bonds."""
+    measured = sim.measures()
+    values = (measured.kinetic_energy(), measured.broken_bonds())
+    if serial is None:
+        return None
+    try:
+        np.asarray(sim.positions)
+        refused = "rank 0 gave positions"
+    except gr.InputError as error:
+        refused = str(error)
+    same = values == (serial.kinetic_energy(), serial.broken_bonds())
+    built = sim._core is not None
+    return f"rank 0: {refused!r}, built {built}; measured as serially {same and not built}"
 
 
 def _thresholds(seen: list[tuple[float, ...]]) -> list[gr.stopping.StopCriterion]:
@@ -247,7 +294,9 @@ def main() -> int:
     measured, seen = check_measures(engine, steps, comm)
     stopped = check_stops(engine, steps, seen, comm)
     written = engine != "grains" or (
-        check_outputs(steps, comm) and check_outputs(steps, comm, own_section=True)
+        check_outputs(steps, comm)
+        and check_outputs(steps, comm, own_section=True)
+        and check_outputs(steps, comm, gather=False)
     )
     return 0 if comm.bcast(measured and stopped and written, root=0) else 1
 

@@ -300,7 +300,9 @@ def test_stop_criteria_read_the_ranks_measures_and_stop_at_the_serial_step(
     gathering the state. The drum's outputs
     in pieces (a tracked grain's columns among them) are the serial run's, every output step
     made of the ranks' measures (the state gathered only at the end), and with a history
-    section of a user's own that reads the simulation, every output step gathers it."""
+    section of a user's own that reads the simulation, every output step gathers it; run with
+    gather=False, never, and rank 0 needs no room for the whole model (its check made to
+    fail), refuses to give the nodes after, and sim.measures() is the serial run's."""
     done = run_ranks(ranks, engine, str(steps), script=STOP_CHECK)
     assert done.returncode == 0, done.stdout + done.stderr
     assert f"measures {engine} on {ranks} ranks: equal True" in done.stdout
@@ -319,6 +321,12 @@ def test_stop_criteria_read_the_ranks_measures_and_stop_at_the_serial_step(
             "differing []; history equal but list searches True (7 rows, 32 columns); the state "
             "gathered 8 times"
         ) in done.stdout
+        assert (
+            f"outputs grains without gathering on {ranks} ranks: 30 files but frames, differing "
+            "[]; history equal but list searches True (7 rows, 31 columns); the state gathered "
+            "0 times; rank 0: \"rank 0's simulation does not hold the run's state at step 600"
+        ) in done.stdout
+        assert "built False; measured as serially True" in done.stdout
 
 
 THREADS_CHECK = Path(__file__).with_name("mpi_threads_check.py")

@@ -203,16 +203,20 @@ def _run_case(
     try:
         # A run cut short by --steps is continued with --resume as if never stopped, so it
         # ends like an interrupted one: no extra frame at its last step.
+        # On ranks, rank 0 takes the whole state only when an output reads it: the command
+        # reads the run's measures (every rank together), not rank 0's simulation.
         reason = sim.run(
             steps,
             stop=stop,
             check_every=check_every,
             progress=reporter,
             write_final=not cut_short,
+            gather=False,
         )
     finally:
         reporter.close()
     sim.save_checkpoint(sim.checkpoint_path)
+    broken = sim.measures().broken_bonds()
     if not speaks:
         return 0
     summary = sim.summary()
@@ -220,7 +224,7 @@ def _run_case(
     ended = f"stopped: {reason}" if reason else "finished"
     print(
         f"{ended} at step {sim.step} (t = {sim.time:.6g} s) in {summary['wall_seconds']:.1f} s, "
-        f"{rate / 1e6:.2f} M node-steps/s, {sim.broken_bonds()} broken bonds"
+        f"{rate / 1e6:.2f} M node-steps/s, {broken} broken bonds"
     )
     return 0
 

@@ -52,6 +52,8 @@ class RunPlan:
     check_every: int
     progress: Callable[[Progress], None] | None
     write_final: bool
+    #: A distributed run's end state into rank 0's simulation (Simulation.run's `gather`).
+    gather: bool = True
 
 
 T = TypeVar("T")
@@ -310,8 +312,10 @@ def advance(sim: Simulation, plan: RunPlan, parts: LoopParts) -> str | None:
         _core.set_num_threads(most)
         parts.record.wall_seconds += wallclock.perf_counter() - start
         parts.record.steps_run += stepper.step - first_step
-    stepper.collect()  # the end state in the simulation (rank 0's, in a distributed run)
-    write_outputs(stepper, sim, out, final=plan.write_final or reason is not None, collected=True)
+    if plan.gather:
+        stepper.collect()  # the end state in the simulation (rank 0's, in a distributed run)
+    final = plan.write_final or reason is not None
+    write_outputs(stepper, sim, out, final=final, collected=plan.gather)
     return reason
 
 

@@ -47,7 +47,7 @@ from granulate.run_loop import LoopParts, Progress, RunPlan, RunRecord
 from granulate.shapes import Shape
 from granulate.simulation_results import SimulationResults
 from granulate.simulation_setup import SimulationSetup
-from granulate.stopping import StopCriterion
+from granulate.stopping import RunMeasures, StopCriterion
 from granulate.writers.outputs import Outputs
 from granulate.writers.vtu_frame import FIELDS
 
@@ -130,6 +130,10 @@ class Simulation(SimulationSetup, SimulationResults):
         self._model: _core.Model | None = None
         self._analysis: Analysis | None = None
         self._gathered: Evaluation | None = None  # a distributed run's, on rank 0
+        #: Rank 0 of a distributed run: the ranks have moved on (steps, a checkpoint loaded in
+        #: pieces) since its simulation last took their state, which it then refuses to give.
+        self._ranks_ahead = False
+        self._room_checked = False  # rank 0's memory for the whole model (_require_room_on_root)
         self._reference: NDArray[np.float64] | None = None
         self._record = RunRecord()
         self._precracks: list[tuple[NDArray[np.float64], NDArray[np.float64], Shape | None]] = []
@@ -184,15 +188,22 @@ class Simulation(SimulationSetup, SimulationResults):
         """The core simulation, made on first use: the model (materials, shapes, particles,
         bonds), contact laws, walls and damping, the time step, loads, initial velocities,
         precracks."""
-        if self._core is not None:
-            return self._core
-        if not self.bodies:
-            raise InputError("the simulation has no body; add one with add_body")
         if self._comm is not None and self._comm.Get_rank() != 0:
             raise InputError(
                 f"this is rank {self._comm.Get_rank()} of a distributed simulation: the whole "
                 "state is on rank 0 (read results where comm.Get_rank() == 0)"
             )
+        if self._ranks_ahead:
+            raise InputError(
+                f"rank 0's simulation does not hold the run's state at step {self.step}: it "
+                "takes the ranks' state at the end of run() and at outputs that read it, not "
+                "after run(..., gather=False) or a checkpoint loaded in pieces; run with "
+                "gather=True, read sim.measures() on every rank, or read the run's outputs"
+            )
+        if self._core is not None:
+            return self._core
+        if not self.bodies:
+            raise InputError("the simulation has no body; add one with add_body")
         outer_layers = self._interactions.uses_surface_law()
         model, core_materials = core_model.build_model(self._assembly, self.plane, outer_layers)
         core = _core.Simulation(model)
@@ -304,6 +315,7 @@ class Simulation(SimulationSetup, SimulationResults):
         check_every: int = 100,
         progress: Callable[[Progress], None] | bool | None = None,
         write_final: bool = True,
+        gather: bool = True,
     ) -> str | None:
         """Advance ``steps`` time steps, or until simulated time ``until`` [s].
 
@@ -322,6 +334,13 @@ class Simulation(SimulationSetup, SimulationResults):
         and history row of its last step are written too (``write_final=False`` skips them at
         the last step, for a run advanced in pieces; a stop criterion met always writes them),
         and run.json is brought up to date.
+
+        In a distributed run (``comm``), every rank calls it; at its end rank 0's simulation
+        takes the ranks' state, so that its results (positions, tables, energies) can be read
+        there. ``gather=False`` skips that, for a run too large for one process: rank 0 then
+        never builds the whole model unless an output reads it (frames not in pieces, a
+        writer that reads the simulation) or a stop criterion does, and its results raise an
+        InputError until it takes the state again; ``measures()`` and the outputs give them.
         """
         stepper = self._stepper()
         steps = run_loop.steps_to_run(stepper.time, self.dt, steps, until, check_every)
@@ -331,7 +350,9 @@ class Simulation(SimulationSetup, SimulationResults):
                 f"progress must be True, False or a function of a Progress, got {progress!r}"
             )
         callback = None if isinstance(progress, bool) else progress
-        plan = RunPlan(steps, tuple(stop), check_every, callback, write_final)
+        plan = RunPlan(steps, tuple(stop), check_every, callback, write_final, gather)
+        if self._comm is not None:
+            self._require_room_on_root(plan)
         parts = LoopParts(
             self._output,
             self._record,
@@ -369,8 +390,6 @@ class Simulation(SimulationSetup, SimulationResults):
         when nothing touches, the nodes dealt to the ranks (granulate.parallel.node_split)."""
         if self._distributed is None:
             from granulate.parallel import DistributedRun
-            from granulate.parallel.agreement import on_root
-            from granulate.parallel.whole_state import require_room
 
             if self._interactions.contact_free():  # nothing touches: the nodes are dealt
                 from granulate.parallel.node_split import NodeSplitRun
@@ -379,14 +398,43 @@ class Simulation(SimulationSetup, SimulationResults):
             else:
                 run = DistributedRun(self, self._comm)
             _check_time_step(run.dt, run.stable_dt)
-            # Rank 0 takes the whole state at the end of each run: refuse now
-            # a model it cannot hold, rather than then.
-            on_root(self._comm, lambda: require_room(self))
             if self._comm.Get_rank() == 0 and self._dt is not None:
                 _warn_above_stable(run.dt, run.stable_dt, stacklevel=4)
             self._dt_warned = True  # rank 0's whole simulation, built later, is quiet
             self._distributed = run
         return self._distributed
+
+    def _require_room_on_root(self, plan: RunPlan) -> None:
+        """Every rank, before a distributed run's first step: InputError when rank 0 will take
+        the whole state in this run (at its end unless plan.gather is False, for outputs or
+        stop criteria that read the whole simulation, or for every output of bodies cut at
+        node level) and the whole model would not fit in its memory (whole_state.require_room):
+        refused now, not hours in. Checked once."""
+        from granulate.parallel import NodeSplitRun
+        from granulate.parallel.agreement import on_root
+        from granulate.parallel.whole_state import require_room
+
+        run = self._distributed_run()
+        out = self._output  # rank 0's
+        gathers = self._comm.bcast(
+            plan.gather
+            or isinstance(run, NodeSplitRun)
+            or any(criterion.needs_whole_state for criterion in plan.stop)
+            or (out is not None and out.may_need_whole_state()),
+            root=0,
+        )
+        if gathers and not self._room_checked:
+            on_root(self._comm, lambda: require_room(self))
+            self._room_checked = True
+
+    def measures(self) -> RunMeasures:
+        """What the stop criteria read (granulate.stopping.RunMeasures: time, kinetic energy,
+        farthest node, broken bonds, fully broken particles, wall displacements): this
+        simulation, or in a distributed run the ranks' measures put together, the same bits,
+        without gathering the state (every rank calls it and each of its methods together)."""
+        if self._comm is None:
+            return self
+        return self._distributed_run().measures()
 
     def _after_chunk(self) -> None:
         """After each chunk of steps: the warning about bodies pressed deep into each other (in

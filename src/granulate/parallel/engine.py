@@ -716,6 +716,7 @@ class DistributedRun:
         more than half the margin: the ghosts would no longer be enough. An error in one
         rank's step ends every rank: that rank raises its own, the others RankFailed naming
         it (no rank is left waiting for a message)."""
+        self._sim._ranks_ahead |= steps > 0  # rank 0's simulation until it takes the state
         for _ in range(steps):
             if self._migration_due:  # before the step, so the parts hold its evaluation after
                 self.migrate()
@@ -1018,6 +1019,7 @@ class DistributedRun:
             if "pieces" in header:
                 return header, moment_of(state), np.asarray(state["piece_of_grain"])
             sim = self._sim
+            sim._ranks_ahead = False  # it takes the whole state itself
             with warnings.catch_warnings():  # the start checks were made when the run was set up
                 warnings.simplefilter("ignore")
                 sim.core.restore(state)
@@ -1049,6 +1051,7 @@ class DistributedRun:
             received |= box
         together(self.comm, lambda: self._rebuild(held, received, moment))
         on_root(self.comm, lambda: checkpoints.resume_outputs(path, header, outputs))
+        self._sim._ranks_ahead |= piece_of_grain is not None  # rank 0 read the header only
         self._exchange_caps()
         self._loaded_walls = np.asarray(moment["contact_wall_reactions"]).reshape(-1, 6)
         self._migration_due = False

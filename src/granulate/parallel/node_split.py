@@ -115,6 +115,7 @@ class NodeSplitRun:
     def run(self, steps: int) -> None:
         """Advance every rank `steps` steps. An error in one rank's step (an instability) ends
         every rank after that step: that rank raises its own, the others RankFailed."""
+        self._sim._ranks_ahead |= steps > 0  # rank 0's simulation until it takes the state
         for _ in range(steps):
             self._step()
 
@@ -214,6 +215,7 @@ class NodeSplitRun:
     ) -> None:
         """Rank 0: every rank's nodes (`parts`, in rank order) into its whole simulation."""
         sim = self._sim
+        sim._ranks_ahead = False  # it takes the ranks' state now
         core = sim._build()
         bonds = np.empty(self._offsets[-1], dtype=np.uint8)
         for nodes, part in zip(self.nodes_of, parts, strict=True):
@@ -255,6 +257,7 @@ class NodeSplitRun:
         `outputs`' bookkeeping) and every rank restores the whole state from it."""
 
         def read() -> dict[str, Any]:
+            self._sim._ranks_ahead = False  # it reads the whole state itself
             checkpoints.load(self._sim, path, outputs, self.fingerprint())
             self._sim._gathered = None  # the evaluation gathered before is not the checkpoint's
             return dict(self._sim.core.checkpoint())

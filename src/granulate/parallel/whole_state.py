@@ -191,6 +191,7 @@ def install(
     """Rank 0: `parts` (every rank's) into `sim`, built whole on first use: its nodes and bonds
     at `moment` (time [s], step), its last evaluation (Simulation.evaluation) and, when every
     part has them, its grains' measures (Analysis.give)."""
+    sim._ranks_ahead = False  # it takes the ranks' state now
     core = sim._build()
     starts = np.array([body.first_node for body in sim.bodies] + [sim.node_count])
     bond_starts = np.asarray(sim.model.bond_offsets, dtype=np.int64)[starts]

@@ -111,6 +111,11 @@ class Outputs:
         Otherwise a distributed run makes them of its ranks' measures (StepData)."""
         return (self.frame_due(step, final) and not self.pieces) or not registry.reads_values_only()
 
+    def may_need_whole_state(self) -> bool:
+        """Whether some output step may read the whole simulation (needs_whole_state): frames
+        of every node, or a writer that may read it."""
+        return not self.pieces or not registry.reads_values_only()
+
     def piece_folder(self, step: int, final: bool | None = None) -> Path | None:
         """The folder of the pieces the ranks write of the frame `step`'s outputs write
         (frame_due), or None when there is none or it is not written by ranks."""
