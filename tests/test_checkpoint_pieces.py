@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 import granulate as gr
-from granulate import checkpoints
+from granulate import checkpoints, fingerprints
 from granulate.io import checkpoint as checkpoint_file
 from granulate.io.run_folder import CHECKPOINT_PIECES
 from granulate.parallel import checkpoint_pieces
@@ -70,15 +70,15 @@ def test_the_fingerprint_of_a_ranks_parts_is_the_whole_models() -> None:
     for grains in ([0, 1], [2, 3]):
         part, _ = sim._subdomain(np.array(grains))
         slices = [part.bodies[k].node_slice for k in range(len(grains))]
-        digests += checkpoints.model_grain_digests(part.model, slices)
-    made = checkpoints.fingerprint(sim, checkpoints.set_up_digest(sim, digests), sim.dt)
+        digests += fingerprints.model_grain_digests(part.model, slices)
+    made = fingerprints.fingerprint(sim, fingerprints.set_up_digest(sim, digests), sim.dt)
     assert made == whole
     model = sim.model
     offsets = np.asarray(model.bond_offsets)
     grain = sim.bodies[2].node_slice
     volumes = np.array(model.volumes[grain])
     volumes[0] = np.nextafter(volumes[0], np.inf)
-    changed = checkpoints.grain_digest(
+    changed = fingerprints.grain_digest(
         model.reference_positions[grain], volumes, offsets[grain.start : grain.stop + 1]
     )
     assert changed != digests[64:96]

@@ -31,6 +31,7 @@ from granulate import (
     _core,
     checkpoints,
     core_model,
+    fingerprints,
     run_loop,
     threads,
 )
@@ -515,7 +516,7 @@ class Simulation(SimulationSetup, SimulationResults):
     def fingerprint(self) -> str:
         """Identifies the set-up a checkpoint belongs to: each body's nodes, volumes and bonds,
         loading, walls, contact (frozen once built: hashed once), time step, body force,
-        damping and ``case_fingerprint`` (granulate.checkpoints.fingerprint). Materials are
+        damping and ``case_fingerprint`` (granulate.fingerprints). Materials are
         named by their order, not by object identity, so the fingerprint is the same in every
         process. In a distributed run every rank calls it; each hashes its own grains."""
         if self._comm is not None:
@@ -523,9 +524,9 @@ class Simulation(SimulationSetup, SimulationResults):
         core = self._build()
         if self._setup_digest is None:
             slices = [body.node_slice for body in self.bodies]
-            grains = checkpoints.model_grain_digests(self.model, slices)
-            self._setup_digest = checkpoints.set_up_digest(self, grains)
-        return checkpoints.fingerprint(self, self._setup_digest, core.time_step)
+            grains = fingerprints.model_grain_digests(self.model, slices)
+            self._setup_digest = fingerprints.set_up_digest(self, grains)
+        return fingerprints.fingerprint(self, self._setup_digest, core.time_step)
 
     def save_checkpoint(self, path: str | Path) -> Path:
         """Write the state (positions, velocities, forces, bond states, contact history, time,

@@ -23,9 +23,10 @@ the cap margin, the ranks pick the caps anew; after it, past a quarter of the ma
 the grains anew where they are (which also rebalances) and hand grains over with their whole
 state (transplant.py).
 Wall reactions are summed on rank 0 in the serial order. `collect` gathers every grain's state
-and the last evaluation into rank 0's simulation (whole_state.py), whose serial writers, stop
-criteria and checkpoints then see the serial run (Simulation(comm=...) runs through
-stepper.py); checkpoints restart on any number of ranks, or serially.
+and the last evaluation into rank 0's simulation (whole_state.py), whose serial writers and
+stop criteria then see the serial run (Simulation(comm=...) runs through stepper.py).
+Checkpoints are written in pieces, each rank its own grains (checkpoint_pieces.py), and
+restart on any number of ranks, or serially.
 """
 
 from __future__ import annotations
@@ -41,7 +42,7 @@ from typing import TYPE_CHECKING, Any, NamedTuple
 import numpy as np
 from numpy.typing import NDArray
 
-from granulate import checkpoints
+from granulate import checkpoints, fingerprints
 from granulate._core import combined_time_step, points_within
 from granulate.errors import InputError
 from granulate.parallel import checkpoint_pieces
@@ -966,7 +967,7 @@ class DistributedRun:
             local = self.local.model
             offsets = np.asarray(local.bond_offsets)
             mine = {
-                int(g): checkpoints.grain_digest(
+                int(g): fingerprints.grain_digest(
                     local.reference_positions[s], local.volumes[s], offsets[s.start : s.stop + 1]
                 )
                 for g, s in ((g, self.local_slice(g)) for g in self._owned)
@@ -977,10 +978,10 @@ class DistributedRun:
                 assert parts is not None
                 every = {g: d for part in parts for g, d in part.items()}
                 grains = b"".join(every[g] for g in range(len(self._slices)))
-                return checkpoints.set_up_digest(self._sim, grains)
+                return fingerprints.set_up_digest(self._sim, grains)
 
             self._setup_digest = str(self.comm.bcast(on_root(self.comm, digest), root=0))
-        return checkpoints.fingerprint(self._sim, self._setup_digest, self.dt)
+        return fingerprints.fingerprint(self._sim, self._setup_digest, self.dt)
 
     def checkpoint_part(self) -> tuple[dict[str, Any], dict[int, GrainState]]:
         """This rank's part of a checkpoint now (every rank together): the moment (the time,

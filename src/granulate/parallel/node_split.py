@@ -34,7 +34,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
-from granulate import checkpoints
+from granulate import checkpoints, fingerprints
 from granulate.errors import InputError
 from granulate.evaluation import Evaluation
 from granulate.parallel.agreement import attempt, on_root, stop_if_any_failed, together
@@ -234,9 +234,9 @@ class NodeSplitRun:
         model it holds (no message)."""
         if self._setup_digest is None:
             slices = [body.node_slice for body in self._sim.bodies]
-            grains = checkpoints.model_grain_digests(self.local.model, slices)
-            self._setup_digest = checkpoints.set_up_digest(self._sim, grains)
-        return checkpoints.fingerprint(self._sim, self._setup_digest, self.dt)
+            grains = fingerprints.model_grain_digests(self.local.model, slices)
+            self._setup_digest = fingerprints.set_up_digest(self._sim, grains)
+        return fingerprints.fingerprint(self._sim, self._setup_digest, self.dt)
 
     def save_checkpoint(self, path: str | os.PathLike[str], outputs: Outputs | None = None) -> Path:
         """The serial run's checkpoint (granulate.checkpoints, with `outputs`' bookkeeping),

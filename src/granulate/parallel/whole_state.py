@@ -1,6 +1,6 @@
-"""The whole state of a distributed run on rank 0, for a frame of every node, a checkpoint, the
-end of a run and outputs of writers that may read the simulation (an output step of the built-in
-writers is made of the ranks' measures instead: step_parts.py).
+"""The whole state of a distributed run on rank 0, for a frame of every node, the end of a run
+(unless run(..., gather=False)) and outputs of writers that may read the simulation (an output
+step of the built-in writers is made of the ranks' measures instead: step_parts.py).
 
 Each rank sends its own grains' nodes (positions, velocities, forces, dilatation) and bonds, and
 what its last force evaluation left for them: the contacts whose first body it owns (the
