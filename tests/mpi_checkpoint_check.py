@@ -13,6 +13,9 @@ every rank with one InputError naming the piece, and the run's history.csv is le
 `write-fail`: the last rank failing to write its piece (a full disk) ends every rank; the
 checkpoint written before is left whole (its header's bytes, its pieces) and a run continues
 from it.
+
+`cli`: `granulate run` (in this process, on the ranks) of the drum case with frames in pieces,
+cut short and resumed from its checkpoint in pieces, never builds rank 0's whole simulation.
 """
 
 from __future__ import annotations
@@ -27,7 +30,7 @@ from mpi4py import MPI
 
 sys.path.insert(0, str(Path(__file__).parent))
 import granulate as gr
-from granulate import checkpoints
+from granulate import checkpoints, cli
 from granulate.parallel import DistributedRun, checkpoint_pieces
 from test_checkpoint import tumbling_drum
 
@@ -140,7 +143,48 @@ def check_write_failure(folder: Path, comm: MPI.Comm) -> int:
     return 0 if failed and kept and step == 310 else 1
 
 
-CASES = {"pieces": check_pieces, "damaged": check_damaged, "write-fail": check_write_failure}
+def check_command_line(folder: Path, comm: MPI.Comm) -> int:
+    """0 when `granulate run` of the drum case with frames in pieces, cut short at step 1,700
+    (its checkpoints in pieces, at 1,000 and at the end) and resumed to step 3,000, never
+    builds rank 0's whole simulation (the only one given the communicator), and both commands
+    succeed."""
+    case = folder / "drum_pieces.yaml"
+    if comm.Get_rank() == 0:
+        text = (Path(__file__).parent / "cases" / "drum_mpi.yaml").read_text()
+        case.write_text(text.replace("output: {every: 250}", "output: {every: 250, pieces: true}"))
+    comm.Barrier()
+    builds = []
+    build = gr.Simulation._build
+
+    def watched(sim: gr.Simulation) -> object:
+        before = sim._core is None
+        core = build(sim)
+        if sim._comm is not None and before:
+            builds.append(sim.step)
+        return core
+
+    gr.Simulation._build = watched  # type: ignore[method-assign]
+    out = ["--out", str(folder / "out"), "--quiet"]
+    codes = [
+        cli.main(["run", str(case), *out, "--steps", "1700"]),
+        cli.main(["run", str(case), *out, "--resume"]),
+    ]
+    gr.Simulation._build = build  # type: ignore[method-assign]
+    every_build = comm.gather(builds, root=0)
+    if comm.Get_rank() != 0:
+        return 0
+    files = pieces_of(folder / "out" / "checkpoint.npz")
+    print(f"exit codes {codes}; rank 0's whole builds {every_build[0]}; checkpoint {files}")
+    at_end = len(files) == comm.Get_size() and all(f.startswith("3000-") for f in files)
+    return 0 if codes == [0, 0] and not every_build[0] and at_end else 1
+
+
+CASES = {
+    "pieces": check_pieces,
+    "damaged": check_damaged,
+    "write-fail": check_write_failure,
+    "cli": check_command_line,
+}
 
 
 def main() -> int:

@@ -192,6 +192,14 @@ def test_a_checkpoint_missing_a_piece_or_with_a_foreign_one_is_refused_on_every_
     assert "is missing its piece" in done.stdout and "history.csv kept True" in done.stdout
 
 
+def test_granulate_run_with_frames_in_pieces_never_builds_the_whole_model_on_rank_0() -> None:
+    """The drum case on 2 ranks, cut short at step 1,700 and resumed to 3,000 from its
+    checkpoint in pieces: rank 0's whole simulation is never built."""
+    done = run_ranks(2, "cli", script=CHECKPOINT_CHECK)
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert "exit codes [0, 0]; rank 0's whole builds []" in done.stdout
+
+
 def test_a_rank_failing_to_write_its_piece_leaves_the_last_checkpoint_whole() -> None:
     """The last of 3 ranks cannot write (a full disk): every rank stops, the checkpoint before
     keeps its header and pieces, and a run continues from it."""

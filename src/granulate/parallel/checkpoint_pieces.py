@@ -85,8 +85,7 @@ def unpack(arrays: dict[str, Any], source: Path) -> dict[int, GrainState]:
 def save(run: DistributedRun, path: str | Path, outputs: Outputs | None) -> Path:
     """Every rank of `run`: its owned grains' states as its piece of the checkpoint at `path`,
     then rank 0's header (with `outputs`' bookkeeping). An error on any rank ends every rank
-    (that rank's error, RankFailed on the others) and leaves the last checkpoint as it was.
-    The path, on every rank."""
+    (agreement.together) and leaves the last checkpoint as it was. The path, on every rank."""
     comm, target = run.comm, Path(path)
     fingerprint = run.fingerprint()
     moment, states = run.checkpoint_part()

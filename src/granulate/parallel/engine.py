@@ -47,7 +47,6 @@ from granulate._core import combined_time_step, points_within
 from granulate.errors import InputError
 from granulate.parallel import checkpoint_pieces
 from granulate.parallel.agreement import RankFailed, attempt, on_root, together
-from granulate.parallel.checkpoint_pieces import read_pieces
 from granulate.parallel.overlap import while_travelling
 from granulate.parallel.partition import (
     Partition,
@@ -961,7 +960,7 @@ class DistributedRun:
 
     def fingerprint(self) -> str:
         """The set-up's fingerprint (Simulation.fingerprint), on every rank: each rank hashes
-        the grains it owns (checkpoints.grain_digest; one gather, once per run), rank 0 puts
+        the grains it owns (fingerprints.grain_digest; one gather, once per run), rank 0 puts
         the digests together in grain order."""
         if self._setup_digest is None:
             local = self.local.model
@@ -1016,30 +1015,50 @@ class DistributedRun:
         states: dict[int, GrainState] = {}
 
         def read() -> tuple[dict[str, Any], dict[str, Any], NDArray[np.int64] | None]:
-            state, header = checkpoints.read(path, fingerprint)
-            if "pieces" in header:
-                return header, moment_of(state), np.asarray(state["piece_of_grain"])
-            sim = self._sim
-            sim._ranks_ahead = False  # it takes the whole state itself
-            with warnings.catch_warnings():  # the start checks were made when the run was set up
-                warnings.simplefilter("ignore")
-                sim.core.restore(state)
-            sim.analysis.forget_fragments()
-            sim._gathered = None  # the evaluation gathered before is not the checkpoint's
-            saved = dict(sim.core.checkpoint())
-            every = {g: self._slices[g] for g in range(len(self._slices))}
-            states.update(grain_states(sim, saved, np.arange(self._node_count), every))
-            return header, moment_of(saved), None
+            return self._read_checkpoint(path, fingerprint, states)
 
         header, moment, piece_of_grain = self.comm.bcast(on_root(self.comm, read), root=0)
         if piece_of_grain is not None:
             ranks, rank = self.comm.Get_size(), self.comm.Get_rank()
             mine = list(range(rank, header["pieces"]["count"], ranks))
-            together(
-                self.comm,
-                lambda: states.update(read_pieces(path, header, piece_of_grain, mine)),
-                "reading its pieces of the checkpoint",
-            )
+
+            def read_mine() -> None:
+                states.update(checkpoint_pieces.read_pieces(path, header, piece_of_grain, mine))
+
+            together(self.comm, read_mine, "reading its pieces of the checkpoint")
+        self._rebuild_from(states, moment)
+        on_root(self.comm, lambda: checkpoints.resume_outputs(path, header, outputs))
+        self._sim._ranks_ahead |= piece_of_grain is not None  # rank 0 read the header only
+        self._exchange_caps()
+        self._loaded_walls = np.asarray(moment["contact_wall_reactions"]).reshape(-1, 6)
+        self._migration_due = False
+        self.seconds["migrate"] += time.perf_counter() - start
+
+    def _read_checkpoint(
+        self, path: str | os.PathLike[str], fingerprint: str, states: dict[int, GrainState]
+    ) -> tuple[dict[str, Any], dict[str, Any], NDArray[np.int64] | None]:
+        """Rank 0: the checkpoint at `path`'s header, its moment (transplant.moment_of) and the
+        piece of each grain; or, of a whole checkpoint (None for the pieces), every grain's
+        state into `states`, through rank 0's whole simulation (which then holds it)."""
+        state, header = checkpoints.read(path, fingerprint)
+        if "pieces" in header:
+            return header, moment_of(state), np.asarray(state["piece_of_grain"])
+        sim = self._sim
+        sim._ranks_ahead = False  # it takes the whole state itself
+        with warnings.catch_warnings():  # the start checks were made when the run was set up
+            warnings.simplefilter("ignore")
+            sim.core.restore(state)
+        sim.analysis.forget_fragments()
+        sim._gathered = None  # the evaluation gathered before is not the checkpoint's
+        saved = dict(sim.core.checkpoint())
+        every = {g: self._slices[g] for g in range(len(self._slices))}
+        states.update(grain_states(sim, saved, np.arange(self._node_count), every))
+        return header, moment_of(saved), None
+
+    def _rebuild_from(self, states: dict[int, GrainState], moment: dict[str, Any]) -> None:
+        """Every rank: the grains cut anew where `states` (the grains' states this rank read,
+        each grain's on one rank) put them, each state sent to the ranks that hold its grain
+        (one all-to-all), and this rank's part built of them at `moment`."""
         grains = np.array(sorted(states), dtype=np.int64)
         held = self._distribute(*self._gathered_layout(grains, lambda g: states[g].positions))
         outgoing = [
@@ -1051,12 +1070,6 @@ class DistributedRun:
         for box in self.comm.alltoall(outgoing):
             received |= box
         together(self.comm, lambda: self._rebuild(held, received, moment))
-        on_root(self.comm, lambda: checkpoints.resume_outputs(path, header, outputs))
-        self._sim._ranks_ahead |= piece_of_grain is not None  # rank 0 read the header only
-        self._exchange_caps()
-        self._loaded_walls = np.asarray(moment["contact_wall_reactions"]).reshape(-1, 6)
-        self._migration_due = False
-        self.seconds["migrate"] += time.perf_counter() - start
 
     def write_piece(self, folder: Path, fields: tuple[str, ...]) -> None:
         """This rank's piece of a frame in pieces (writers/vtu_frame.py): its own nodes now,
