@@ -3,9 +3,9 @@ a distributed run's checkpoint in pieces (granulate/parallel/checkpoint_pieces.p
 checkpoint tests' tumbling drum (tests/test_checkpoint.py). Rank 0 prints one line; the exit
 status is non-zero when the check fails.
 
-`pieces`: a checkpoint of 600 steps is a header and one piece per rank, written and read again
-on the ranks without rank 0 ever building the whole simulation, and a second checkpoint at the
-same path leaves only its own pieces.
+`pieces`: a checkpoint of 600 steps written on K - 1 ranks is a header and one piece per rank;
+it continues on all K ranks bit for bit as the serial run, without rank 0 ever building the
+whole simulation, and a second checkpoint at the same path leaves only its own pieces.
 
 `damaged`: a checkpoint missing a piece, or holding a piece of another checkpoint, is refused on
 every rank with one InputError naming the piece, and the run's history.csv is left as it was.
@@ -26,6 +26,7 @@ import tempfile
 import warnings
 from pathlib import Path
 
+import numpy as np
 from mpi4py import MPI
 
 sys.path.insert(0, str(Path(__file__).parent))
@@ -53,29 +54,42 @@ def messages_of(action: object, comm: MPI.Comm) -> list[str] | None:
 
 
 def check_pieces(folder: Path, comm: MPI.Comm) -> int:
-    """0 when a checkpoint of the ranks is a header and a piece per rank, written and loaded
-    with rank 0's simulation never built, and a second one replaces the first's pieces."""
-    path = folder / "checkpoint.npz"
-    first = DistributedRun(tumbling_drum(folder, outputs=False), comm)
-    first.run(600)
-    first.save_checkpoint(path)
-    after_first = pieces_of(path) if comm.Get_rank() == 0 else []
+    """0 when a checkpoint written on K - 1 ranks at step 600 (a header and a piece per rank)
+    continues on all K ranks (more pieces to hold than were written) to step 700 bit for bit as
+    the serial run, rank 0's simulation never built, and a second checkpoint at the same path
+    leaves only its own pieces."""
+    path, rank = folder / "checkpoint.npz", comm.Get_rank()
+    fewer = comm.Split(0 if rank < comm.Get_size() - 1 else MPI.UNDEFINED, rank)
+    built = False
+    if fewer != MPI.COMM_NULL:
+        first = DistributedRun(tumbling_drum(folder, outputs=False), fewer)
+        first.run(600)
+        first.save_checkpoint(path)
+        built = first._sim._core is not None
+    comm.Barrier()
+    after_first = pieces_of(path) if rank == 0 else []
     second = DistributedRun(tumbling_drum(folder, outputs=False), comm)
     second.load_checkpoint(path)
     second.run(100)
     second.save_checkpoint(path)
-    built = comm.gather(first._sim._core is not None or second._sim._core is not None, root=0)
-    if comm.Get_rank() != 0:
+    fields = {name: second.gather(name) for name in ("positions", "velocities", "forces")}
+    built = comm.gather(built or second._sim._core is not None, root=0)
+    if rank != 0:
         return 0
+    serial = tumbling_drum(folder, outputs=False)
+    serial.core.run(700)
+    same = {name: bool(np.array_equal(fields[name], getattr(serial, name))) for name in fields}
     after_second = pieces_of(path)
-    print(f"first {after_first}; second {after_second}; rank 0 built the whole: {built[0]}")
-    names = {f"piece_{r}.npz" for r in range(comm.Get_size())}
-    one_folder = [
-        len({f.split("/")[0] for f in files}) == 1 and {f.split("/")[1] for f in files} == names
-        for files in (after_first, after_second)
-    ]
+    print(
+        f"first {after_first}; second {after_second}; rank 0 built the whole: {any(built)}; "
+        f"continued on {comm.Get_size()} ranks as serially: {same}"
+    )
+    pieces = [{f.split("/")[1] for f in files} for files in (after_first, after_second)]
+    folders = [len({f.split("/")[0] for f in files}) for files in (after_first, after_second)]
+    names = [{f"piece_{r}.npz" for r in range(k)} for k in (comm.Get_size() - 1, comm.Get_size())]
     steps = [files[0].split("-")[0] for files in (after_first, after_second)]
-    return 0 if all(one_folder) and steps == ["600", "700"] and not any(built) else 1
+    whole = folders == [1, 1] and pieces == names and steps == ["600", "700"]
+    return 0 if whole and all(same.values()) and not any(built) else 1
 
 
 def check_damaged(folder: Path, comm: MPI.Comm) -> int:

@@ -178,11 +178,13 @@ CHECKPOINT_CHECK = Path(__file__).with_name("mpi_checkpoint_check.py")
 
 @pytest.mark.parametrize("ranks", [2, 3])
 def test_a_distributed_checkpoint_is_a_header_and_a_piece_per_rank(ranks: int) -> None:
-    """Each rank writes its own grains' states and reads some pieces back; rank 0 never builds
-    the whole simulation; the next checkpoint at the path leaves only its own pieces."""
+    """Written on one rank fewer, each rank its own grains' states, and continued on `ranks`
+    ranks (more than wrote it) bit for bit as the serial run; rank 0 never builds the whole
+    simulation; the next checkpoint at the path leaves only its own pieces."""
     done = run_ranks(ranks, "pieces", script=CHECKPOINT_CHECK)
     assert done.returncode == 0, done.stdout + done.stderr
     assert "rank 0 built the whole: False" in done.stdout
+    assert "'positions': True, 'velocities': True, 'forces': True}" in done.stdout
 
 
 def test_a_checkpoint_missing_a_piece_or_with_a_foreign_one_is_refused_on_every_rank() -> None:
