@@ -37,7 +37,9 @@ at the start with a user's error (in a migration with a bug) and expects every r
 when the ranks first gather the state into it, and expects every rank to stop with rank 0's
 InputError; `... DIMENSION STEPS fail-room` makes rank 0's memory check of the whole model
 fail when the drum set up with Simulation(comm=...) starts its run, and expects every rank to
-stop with its InputError before the first step."""
+stop with its InputError before the first step; `... DIMENSION STEPS fail-progress` gives the
+drum's run a progress function that reads rank 0's simulation mid-run, and expects every rank
+to stop with the InputError rank 0's simulation raises."""
 
 from __future__ import annotations
 
@@ -148,6 +150,8 @@ def main() -> int:
         return check_failure(dimension, steps, comm)
     if len(sys.argv) > 3 and sys.argv[3] == "fail-room":
         return check_room_failure(steps, comm)
+    if len(sys.argv) > 3 and sys.argv[3] == "fail-progress":
+        return check_progress_failure(steps, comm)
     if len(sys.argv) > 3 and sys.argv[3] == "fail-whole":
         return check_whole_failure(dimension, steps, comm)
     if len(sys.argv) > 3 and sys.argv[3] in ("fail-start", "fail-migration"):
@@ -436,6 +440,24 @@ def check_room_failure(steps: int, comm: MPI.Comm) -> int:
         return 0
     print("room", messages)
     reason = "rank 0 holds the whole model at the end of a run"
+    return 0 if len(set(messages)) == 1 and reason in messages[0] else 1
+
+
+def check_progress_failure(steps: int, comm: MPI.Comm) -> int:
+    """0 when a progress function reading rank 0's simulation during the drum's run (which
+    it refuses: the ranks are ahead of it) stops every rank with that InputError, none left
+    waiting for the next chunk."""
+    sim = tumbling_drum(Path("unused"), comm=comm, outputs=False)
+
+    def watch(report: gr.Progress) -> None:
+        if comm.Get_rank() == 0:
+            np.asarray(sim.positions)
+
+    messages = stop_messages(lambda: sim.run(steps, progress=watch), comm)
+    if messages is None:
+        return 0
+    print("progress", messages)
+    reason = "rank 0's simulation does not hold the run's state"
     return 0 if len(set(messages)) == 1 and reason in messages[0] else 1
 
 

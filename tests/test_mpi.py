@@ -261,6 +261,14 @@ def test_rank_0_without_room_for_the_whole_model_stops_every_rank_at_the_start()
     assert "room ['InputError: the model would need about 9 TB" in done.stdout
 
 
+def test_a_progress_function_failing_on_rank_0_ends_every_rank_without_a_hang() -> None:
+    """A progress function reading rank 0's simulation mid-run, which refuses (the ranks are
+    ahead of it): every rank stops with that InputError, none waits for the next chunk."""
+    done = run_ranks(2, "2", "400", "fail-progress")
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert "progress [\"InputError: rank 0's simulation does not hold" in done.stdout
+
+
 @pytest.mark.parametrize("during", ["start", "migration"])
 def test_a_failure_building_one_ranks_part_ends_every_rank_without_a_hang(during: str) -> None:
     """At the start a user's error on the last rank, which every rank raises; in a migration a

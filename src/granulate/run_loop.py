@@ -9,6 +9,7 @@ writes or checks, and shares its errors, so that every rank takes the same steps
 
 from __future__ import annotations
 
+import functools
 import signal
 import threading
 import time as wallclock
@@ -87,6 +88,10 @@ class Stepper(Protocol):
     def any_rank(self, flag: bool) -> bool:
         """Whether `flag` is set on any rank."""
 
+    def together(self, action: Callable[[], object], doing: str) -> None:
+        """action() on every rank; an error on one rank ends every rank (a user's InputError
+        with its message, else that rank's own error and RankFailed on the others)."""
+
     def broken_bonds(self) -> int:
         """The broken bonds of the whole simulation."""
 
@@ -140,6 +145,9 @@ class CoreStepper:
 
     def any_rank(self, flag: bool) -> bool:
         return flag
+
+    def together(self, action: Callable[[], object], doing: str) -> None:
+        action()
 
     def broken_bonds(self) -> int:
         return int(self.core.broken_bonds())
@@ -266,6 +274,12 @@ def _start_writing(sim: Simulation, plan: RunPlan, out: Outputs | None) -> None:
     out.folder.start_writing()
 
 
+def _report(progress: Callable[[Progress], None] | None, report: Progress) -> None:
+    """`report` to the `progress` function, when this rank has one."""
+    if progress is not None:
+        progress(report)
+
+
 def chunk_end(step: int, plan: RunPlan, parts: LoopParts, target: int, limit: int) -> int:
     """Steps from `step` to the next place the loop must stop at: the run's end, an output or
     history step, a stop check, a checkpoint, or `limit` (about half a second)."""
@@ -299,10 +313,9 @@ def advance(sim: Simulation, plan: RunPlan, parts: LoopParts) -> str | None:
             reports = stepper.agree(plan.progress is not None)
             while stepper.step < target and reason is None:
                 reason = chunks.run(target)
-                if reports:
-                    report = chunks.progress(target)
-                    if plan.progress is not None:
-                        plan.progress(report)
+                if reports:  # every rank together: a function raising on one stops every rank
+                    call = functools.partial(_report, plan.progress, chunks.progress(target))
+                    stepper.together(call, "in its progress function")
                 if stepper.any_rank(signals.caught):
                     path = stepper.agree(checkpoints.interrupt_path(parts.checkpoints, out))
                     saved = None if path is None else stepper.save_checkpoint(sim, path, out)

@@ -57,6 +57,9 @@ class DistributedStepper:
     def any_rank(self, flag: bool) -> bool:
         return bool(self.comm.allreduce(bool(flag), op=self.run.mpi.LOR))
 
+    def together(self, action: Callable[[], object], doing: str) -> None:
+        together(self.comm, action, doing)
+
     def broken_bonds(self) -> int:
         return self.run.broken_bonds()
 
