@@ -45,11 +45,10 @@ def attempt(action: Callable[[], object], failure: Exception | None = None) -> E
 
 
 def stop_if_any_failed(comm: Any, failure: Exception | None, doing: str) -> None:
-    """One reduction: when some rank's `failure` is set, every rank stops. When the first such
-    rank's is an InputError (a user's error: a missing file, a model too large), every rank
-    raises it with its message (one broadcast), so that rank 0 reports it; else that rank
-    raises its own error, the others RankFailed naming it and what it was `doing`. Another
-    failing rank raises its own error."""
+    """One reduction: when some rank's `failure` is set, every rank stops. Each failing rank
+    raises its own error. When the first one's is an InputError (a user's error: a missing
+    file, a model too large), the others raise it with its message (one broadcast), so that
+    rank 0 reports it; else RankFailed naming that rank and what it was `doing`."""
     from mpi4py import MPI
 
     size = comm.Get_size()
@@ -58,7 +57,7 @@ def stop_if_any_failed(comm: Any, failure: Exception | None, doing: str) -> None
         return
     mine = str(failure) if isinstance(failure, InputError) else None
     shared = comm.bcast(mine, root=first)
-    if failure is not None and (shared is None or comm.Get_rank() == first):
+    if failure is not None:
         raise failure
     if shared is not None:
         raise InputError(shared)
