@@ -14,17 +14,23 @@ every rank with one InputError naming the piece, and the run's history.csv is le
 checkpoint written before is left whole (its header's bytes, its pieces) and a run continues
 from it.
 
+`unshared`: the last rank writing its piece to a disk rank 0 does not see (a node's own disk)
+ends every rank with one InputError that says so, before any header names the piece; the
+checkpoint before is left whole.
+
 `cli`: `granulate run` (in this process, on the ranks) of the drum case with frames in pieces,
 cut short and resumed from its checkpoint in pieces, never builds rank 0's whole simulation.
 """
 
 from __future__ import annotations
 
+import functools
 import shutil
 import sys
 import tempfile
 import warnings
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from mpi4py import MPI
@@ -32,6 +38,7 @@ from mpi4py import MPI
 sys.path.insert(0, str(Path(__file__).parent))
 import granulate as gr
 from granulate import checkpoints, cli
+from granulate.io import checkpoint as checkpoint_file
 from granulate.parallel import DistributedRun, checkpoint_pieces
 from test_checkpoint import tumbling_drum
 
@@ -125,8 +132,23 @@ def check_damaged(folder: Path, comm: MPI.Comm) -> int:
     return 0 if refused and same_history else 1
 
 
-def check_write_failure(folder: Path, comm: MPI.Comm) -> int:
-    """0 when the last rank failing to write its piece ends every rank, the checkpoint written
+class LocalDisk:
+    """granulate.io.checkpoint as seen by a rank that writes to a disk of its own: its pieces
+    go to `where`, a folder no other rank reads."""
+
+    def __init__(self, where: Path) -> None:
+        self.where = where
+
+    def save(self, path: Path, state: dict[str, Any], header: dict[str, Any]) -> None:
+        checkpoint_file.save(self.where / Path(path).name, state, header)
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(checkpoint_file, name)
+
+
+def check_failed_save(folder: Path, comm: MPI.Comm, failure: str) -> int:
+    """0 when a checkpoint the last rank cannot give (`failure`: "full", its disk full; or
+    "local", its piece on a disk rank 0 does not see) ends every rank, the checkpoint written
     before is left whole, and a run continues from it."""
     path = folder / "checkpoint.npz"
     run = DistributedRun(tumbling_drum(folder, outputs=False), comm)
@@ -136,12 +158,15 @@ def check_write_failure(folder: Path, comm: MPI.Comm) -> int:
     header = path.read_bytes() if rank == 0 else b""
     pieces = pieces_of(path) if rank == 0 else []
     run.run(300)
-    if rank == last:
+    if rank == last and failure == "full":
 
         def full_disk(*_: object) -> object:
             raise OSError(28, "No space left on device")
 
         checkpoint_pieces.pack = full_disk  # type: ignore[assignment]
+    if rank == last and failure == "local":
+        (folder / "local_disk").mkdir()  # beside the checkpoint, not where its pieces go
+        checkpoint_pieces.checkpoint_file = LocalDisk(folder / "local_disk")  # type: ignore[assignment]
     messages = messages_of(lambda: run.save_checkpoint(path), comm)
     resumed = DistributedRun(tumbling_drum(folder, outputs=False), comm)
     resumed.load_checkpoint(path)
@@ -150,10 +175,13 @@ def check_write_failure(folder: Path, comm: MPI.Comm) -> int:
     if rank != 0:
         return 0
     kept = path.read_bytes() == header and pieces_of(path) == pieces
-    print(f"messages {messages}; checkpoint kept {kept}; continued to step {step}")
-    failed = messages[last].startswith("OSError") and all(
-        f"rank {last} failed" in m for m in messages[:last]
-    )
+    print(f"{failure}: messages {messages}; checkpoint kept {kept}; continued to step {step}")
+    if failure == "full":
+        failed = messages[last].startswith("OSError") and all(
+            f"rank {last} failed" in m for m in messages[:last]
+        )
+    else:
+        failed = len(set(messages)) == 1 and "cannot be seen" in messages[0]
     return 0 if failed and kept and step == 310 else 1
 
 
@@ -196,7 +224,8 @@ def check_command_line(folder: Path, comm: MPI.Comm) -> int:
 CASES = {
     "pieces": check_pieces,
     "damaged": check_damaged,
-    "write-fail": check_write_failure,
+    "write-fail": functools.partial(check_failed_save, failure="full"),
+    "unshared": functools.partial(check_failed_save, failure="local"),
     "cli": check_command_line,
 }
 

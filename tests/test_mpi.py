@@ -202,6 +202,16 @@ def test_granulate_run_with_frames_in_pieces_never_builds_the_whole_model_on_ran
     assert "exit codes [0, 0]; rank 0's whole builds []" in done.stdout
 
 
+def test_a_piece_on_a_disk_rank_0_does_not_see_is_refused_before_the_header() -> None:
+    """The last of 3 ranks writes its piece to a disk of its own (a node's local disk): every
+    rank stops with one InputError that says the checkpoint must be on a shared file system,
+    no header names the piece, and the checkpoint before is left whole."""
+    done = run_ranks(3, "unshared", script=CHECKPOINT_CHECK)
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert "on a file system every rank shares" in done.stdout
+    assert "checkpoint kept True" in done.stdout
+
+
 def test_a_rank_failing_to_write_its_piece_leaves_the_last_checkpoint_whole() -> None:
     """The last of 3 ranks cannot write (a full disk): every rank stops, the checkpoint before
     keeps its header and pieces, and a run continues from it."""

@@ -125,8 +125,18 @@ def _write_header(
 ) -> None:
     """Rank 0: the checkpoint's header at `path` (atomically), for its pieces in `folder`,
     piece r holding the `grains`[r], at `moment`; then the pieces of the checkpoints before
-    are removed."""
+    are removed. InputError, and no header, when rank 0 cannot see every piece (the ranks
+    wrote to disks they do not share: the checkpoint could not be read back)."""
     assert grains is not None
+    missing = [
+        f"piece_{r}.npz" for r in range(len(grains)) if not (folder / f"piece_{r}.npz").is_file()
+    ]
+    if missing:
+        raise InputError(
+            f"checkpoint {path}: {', '.join(missing)} written by the other ranks cannot be seen "
+            f"in {folder} from rank 0: the checkpoint must be on a file system every rank "
+            "shares (on a cluster, not a node's local disk); choose its path or --out there"
+        )
     piece_of_grain = np.full(sum(len(g) for g in grains), -1, dtype=np.int64)
     for piece, held in enumerate(grains):
         piece_of_grain[held] = piece
