@@ -29,6 +29,7 @@ import shutil
 import sys
 import tempfile
 import warnings
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -49,11 +50,11 @@ def pieces_of(path: Path) -> list[str]:
     return sorted(str(p.relative_to(folder)) for p in folder.rglob("*") if p.is_file())
 
 
-def messages_of(action: object, comm: MPI.Comm) -> list[str] | None:
+def messages_of(action: Callable[[], object], comm: MPI.Comm) -> list[str] | None:
     """action() on every rank; on rank 0 each rank's "ErrorType: message" (empty if it
     finished), None on the others."""
     try:
-        action()  # type: ignore[operator]
+        action()
         message = ""
     except (gr.InputError, RuntimeError, OSError) as error:
         message = f"{type(error).__name__}: {error}"
@@ -62,7 +63,7 @@ def messages_of(action: object, comm: MPI.Comm) -> list[str] | None:
 
 def check_pieces(folder: Path, comm: MPI.Comm) -> int:
     """0 when a checkpoint written on K - 1 ranks at step 600 (a header and a piece per rank)
-    continues on all K ranks (more pieces to hold than were written) to step 700 bit for bit as
+    continues on all K ranks (more ranks than pieces) to step 700 bit for bit as
     the serial run, rank 0's simulation never built, and a second checkpoint at the same path
     leaves only its own pieces."""
     path, rank = folder / "checkpoint.npz", comm.Get_rank()
