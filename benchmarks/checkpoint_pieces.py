@@ -1,5 +1,5 @@
 """What a distributed run's checkpoint costs each rank: the seconds to save it and to load it
-again, how much each rank's peak resident memory rose in each (getrusage's ru_maxrss), and the
+again, how much each rank's peak resident memory rose in each (VmHWM), and the
 files written; and whether rank 0 built the whole model for it. Since session 51 each rank
 writes its own grains' piece (granulate/parallel/checkpoint_pieces.py); before, rank 0 took
 every grain's state into its whole simulation and wrote one file. Run it from two installs,
@@ -14,31 +14,22 @@ The case is the 3D pile of `granulate bench --ranks` (1,000 grains: 258,624 node
 from __future__ import annotations
 
 import argparse
-import resource
 import shutil
 import tempfile
-import time
-import warnings
+from collections.abc import Callable
 from pathlib import Path
 
 from mpi4py import MPI
-
-from granulate import bench_ranks
-from granulate.parallel import DistributedRun
-from granulate.threads import set_num_threads
+from pile_ranks import mean_seconds, stepped_pile
+from process_memory import status_mb
 
 
-def peak_mb() -> float:
-    """This process's peak resident memory so far [MB] (ru_maxrss is in kB on Linux)."""
-    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
-
-
-def timed(comm: MPI.Comm, action: object) -> tuple[float, float]:
-    """Seconds `action()` took, every rank starting together, and the peak memory it added."""
-    comm.Barrier()
-    before, start = peak_mb(), time.perf_counter()
-    action()  # type: ignore[operator]
-    return time.perf_counter() - start, peak_mb() - before
+def timed(comm: MPI.Comm, action: Callable[[], object]) -> tuple[float, float]:
+    """Seconds `action()` took, every rank starting together, and how much it raised this
+    process's peak resident memory (VmHWM) [MB]."""
+    before = status_mb("VmHWM")[0]
+    seconds = mean_seconds(action, 1, comm)
+    return seconds, status_mb("VmHWM")[0] - before
 
 
 def main() -> None:
@@ -46,17 +37,13 @@ def main() -> None:
     parser.add_argument("--grains", type=int, default=1000)
     parser.add_argument("--steps", type=int, default=5)
     options = parser.parse_args()
-    set_num_threads(1, adaptive=False)
     comm = MPI.COMM_WORLD
-    sim = bench_ranks.pile3d(options.grains)
-    with warnings.catch_warnings():
-        warnings.filterwarnings("ignore")
-        run = DistributedRun(sim, comm)
-        run.run(options.steps)
-        folder = Path(comm.bcast(tempfile.mkdtemp() if comm.Get_rank() == 0 else None, root=0))
-        path = folder / "checkpoint.npz"
-        saved = timed(comm, lambda: run.save_checkpoint(path))
-        loaded = timed(comm, lambda: run.load_checkpoint(path))
+    run = stepped_pile(options.grains, options.steps, comm)
+    sim = run._sim
+    folder = Path(comm.bcast(tempfile.mkdtemp() if comm.Get_rank() == 0 else None, root=0))
+    path = folder / "checkpoint.npz"
+    saved = timed(comm, lambda: run.save_checkpoint(path))
+    loaded = timed(comm, lambda: run.load_checkpoint(path))
     rows = comm.gather((saved, loaded), root=0)
     if rows is None:
         return

@@ -17,15 +17,12 @@ and the step's seconds, for scale. Both give the same values (printed).
 from __future__ import annotations
 
 import argparse
-import time
-import warnings
 
 from mpi4py import MPI
+from pile_ranks import mean_seconds, stepped_pile
 from process_memory import resident_mb
 
-from granulate import bench_ranks
 from granulate.parallel import DistributedRun
-from granulate.threads import set_num_threads
 
 CRITERIA = (
     "kinetic_energy",
@@ -50,28 +47,13 @@ def gathered(run: DistributedRun, comm: MPI.Comm) -> tuple[float, ...] | None:
     return (*(getattr(sim, name)() for name in CRITERIA), sim.wall_displacement("floor"))
 
 
-def mean_seconds(action: object, checks: int, comm: MPI.Comm) -> float:
-    """The mean wall-clock seconds of `checks` calls of `action`, every rank together."""
-    comm.Barrier()
-    start = time.perf_counter()
-    for _ in range(checks):
-        action()  # type: ignore[operator]
-    comm.Barrier()
-    return (time.perf_counter() - start) / checks
-
-
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--grains", type=int, default=1000)
     parser.add_argument("--checks", type=int, default=5)
     arguments = parser.parse_args()
-    set_num_threads(1, adaptive=False)
     comm = MPI.COMM_WORLD
-    sim = bench_ranks.pile3d(arguments.grains)
-    with warnings.catch_warnings():
-        warnings.filterwarnings("ignore", message="contact.*bodies pressed")
-        run = DistributedRun(sim, comm)
-        run.run(5)
+    run = stepped_pile(arguments.grains, 5, comm)
     step = mean_seconds(lambda: run.run(1), 5, comm)
     before = resident_mb()
     ours = measured(run)

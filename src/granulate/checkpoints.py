@@ -129,7 +129,7 @@ def save(
 def pieces_folder(path: str | Path) -> Path:
     """Where a distributed run's checkpoint at `path` keeps its ranks' pieces: path.pieces."""
     target = Path(path)
-    return target.with_name(f"{target.name}.pieces")
+    return target.with_name(target.name + checkpoint_file.PIECES_SUFFIX)
 
 
 def read(path: str | Path, fingerprint: str) -> tuple[dict[str, Any], dict[str, Any]]:

@@ -72,6 +72,15 @@ def build_model(
     return model, core_materials
 
 
+def materials_in_core_order(bodies: list[Body]) -> list[Material]:
+    """The materials of `bodies` in the order they first use them: the order build_model adds
+    them to the core (its core_materials), known without building."""
+    materials: dict[int, Material] = {}
+    for body in bodies:
+        materials.setdefault(id(body.material), body.material)
+    return list(materials.values())
+
+
 @dataclass(frozen=True)
 class _ShapeSource:
     """The nodes a body's core shape is made from: its own, or those of the earlier body it is

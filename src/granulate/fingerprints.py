@@ -14,11 +14,15 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
+from granulate.core_model import materials_in_core_order
 from granulate.io import checkpoint as checkpoint_file
 
 if TYPE_CHECKING:
-    from granulate.materials import Material
     from granulate.simulation import Simulation
+
+
+#: The bytes of one grain_digest (SHA-256).
+GRAIN_DIGEST_BYTES = hashlib.sha256().digest_size
 
 
 def grain_digest(
@@ -50,8 +54,15 @@ def set_up_digest(sim: Simulation, grain_digests: bytes) -> str:
     return checkpoint_file.fingerprint(
         grain_digests,
         *sim._loading.fingerprint_parts(),
-        *sim._interactions.fingerprint_parts(_materials_in_core_order(sim)),
+        *sim._interactions.fingerprint_parts(materials_in_core_order(sim.bodies)),
     )
+
+
+def whole_model_digest(sim: Simulation, model: Any) -> str:
+    """set_up_digest of sim from `model`, a core Model of every body (the whole simulation's,
+    or a node-split rank's, which holds them all)."""
+    slices = [body.node_slice for body in sim.bodies]
+    return set_up_digest(sim, model_grain_digests(model, slices))
 
 
 def fingerprint(sim: Simulation, setup: str, time_step: float) -> str:
@@ -64,12 +75,3 @@ def fingerprint(sim: Simulation, setup: str, time_step: float) -> str:
         sim._viscous_damping,
         sim.case_fingerprint,
     )
-
-
-def _materials_in_core_order(sim: Simulation) -> list[Material]:
-    """sim's materials in the order its bodies first use them, as core_model.build_model adds
-    them to the core."""
-    materials: dict[int, Material] = {}
-    for body in sim.bodies:
-        materials.setdefault(id(body.material), body.material)
-    return list(materials.values())

@@ -23,7 +23,7 @@ import numpy as np
 from granulate import _core, checkpoints, threads
 from granulate.errors import InputError
 from granulate.input_errors import check_number
-from granulate.stopping import RunMeasures, StopCriterion
+from granulate.stopping import StopCriterion
 
 if TYPE_CHECKING:
     from granulate.checkpoints import CheckpointPlan
@@ -95,10 +95,6 @@ class Stepper(Protocol):
     def broken_bonds(self) -> int:
         """The broken bonds of the whole simulation."""
 
-    def measures(self, sim: Simulation) -> RunMeasures:
-        """What the stop criteria read (stopping.RunMeasures): `sim` itself, or the ranks'
-        measures put together on every rank."""
-
     def step_data(self, sim: Simulation, tracked: tuple[int, ...], whole: bool) -> StepData | None:
         """The current output step made of the ranks' measures of their own grains, with the
         sums of the `tracked` bodies, on rank 0 (None elsewhere); or None once `sim` holds
@@ -151,9 +147,6 @@ class CoreStepper:
 
     def broken_bonds(self) -> int:
         return int(self.core.broken_bonds())
-
-    def measures(self, sim: Simulation) -> RunMeasures:
-        return sim
 
     def step_data(self, sim: Simulation, tracked: tuple[int, ...], whole: bool) -> StepData | None:
         return None
@@ -369,9 +362,9 @@ def write_outputs(
 
 def stop_reason(stepper: Stepper, sim: Simulation, criteria: Sequence[StopCriterion]) -> str | None:
     """The reason of the first of `criteria` met now, or None, on every rank: each reads the
-    stepper's measures, or rank 0's whole simulation when it needs the whole state (its
-    state collected before)."""
-    measured = stepper.measures(sim)
+    run's measures (Simulation.measures: on ranks, the ranks' put together), or rank 0's whole
+    simulation when it needs the whole state (its state collected before)."""
+    measured = sim.measures()
     for criterion in criteria:
         if criterion.needs_whole_state:
             reason = stepper.on_root(lambda c=criterion: c.check(sim))

@@ -523,9 +523,7 @@ class Simulation(SimulationSetup, SimulationResults):
             return self._distributed_run().fingerprint()
         core = self._build()
         if self._setup_digest is None:
-            slices = [body.node_slice for body in self.bodies]
-            grains = fingerprints.model_grain_digests(self.model, slices)
-            self._setup_digest = fingerprints.set_up_digest(self, grains)
+            self._setup_digest = fingerprints.whole_model_digest(self, self.model)
         return fingerprints.fingerprint(self, self._setup_digest, core.time_step)
 
     def save_checkpoint(self, path: str | Path) -> Path:

@@ -30,6 +30,8 @@ from granulate.io.atomic import atomic_write
 # distributed run's checkpoint in pieces has no rank holding the whole model)
 FORMAT = 7
 HEADER = "__header__"
+#: A distributed run's checkpoint at a path keeps its ranks' pieces in path + this, a folder.
+PIECES_SUFFIX = ".pieces"
 
 
 def content_checksum(arrays: dict[str, np.ndarray]) -> str:

@@ -11,13 +11,14 @@ import socket
 from pathlib import Path
 
 from granulate.errors import InputError
+from granulate.io.checkpoint import PIECES_SUFFIX
 from granulate.resources import size_text
 
 LOCK = ".granulate.lock"
 #: What a run writes (replaced together with --overwrite).
 RUN_FILES = ("simulation.pvd", "contacts.pvd", "history.csv", "run.json", "checkpoint.npz")
 #: The pieces of a distributed run's checkpoint.npz (granulate.checkpoints.pieces_folder).
-CHECKPOINT_PIECES = "checkpoint.npz.pieces"
+CHECKPOINT_PIECES = "checkpoint.npz" + PIECES_SUFFIX
 FRAME_PATTERNS = ("frame_*.vtu", "frame_*.pvtu", "particles_*.csv")
 
 

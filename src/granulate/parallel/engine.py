@@ -44,6 +44,7 @@ from numpy.typing import NDArray
 
 from granulate import checkpoints, fingerprints
 from granulate._core import combined_time_step, points_within
+from granulate.core_model import materials_in_core_order
 from granulate.errors import InputError
 from granulate.parallel import checkpoint_pieces
 from granulate.parallel.agreement import RankFailed, attempt, on_root, together
@@ -343,18 +344,16 @@ class DistributedRun:
         spheres: those, PeriDEM's damped centres' positions and the large bodies' pairs."""
         damped = None
         if self._damped_centres is not None:
-            starts = [where.start for where in self._slices]
-            dimension = self._sim.dimension
-            damped = np.array(
-                [
-                    nodes[centre - start, :dimension]
-                    for nodes, centre, start in zip(
-                        grains, self._damped_centres, starts, strict=True
-                    )
-                ]
-            )
+            damped = np.array([self._centre_point(g, nodes) for g, nodes in enumerate(grains)])
         large = self._pairs_of_large(centres, radii, {int(g): grains[g] for g in self._large})
         return centres, radii, damped, large
+
+    def _centre_point(self, grain: int, nodes: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Where `grain`'s centre node (PeriDEM's damping) is, of its nodes' positions `nodes`
+        (its first `dimension` coordinates)."""
+        assert self._damped_centres is not None
+        centre = self._damped_centres[grain] - self._slices[grain].start
+        return nodes[centre, : self._sim.dimension]
 
     def _pairs_of_large(
         self,
@@ -908,10 +907,7 @@ class DistributedRun:
         mine = _spheres([nodes_of(int(g)) for g in grains], dimension)
         points = None
         if self._damped_centres is not None:
-            points = [
-                nodes_of(int(g))[self._damped_centres[g] - self._slices[g].start, :dimension]
-                for g in grains
-            ]
+            points = [self._centre_point(int(g), nodes_of(int(g))) for g in grains]
         centres = np.empty((len(self._slices), dimension))
         radii = np.empty(len(self._slices))
         damped = None if points is None else np.empty((len(self._slices), dimension))
@@ -963,21 +959,17 @@ class DistributedRun:
         the grains it owns (fingerprints.grain_digest; one gather, once per run), rank 0 puts
         the digests together in grain order."""
         if self._setup_digest is None:
-            local = self.local.model
-            offsets = np.asarray(local.bond_offsets)
-            mine = {
-                int(g): fingerprints.grain_digest(
-                    local.reference_positions[s], local.volumes[s], offsets[s.start : s.stop + 1]
-                )
-                for g, s in ((g, self.local_slice(g)) for g in self._owned)
-            }
+            slices = [self.local_slice(g) for g in self._owned]
+            mine = (self._owned, fingerprints.model_grain_digests(self.local.model, slices))
             parts = self.comm.gather(mine, root=0)
 
             def digest() -> str:
                 assert parts is not None
-                every = {g: d for part in parts for g, d in part.items()}
-                grains = b"".join(every[g] for g in range(len(self._slices)))
-                return fingerprints.set_up_digest(self._sim, grains)
+                size = fingerprints.GRAIN_DIGEST_BYTES
+                every = np.empty((len(self._slices), size), np.uint8)
+                for grains, digests in parts:
+                    every[grains] = np.frombuffer(digests, np.uint8).reshape(-1, size)
+                return fingerprints.set_up_digest(self._sim, every.tobytes())
 
             self._setup_digest = str(self.comm.bcast(on_root(self.comm, digest), root=0))
         return fingerprints.fingerprint(self._sim, self._setup_digest, self.dt)
@@ -1322,10 +1314,7 @@ def _check_grains_for_ranks(grains: int, ranks: int) -> None:
 
 def _material_numbers(sim: Simulation) -> dict[int, int]:
     """The run's materials (by identity) numbered in the order its bodies first use them."""
-    numbers: dict[int, int] = {}
-    for body in sim.bodies:
-        numbers.setdefault(id(body.material), len(numbers))
-    return numbers
+    return {id(m): k for k, m in enumerate(materials_in_core_order(sim.bodies))}
 
 
 def _built(part: Simulation) -> Simulation:

@@ -233,9 +233,7 @@ class NodeSplitRun:
         """The set-up's fingerprint (Simulation.fingerprint), on every rank from the whole
         model it holds (no message)."""
         if self._setup_digest is None:
-            slices = [body.node_slice for body in self._sim.bodies]
-            grains = fingerprints.model_grain_digests(self.local.model, slices)
-            self._setup_digest = fingerprints.set_up_digest(self._sim, grains)
+            self._setup_digest = fingerprints.whole_model_digest(self._sim, self.local.model)
         return fingerprints.fingerprint(self._sim, self._setup_digest, self.dt)
 
     def save_checkpoint(self, path: str | os.PathLike[str], outputs: Outputs | None = None) -> Path:

@@ -17,7 +17,6 @@ from granulate.parallel.engine import DistributedRun
 if TYPE_CHECKING:
     from granulate.parallel.node_split import NodeSplitRun
     from granulate.simulation import Simulation
-    from granulate.stopping import RunMeasures
     from granulate.writers.outputs import Outputs
     from granulate.writers.step_data import StepData
 
@@ -62,9 +61,6 @@ class DistributedStepper:
 
     def broken_bonds(self) -> int:
         return self.run.broken_bonds()
-
-    def measures(self, sim: Simulation) -> RunMeasures:
-        return self.run.measures()
 
     def step_data(self, sim: Simulation, tracked: tuple[int, ...], whole: bool) -> StepData | None:
         if whole or not isinstance(self.run, DistributedRun):  # a node split's pieces span ranks
