@@ -59,6 +59,7 @@ sys.path.insert(0, str(Path(__file__).parent))
 import granulate as gr
 from granulate import checkpoints, core_model, resources
 from granulate.parallel import DistributedRun
+from rank_zero import on_rank_0, wait_asleep
 from run_folders import SEARCHES, differing, history
 from test_checkpoint import tumbling_drum
 from test_locality import RADIUS, assembly, layout, rock
@@ -192,8 +193,7 @@ def compare(
     `narrow`: a step's message carries one break and one body per grain at most (the others go
     in a second message, NarrowMessages); `widen`: the default margin widens after short
     distributions, as in a run (else it stays, so that the grains migrate often)."""
-    serial = make()
-    serial.core.run(steps)
+    serial = on_rank_0(comm, lambda: run_serially(make, steps))
     kind = NarrowMessages if renew or narrow else DistributedRun
     distributed = kind(make(), comm, margin=margin, cap_margin=cap_margin)
     distributed.always_renew = renew
@@ -206,7 +206,7 @@ def compare(
     held = comm.gather((distributed.ghost_node_count, distributed.exchanged_node_count), root=0)
     seconds = comm.allreduce(distributed.second_messages)
     joined = comm.allreduce(distributed.nodes_joined)
-    if comm.Get_rank() != 0:
+    if serial is None:
         return 0
     worst = {name: float(np.abs(fields[name] - getattr(serial, name)).max()) for name in fields}
     worst["walls"] = wall_difference(walls, serial)
@@ -226,6 +226,13 @@ def compare(
     return 0 if same_dt and not any(worst.values()) else 1
 
 
+def run_serially(make: Callable[[], gr.Simulation], steps: int) -> gr.Simulation:
+    """make() after `steps` steps of its core: the serial reference."""
+    serial = make()
+    serial.core.run(steps)
+    return serial
+
+
 def wall_difference(walls: np.ndarray, serial: gr.Simulation) -> float:
     """The largest difference of the walls' forces and torques from the serial run's (0 for
     no wall)."""
@@ -237,8 +244,7 @@ def check_restart(make: Callable[[], gr.Simulation], steps: int, comm: MPI.Comm)
     """0 when a run on all K ranks that saves a checkpoint half way, continued from it on K - 1
     ranks, ends bit for bit where the serial run does; and a checkpoint of another set-up is
     refused on every rank."""
-    serial = make()
-    serial.core.run(steps)
+    serial = on_rank_0(comm, lambda: run_serially(make, steps))
     first = DistributedRun(make(), comm)
     first.run(steps // 2)
     folder = Path(tempfile.gettempdir()) if comm.Get_rank() else Path(tempfile.mkdtemp())
@@ -246,16 +252,13 @@ def check_restart(make: Callable[[], gr.Simulation], steps: int, comm: MPI.Comm)
     first.save_checkpoint(path)
     fewer = comm.Split(0 if comm.Get_rank() < comm.Get_size() - 1 else 1, comm.Get_rank())
     if comm.Get_rank() == comm.Get_size() - 1:
-        comm.Barrier()
+        wait_asleep(comm)
         return 0
     second = DistributedRun(make(), fewer)
     second.load_checkpoint(path)
     second.run(steps - steps // 2)
     fields = {name: second.gather(name) for name in ("positions", "velocities", "forces")}
     walls = second.wall_reactions()
-    resumed = make()  # serially, from the distributed checkpoint
-    checkpoints.load(resumed, path, None)
-    resumed.core.run(steps - steps // 2)
     other = set_up(2)  # the locality assembly: other grains
     try:
         DistributedRun(other, fewer).load_checkpoint(path)
@@ -263,8 +266,8 @@ def check_restart(make: Callable[[], gr.Simulation], steps: int, comm: MPI.Comm)
     except gr.InputError as error:
         refused = str(error)
     refusals = fewer.gather(refused, root=0)
-    comm.Barrier()
-    if fewer.Get_rank() != 0:
+    resumed = on_rank_0(comm, lambda: continued_serially(make, path, steps - steps // 2))
+    if resumed is None:
         return 0
     shutil.rmtree(folder)
     worst = {name: float(np.abs(fields[name] - getattr(serial, name)).max()) for name in fields}
@@ -281,6 +284,14 @@ def check_restart(make: Callable[[], gr.Simulation], steps: int, comm: MPI.Comm)
     return 0 if same and all("different set-up" in r for r in refusals) else 1
 
 
+def continued_serially(make: Callable[[], gr.Simulation], path: Path, steps: int) -> gr.Simulation:
+    """make() continued serially from the checkpoint at `path` for `steps` steps."""
+    resumed = make()
+    checkpoints.load(resumed, path, None)
+    resumed.core.run(steps)
+    return resumed
+
+
 def check_api(variant: str, steps: int, comm: MPI.Comm) -> int:
     """0 when the drum set up with Simulation(comm=...) and run with outputs (every 250 steps),
     checkpoints (every 1,000) and a stop check writes the serial run's output folder (all but
@@ -292,7 +303,7 @@ def check_api(variant: str, steps: int, comm: MPI.Comm) -> int:
     if comm.Get_rank() == 0:
         serial = tumbling_drum(folder / "serial", **DRUMS[variant])
         serial.run(steps, stop=stop, check_every=500)
-    comm.Barrier()
+    wait_asleep(comm)
     sim = tumbling_drum(folder / "ranks", comm=comm, **DRUMS[variant])
     sim.run(steps, stop=stop, check_every=500)
     if comm.Get_rank() != 0:
@@ -462,4 +473,6 @@ def check_progress_failure(steps: int, comm: MPI.Comm) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    code = main()
+    wait_asleep(MPI.COMM_WORLD)  # while rank 0 compares
+    sys.exit(code)

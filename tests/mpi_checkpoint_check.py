@@ -41,6 +41,7 @@ import granulate as gr
 from granulate import checkpoints, cli
 from granulate.io import checkpoint as checkpoint_file
 from granulate.parallel import DistributedRun, checkpoint_pieces
+from rank_zero import wait_asleep
 from test_checkpoint import tumbling_drum
 
 
@@ -74,7 +75,7 @@ def check_pieces(folder: Path, comm: MPI.Comm) -> int:
         first.run(600)
         first.save_checkpoint(path)
         built = first._sim._core is not None
-    comm.Barrier()
+    wait_asleep(comm)
     after_first = pieces_of(path) if rank == 0 else []
     second = DistributedRun(tumbling_drum(folder, outputs=False), comm)
     second.load_checkpoint(path)
@@ -238,7 +239,7 @@ def main() -> int:
     try:
         return CASES[sys.argv[1]](folder, comm)
     finally:
-        comm.Barrier()
+        wait_asleep(comm)  # while rank 0 compares
         if comm.Get_rank() == 0:
             shutil.rmtree(folder)
 

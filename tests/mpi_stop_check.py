@@ -35,6 +35,7 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from mpi4py import MPI
@@ -46,6 +47,7 @@ from granulate.parallel import DistributedRun
 from granulate.parallel.node_split import NodeSplitRun
 from granulate.writers import registry
 from granulate.writers.step_data import StepData
+from rank_zero import on_rank_0, wait_asleep
 from run_folders import SEARCHES, history, outputs
 from test_checkpoint import tumbling_drum
 from test_node_split import pulled
@@ -76,25 +78,21 @@ def check_measures(engine: str, steps: int, comm: MPI.Comm) -> tuple[bool, list[
     """The ranks' measures every CHECK_EVERY steps and after breaking bodies 0 and 2 by hand,
     against the serial run's; rank 0 prints them. Whether they agree, and the serial run's
     at each check (rank 0's; none elsewhere)."""
+    wall = "drum" if engine == "grains" else None
+    chosen = [0, 2] if engine == "grains" else [0]
+    expected = on_rank_0(comm, lambda: serial_measures(engine, steps, wall, chosen))
     engines = {"grains": DistributedRun, "split": NodeSplitRun}
     run = engines[engine](set_up(engine), comm)
     held = run.held if isinstance(run, DistributedRun) else np.arange(len(run.local.bodies))
-    serial = set_up(engine) if comm.Get_rank() == 0 else None
-    wall = "drum" if engine == "grains" else None
-    rows: list[tuple[tuple[float, ...], tuple[float, ...]]] = []
+    mine = []
     for _ in range(steps // CHECK_EVERY):
         run.run(CHECK_EVERY)
-        mine = values(run.measures(), wall)
-        if serial is not None:
-            serial.core.run(CHECK_EVERY)
-            rows.append((mine, values(serial, wall)))
-    chosen = [0, 2] if engine == "grains" else [0]
+        mine.append(values(run.measures(), wall))
     _break(run.local, [np.flatnonzero(held == b) for b in chosen])
-    mine = values(run.measures(), wall)
-    if serial is None:
+    mine.append(values(run.measures(), wall))
+    if expected is None:
         return True, []
-    _break(serial, [np.array([b]) for b in chosen])
-    rows.append((mine, values(serial, wall)))
+    rows = list(zip(mine, expected, strict=True))
     same = all(a == b for a, b in rows)
     print(
         f"measures {engine} on {comm.Get_size()} ranks: equal {same}; at the end "
@@ -102,6 +100,20 @@ def check_measures(engine: str, steps: int, comm: MPI.Comm) -> tuple[bool, list[
         f"{rows[-1][0][3]:.0f} particles fully broken by hand (serially {rows[-1][1][3]:.0f})"
     )
     return same, [row[1] for row in rows[:-1]]
+
+
+def serial_measures(
+    engine: str, steps: int, wall: str | None, chosen: list[int]
+) -> list[tuple[float, ...]]:
+    """The serial run's measures every CHECK_EVERY steps, then after breaking bodies `chosen`
+    by hand."""
+    serial = set_up(engine)
+    rows = []
+    for _ in range(steps // CHECK_EVERY):
+        serial.core.run(CHECK_EVERY)
+        rows.append(values(serial, wall))
+    _break(serial, [np.array([b]) for b in chosen])
+    return [*rows, values(serial, wall)]
 
 
 def _break(sim: gr.Simulation, bodies: list[np.ndarray]) -> None:
@@ -122,10 +134,7 @@ def check_stops(engine: str, steps: int, seen: list[tuple[float, ...]], comm: MP
     owner = DistributedRun if engine == "grains" else NodeSplitRun
     same = True
     for criterion in thresholds:
-        expected = None
-        if comm.Get_rank() == 0:
-            serial = set_up(engine)
-            expected = (serial.run(steps, stop=[criterion], check_every=CHECK_EVERY), serial.step)
+        expected = on_rank_0(comm, lambda: serial_stop(engine, steps, criterion))  # noqa: B023
         with counting(owner) as gathered:
             sim = set_up(engine, comm)
             got = (sim.run(steps, stop=[criterion], check_every=CHECK_EVERY), sim.step)
@@ -214,6 +223,8 @@ def check_outputs(
         for name, ranks in (("serial", None), ("ranks", comm)):
             if ranks is None and comm.Get_rank() != 0:
                 continue
+            if ranks is not None:
+                wait_asleep(comm)  # while rank 0 runs serially
             sim = made[name] = set_up("grains", ranks)
             sim.output(root / name, every=CHECK_EVERY, pieces=True, track=[sim.bodies[3]])
             sim.run(steps, gather=gather)
@@ -267,6 +278,12 @@ def without_gathering(sim: gr.Simulation, serial: gr.Simulation | None) -> str |
     return f"rank 0: {refused!r}, built {built}; measured as serially {same and not built}"
 
 
+def serial_stop(engine: str, steps: int, criterion: Any) -> tuple[Any, int]:
+    """The serial run stopped by `criterion`: its reason and step."""
+    serial = set_up(engine)
+    return serial.run(steps, stop=[criterion], check_every=CHECK_EVERY), serial.step
+
+
 def _thresholds(seen: list[tuple[float, ...]]) -> list[gr.stopping.StopCriterion]:
     """Criteria met first at a check of the serial run whose measures at each check were
     `seen`: each threshold one float past the value there."""
@@ -302,4 +319,6 @@ def main() -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    code = main()
+    wait_asleep(MPI.COMM_WORLD)  # while rank 0 compares
+    sys.exit(code)
