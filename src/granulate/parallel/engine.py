@@ -48,6 +48,7 @@ from granulate.core_model import materials_in_core_order
 from granulate.errors import InputError
 from granulate.parallel import checkpoint_pieces
 from granulate.parallel.agreement import RankFailed, attempt, on_root, together
+from granulate.parallel.large_messages import large_message_comm
 from granulate.parallel.overlap import while_travelling
 from granulate.parallel.partition import (
     Partition,
@@ -158,6 +159,8 @@ class DistributedRun:
 
         self.mpi = MPI
         self.comm = comm
+        #: `comm` for messages of states (large_messages.py).
+        self.large = large_message_comm(comm)
         self._sim = sim
         share_of_cores(comm)
         self._slices = [body.node_slice for body in sim.bodies]  # each grain's global nodes
@@ -932,7 +935,7 @@ class DistributedRun:
         states = grain_states(self.local, saved, self._to_global, owned) if owned else {}
         outgoing = [{int(g): states[int(g)] for g in grains} for grains in wanted]
         received: dict[int, GrainState] = {}
-        for box in self.comm.alltoall(outgoing):
+        for box in self.large.alltoall(outgoing):
             received |= box
         if not renew:
             together(self.comm, lambda: self._plan(self._node_map))
@@ -1059,7 +1062,7 @@ class DistributedRun:
         ]
         states.clear()
         received: dict[int, GrainState] = {}
-        for box in self.comm.alltoall(outgoing):
+        for box in self.large.alltoall(outgoing):
             received |= box
         together(self.comm, lambda: self._rebuild(held, received, moment))
 
@@ -1092,7 +1095,7 @@ class DistributedRun:
         mine = self._is_owned[first]
         kept = self._is_owned[rows]
         place = np.arange(len(rows)) - offsets[rows]  # an entry's place among its node's
-        parts = self.comm.gather(
+        parts = self.large.gather(
             (
                 np.column_stack([self._to_global[first[mine]], slots[mine, 1]]),
                 terms[mine],
@@ -1130,7 +1133,7 @@ class DistributedRun:
         start = time.perf_counter()
         walls = self.wall_reactions()
         part = together(self.comm, lambda: owned_part(self, measures), "measuring its grains")
-        parts = self.comm.gather(part, root=0)
+        parts = self.large.gather(part, root=0)
         moment = (float(self.local.core.time), int(self.local.core.step))
         on_root(self.comm, lambda: install(self._sim, parts, moment, walls))
         self.seconds["collect"] += time.perf_counter() - start
@@ -1188,7 +1191,7 @@ class DistributedRun:
         if field not in ("positions", "velocities", "forces"):
             raise ValueError(f"gather: field must be positions, velocities or forces: {field!r}")
         mine = getattr(self.local.core, field)[self._owned_nodes]
-        parts = self.comm.gather((self._owned, mine), root=root)
+        parts = self.large.gather((self._owned, mine), root=root)
         if parts is None:
             return None
         whole = np.empty((self._node_count, 3))

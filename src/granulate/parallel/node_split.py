@@ -38,6 +38,7 @@ from granulate import checkpoints, fingerprints
 from granulate.errors import InputError
 from granulate.evaluation import Evaluation
 from granulate.parallel.agreement import attempt, on_root, stop_if_any_failed, together
+from granulate.parallel.large_messages import large_message_comm
 from granulate.parallel.overlap import while_travelling
 from granulate.parallel.partition import bisect
 from granulate.parallel.rank_threads import share_of_cores
@@ -67,6 +68,7 @@ class NodeSplitRun:
         from mpi4py import MPI
 
         self.comm, self.mpi, self._sim = comm, MPI, sim
+        self.large = large_message_comm(comm)  # for messages of states (large_messages.py)
         share_of_cores(comm)
         ranks, nodes = comm.Get_size(), sim.node_count
         if ranks > nodes:
@@ -170,7 +172,7 @@ class NodeSplitRun:
         if field not in _NODE_FIELDS:
             raise ValueError(f"gather: field must be one of {', '.join(_NODE_FIELDS)}: {field!r}")
         mine = np.asarray(getattr(self.local.core, field))[self.own]
-        parts = self.comm.gather(mine, root=root)
+        parts = self.large.gather(mine, root=root)
         if parts is None:
             return None
         whole = np.empty((len(self.owner), *mine.shape[1:]))
@@ -204,7 +206,7 @@ class NodeSplitRun:
         core = self.local.core
         intact = np.asarray(core.bond_intact)[_copies_of(self._offsets, self.own)]
         mine = (*(np.asarray(getattr(core, f))[self.own] for f in _NODE_FIELDS), intact)
-        parts = self.comm.gather(mine, root=0)
+        parts = self.large.gather(mine, root=0)
         searches = self.comm.reduce(int(core.contact_statistics.rebuilds), op=self.mpi.MAX, root=0)
         moment = (float(core.time), int(core.step))
         on_root(self.comm, lambda: self._install(parts, moment, int(searches)))
@@ -261,7 +263,7 @@ class NodeSplitRun:
             return dict(self._sim.core.checkpoint())
 
         start = time.perf_counter()
-        state = self.comm.bcast(on_root(self.comm, read), root=0)
+        state = self.large.bcast(on_root(self.comm, read), root=0)
         together(self.comm, lambda: self.local.core.restore(state), "restoring the checkpoint")
         self.seconds["collect"] += time.perf_counter() - start
 
@@ -273,7 +275,7 @@ class NodeSplitRun:
         if "Fragment_ID" in fields:
             whole = on_root(self.comm, lambda: self._sim.analysis.fragment_labels())
             mine = None if whole is None else [whole[nodes] for nodes in self.nodes_of]
-            labels = self.comm.scatter(mine, root=0)
+            labels = self.large.scatter(mine, root=0)
         local = [f for f in fields if f != "Fragment_ID"]
         values = point_fields(self.local, tuple(local), self.local.core.damage())
         rows = {name: field[self.own] for name, field in values.items()}
