@@ -37,7 +37,9 @@ at the start with a user's error (in a migration with a bug) and expects every r
 when the ranks first gather the state into it, and expects every rank to stop with rank 0's
 InputError; `... DIMENSION STEPS fail-room` makes rank 0's memory check of the whole model
 fail when the drum set up with Simulation(comm=...) starts its run, and expects every rank to
-stop with its InputError before the first step; `... DIMENSION STEPS fail-progress` gives the
+stop with its InputError before the first step; `... DIMENSION STEPS fail-frame-room` does
+so with rank 0's memory check of the frames of every node it joins of the ranks' rows;
+`... DIMENSION STEPS fail-progress` gives the
 drum's run a progress function that reads rank 0's simulation mid-run, and expects every rank
 to stop with the InputError rank 0's simulation raises."""
 
@@ -151,6 +153,8 @@ def main() -> int:
         return check_failure(dimension, steps, comm)
     if len(sys.argv) > 3 and sys.argv[3] == "fail-room":
         return check_room_failure(steps, comm)
+    if len(sys.argv) > 3 and sys.argv[3] == "fail-frame-room":
+        return check_frame_room_failure(steps, comm)
     if len(sys.argv) > 3 and sys.argv[3] == "fail-progress":
         return check_progress_failure(steps, comm)
     if len(sys.argv) > 3 and sys.argv[3] == "fail-whole":
@@ -452,6 +456,26 @@ def check_room_failure(steps: int, comm: MPI.Comm) -> int:
     print("room", messages)
     reason = "rank 0 holds the whole model at the end of a run"
     return 0 if len(set(messages)) == 1 and reason in messages[0] else 1
+
+
+def check_frame_room_failure(steps: int, comm: MPI.Comm) -> int:
+    """0 when rank 0, too short of memory for the frames of every node it joins of the
+    ranks' rows (vtu_frame.require_room_for_frames: 1 kB free, forced once the ranks have
+    built their parts), stops every rank with its InputError before the drum's run
+    (Simulation(comm=...), frames in one file, run(gather=False)) takes a step."""
+    folder = Path(comm.bcast(tempfile.mkdtemp() if comm.Get_rank() == 0 else None, root=0))
+    sim = tumbling_drum(folder, comm=comm)
+    sim._distributed_run()  # the ranks' parts, built with the memory the machine has
+    if comm.Get_rank() == 0:
+        resources.available_memory = lambda: 10**3
+    messages = stop_messages(lambda: sim.run(steps, gather=False), comm)
+    if messages is None:
+        return 0
+    shutil.rmtree(folder)
+    print("frame room", messages, "steps taken", sim._distributed.local.core.step)
+    reason = "Rank 0's frames of all 184 nodes in one file would need about 62.2 kB"
+    stopped = len(set(messages)) == 1 and reason in messages[0] and "in pieces" in messages[0]
+    return 0 if stopped and sim._distributed.local.core.step == 0 else 1
 
 
 def check_progress_failure(steps: int, comm: MPI.Comm) -> int:

@@ -19,7 +19,8 @@ ends every rank with one InputError that says so, before any header names the pi
 checkpoint before is left whole.
 
 `cli`: `granulate run` (in this process, on the ranks) of the drum case with frames in pieces,
-cut short and resumed from its checkpoint in pieces, never builds rank 0's whole simulation.
+cut short and resumed from its checkpoint in pieces, never builds rank 0's whole simulation;
+`cli-one-file`: the same with each frame in one file, which rank 0 joins of the ranks' rows.
 """
 
 from __future__ import annotations
@@ -187,15 +188,17 @@ def check_failed_save(folder: Path, comm: MPI.Comm, failure: str) -> int:
     return 0 if failed and kept and step == 310 else 1
 
 
-def check_command_line(folder: Path, comm: MPI.Comm) -> int:
-    """0 when `granulate run` of the drum case with frames in pieces, cut short at step 1,700
-    (its checkpoints in pieces, at 1,000 and at the end) and resumed to step 3,000, never
-    builds rank 0's whole simulation (the only one given the communicator), and both commands
-    succeed."""
-    case = folder / "drum_pieces.yaml"
+def check_command_line(folder: Path, comm: MPI.Comm, pieces: bool) -> int:
+    """0 when `granulate run` of the drum case, its frames in pieces (`pieces`) or each in one
+    file, cut short at step 1,700 (its checkpoints in pieces, at 1,000 and at the end) and
+    resumed to step 3,000, never builds rank 0's whole simulation (the only one given the
+    communicator), and both commands succeed."""
+    case = folder / "drum.yaml"
     if comm.Get_rank() == 0:
         text = (Path(__file__).parent / "cases" / "drum_mpi.yaml").read_text()
-        case.write_text(text.replace("output: {every: 250}", "output: {every: 250, pieces: true}"))
+        if pieces:
+            text = text.replace("output: {every: 250}", "output: {every: 250, pieces: true}")
+        case.write_text(text)
     comm.Barrier()
     builds = []
     build = gr.Simulation._build
@@ -228,7 +231,8 @@ CASES = {
     "damaged": check_damaged,
     "write-fail": functools.partial(check_failed_save, failure="full"),
     "unshared": functools.partial(check_failed_save, failure="local"),
-    "cli": check_command_line,
+    "cli": functools.partial(check_command_line, pieces=True),
+    "cli-one-file": functools.partial(check_command_line, pieces=False),
 }
 
 

@@ -194,10 +194,12 @@ def test_a_checkpoint_missing_a_piece_or_with_a_foreign_one_is_refused_on_every_
     assert "is missing its piece" in done.stdout and "history.csv kept True" in done.stdout
 
 
-def test_granulate_run_with_frames_in_pieces_never_builds_the_whole_model_on_rank_0() -> None:
-    """The drum case on 2 ranks, cut short at step 1,700 and resumed to 3,000 from its
-    checkpoint in pieces: rank 0's whole simulation is never built."""
-    done = run_ranks(2, "cli", script=CHECKPOINT_CHECK)
+@pytest.mark.parametrize("case", ["cli", "cli-one-file"])
+def test_granulate_run_never_builds_the_whole_model_on_rank_0(case: str) -> None:
+    """The drum case on 2 ranks, its frames in pieces or each in one file (joined on rank 0
+    from the ranks' rows), cut short at step 1,700 and resumed to 3,000 from its checkpoint in
+    pieces: rank 0's whole simulation is never built."""
+    done = run_ranks(2, case, script=CHECKPOINT_CHECK)
     assert done.returncode == 0, done.stdout + done.stderr
     assert "exit codes [0, 0]; rank 0's whole builds []" in done.stdout
 
@@ -269,6 +271,15 @@ def test_rank_0_without_room_for_the_whole_model_stops_every_rank_at_the_start()
     done = run_ranks(2, "2", "10", "fail-room")
     assert done.returncode == 0, done.stdout + done.stderr
     assert "room ['InputError: the model would need about 9 TB" in done.stdout
+
+
+def test_rank_0_without_room_for_one_file_frames_stops_every_rank_at_the_start() -> None:
+    """Rank 0 joins each frame of every node from the ranks' rows; without the memory for them
+    (forced), every rank stops with its InputError, which says to write the frames in
+    pieces, before a step."""
+    done = run_ranks(2, "2", "10", "fail-frame-room")
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert "steps taken 0" in done.stdout
 
 
 def test_a_progress_function_failing_on_rank_0_ends_every_rank_without_a_hang() -> None:

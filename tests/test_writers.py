@@ -11,6 +11,7 @@ import pytest
 
 import granulate as gr
 from granulate import writers
+from granulate.writers import vtu_frame
 from granulate.writers.step_data import StepData
 
 
@@ -67,3 +68,20 @@ def test_the_built_in_writers_alone_by_default(tmp_path: Path) -> None:
     assert not list((tmp_path / "out" / "frames").glob("log_*"))
     with (tmp_path / "out" / "history.csv").open() as handle:
         assert "max_speed" not in next(csv.reader(handle))
+
+
+@pytest.mark.parametrize("fields", [vtu_frame.FIELDS, ("Displacement", "Damage", "Fixity")])
+def test_the_frame_size_rank_0_checks_is_the_rows_it_holds(
+    tmp_path: Path, fields: tuple[str, ...]
+) -> None:
+    """vtu_frame.frame_bytes, which rank 0 of a distributed run checks against its free memory
+    before joining frames of every node (twice: the ranks' rows and the frame), is the bytes
+    of a frame's rows: positions, the fields and the nodes' numbers (169 bytes a node with
+    every field)."""
+    sim = falling_disc(tmp_path)
+    sim.run(10)
+    rows = vtu_frame.node_rows(sim, fields)
+    held = rows.numbers.astype(np.int64).nbytes + rows.positions.nbytes
+    held += sum(values.nbytes for values in rows.values.values())
+    assert vtu_frame.frame_bytes(sim.node_count, fields) == held
+    assert vtu_frame.frame_bytes(1, vtu_frame.FIELDS) == 169

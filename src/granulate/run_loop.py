@@ -95,11 +95,14 @@ class Stepper(Protocol):
     def broken_bonds(self) -> int:
         """The broken bonds of the whole simulation."""
 
-    def step_data(self, sim: Simulation, tracked: tuple[int, ...], whole: bool) -> StepData | None:
+    def step_data(
+        self, sim: Simulation, tracked: tuple[int, ...], whole: bool, frame: tuple[str, ...] | None
+    ) -> StepData | None:
         """The current output step made of the ranks' measures of their own grains, with the
-        sums of the `tracked` bodies, on rank 0 (None elsewhere); or None once `sim` holds
-        the whole state (collect), which the outputs then read: always serially, and on ranks
-        when `whole` (the outputs read the whole simulation) or the bodies are cut at node
+        sums of the `tracked` bodies and, for a frame of every node with the fields `frame`,
+        the ranks' rows of it, on rank 0 (None elsewhere); or None once `sim` holds the whole
+        state (collect), which the outputs then read: always serially, and on ranks when
+        `whole` (the outputs read the whole simulation) or the bodies are cut at node
         level."""
 
     def save_checkpoint(self, sim: Simulation, path: Path, outputs: Outputs | None) -> Path:
@@ -148,7 +151,9 @@ class CoreStepper:
     def broken_bonds(self) -> int:
         return int(self.core.broken_bonds())
 
-    def step_data(self, sim: Simulation, tracked: tuple[int, ...], whole: bool) -> StepData | None:
+    def step_data(
+        self, sim: Simulation, tracked: tuple[int, ...], whole: bool, frame: tuple[str, ...] | None
+    ) -> StepData | None:
         return None
 
     def save_checkpoint(self, sim: Simulation, path: Path, outputs: Outputs | None) -> Path:
@@ -342,7 +347,8 @@ def write_outputs(
         planned = None  # rank 0's: the tracked bodies, and whether the outputs read the whole
         if out is not None:
             tracked = tuple(body.index for body in out.tracked)
-            planned = (tracked, out.needs_whole_state(stepper.step, final))
+            step = stepper.step
+            planned = (tracked, out.needs_whole_state(step, final), out.one_file_frame(step, final))
         agreed = stepper.agree(planned)
         if agreed is not None:  # the step made of the ranks' measures, or the state collected
             data = stepper.step_data(sim, *agreed)

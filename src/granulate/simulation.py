@@ -409,24 +409,33 @@ class Simulation(SimulationSetup, SimulationResults):
         """Every rank, before a distributed run's first step: InputError when rank 0 will take
         the whole state in this run (at its end unless plan.gather is False, for outputs or
         stop criteria that read the whole simulation, or for every output of bodies cut at
-        node level) and the whole model would not fit in its memory (whole_state.require_room):
-        refused now, not hours in. Checked once."""
+        node level) and the whole model would not fit in its memory (whole_state.require_room);
+        or when it will join frames of every node from the ranks' rows and those would not
+        (vtu_frame.frame_bytes): refused now, not hours in. Checked once."""
         from granulate.parallel import NodeSplitRun
         from granulate.parallel.agreement import on_root
         from granulate.parallel.whole_state import require_room
+        from granulate.writers.vtu_frame import require_room_for_frames
 
         run = self._distributed_run()
         out = self._output  # rank 0's
-        gathers = self._comm.bcast(
-            plan.gather
-            or isinstance(run, NodeSplitRun)
-            or any(criterion.needs_whole_state for criterion in plan.stop)
-            or (out is not None and out.may_need_whole_state()),
+        gathers, frames = self._comm.bcast(
+            (
+                plan.gather
+                or isinstance(run, NodeSplitRun)
+                or any(criterion.needs_whole_state for criterion in plan.stop)
+                or (out is not None and out.may_need_whole_state()),
+                out is not None and not out.pieces,
+            ),
             root=0,
         )
-        if gathers and not self._room_checked:
+        if self._room_checked:
+            return
+        if gathers:
             on_root(self._comm, lambda: require_room(self))
-            self._room_checked = True
+        elif frames:
+            on_root(self._comm, lambda: require_room_for_frames(self.node_count, out.fields))
+        self._room_checked = True
 
     def measures(self) -> RunMeasures:
         """What the stop criteria read (granulate.stopping.RunMeasures: time, kinetic energy,

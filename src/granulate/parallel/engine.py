@@ -70,7 +70,7 @@ from granulate.parallel.transplant import (
     wall_lists,
 )
 from granulate.parallel.whole_state import install, owned_part
-from granulate.writers.vtu_frame import write_piece
+from granulate.writers.vtu_frame import NodeRows, node_rows, write_piece
 
 if TYPE_CHECKING:
     from granulate.node_map import NodeMap
@@ -1108,18 +1108,35 @@ class DistributedRun:
         total = on_root(self.comm, lambda: _sum_wall_terms(parts, walls))
         return self.comm.bcast(total, root=0)
 
-    def step_data(self, tracked: tuple[int, ...]) -> StepData | None:
+    def step_data(
+        self, tracked: tuple[int, ...], frame: tuple[str, ...] | None = None
+    ) -> StepData | None:
         """Every rank: the current output step made of what each rank measures of its own
-        grains (step_parts.py), with the sums of the `tracked` grains; on rank 0 (None on the
-        others), with no node array: rank 0's simulation is not built for it."""
+        grains (step_parts.py), with the sums of the `tracked` grains and, for a frame of
+        every node with the fields `frame`, each rank's rows of its own nodes, joined in node
+        order (StepData.frame_rows); on rank 0 (None on the others): rank 0's simulation is
+        not built for it."""
         start = time.perf_counter()
         walls = self.wall_reactions()
         broken = self.broken_bonds()
         part = together(self.comm, lambda: step_part(self, tracked), "measuring its grains")
         parts = self.comm.gather(part, root=0)
-        data = on_root(self.comm, lambda: step_data(self._sim, self, parts, broken, walls))
+        rows = None if frame is None else self._frame_rows(frame)
+        data = on_root(self.comm, lambda: step_data(self._sim, self, parts, broken, walls, rows))
         self.seconds["collect"] += time.perf_counter() - start
         return data
+
+    def _frame_rows(self, fields: tuple[str, ...]) -> NodeRows | None:
+        """Every rank: its own nodes' rows of a frame with `fields`, sent to rank 0, which
+        joins them in node order (None on the others)."""
+        numbering = (self._to_global, self.held)
+        mine = together(
+            self.comm,
+            lambda: node_rows(self.local, fields, self._owned_nodes, numbering),
+            "measuring its nodes",
+        )
+        parts = self.large.gather(mine, root=0)
+        return on_root(self.comm, lambda: NodeRows.joined(parts, self._node_count))
 
     def collect(self, measures: bool = True) -> None:
         """Every rank: rank 0's simulation (the one the run was made of, built whole on the

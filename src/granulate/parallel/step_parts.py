@@ -16,9 +16,11 @@ Rank 0 puts the fragment rows in the serial order (by id), the grains' rows in g
 contacts in the serial slot order, and completes the particle table from them
 (analysis.complete_particle_table): every column is the serial run's.
 
-A frame of every node (output without pieces), a writer that may read the simulation
-(writers/base.py), a checkpoint, the end of a run and a body cut at node level (NodeSplitRun,
-whose pieces span ranks) still take the whole state on rank 0 (DistributedRun.collect).
+A frame of every node (output without pieces) is made of the ranks' rows of their own nodes,
+joined on rank 0 (DistributedRun.step_data). A writer that may read the simulation
+(writers/base.py), the end of a run (unless run(gather=False)) and a body cut at node level
+(NodeSplitRun, whose pieces span ranks) still take the whole state on rank 0
+(DistributedRun.collect).
 """
 
 from __future__ import annotations
@@ -40,6 +42,7 @@ from granulate.writers.step_data import StepData, set_up_fields
 if TYPE_CHECKING:
     from granulate.parallel.engine import DistributedRun
     from granulate.simulation import Simulation
+    from granulate.writers.vtu_frame import NodeRows
 
 
 @dataclass(frozen=True)
@@ -86,9 +89,11 @@ def step_data(
     parts: list[StepPart],
     broken: int,
     wall_reactions: NDArray[np.float64],
+    frame_rows: NodeRows | None = None,
 ) -> StepData:
     """Rank 0: the output step of `sim` (its set-up: walls, gravity, bodies) from every rank's
-    part, with `broken` bonds in all and the walls' reactions."""
+    part, with `broken` bonds in all, the walls' reactions and the rows of a frame of every
+    node (`frame_rows`, when one is due)."""
     core, grains = run.local.core, len(sim.bodies)
     totals = functools.reduce(operator.add, (part.totals for part in parts))
     table = _merged_fragments([part.fragments for part in parts])
@@ -114,6 +119,7 @@ def step_data(
         particles,
         (stresses, volumes),
         *set_up_fields(sim, core),
+        frame_rows=frame_rows,
     )
 
 

@@ -1,8 +1,8 @@
 """Simulation.run's loop on the ranks of a distributed run (granulate.run_loop.Stepper): every
 rank takes the steps of the chunks rank 0 decides; rank 0 writes the outputs of the step its
-ranks measured of their grains (step_parts.py), or of the whole state its simulation takes
-(DistributedRun.collect) for a frame of every node, writers that may read the simulation or
-bodies cut at node level; the stop criteria read the ranks' measures put together
+ranks measured of their grains (step_parts.py; a frame of every node from their rows), or of
+the whole state its simulation takes (DistributedRun.collect) for writers that may read the
+simulation or bodies cut at node level; the stop criteria read the ranks' measures put together
 (run_measures.py); rank 0's decisions and errors reach every rank."""
 
 from __future__ import annotations
@@ -62,11 +62,13 @@ class DistributedStepper:
     def broken_bonds(self) -> int:
         return self.run.broken_bonds()
 
-    def step_data(self, sim: Simulation, tracked: tuple[int, ...], whole: bool) -> StepData | None:
+    def step_data(
+        self, sim: Simulation, tracked: tuple[int, ...], whole: bool, frame: tuple[str, ...] | None
+    ) -> StepData | None:
         if whole or not isinstance(self.run, DistributedRun):  # a node split's pieces span ranks
             self.run.collect(measures=True)
             return None
-        return self.run.step_data(tracked)
+        return self.run.step_data(tracked, frame)
 
     def save_checkpoint(self, sim: Simulation, path: Path, outputs: Outputs | None) -> Path:
         return self.run.save_checkpoint(path, outputs)

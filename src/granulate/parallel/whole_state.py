@@ -1,6 +1,7 @@
-"""The whole state of a distributed run on rank 0, for a frame of every node, the end of a run
-(unless run(..., gather=False)) and outputs of writers that may read the simulation (an output
-step of the built-in writers is made of the ranks' measures instead: step_parts.py).
+"""The whole state of a distributed run on rank 0, for the end of a run (unless
+run(..., gather=False)) and outputs of writers that may read the simulation (an output step of
+the built-in writers, a frame of every node included, is made of the ranks' measures instead:
+step_parts.py).
 
 Each rank sends its own grains' nodes (positions, velocities, forces, dilatation) and bonds, and
 what its last force evaluation left for them: the contacts whose first body it owns (the
@@ -57,8 +58,8 @@ def require_room(sim: Simulation) -> None:
     except InputError as error:
         raise InputError(
             f"{error}. On MPI ranks, rank 0 holds the whole model at the end of a run (and for "
-            "frames of every node): give it a machine with that much memory free (fewer ranks "
-            "beside it)"
+            "writers that read the simulation): give it a machine with that much memory free "
+            "(fewer ranks beside it), or run(..., gather=False)"
         ) from None
 
 

@@ -107,14 +107,19 @@ class Outputs:
 
     def needs_whole_state(self, step: int, final: bool | None = None) -> bool:
         """Whether the outputs of `step` (write_step's, or write_final's) read the whole
-        simulation: a frame of every node, or a writer that may read it (base.py).
-        Otherwise a distributed run makes them of its ranks' measures (StepData)."""
-        return (self.frame_due(step, final) and not self.pieces) or not registry.reads_values_only()
+        simulation: a writer that may read it (base.py). Otherwise a distributed run makes
+        them of its ranks' measures (StepData), and a frame of every node of their rows
+        (one_file_frame)."""
+        return not registry.reads_values_only()
 
     def may_need_whole_state(self) -> bool:
-        """Whether some output step may read the whole simulation (needs_whole_state): frames
-        of every node, or a writer that may read it."""
-        return not self.pieces or not registry.reads_values_only()
+        """Whether some output step may read the whole simulation (needs_whole_state)."""
+        return not registry.reads_values_only()
+
+    def one_file_frame(self, step: int, final: bool | None = None) -> tuple[str, ...] | None:
+        """The fields of the frame of every node in one file that the outputs of `step` write
+        (frame_due, not in pieces), or None."""
+        return self.fields if self.frame_due(step, final) and not self.pieces else None
 
     def piece_folder(self, step: int, final: bool | None = None) -> Path | None:
         """The folder of the pieces the ranks write of the frame `step`'s outputs write

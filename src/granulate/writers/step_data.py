@@ -1,6 +1,7 @@
 """What every writer of one output step reads, computed once for the frame and the history row
 of that step: from a simulation's whole state (StepData.of), or in a distributed run from what
-its ranks measured of their own grains (parallel/step_parts.py), with no node array."""
+its ranks measured of their own grains (parallel/step_parts.py), with no node array but, for a
+frame of every node, the ranks' rows of it."""
 
 from __future__ import annotations
 
@@ -19,6 +20,7 @@ if TYPE_CHECKING:
     from granulate.assembly import Body
     from granulate.simulation import Simulation
     from granulate.walls import Wall
+    from granulate.writers.vtu_frame import NodeRows
 
 
 @dataclass(frozen=True)
@@ -26,7 +28,7 @@ class StepData:
     """The current step: its time, sums over the nodes (StepTotals), broken bonds, fragment
     table, the last force evaluation (contacts, contact counts, wall reactions), the particles
     and the walls' displacements; and, when made of the whole state, the simulation and its
-    damage per node (for a frame of every node)."""
+    damage per node (for writers that read them)."""
 
     step: int
     time: float  #: [s]
@@ -45,6 +47,9 @@ class StepData:
     #: ranks' measures (a frame in pieces, written by the ranks)
     simulation: Simulation | None = None
     damage: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None
+    #: when made of the ranks' measures for a frame of every node: the ranks' rows of it,
+    #: joined in node order (Outputs.one_file_frame)
+    frame_rows: NodeRows | None = None
 
     @property
     def contacts(self) -> network.Table:

@@ -10,12 +10,14 @@ the whole run's particles and fragments, so the pieces joined are the one-file f
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
 
+from granulate import resources
 from granulate.errors import InputError
 from granulate.io import write_vtu
 from granulate.io.vtu import NODE_ID, write_pvtu
@@ -60,6 +62,52 @@ _NODE_ID_TYPE = np.dtype(np.int64)
 Numbering = tuple[NDArray[np.int64], NDArray[np.int64]]
 
 
+@dataclass(frozen=True)
+class NodeRows:
+    """Nodes' positions (n, 3) [m] and point fields (point_fields' arrays), in the order of
+    `numbers`, their numbers in the whole run: a rank's rows of a frame, or, put together in
+    node order (joined), the rows of a frame of every node."""
+
+    numbers: NDArray[np.int64]
+    positions: NDArray[np.float64]
+    values: dict[str, NDArray[np.generic]]
+
+    @staticmethod
+    def joined(parts: list[NodeRows], node_count: int) -> NodeRows:
+        """The rows of every node, in node order, from the parts that hold each once."""
+        numbers = np.arange(node_count)
+        positions = np.empty((node_count, 3))
+        values = {
+            name: np.empty((node_count, *field.shape[1:]), field.dtype)
+            for name, field in parts[0].values.items()
+        }
+        for part in parts:
+            positions[part.numbers] = part.positions
+            for name, field in part.values.items():
+                values[name][part.numbers] = field
+        return NodeRows(numbers, positions, values)
+
+
+def frame_bytes(nodes: int, fields: tuple[str, ...]) -> int:
+    """A frame's rows of `nodes` nodes with `fields`: positions, the fields and the nodes'
+    numbers [bytes]."""
+    row = 3 * 8 + _NODE_ID_TYPE.itemsize
+    row += sum(FIELD_TYPES[f][0].itemsize * FIELD_TYPES[f][1] for f in fields)
+    return nodes * row
+
+
+def require_room_for_frames(nodes: int, fields: tuple[str, ...]) -> None:
+    """Rank 0 of a distributed run writing frames of every node in one file: InputError when
+    the ranks' rows it receives and the frame it joins of them (frame_bytes, twice) would not
+    fit in the memory free now."""
+    resources.require_memory(
+        2 * frame_bytes(nodes, fields),
+        f"Rank 0's frames of all {nodes:,} nodes in one file",
+        "write the frames in pieces, each rank its own nodes (the case's output: {pieces: "
+        "true}; Simulation.output(pieces=True)), or fewer fields",
+    )
+
+
 def point_fields(
     sim: Simulation,
     fields: tuple[str, ...],
@@ -96,6 +144,25 @@ def point_fields(
     return {f: np.asarray(available[f](), dtype=FIELD_TYPES[f][0]) for f in fields}
 
 
+def node_rows(
+    sim: Simulation,
+    fields: tuple[str, ...],
+    nodes: NDArray[np.int64] | None = None,
+    numbering: Numbering | None = None,
+    damage: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None,
+) -> NodeRows:
+    """The rows of the nodes `nodes` of `sim` (all when None): their `fields` and their
+    numbers in the whole run (`numbering`, for a part of a distributed run); `damage` as
+    point_fields takes it (core.damage() when not given)."""
+    values = point_fields(sim, fields, damage or sim.core.damage(), numbering)
+    if nodes is None and numbering is None:  # every node, as they are
+        return NodeRows(np.arange(sim.node_count), np.asarray(sim.core.positions), values)
+    chosen = np.arange(sim.node_count) if nodes is None else nodes
+    numbers = chosen if numbering is None else numbering[0][chosen]
+    rows = {name: field[chosen] for name, field in values.items()}
+    return NodeRows(numbers, sim.core.positions[chosen], rows)
+
+
 def write_piece(
     path: Path,
     sim: Simulation,
@@ -104,14 +171,9 @@ def write_piece(
     numbering: Numbering | None = None,
     damage: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None,
 ) -> None:
-    """One piece of a frame: the nodes `nodes` of `sim` (all when None), their `fields` and
-    their numbers in the whole run (`numbering`, for a part of a distributed run); `damage`
-    as point_fields takes it (core.damage() when not given)."""
-    values = point_fields(sim, fields, damage or sim.core.damage(), numbering)
-    chosen = np.arange(sim.node_count) if nodes is None else nodes
-    numbers = chosen if numbering is None else numbering[0][chosen]
-    rows = {name: field[chosen] for name, field in values.items()}
-    write_piece_rows(path, sim.core.positions[chosen], rows, numbers)
+    """One piece of a frame: node_rows(...) of those arguments, with the nodes' numbers."""
+    rows = node_rows(sim, fields, nodes, numbering, damage)
+    write_piece_rows(path, rows.positions, rows.values, rows.numbers)
 
 
 def write_piece_rows(
@@ -131,18 +193,20 @@ class VtuFrame:
     """The node frame: positions and the fields of ``Simulation.output(fields=...)``, in one
     file or in pieces (module docstring)."""
 
-    # In pieces it reads StepData's values; a frame of every node reads the simulation, for
-    # which Outputs.needs_whole_state asks.
+    # It reads StepData's values: in pieces, the ranks write theirs; a frame of every node,
+    # the rows the ranks sent (StepData.frame_rows, Outputs.one_file_frame).
     needs_whole_state = False
 
     def write(self, data: StepData, outputs: Outputs) -> None:
         sim, damage = data.simulation, data.damage
         name = f"frame_{outputs.frames:06d}"
         frames = outputs.directory / "frames"
-        if not outputs.pieces:
-            assert sim is not None and damage is not None  # a frame of every node
-            values = point_fields(sim, outputs.fields, damage)
-            write_vtu(frames / f"{name}.vtu", sim.core.positions, values)
+        if not outputs.pieces:  # a frame of every node: the ranks' rows, or the simulation's
+            rows = data.frame_rows
+            if rows is None:
+                assert sim is not None and damage is not None
+                rows = node_rows(sim, outputs.fields, damage=damage)
+            write_vtu(frames / f"{name}.vtu", rows.positions, rows.values)
             outputs.pvd.add(data.time, Path("frames") / f"{name}.vtu")
             return
         if not outputs.piece_ranks:  # a serial run's one piece; else the ranks wrote theirs
