@@ -134,7 +134,8 @@ class Simulation(SimulationSetup, SimulationResults):
         #: Rank 0 of a distributed run: the ranks have moved on (steps, a checkpoint loaded in
         #: pieces) since its simulation last took their state, which it then refuses to give.
         self._ranks_ahead = False
-        self._room_checked = False  # rank 0's memory for the whole model (_require_room_on_root)
+        #: what rank 0 checked it has the memory for (_require_room_on_root)
+        self._room_checked: set[str] = set()
         self._reference: NDArray[np.float64] | None = None
         self._record = RunRecord()
         self._precracks: list[tuple[NDArray[np.float64], NDArray[np.float64], Shape | None]] = []
@@ -411,7 +412,7 @@ class Simulation(SimulationSetup, SimulationResults):
         stop criteria that read the whole simulation, or for every output of bodies cut at
         node level) and the whole model would not fit in its memory (whole_state.require_room);
         or when it will join frames of every node from the ranks' rows and those would not
-        (vtu_frame.frame_bytes): refused now, not hours in. Checked once."""
+        (vtu_frame.require_room_for_frames): refused now, not hours in. Each checked once."""
         from granulate.parallel import NodeSplitRun
         from granulate.parallel.agreement import on_root
         from granulate.parallel.whole_state import require_room
@@ -429,13 +430,12 @@ class Simulation(SimulationSetup, SimulationResults):
             ),
             root=0,
         )
-        if self._room_checked:
-            return
-        if gathers:
+        if gathers and "whole model" not in self._room_checked:
             on_root(self._comm, lambda: require_room(self))
-        elif frames:
+            self._room_checked.add("whole model")
+        if frames and "frames" not in self._room_checked:
             on_root(self._comm, lambda: require_room_for_frames(self.node_count, out.fields))
-        self._room_checked = True
+            self._room_checked.add("frames")
 
     def measures(self) -> RunMeasures:
         """What the stop criteria read (granulate.stopping.RunMeasures: time, kinetic energy,
