@@ -8,6 +8,7 @@ import filecmp
 import json
 import os
 import signal
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -314,3 +315,57 @@ def test_surface_nodes_that_took_new_anchors_resume_with_them(tmp_path: Path) ->
     second.run(600)
     np.testing.assert_array_equal(whole.positions, second.positions)
     np.testing.assert_array_equal(whole.velocities, second.velocities)
+
+
+def lattice_block() -> gr.Simulation:
+    """A 3D LPS block, 12 lattice spacings a side (1,728 nodes), unbreakable."""
+    a = 0.5e-3
+    rock = gr.Material(
+        density=2200, bulk_modulus=14.9e9, shear_modulus=14.0e9, horizon=3.015 * a, fracture=False
+    )
+    sim = gr.Simulation(3, dt=1e-8)
+    sim.add_body(gr.Box((0, 0, 0), (12 * a,) * 3), rock, a)
+    return sim
+
+
+def breakable_square() -> gr.Simulation:
+    """A 2D square, 60 mesh sizes a side (3,600 nodes), breakable."""
+    h = 1e-4
+    clay = gr.Material(
+        density=1200, bulk_modulus=2.16e7, shear_modulus=1.296e7, fracture_energy=50.0
+    )
+    sim = gr.Simulation(2)
+    sim.add_body(gr.Rectangle((0, 0), (60 * h, 60 * h)), clay, h)
+    return sim
+
+
+@pytest.mark.parametrize("make", [breakable_square, lattice_block])
+def test_a_checkpoint_is_the_size_the_run_budgets_for(
+    tmp_path: Path, make: Callable[[], gr.Simulation]
+) -> None:
+    """checkpoints.checkpoint_bytes (116 bytes a node, 1 a bond copy), which a run's checkpoint
+    budget multiplies, is a checkpoint's file size less its arrays' headers and the contact
+    lists' entries: measured 98.4 % of the square's (3,600 nodes, 96,516 bond copies) and
+    97.6 % of the block's (1,728 nodes, 155,512), against 71 % and 53 % with 100 bytes a node
+    and a bit a bond, the estimate before. (A model of a few hundred nodes is mostly headers:
+    the drum's 184 nodes, 77 %.)"""
+    from granulate import checkpoints
+
+    sim = make()
+    sim.run(50)
+    path = checkpoints.save(sim, tmp_path / "checkpoint.npz", None)
+    estimate = checkpoints.checkpoint_bytes(sim.node_count, sim.bond_count)
+    assert 0.9 * path.stat().st_size < estimate <= path.stat().st_size
+
+
+def test_checkpoints_every_few_steps_of_a_large_run_are_refused(tmp_path: Path) -> None:
+    """A checkpoint every step of a 10^7-node run for 10^6 steps would write about 1.2 EB: one
+    InputError naming the sizes and the way out; every 10^5 steps, 10 checkpoints of 1.2 GB,
+    is accepted."""
+    from granulate.checkpoints import CheckpointPlan
+
+    plan = CheckpointPlan.create(1, None, tmp_path / "c.npz", None)
+    with pytest.raises(gr.InputError, match="checkpoint less often") as refused:
+        plan.require_budget(10**6, 10**7, 10**8)
+    assert "1,000,000 checkpoints of about 1.26 GB" in str(refused.value)
+    CheckpointPlan.create(10**5, None, tmp_path / "c.npz", None).require_budget(10**6, 10**7, 10**8)
