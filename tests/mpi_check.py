@@ -20,6 +20,9 @@ with the serial run's, and continuing serially from the distributed checkpoint.
 checkpoint, and continues from it on K - 1 ranks (one rank fewer: a checkpoint restarts on
 another number of ranks) and serially, comparing both ends with the serial run's bit for bit.
 
+`... balance STEPS` compares discs at rest whose left half has more bonds a node
+(uneven_horizons), which the ranks cut anew by their work before the first step.
+
 `... fine STEPS MARGIN CAP_MARGIN [peridem]` compares finely meshed brittle discs (fine_discs)
 thrown at each other, whose ghosts' caps are a small part of them, with those margins [m]
 (with `peridem`, under PeriDEM's damping, on a slab that is a PeriDEM wall).
@@ -106,6 +109,22 @@ def fine_discs(peridem: bool = False, node_pairs: bool = False) -> gr.Simulation
     return sim
 
 
+def uneven_horizons() -> gr.Simulation:
+    """40 discs (0.99 mm, h = R/8) at rest on a floor, in rows of 10 on a hexagonal lattice
+    2 mm apart: the left half of horizon 4.5 h, the right 3 h (2.25 times fewer bonds a node).
+    Cut by nodes, the left half's rank has the more work (parallel/work_load.py)."""
+    h = RADIUS / 8
+    sim = gr.Simulation(2, gravity=(0.0, -9.81, 0.0))
+    sim.contact = gr.Contact(restitution=0.5, friction=0.5)
+    for k in range(40):
+        row, column = divmod(k, 10)
+        centre = (2 * RADIUS * (column + 0.5 * (row % 2)), np.sqrt(3) * RADIUS * row)
+        horizon = (4.5 if column < 5 else 3.0) * h
+        sim.add_body(gr.Disc(centre, 0.99 * RADIUS), rock(horizon), h)
+    sim.add_wall(gr.Wall(gr.Plane((0.0, -0.99 * RADIUS, 0.0), (0.0, 1.0, 0.0))), name="floor")
+    return sim
+
+
 DRUMS: dict[str, dict[str, Any]] = {
     "lattice": {},
     "grid": {"grid": True},
@@ -142,6 +161,8 @@ def main() -> int:
             cap_margin=cap_margin,
             narrow=True,
         )
+    if sys.argv[1] == "balance":
+        return compare(uneven_horizons, "uneven horizons", int(sys.argv[2]), comm)
     if sys.argv[1] == "drum":
         variant, steps = sys.argv[2], int(sys.argv[3])
         renew, widen = sys.argv[4:] == ["renew"], sys.argv[4:] == ["widen"]
@@ -203,6 +224,7 @@ def compare(
     distributed.always_renew = renew
     if not widen:
         distributed.short_distribution = 0
+    first_imbalance = distributed.work_imbalance  # the start's check, of the cut by nodes
     distributed.run(steps)
     fields = {name: distributed.gather(name) for name in ("positions", "velocities", "forces")}
     walls = distributed.wall_reactions()
@@ -221,7 +243,10 @@ def compare(
         f"rank {ghosts}, migrations {distributed.migrations}, margin widened "
         f"{distributed.margin_widenings} times to {distributed.margin:.3g} m, grains handed over "
         f"{distributed.handed_over}, parts built anew per rank {renewals}, caps picked anew "
-        f"{distributed.cap_refreshes}, cap margin widened "
+        f"{distributed.cap_refreshes}, rebalanced before steps {distributed.rebalance_steps} "
+        f"(work over the mean {first_imbalance:.3f} at the start, "
+        f"{distributed.work_imbalance:.3f} at the last check), "
+        f"cap margin widened "
         f"{distributed.cap_margin_widenings} times to {distributed.cap_margin:.3g} m, ghost "
         f"nodes held and sent a step per rank {held}, second messages {seconds}, nodes joining "
         f"caps {joined}, bonds broken "

@@ -446,6 +446,26 @@ void bind_state(nb::class_<Simulation>& cls) {
             return copy_out(counts);
           },
           "nodes"_a, "Each of these nodes' intact bond copies.")
+      .def(
+          "contact_list_entries",
+          [](const Simulation& self, nb::ndarray<const std::int64_t, nb::ndim<1>, nb::c_contig> nodes) {
+            const auto& pairs = self.contact().pair_offsets();
+            const auto& walls = self.contact().wall_offsets();
+            const auto count = static_cast<std::int64_t>(self.model().node_count());
+            const auto span = [](const std::vector<index_t>& offsets, std::int64_t i) {
+              return offsets.empty() ? index_t{0} : offsets[i + 1] - offsets[i];
+            };
+            std::vector<index_t> counts(nodes.shape(0));
+            for (std::size_t k = 0; k < counts.size(); ++k) {
+              const std::int64_t i = nodes.data()[k];
+              if (i < 0 || i >= count) throw InputError("contact_list_entries: nodes out of range");
+              counts[k] = span(pairs, i) + span(walls, i);
+            }
+            return copy_out(counts);
+          },
+          "nodes"_a,
+          "Each of these nodes' entries in the contact lists of their last build: node pairs and "
+          "wall surfaces (0 before the first).")
       .def_prop_ro("bond_intact",
                    [](Simulation& self) {  // a read-only copy, 1 byte per bond (stored as bits)
                      nb::object array =

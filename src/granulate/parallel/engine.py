@@ -70,6 +70,7 @@ from granulate.parallel.transplant import (
     wall_lists,
 )
 from granulate.parallel.whole_state import install, owned_part
+from granulate.parallel.work_load import imbalance, node_work
 from granulate.writers.vtu_frame import NodeRows, node_rows, write_piece
 
 if TYPE_CHECKING:
@@ -126,6 +127,10 @@ class DistributedRun:
     ``short_cap_period`` steps (flowing grains refresh less often); a cap margin given is
     kept. Caps that hold every ghost node (coarse grains) are never picked anew.
 
+    The start cuts the grains by their nodes; every migration cuts them by their work
+    (work_load.py), and at the start and every ``balance_every`` steps the ranks compare their
+    work and migrate when it has drifted past ``balance_threshold`` (_check_balance).
+
     Every rank calls the constructor and each method together.
     """
 
@@ -146,6 +151,11 @@ class DistributedRun:
     #: Caps picked anew fewer than this many steps after they were picked widen the default
     #: cap margin.
     short_cap_period = 50
+    #: Every this many steps (and at the start) the ranks compare their work (work_load.py);
+    #: when the most loaded one has over balance_threshold times the mean, and over that many
+    #: times what the last cut left it, they migrate, cut by the grains' work.
+    balance_every = 100
+    balance_threshold = 1.1
 
     def __init__(
         self,
@@ -225,6 +235,12 @@ class DistributedRun:
         #: tests of the hand-over, tests/mpi_check.py).
         self.always_renew = False
         self._migration_due = False
+        #: The steps before which the ranks migrated for their balance (_check_balance).
+        self.rebalance_steps: list[int] = []
+        self._rebalance_due = False
+        self._left_imbalance = 1.0  # what the last cut left, by the work it was cut by
+        #: The most loaded rank's work over the mean at the last check (_check_balance).
+        self.work_imbalance = 1.0
         # The wall reactions a loaded checkpoint holds, until the next step evaluates them.
         self._loaded_walls: NDArray[np.float64] | None = None
         self._setup_digest: str | None = None  # of the set-up's fingerprint, made once
@@ -241,6 +257,7 @@ class DistributedRun:
         #: Of the exchange's seconds, those spent waiting for the step's messages (Waitall,
         #: after the bond forces): what the overlap did not hide.
         self.waiting = 0.0
+        self._check_balance()
 
     def _stable_time_step(
         self, probe: Simulation, own: NDArray[np.int64], partition: Partition
@@ -774,6 +791,8 @@ class DistributedRun:
         farthest = self._check_step(int(core.step), failure)
         self._loaded_walls = None
         self._migration_due = self._migrates and self._travelled + farthest > 0.25 * self.margin
+        if int(core.step) % self.balance_every == 0:
+            self._check_balance()
         spans = np.diff(times)  # begin, caps' check, send, bonds, receive, finish
         self.seconds["steps"] += spans[0] + spans[3] - testing + spans[5]
         self.seconds["exchange"] += spans[2] + testing + spans[4]
@@ -829,9 +848,38 @@ class DistributedRun:
             )
         return farthest
 
+    def _check_balance(self) -> None:
+        """Whether the ranks' work (work_load.py: each rank's own nodes, intact bond copies and
+        contact list entries; one allgather) has drifted out of balance: the most loaded rank
+        over balance_threshold times the mean, and over balance_threshold times what the last
+        cut left it (so that grains too heavy to share out do not cut again and again). Then
+        the next step begins with a migration. Not without migrate, nor with one already due."""
+        if not self._migrates or self._migration_due:
+            return
+        start = time.perf_counter()
+        mine = node_work(self.local.core, self._owned_nodes, self._sim.dimension).sum()
+        self.work_imbalance = imbalance(np.array(self.comm.allgather(float(mine))))
+        limit = self.balance_threshold * max(1.0, self._left_imbalance)
+        self._rebalance_due = self.work_imbalance > limit
+        self._migration_due = self._rebalance_due
+        self.seconds["check"] += time.perf_counter() - start
+
+    def _grain_work(self) -> NDArray[np.float64]:
+        """Every grain's work now (work_load.node_work summed over its nodes), on every rank:
+        each owner's grains (one allgather)."""
+        work = node_work(self.local.core, self._owned_nodes, self._sim.dimension)
+        sizes = [self._slices[g].stop - self._slices[g].start for g in self._owned]
+        mine = np.add.reduceat(work, np.cumsum([0, *sizes[:-1]]))
+        weights = np.empty(len(self._slices))
+        for grains, theirs in self.comm.allgather((self._owned, mine)):
+            weights[grains] = theirs
+        return weights
+
     def migrate(self) -> None:
         """Cut the assembly anew where the grains are now (recursive coordinate bisection of
-        their current bounding spheres, which also rebalances the ranks). A rank that now
+        their current bounding spheres, weighted by their work: work_load.py), which also
+        rebalances the ranks; a migration for the balance (_check_balance) does only
+        that, and does not widen the margin. A rank that now
         holds other grains than before, or owns one it held as a ghost, builds its part anew
         from the owners' states of them (transplant.py): of a ghost only the caps move with
         its owner (_exchange_caps), so its contacts with the other ghosts are not the serial
@@ -839,13 +887,18 @@ class DistributedRun:
         ghost's positions, velocities and forces are made their owners' first, and the caps
         are picked anew. Either way the run goes on as the serial run, bit for bit."""
         start = time.perf_counter()
-        self._migration_due = False
-        self._widen_margin()
+        for_balance, self._rebalance_due, self._migration_due = self._rebalance_due, False, False
+        if not for_balance:
+            self._widen_margin()
         self._exchange_state()
         before, owners_before = self._held_by_rank(), self.partition.owner
         positions = self.local.core.positions
         layout = self._gathered_layout(self._owned, lambda g: positions[self.local_slice(g)])
+        self._weights = self._grain_work()
         held = self._distribute(*layout)
+        self._left_imbalance = imbalance(self.partition.loads(self._weights))
+        if for_balance:
+            self.rebalance_steps.append(int(self.local.core.step))
         self.handed_over += int(np.count_nonzero(self.partition.owner != owners_before))
         after = self._held_by_rank()
         owner = self.partition.owner
@@ -1027,6 +1080,8 @@ class DistributedRun:
         self._exchange_caps()
         self._loaded_walls = np.asarray(moment["contact_wall_reactions"]).reshape(-1, 6)
         self._migration_due = False
+        self._left_imbalance = 1.0  # cut by the work the grains had before
+        self._check_balance()
         self.seconds["migrate"] += time.perf_counter() - start
 
     def _read_checkpoint(

@@ -170,6 +170,9 @@ class ContactModel {
   /// the nodes moved too far), carrying the collisions and friction springs of the pairs the
   /// lists held over to the new lists. No-op without laws or walls.
   void search(const Model& model, const State& state, std::uint64_t broken_bonds);
+  /// The node-pair lists: per node (CSR offsets, n + 1; empty before the first build) where its
+  /// partners start.
+  const std::vector<index_t>& pair_offsets() const { return pair_offsets_; }
   /// The wall lists: per node (CSR offsets, n + 1) its (wall, surface) candidates, in the order
   /// of the checkpoint's wall_springs.
   const std::vector<index_t>& wall_offsets() const { return wall_offsets_; }
