@@ -91,17 +91,20 @@ def test_grains_migrating_between_ranks_keep_the_serial_run_bit_for_bit(
 
 def test_ranks_cut_by_their_work_keep_the_serial_run_bit_for_bit() -> None:
     """40 discs at rest, the left half with 2.25 times the bonds a node of the right
-    (mpi_check.uneven_horizons), on 2 ranks: cut by nodes at the start, the left half's rank
-    has 1.18 times the mean work (parallel/work_load.py: nodes, intact bond copies, contact
+    (mpi_check.uneven_horizons), on 3 ranks: cut by nodes at the start, the most loaded rank
+    has 1.14 times the mean work (parallel/work_load.py: nodes, intact bond copies, contact
     list entries); the first check cuts the grains anew by their work before the first step,
-    after which the checks every 100 steps find 1.00 (asserted: above 1.15, then below 1.05).
-    Every node ends as in the serial run."""
-    done = run_ranks(2, "balance", "200")
+    after which the check at step 100 finds 1.03 (asserted: above 1.1, then below 1.05).
+    Every node ends as in the serial run. Before 2026-12-07 the cut by work left rank 0 only
+    wide-horizon discs, and their bond sums took their terms in another order than serially
+    (Model::cut_bond_blocks cut a particle by the model's bonds): forces 5.8e-11 apart after
+    200 steps."""
+    done = run_ranks(3, "balance", "200")
     assert done.returncode == 0, done.stdout + done.stderr
     assert "'positions': 0.0, 'velocities': 0.0, 'forces': 0.0, 'walls': 0.0}" in done.stdout
     assert "rebalanced before steps [0] " in done.stdout, done.stdout
     start, last = done.stdout.split("work over the mean ")[1].split(", ")[:2]
-    assert float(start.split()[0]) > 1.15 and float(last.split()[0]) < 1.05, done.stdout
+    assert float(start.split()[0]) > 1.1 and float(last.split()[0]) < 1.05, done.stdout
 
 
 def test_the_default_margin_widens_when_grains_migrate_often() -> None:

@@ -332,14 +332,15 @@ void Model::build_bonds() {
 }
 
 void Model::build_bond_schedule() {
-  // Blocks of consecutive nodes with about `target` bonds to evaluate: enough blocks per colour
-  // for the threads, few enough that a block's work dwarfs its scheduling. The cut depends on
-  // the model only.
-  // - Particles of up to 4 targets are not cut: consecutive ones form a block. Their blocks
-  //   never share a node, so many-grain models need one colour.
+  // Blocks of consecutive nodes with about 1/64 of the bonds to evaluate (block_bonds): enough
+  // blocks per colour for the threads, few enough that a block's work dwarfs its scheduling.
+  // - Particles of up to whole_particle_bonds are not cut: consecutive ones form a block of
+  //   1/64 of the model's bonds. Their blocks never share a node, so many-grain models need one
+  //   colour.
   // - Larger particles numbered in bands (every bond joins nodes less than a quarter of the
-  //   particle apart, as on lattices and our meshes) are cut into ranges: a range touches only
-  //   the ranges within a band, so each colour holds at least about four ranges.
+  //   particle apart, as on lattices and our meshes) are cut into ranges of 1/64 of their own
+  //   bonds (the cut depends on the particle alone): a range touches only the ranges within a
+  //   band, so each colour holds at least about four ranges.
   // - Larger particles numbered otherwise (a mesh file numbered at random, say) would need a
   //   colour per range: their nodes gather instead (each evaluates all its bonds and writes only
   //   its own sums), twice the bond evaluations but parallel.
@@ -356,7 +357,11 @@ void Model::cut_bond_blocks() {
     forward_total += static_cast<std::size_t>(bonds.count - bonds.forward);
     particle_forward[node_particle_[i]] += static_cast<std::size_t>(bonds.count - bonds.forward);
   }
-  const std::size_t target = std::clamp<std::size_t>(forward_total / 64, 1024, 16384);
+  // Whole particles are grouped into blocks of a share of the model's bonds (their nodes take
+  // their terms in node order, whatever block they are in); a particle is cut, and its ranges
+  // sized, by its own bonds alone, so that a distributed run's part (a subset of the
+  // particles) sums every node's terms in the whole model's order.
+  const std::size_t group = block_bonds(forward_total);
   BondSchedule& s = bond_schedule_;
   s = {};
   s.particle_gathers.assign(particles_.size(), 0);
@@ -369,9 +374,9 @@ void Model::cut_bond_blocks() {
   for (std::size_t q = 0; q < particles_.size(); ++q) {
     const Particle& particle = particles_[q];
     const index_t first = particle.first_node, last = first + particle.node_count;
-    if (particle_forward[q] <= 4 * target) {
+    if (particle_forward[q] <= whole_particle_bonds) {
       in_block += particle_forward[q];
-      if (in_block >= target) close_block(last);
+      if (in_block >= group) close_block(last);
       continue;
     }
     close_block(first);
@@ -382,10 +387,11 @@ void Model::cut_bond_blocks() {
     }
     const bool gathers = 4 * std::size_t{band} > particle.node_count;
     s.particle_gathers[q] = gathers ? 1 : 0;
+    const std::size_t range = block_bonds(particle_forward[q]);
     for (index_t i = first; i < last; ++i) {
       const NodeBonds bonds = node_bonds(i);
       in_block += static_cast<std::size_t>(gathers ? bonds.count : bonds.count - bonds.forward);
-      if (in_block >= target) close_block(i + 1);
+      if (in_block >= range) close_block(i + 1);
     }
     close_block(last);
   }
