@@ -7,7 +7,7 @@ T = a n + b c + d e (least squares of the relative misses).
 2D: granulate.bench_ranks' pile, drum, fine2d and shatter, and the pile's grains far apart
 (no contact), resting barely apart (listed, not pressed), fine2d without contact and with a
 horizon of 4.5 mesh sizes. 3D: pile3d, its spheres far apart, without contact, with a horizon
-of 4 mesh sizes, and pressed 1.97 R apart. Prints each case's counts and seconds, the fit in
+of 4 mesh sizes, and pressed 1.95 R apart. Prints each case's counts and seconds, the fit in
 nodes' work (b / a, d / a) and each case's miss.
 """
 

@@ -18,6 +18,7 @@ import numpy as np
 import pytest
 
 import granulate as gr
+from granulate import core_model
 from test_checkpoint import tumbling_drum
 from test_node_split import pulled
 
@@ -280,14 +281,18 @@ def test_inert_nodes_leave_the_lists_and_come_back(tmp_path: Path) -> None:
 
 
 @pytest.mark.parametrize("case", ["plate", "drum"])
-def test_bond_forces_in_parts_are_the_same_bits(case: str, tmp_path: Path) -> None:
+def test_bond_forces_in_parts_are_the_same_bits(
+    case: str, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
     """core.evaluate_dilatation(share) and evaluate_bonds(share) walk pass 1's and pass 2's
     blocks in schedule order up to that share of them (with no foreign node every block is
     inner), from where their last call stopped, and begin_step and finish_step take the rest:
     a distributed run evaluates them in parts while its exchanges are under way. Stepped so,
     with the parts cutting through colours, the notched LPS plate cracking under tension
     (several colours) and the tumbling drum (grains: one colour, contact) are bit for bit the
-    runs stepped whole. A share outside [0, 1] is refused."""
+    runs stepped whole. A share outside [0, 1] is refused. The plate (under 16,384 forward
+    bonds) is cut into blocks as a larger body is: core_model.WHOLE_PARTICLE_BONDS 4,096."""
+    monkeypatch.setattr(core_model, "WHOLE_PARTICLE_BONDS", 4096)
     whole, parted = (
         (pulled("plate", "lps"), pulled("plate", "lps"))
         if case == "plate"

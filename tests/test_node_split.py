@@ -20,6 +20,7 @@ import numpy as np
 import pytest
 
 import granulate as gr
+from granulate import core_model
 
 RATE = 60.0  # the strain rate [1/s]
 GLASS = dict(density=2500, youngs_modulus=70e9, poisson_ratio=0.22, fracture_energy=8.0)
@@ -134,11 +135,14 @@ def bond_copies_of(sim: gr.Simulation, nodes: np.ndarray) -> np.ndarray:
     ],
 )
 def test_a_split_body_steps_as_the_whole_bit_for_bit(
-    shape: str, model: str, parts: int, dealt: str
+    shape: str, model: str, parts: int, dealt: str, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     """`parts` parts stepped with their two exchanges against the whole body, `steps` steps
     into its cracking: own nodes' state and bonds bit for bit, each bond broken counted once.
-    Cut in slabs, the parts' inner blocks (evaluated before the halo is given) hold nodes."""
+    Cut in slabs, the parts' inner blocks (evaluated before the halo is given) hold nodes. The
+    plate and the strip (under 16,384 forward bonds) are cut into blocks as larger bodies are:
+    core_model.WHOLE_PARTICLE_BONDS 4,096."""
+    monkeypatch.setattr(core_model, "WHOLE_PARTICLE_BONDS", 4096)
     steps = 200 if shape == "block" else 300
     whole = pulled(shape, model)
     assert list(whole.model.particle_gathers) == [shape == "strip"]

@@ -34,6 +34,12 @@ void Model::require_not_finalized(const char* what) const {
   }
 }
 
+void Model::set_whole_particle_bonds(std::size_t bonds) {
+  require_not_finalized("set the bonds of a particle evaluated whole");
+  if (bonds < 1) throw InputError("whole_particle_bonds must be at least 1");
+  whole_particle_bonds_ = bonds;
+}
+
 index_t Model::add_material(const MaterialParams& params) {
   require_not_finalized("add a material");
   const auto key = std::make_pair(params.model, params.influence);
@@ -334,7 +340,7 @@ void Model::build_bonds() {
 void Model::build_bond_schedule() {
   // Blocks of consecutive nodes with about 1/64 of the bonds to evaluate (block_bonds): enough
   // blocks per colour for the threads, few enough that a block's work dwarfs its scheduling.
-  // - Particles of up to whole_particle_bonds are not cut: consecutive ones form a block of
+  // - Particles of up to whole_particle_bonds_ forward bonds are not cut: consecutive ones form a block of
   //   1/64 of the model's bonds. Their blocks never share a node, so many-grain models need one
   //   colour.
   // - Larger particles numbered in bands (every bond joins nodes less than a quarter of the
@@ -374,7 +380,7 @@ void Model::cut_bond_blocks() {
   for (std::size_t q = 0; q < particles_.size(); ++q) {
     const Particle& particle = particles_[q];
     const index_t first = particle.first_node, last = first + particle.node_count;
-    if (particle_forward[q] <= whole_particle_bonds) {
+    if (particle_forward[q] <= whole_particle_bonds_) {
       in_block += particle_forward[q];
       if (in_block >= group) close_block(last);
       continue;

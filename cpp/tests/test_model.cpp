@@ -304,6 +304,35 @@ TEST_CASE("bond schedule: small particles are not cut, so their blocks need one 
   }
 }
 
+TEST_CASE("bond schedule: a particle is cut by its own bonds, whatever else the model holds") {
+  // A distributed run's part holds some of the particles: each must be cut into the same
+  // ranges as in the whole model, or its nodes take their terms in another order.
+  auto ranges_of_last = [](int others, std::size_t whole) {
+    auto model = std::make_shared<Model>(2, PlaneMode::strain);
+    model->add_material(granulate_test::test_material());
+    model->set_whole_particle_bonds(whole);
+    for (int body = 0; body < others; ++body) granulate_test::add_square(*model, 0, 10, body * 11e-3, 0.0);
+    const index_t first = model->node_count();
+    granulate_test::add_square(*model, 0, 30, -50e-3, 0.0);
+    model->finalize();
+    check_schedule(*model);
+    std::vector<index_t> starts;
+    for (index_t start : model->bond_schedule().block_starts)
+      if (start >= first) starts.push_back(start - first);
+    return starts;
+  };
+  for (std::size_t whole : {std::size_t{4096}, default_whole_particle_bonds}) {
+    const auto alone = ranges_of_last(0, whole);
+    CHECK(alone == ranges_of_last(300, whole));
+    CHECK((alone.size() > 2) == (whole == 4096));  // 30 x 30 nodes: 4,096-16,384 forward bonds
+  }
+  Model finished(2, PlaneMode::strain);
+  finished.add_material(granulate_test::test_material());
+  granulate_test::add_square(finished, 0, 4, 0.0, 0.0);
+  finished.finalize();
+  CHECK_THROWS(finished.set_whole_particle_bonds(100), InputError);
+}
+
 TEST_CASE("bonds break irreversibly at the critical stretch") {
   auto model = lattice_block(2, 8, ForceModel::lps, InfluenceKind::linear, true);
   Simulation sim(model);

@@ -26,6 +26,12 @@ from granulate.shapes import Shape
 MOST_HORIZON_FACTOR = 20.0
 
 
+#: The most forward bonds of a particle the bond passes evaluate whole; a larger one is cut
+#: into ranges that threads share (_core.Model.set_whole_particle_bonds). Lower it to spread a
+#: small body over threads; the forces' bits follow it, never the other particles held.
+WHOLE_PARTICLE_BONDS = 16384
+
+
 def build_model(
     assembly: Assembly, plane: str, outer_layers: bool
 ) -> tuple[_core.Model, list[Material]]:
@@ -35,6 +41,7 @@ def build_model(
     discretisations' outer layers carry surface points (the node-sphere law sees those nodes at
     themselves: no anchors)."""
     model = _core.Model(assembly.dimension, getattr(_core.PlaneMode, plane))
+    model.set_whole_particle_bonds(WHOLE_PARTICLE_BONDS)
     sources = _shape_sources(assembly, outer_layers)
     _require_memory_for_model(assembly, plane, {b: source.key for b, source in sources.items()})
     material_ids: dict[int, int] = {}

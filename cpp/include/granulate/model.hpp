@@ -94,8 +94,8 @@ struct NodeBonds {
 };
 
 /// A particle of more forward bonds than this is cut into ranges of BondSchedule blocks; one of
-/// up to this many is evaluated whole, in one block.
-inline constexpr std::size_t whole_particle_bonds = 16384;
+/// up to this many is evaluated whole, in one block (Model::set_whole_particle_bonds).
+inline constexpr std::size_t default_whole_particle_bonds = 16384;
 /// The bonds a block of BondSchedule evaluates, about, when cut from `bonds`: 1/64 of them,
 /// from 1,024 to 16,384. Of a particle's own bonds for its ranges, so that a particle's cut, and
 /// the order in which its nodes take their terms, depends on the particle alone (a distributed
@@ -152,6 +152,12 @@ class Model {
 
   /// Builds bond families (cell list, O(nodes)), partial volumes and LPS constants.
   void finalize();
+
+  /// The most forward bonds of a particle evaluated whole (default_whole_particle_bonds); a
+  /// larger one is cut into ranges (BondSchedule). A tuning of the bond passes' parallelism,
+  /// before finalize(): the bits of the forces depend on it, never on the other particles.
+  void set_whole_particle_bonds(std::size_t bonds);
+  std::size_t whole_particle_bonds() const { return whole_particle_bonds_; }
 
   bool finalized() const { return finalized_; }
   int dimension() const { return dimension_; }
@@ -230,6 +236,7 @@ class Model {
   int dimension_;
   PlaneMode plane_;
   bool finalized_ = false;
+  std::size_t whole_particle_bonds_ = default_whole_particle_bonds;
   std::vector<Material> materials_;
   std::map<std::pair<ForceModel, InfluenceKind>, FractureCoefficients> fracture_coefficients_;
   std::vector<Shape> shapes_;

@@ -48,6 +48,8 @@ void bind_building(nb::class_<Model>& model) {
              }
              return bytes;
            })
+      .def("set_whole_particle_bonds", &Model::set_whole_particle_bonds, "bonds"_a,
+           "The most forward bonds of a particle the bond passes evaluate whole (before finalize).")
       .def("finalize", &Model::finalize, nb::call_guard<nb::gil_scoped_release>());
 }
 

@@ -878,14 +878,14 @@ class DistributedRun:
     def migrate(self) -> None:
         """Cut the assembly anew where the grains are now (recursive coordinate bisection of
         their current bounding spheres, weighted by their work: work_load.py), which also
-        rebalances the ranks; a migration for the balance (_check_balance) does only
-        that, and does not widen the margin. A rank that now
-        holds other grains than before, or owns one it held as a ghost, builds its part anew
-        from the owners' states of them (transplant.py): of a ghost only the caps move with
-        its owner (_exchange_caps), so its contacts with the other ghosts are not the serial
-        run's. A rank that holds the same grains and owns no new one keeps its part; every
-        ghost's positions, velocities and forces are made their owners' first, and the caps
-        are picked anew. Either way the run goes on as the serial run, bit for bit."""
+        rebalances the ranks; a migration for the balance (_check_balance) does not widen the
+        margin. A rank that now holds other grains than before, or owns one it held as a
+        ghost, builds its part anew from the owners' states of them (transplant.py): of a
+        ghost only the caps move with its owner (_exchange_caps), so its contacts with the
+        other ghosts are not the serial run's. A rank that holds the same grains and owns no
+        new one keeps its part; every ghost's positions, velocities and forces are made their
+        owners' first, and the caps are picked anew. Either way the run goes on as the serial
+        run, bit for bit."""
         start = time.perf_counter()
         for_balance, self._rebalance_due, self._migration_due = self._rebalance_due, False, False
         if not for_balance:

@@ -9,10 +9,11 @@ A node's integration, dilatation and surface point; a bond copy's force; an entr
 test and, in contact, its force. The weights come from serial runs on one thread
 (benchmarks/work_weights.py, which fits T = a n + b c + d e over its cases):
 - a bond copy: 0.06 of a node in 2D (the pile's grains far apart against fine2d and fine2d
-  with a horizon of 4.5 mesh sizes), 0.11 in 3D;
+  with a horizon of 4.5 mesh sizes), 0.08-0.11 in 3D (two runs);
 - an entry: 1.0 of a node's work where the grains rest barely apart (listed, not pressed:
   4.2 against 6.4 ms a step for 32,000 nodes and 37,474 entries), 1.9 in a pressed pile, more
-  where grains shatter (breaking bonds cost more than their count says); 1.5 is taken. On
+  where grains shatter (breaking bonds cost more than their count says); in 3D 0.9-1.8 (two
+  runs of the fit: pile3d and spheres pressed 1.95-1.97 R apart). 1.5 is taken in both. On
   2 ranks (benchmarks/work_balance.py) an entry of grains at rest cost 1.1.
 Between cases a fit of these three counts misses by up to 34 %; within a run, where the grains
 share a law and a mesh, it is the counts that differ. The counts are the run's own, not
