@@ -329,8 +329,8 @@ def bench_ranks(*arguments: str, ranks: int = 2) -> subprocess.CompletedProcess[
 def test_bench_ranks_prints_each_ranks_speed_and_communication() -> None:
     """`mpiexec -n 2 granulate bench --ranks --quick --json` (the 3D pile, 200 grains): one JSON
     object, from rank 0: a row per rank, whose grains and nodes add up to the case's, each
-    rank holding the other's nearby grains as ghosts, with its speed and time shares, and the
-    ghost and cap margins; one thread per rank by default."""
+    rank holding the other's nearby grains as ghosts, with its work, speed and time shares,
+    and the ghost and cap margins; one thread per rank by default."""
     done = bench_ranks("--quick", "--json")
     assert done.returncode == 0, done.stderr
     (line,) = done.stdout.splitlines()
@@ -351,6 +351,11 @@ def test_bench_ranks_prints_each_ranks_speed_and_communication() -> None:
     # and the default cap margin kept: half the mesh size (R/h = 4)
     assert (result["cap_margin"], result["cap_margin_widenings"]) == (0.125e-3, 0)
     assert sum(row["nodes"] for row in rows) == 51_712
+    # the ranks' work (nodes, bond copies, list entries) within the balance threshold of the
+    # mean (measured 206,967 and 208,445), no rebalance in the timed steps
+    work = [row["work"] for row in rows]
+    assert all(w > 51_712 / 2 for w in work) and max(work) <= 1.1 * sum(work) / 2
+    assert result["rebalance_steps"] == []
     for row in rows:
         assert 0 < row["ghost_nodes"] < row["nodes"]
         assert 0 < row["exchanged_nodes"] <= row["ghost_nodes"]  # the caps: near nodes

@@ -28,7 +28,9 @@ block   one body cut at node level (granulate.parallel.node_split): a notched LP
 
 Each rank runs one thread unless ``granulate --threads N`` says otherwise. After 20 untimed
 steps (lists built, caches warm) the ranks' clocks start together and run the steps. Rank 0
-prints a table: per rank the grains and nodes it owns at the end, the ghost nodes it holds
+prints a table: per rank the grains and nodes it owns at the end, its work then (nodes, bond
+copies and contact list entries weighted: granulate/parallel/work_load.py), the ghost nodes it
+holds
 besides and those it received a step on average (the caps), the surface normals it received
 a step on average (of the caps' nodes within the normal reach), its owned node-steps per second,
 and the shares of its wall-clock time spent in the ghost exchange (and of that, waiting for
@@ -40,11 +42,10 @@ caps anew, in migrations and, with
 of the ranks' measures of their grains (DistributedRun.step_data, as a run with frames in pieces
 or no frames does at its output steps); of a body cut at node level, the whole state gathered
 into rank 0's simulation (NodeSplitRun.collect, as its outputs do); nothing is written, and
-no row is computed from it; then the
-migrations and grains handed over, the ghost and cap margins and how often the caps were
-picked anew. With ``--json``, one JSON object instead. On fewer cores
-than ranks (oversubscribed) the shares include waiting for the other ranks and are an upper
-bound.
+no row is computed from it; then the migrations (and the steps the ranks rebalanced before)
+and grains handed over, the ghost and cap margins and how often the caps were picked anew.
+With ``--json``, one JSON object instead. On fewer cores than ranks (oversubscribed) the
+shares include waiting for the other ranks and are an upper bound.
 """
 
 from __future__ import annotations
@@ -59,6 +60,7 @@ import numpy as np
 
 import granulate as gr
 from granulate.errors import InputError
+from granulate.parallel.work_load import node_work
 
 RADIUS = 1e-3
 ROCK = gr.Material(
@@ -233,7 +235,7 @@ def measure(
         warnings.filterwarnings("ignore", message="contact.*bodies pressed")  # placed pressed
         run = DistributedRun(make(grains), comm)
         run.run(20)  # lists built, caches warm
-    migrations, handed = run.migrations, run.handed_over
+    migrations, handed, rebalanced = run.migrations, run.handed_over, len(run.rebalance_steps)
     refreshes, received, normals = run.cap_refreshes, run.nodes_received, run.normals_received
     broken = run.broken_bonds()
     wall = _timed(run, steps, collect_every, comm)
@@ -241,6 +243,7 @@ def measure(
     row = {
         "grains": len(run.owned),
         "nodes": run.owned_node_count,
+        "work": float(node_work(run.local.core, run.owned_nodes, run.local.dimension).sum()),
         "ghost_nodes": run.ghost_node_count,
         "exchanged_nodes": (run.nodes_received - received) / steps,
         "exchanged_normals": (run.normals_received - normals) / steps,
@@ -260,6 +263,7 @@ def measure(
         "threads": gr.get_num_threads(),
         "rows": rows,
         "migrations": run.migrations - migrations,
+        "rebalance_steps": run.rebalance_steps[rebalanced:],
         "handed_over": run.handed_over - handed,
         "margin": run.margin,
         "margin_widenings": run.margin_widenings,
@@ -335,21 +339,23 @@ def table(result: dict[str, Any]) -> str:
     lines = [
         f"{result['case']}: {result['grains']} grains, {result['steps']} steps, "
         f"{result['ranks']} ranks, {result['threads']} thread(s) each",
-        "| rank | grains | nodes | ghost nodes | received a step | normals a step | node-steps/s "
-        "| exchange % | waiting % | check % | caps % | migrate % | collect % |",
-        "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
+        "| rank | grains | nodes | work | ghost nodes | received a step | normals a step "
+        "| node-steps/s | exchange % | waiting % | check % | caps % | migrate % | collect % |",
+        "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
     ]
     for rank, row in enumerate(result["rows"]):
         shares = " | ".join(
             f"{100 * row[f'{name}_share']:.1f}" for name in (SHARES[0], "wait", *SHARES[1:])
         )
         lines.append(
-            f"| {rank} | {row['grains']} | {row['nodes']:,} | {row['ghost_nodes']:,} | "
+            f"| {rank} | {row['grains']} | {row['nodes']:,} | {row['work']:,.0f} | "
+            f"{row['ghost_nodes']:,} | "
             f"{row['exchanged_nodes']:,.0f} | {row['exchanged_normals']:,.0f} | "
             f"{row['node_steps_per_s'] / 1e6:.2f} M | {shares} |"
         )
     lines.append(
-        f"{result['migrations']} migrations, {result['handed_over']} grains handed over in the "
+        f"{result['migrations']} migrations (for the balance before steps "
+        f"{result['rebalance_steps']}), {result['handed_over']} grains handed over in the "
         f"timed steps; ghost margin {1e3 * result['margin']:.3g} mm (widened "
         f"{result['margin_widenings']} times); cap margin {1e3 * result['cap_margin']:.3g} mm ("
         f"widened {result['cap_margin_widenings']} times), caps picked anew "
