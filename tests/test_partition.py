@@ -10,6 +10,7 @@ import pytest
 import granulate as gr
 from granulate.parallel import bisect, ghosts, near_pairs
 from granulate.parallel.partition import near_nodes, near_pairs_with_large
+from granulate.parallel.work_load import BOND_COPY, LIST_ENTRY, node_work
 
 
 def grains(count: int, dimension: int, seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
@@ -142,11 +143,8 @@ def test_bad_partition_input_is_refused() -> None:
 
 def test_a_grains_work_counts_its_nodes_bonds_and_the_contact_entries_near_its_partner() -> None:
     """work_load.node_work of two discs pressed 0.05 mm into each other: per node 1 + 0.06
-    intact bond copies + 1.5 list entries; only nodes within the contact reach of the other
-    disc have entries, and each has one at least on the side facing it."""
-    from granulate.errors import InputError as CoreInputError
-    from granulate.parallel.work_load import BOND_COPY, LIST_ENTRY, node_work
-
+    intact bond copies + 1.5 list entries; some nodes have entries, and only nodes within the
+    contact reach of the other disc's edge."""
     rock = gr.Material(density=1200, youngs_modulus=1e8, poisson_ratio=0.25, fracture=False)
     sim = gr.Simulation(2)
     sim.contact = gr.Contact(restitution=0.5)
@@ -163,5 +161,5 @@ def test_a_grains_work_counts_its_nodes_bonds_and_the_contact_entries_near_its_p
     gap_to_other = np.where(first, 0.95e-3 - x, x - 1.0e-3)  # from the other disc's edge
     reach = sim.core.contact_reach
     assert entries.sum() > 0 and np.all(gap_to_other[entries > 0] <= reach)
-    with pytest.raises(CoreInputError, match="out of range"):
+    with pytest.raises(gr.InputError, match="out of range"):
         sim.core.contact_list_entries(np.array([sim.node_count], dtype=np.int64))
