@@ -30,9 +30,9 @@ Each rank runs one thread unless ``granulate --threads N`` says otherwise. After
 steps (lists built, caches warm) the ranks' clocks start together and run the steps. Rank 0
 prints a table: per rank the grains and nodes it owns at the end, its work then (nodes, bond
 copies and contact list entries weighted: granulate/parallel/work_load.py), the ghost nodes it
-holds
-besides and those it received a step on average (the caps), the surface normals it received
-a step on average (of the caps' nodes within the normal reach), its owned node-steps per second,
+holds besides and those it received a step on average (the caps), the surface normals it
+received a step on average (of the caps' nodes within the normal reach), its owned node-steps
+per second,
 and the shares of its wall-clock time spent in the ghost exchange (and of that, waiting for
 the step's messages after the bond forces it evaluates while they travel: what the overlap
 did not hide), in the checks (a reduction
