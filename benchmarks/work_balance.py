@@ -12,7 +12,7 @@ Cases (granulate.bench_ranks' pile layout, 2D, at rest on a floor between two wa
 Each round runs the case once with the checks off (balance_threshold infinite: the ranks cut by
 nodes at the start and never again) and once on, the order alternating, one thread a rank.
 Rank 0 prints per run the wall seconds of the steps, each rank's step seconds (its own work,
-without the exchange and checks), each rank's work (work_load.node_work) at the end with its
+without the exchange and checks), each rank's work (DistributedRun.owned_work) at the end with its
 nodes, intact bond copies and contact list entries, and the steps the ranks rebalanced before
 (0: the start's check, before the timed steps).
 """
@@ -30,7 +30,6 @@ from mpi4py import MPI
 import granulate as gr
 from granulate import bench_ranks
 from granulate.parallel import DistributedRun
-from granulate.parallel.work_load import node_work
 
 RADIUS = bench_ranks.RADIUS
 
@@ -88,7 +87,7 @@ def one_run(case: str, steps: int, balance: bool, comm: MPI.Comm) -> dict | None
         int(np.asarray(core.intact_bond_copies(own)).sum()),
         int(np.asarray(core.contact_list_entries(own)).sum()),
     )
-    work = float(node_work(core, own, 2).sum())
+    work = run.owned_work()
     rows = comm.gather((run.seconds["steps"], work, counts), root=0)
     if rows is None:
         return None

@@ -155,7 +155,7 @@ def test_a_grains_work_counts_its_nodes_bonds_and_the_contact_entries_near_its_p
     copies = np.asarray(sim.core.intact_bond_copies(nodes), dtype=float)
     entries = np.asarray(sim.core.contact_list_entries(nodes), dtype=float)
     work = node_work(sim.core, nodes, 2)
-    assert np.array_equal(work, 1 + BOND_COPY[2] * copies + LIST_ENTRY[2] * entries)
+    assert np.array_equal(work, 1 + BOND_COPY[2] * copies + LIST_ENTRY * entries)
     x = np.asarray(sim.core.positions)[:, 0]
     first = nodes < sim.bodies[1].node_slice.start
     gap_to_other = np.where(first, 0.95e-3 - x, x - 1.0e-3)  # from the other disc's edge

@@ -18,6 +18,14 @@ std::string str(real v) {
   return o.str();
 }
 
+/// The bonds a block of BondSchedule evaluates, about, when cut from `bonds`: 1/64 of them,
+/// from 1,024 to 16,384. Of a particle's own bonds for its ranges, so that a particle's cut, and
+/// the order in which its nodes take their terms, depends on the particle alone (a distributed
+/// run's part of the particles sums them as the whole model does).
+std::size_t block_bonds(std::size_t bonds) {
+  return std::clamp<std::size_t>(bonds / 64, 1024, 16384);
+}
+
 }  // namespace
 
 Model::Model(int dimension, PlaneMode plane) : dimension_(dimension), plane_(plane) {
@@ -340,9 +348,9 @@ void Model::build_bonds() {
 void Model::build_bond_schedule() {
   // Blocks of consecutive nodes with about 1/64 of the bonds to evaluate (block_bonds): enough
   // blocks per colour for the threads, few enough that a block's work dwarfs its scheduling.
-  // - Particles of up to whole_particle_bonds_ forward bonds are not cut: consecutive ones form a block of
-  //   1/64 of the model's bonds. Their blocks never share a node, so many-grain models need one
-  //   colour.
+  // - Particles of up to whole_particle_bonds_ forward bonds are not cut: consecutive ones form
+  //   a block of 1/64 of the model's bonds. Their blocks never share a node, so many-grain
+  //   models need one colour.
   // - Larger particles numbered in bands (every bond joins nodes less than a quarter of the
   //   particle apart, as on lattices and our meshes) are cut into ranges of 1/64 of their own
   //   bonds (the cut depends on the particle alone): a range touches only the ranges within a

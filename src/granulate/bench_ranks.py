@@ -60,7 +60,6 @@ import numpy as np
 
 import granulate as gr
 from granulate.errors import InputError
-from granulate.parallel.work_load import node_work
 
 RADIUS = 1e-3
 ROCK = gr.Material(
@@ -243,7 +242,7 @@ def measure(
     row = {
         "grains": len(run.owned),
         "nodes": run.owned_node_count,
-        "work": float(node_work(run.local.core, run.owned_nodes, run.local.dimension).sum()),
+        "work": run.owned_work(),
         "ghost_nodes": run.ghost_node_count,
         "exchanged_nodes": (run.nodes_received - received) / steps,
         "exchanged_normals": (run.normals_received - normals) / steps,

@@ -26,10 +26,11 @@ from granulate.shapes import Shape
 MOST_HORIZON_FACTOR = 20.0
 
 
-#: The most forward bonds of a particle the bond passes evaluate whole; a larger one is cut
-#: into ranges that threads share (_core.Model.set_whole_particle_bonds). Lower it to spread a
-#: small body over threads; the forces' bits follow it, never the other particles held.
-WHOLE_PARTICLE_BONDS = 16384
+#: The most forward bonds of a particle the bond passes evaluate whole, None for the core's
+#: default (16,384); a larger one is cut into ranges that threads share
+#: (_core.Model.set_whole_particle_bonds). Lower it to spread a small body over threads; the
+#: forces' bits follow it, never the other particles held.
+WHOLE_PARTICLE_BONDS: int | None = None
 
 
 def build_model(
@@ -41,7 +42,8 @@ def build_model(
     discretisations' outer layers carry surface points (the node-sphere law sees those nodes at
     themselves: no anchors)."""
     model = _core.Model(assembly.dimension, getattr(_core.PlaneMode, plane))
-    model.set_whole_particle_bonds(WHOLE_PARTICLE_BONDS)
+    if WHOLE_PARTICLE_BONDS is not None:
+        model.set_whole_particle_bonds(WHOLE_PARTICLE_BONDS)
     sources = _shape_sources(assembly, outer_layers)
     _require_memory_for_model(assembly, plane, {b: source.key for b, source in sources.items()})
     material_ids: dict[int, int] = {}

@@ -2,7 +2,6 @@
 // frozen by finalize(), which builds the bond families and the per-node constants.
 #pragma once
 
-#include <algorithm>
 #include <cstdint>
 #include <map>
 #include <optional>
@@ -96,14 +95,6 @@ struct NodeBonds {
 /// A particle of more forward bonds than this is cut into ranges of BondSchedule blocks; one of
 /// up to this many is evaluated whole, in one block (Model::set_whole_particle_bonds).
 inline constexpr std::size_t default_whole_particle_bonds = 16384;
-/// The bonds a block of BondSchedule evaluates, about, when cut from `bonds`: 1/64 of them,
-/// from 1,024 to 16,384. Of a particle's own bonds for its ranges, so that a particle's cut, and
-/// the order in which its nodes take their terms, depends on the particle alone (a distributed
-/// run's part of the particles sums them as the whole model does).
-constexpr std::size_t block_bonds(std::size_t bonds) {
-  return std::clamp<std::size_t>(bonds / 64, 1024, 16384);
-}
-
 /// The order of the force loops, which evaluate each bond once, at its lower-numbered end, and
 /// add the result to both ends. Nodes are cut into blocks of consecutive nodes (small particles
 /// whole); a block touches its nodes and their forward neighbours. Blocks that touch a common

@@ -25,6 +25,19 @@ BodyMotion motion_from(const double* numbers) {
   return motion;
 }
 
+/// count_of(i) for each node i of `nodes` (InputError naming `what` for one out of range).
+template <typename CountOf>
+std::vector<index_t> per_node(const Simulation& self, const std::int64_t* nodes, std::size_t size,
+                              const char* what, CountOf count_of) {
+  const auto count = static_cast<std::int64_t>(self.model().node_count());
+  std::vector<index_t> counts(size);
+  for (std::size_t k = 0; k < size; ++k) {
+    if (nodes[k] < 0 || nodes[k] >= count) throw InputError(std::string(what) + ": nodes out of range");
+    counts[k] = count_of(static_cast<index_t>(nodes[k]));
+  }
+  return counts;
+}
+
 // The time step, PeriDEM's damping, time and step, checkpoints, body forces.
 void bind_run_setup(nb::class_<Simulation>& cls) {
   cls.def(nb::init<std::shared_ptr<Model>>(), "model"_a, nb::call_guard<nb::gil_scoped_release>())
@@ -436,14 +449,8 @@ void bind_state(nb::class_<Simulation>& cls) {
           "intact_bond_copies",
           [](const Simulation& self, nb::ndarray<const std::int64_t, nb::ndim<1>, nb::c_contig> nodes) {
             const auto& offsets = self.model().bond_offsets();
-            const auto count = static_cast<std::int64_t>(self.model().node_count());
-            std::vector<index_t> counts(nodes.shape(0));
-            for (std::size_t k = 0; k < counts.size(); ++k) {
-              const std::int64_t i = nodes.data()[k];
-              if (i < 0 || i >= count) throw InputError("intact_bond_copies: nodes out of range");
-              counts[k] = self.state().bonds.intact_count(offsets, static_cast<index_t>(i));
-            }
-            return copy_out(counts);
+            return copy_out(per_node(self, nodes.data(), nodes.shape(0), "intact_bond_copies",
+                                     [&](index_t i) { return self.state().bonds.intact_count(offsets, i); }));
           },
           "nodes"_a, "Each of these nodes' intact bond copies.")
       .def(
@@ -451,17 +458,11 @@ void bind_state(nb::class_<Simulation>& cls) {
           [](const Simulation& self, nb::ndarray<const std::int64_t, nb::ndim<1>, nb::c_contig> nodes) {
             const auto& pairs = self.contact().pair_offsets();
             const auto& walls = self.contact().wall_offsets();
-            const auto count = static_cast<std::int64_t>(self.model().node_count());
-            const auto span = [](const std::vector<index_t>& offsets, std::int64_t i) {
+            const auto span = [](const std::vector<index_t>& offsets, index_t i) {
               return offsets.empty() ? index_t{0} : offsets[i + 1] - offsets[i];
             };
-            std::vector<index_t> counts(nodes.shape(0));
-            for (std::size_t k = 0; k < counts.size(); ++k) {
-              const std::int64_t i = nodes.data()[k];
-              if (i < 0 || i >= count) throw InputError("contact_list_entries: nodes out of range");
-              counts[k] = span(pairs, i) + span(walls, i);
-            }
-            return copy_out(counts);
+            return copy_out(per_node(self, nodes.data(), nodes.shape(0), "contact_list_entries",
+                                     [&](index_t i) { return span(pairs, i) + span(walls, i); }));
           },
           "nodes"_a,
           "Each of these nodes' entries in the contact lists of their last build: node pairs and "

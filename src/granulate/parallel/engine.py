@@ -857,12 +857,15 @@ class DistributedRun:
         if not self._migrates or self._migration_due:
             return
         start = time.perf_counter()
-        mine = node_work(self.local.core, self._owned_nodes, self._sim.dimension).sum()
-        self.work_imbalance = imbalance(np.array(self.comm.allgather(float(mine))))
+        self.work_imbalance = imbalance(np.array(self.comm.allgather(self.owned_work())))
         limit = self.balance_threshold * max(1.0, self._left_imbalance)
         self._rebalance_due = self.work_imbalance > limit
         self._migration_due = self._rebalance_due
         self.seconds["check"] += time.perf_counter() - start
+
+    def owned_work(self) -> float:
+        """This rank's work now: work_load.node_work summed over its own nodes."""
+        return float(node_work(self.local.core, self._owned_nodes, self._sim.dimension).sum())
 
     def _grain_work(self) -> NDArray[np.float64]:
         """Every grain's work now (work_load.node_work summed over its nodes), on every rank:

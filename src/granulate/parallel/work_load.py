@@ -27,9 +27,9 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-#: Work of an intact bond copy and of a contact list entry, in nodes' work, per dimension.
+#: Work of an intact bond copy, per dimension, and of a contact list entry, in nodes' work.
 BOND_COPY = {2: 0.06, 3: 0.11}
-LIST_ENTRY = {2: 1.5, 3: 1.5}
+LIST_ENTRY = 1.5
 
 
 def node_work(core: Any, nodes: NDArray[np.int64], dimension: int) -> NDArray[np.float64]:
@@ -38,7 +38,7 @@ def node_work(core: Any, nodes: NDArray[np.int64], dimension: int) -> NDArray[np
     local = np.ascontiguousarray(nodes, dtype=np.int64)
     copies = np.asarray(core.intact_bond_copies(local), dtype=np.float64)
     entries = np.asarray(core.contact_list_entries(local), dtype=np.float64)
-    return 1.0 + BOND_COPY[dimension] * copies + LIST_ENTRY[dimension] * entries
+    return 1.0 + BOND_COPY[dimension] * copies + LIST_ENTRY * entries
 
 
 def imbalance(loads: NDArray[np.float64]) -> float:
