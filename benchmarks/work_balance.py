@@ -9,8 +9,8 @@ Cases (granulate.bench_ranks' pile layout, 2D, at rest on a floor between two wa
   right half's 3 (2.25 times fewer bonds a node);
 - contact: 400 grains at 5 nodes a radius; the left half touching on its lattice, the right
   half's grains 1.5 times as far apart (no contact among them).
-Each round runs the case once with the checks off (balance_threshold infinite: the ranks cut by
-nodes at the start and never again) and once on, the order alternating, one thread a rank.
+Each round runs the case once with the balance off (gr.LoadBalance(threshold=inf): the ranks cut
+by nodes at the start and never again) and once on, the order alternating, one thread a rank.
 Rank 0 prints per run the wall seconds of the steps, each rank's step seconds (its own work,
 without the exchange and checks), each rank's work (DistributedRun.owned_work) at the end with its
 nodes, intact bond copies and contact list entries, and the steps the ranks rebalanced before
@@ -70,10 +70,11 @@ CASES = {"bonds": bonds_case, "contact": contact_case}
 
 def one_run(case: str, steps: int, balance: bool, comm: MPI.Comm) -> dict | None:
     """The case run `steps` steps after 20 untimed, with the balance checks on or off."""
-    DistributedRun.balance_threshold = 1.1 if balance else float("inf")
+    sim = CASES[case]()
+    sim.load_balance = gr.LoadBalance(threshold=1.1 if balance else float("inf"))
     with warnings.catch_warnings():
         warnings.filterwarnings("ignore", message="contact.*bodies pressed")
-        run = DistributedRun(CASES[case](), comm)
+        run = DistributedRun(sim, comm)
         run.run(20)
     run.seconds = dict.fromkeys(run.seconds, 0.0)
     comm.Barrier()

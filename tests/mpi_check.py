@@ -162,7 +162,9 @@ def main() -> int:
             narrow=True,
         )
     if sys.argv[1] == "balance":
-        return compare(uneven_horizons, "uneven horizons", int(sys.argv[2]), comm)
+        steps = int(sys.argv[2])
+        balanced = compare(uneven_horizons, "uneven horizons", steps, comm)
+        return balanced | check_balance_settings(steps, comm)
     if sys.argv[1] == "drum":
         variant, steps = sys.argv[2], int(sys.argv[3])
         renew, widen = sys.argv[4:] == ["renew"], sys.argv[4:] == ["widen"]
@@ -253,6 +255,31 @@ def compare(
         f"{serial.broken_bonds()}, largest differences {worst}"
     )
     return 0 if same_dt and not any(worst.values()) else 1
+
+
+def check_balance_settings(steps: int, comm: MPI.Comm) -> int:
+    """The uneven horizons' run under two settings of sim.load_balance, each printed with
+    the steps the ranks rebalanced before, the work over the mean at the start's check and at
+    the last one, and the largest differences from the serial run: a check only at the start
+    (every=0) and no cut for the balance (threshold=inf). 0 when both are the serial run."""
+    serial = on_rank_0(comm, lambda: run_serially(uneven_horizons, steps))
+    failed = 0
+    for balance in (gr.LoadBalance(every=0), gr.LoadBalance(threshold=float("inf"))):
+        sim = uneven_horizons()
+        sim.load_balance = balance
+        distributed = DistributedRun(sim, comm)
+        first_imbalance = distributed.work_imbalance
+        distributed.run(steps)
+        positions = distributed.gather("positions")
+        if serial is not None:
+            worst = float(np.abs(positions - serial.positions).max())
+            failed |= worst != 0.0
+            print(
+                f"{balance}: rebalanced before steps {distributed.rebalance_steps}, work over "
+                f"the mean {first_imbalance:.3f} at the start, {distributed.work_imbalance:.3f} "
+                f"at the last check; largest difference in positions {worst}"
+            )
+    return int(comm.bcast(failed, root=0))
 
 
 def run_serially(make: Callable[[], gr.Simulation], steps: int) -> gr.Simulation:

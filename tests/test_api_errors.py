@@ -31,6 +31,12 @@ ROCK = {"density": 2500, "youngs_modulus": 5e9, "poisson_ratio": 0.25, "fracture
         (lambda: gr.stopping.KineticEnergyBelow(1e-6, afer=0.1), "did you mean 'after'"),
         (lambda: gr.RegularPolygon((0, 0), 1e-3, sides=6, angel=0.1), "did you mean 'angle'"),
         (lambda: gr.set_num_threads(0), "positive integer"),
+        (lambda: gr.LoadBalance(evry=50), "did you mean 'every'"),
+        (lambda: gr.LoadBalance(every=-1), "every must be a number of steps >= 0"),
+        (lambda: gr.LoadBalance(every=2.5), "every must be an integer"),
+        (lambda: gr.LoadBalance(threshold=0.9), "threshold must be a ratio >= 1"),
+        (lambda: gr.LoadBalance(threshold=float("nan")), "threshold must be a ratio >= 1"),
+        (lambda: setattr(gr.Simulation(2), "load_balance", 100), "granulate.LoadBalance("),
     ],
 )
 def test_mistakes_in_api_calls_are_input_errors(call, message: str) -> None:

@@ -15,6 +15,7 @@ import yaml
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+import granulate as gr
 from granulate import case as case_files
 from granulate.cli import main
 from granulate.errors import InputError
@@ -60,6 +61,19 @@ def test_broken_cases_exit_2_naming_the_problem(
     assert code == 2, error
     assert error.startswith("granulate: error: ") and "Traceback" not in error
     assert expected in error, error
+
+
+def test_a_case_sets_when_the_ranks_balance_their_work() -> None:
+    """load_balance reaches the simulation (a distributed run reads it: test_mpi.py); left
+    out, the default: every 100 steps, past 1.1 times the mean; .inf is YAML's infinity. It
+    is left out of the case's fingerprint, so a checkpoint resumes under other settings."""
+    text = BASE.read_text()
+    assert case_files.parse_case(text, BASE).build().load_balance == gr.LoadBalance()
+    given = text + "load_balance: {every: 0, threshold: .inf}\n"
+    built = case_files.parse_case(given, BASE).build()
+    assert built.load_balance == gr.LoadBalance(every=0, threshold=float("inf"))
+    # Its speed, not its results: the fingerprint a checkpoint is resumed by is the same.
+    assert built.case_fingerprint == case_files.parse_case(text, BASE).fingerprint
 
 
 def test_base_case_through_run_plot_and_render(tmp_path: Path) -> None:

@@ -98,13 +98,26 @@ def test_ranks_cut_by_their_work_keep_the_serial_run_bit_for_bit() -> None:
     Every node ends as in the serial run. Before 2026-12-07 the cut by work left rank 0 only
     wide-horizon discs, and their bond sums took their terms in another order than serially
     (Model::cut_bond_blocks cut a particle by the model's bonds): forces 5.8e-11 apart after
-    200 steps."""
+    200 steps. The simulation's load_balance is followed: with every=0 the ranks compare
+    their work only at the start (cut anew before step 0, the start's 1.14 the last measure);
+    with threshold=inf they compare it every 100 steps and never cut anew (1.14 at step 200);
+    both end as the serial run does."""
     done = run_ranks(3, "balance", "200")
     assert done.returncode == 0, done.stdout + done.stderr
     assert "'positions': 0.0, 'velocities': 0.0, 'forces': 0.0, 'walls': 0.0}" in done.stdout
     assert "rebalanced before steps [0] " in done.stdout, done.stdout
     start, last = done.stdout.split("work over the mean ")[1].split(", ")[:2]
     assert float(start.split()[0]) > 1.1 and float(last.split()[0]) < 1.05, done.stdout
+    first = start.split()[0]
+    unbalanced = f"work over the mean {first} at the start, {first} at the last check"
+    assert (
+        f"LoadBalance(every=0, threshold=1.1): rebalanced before steps [0], {unbalanced}; "
+        "largest difference in positions 0.0"
+    ) in done.stdout, done.stdout
+    assert (
+        f"LoadBalance(every=100, threshold=inf): rebalanced before steps [], {unbalanced}; "
+        "largest difference in positions 0.0"
+    ) in done.stdout, done.stdout
 
 
 def test_the_default_margin_widens_when_grains_migrate_often() -> None:

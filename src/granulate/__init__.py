@@ -23,6 +23,7 @@ from granulate.functions import (
     TimeFunction,
     VelocityRamp,
 )
+from granulate.load_balance import LoadBalance
 from granulate.materials import Material
 from granulate.meshes import SurfaceMesh, read_mesh
 from granulate.packing import (
@@ -96,6 +97,7 @@ __all__ = [
     "InputError",
     "InstabilityError",
     "Linear",
+    "LoadBalance",
     "LogNormal",
     "Material",
     "Normal",

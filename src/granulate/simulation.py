@@ -42,6 +42,7 @@ from granulate.errors import GranulateWarning, InputError
 from granulate.evaluation import Evaluation
 from granulate.input_errors import check_number, unknown_name
 from granulate.interactions import Interactions
+from granulate.load_balance import LoadBalance
 from granulate.loading import Components, Loading
 from granulate.materials import Material
 from granulate.run_loop import LoopParts, Progress, RunPlan, RunRecord
@@ -146,6 +147,7 @@ class Simulation(SimulationSetup, SimulationResults):
         self._setup_digest: str | None = None
         self._checkpoint: CheckpointPlan | None = None
         self._comm = comm
+        self._load_balance = LoadBalance()
         self._distributed: DistributedRun | NodeSplitRun | None = None
         self._output_path: Path | None = None  # output's directory, on every rank
         self._dt_warned = False  # a distributed run's parts: said once, by rank 0

@@ -24,6 +24,7 @@ from granulate.evaluation import Evaluation
 from granulate.functions import TimeFunction
 from granulate.input_errors import check_number
 from granulate.interactions import Interactions
+from granulate.load_balance import LoadBalance
 from granulate.loading import Components, Loading
 from granulate.materials import Material
 from granulate.packing import Grain, Packing, Placements
@@ -47,6 +48,7 @@ class SimulationSetup:
     _model: _core.Model | None
     _gravity: NDArray[np.float64]
     _viscous_damping: float
+    _load_balance: LoadBalance
     _output: Outputs | None
     _output_path: Path | None
     _comm: Any
@@ -318,6 +320,23 @@ class SimulationSetup:
         if not (np.isfinite(value) and value >= 0):
             raise InputError(f"viscous_damping must be a non-negative rate in 1/s, got {value}")
         self._viscous_damping = float(value)
+
+    @property
+    def load_balance(self) -> LoadBalance:
+        """When the ranks of a distributed run (``comm``) compare their work and cut the grains
+        anew (granulate.LoadBalance; default every 100 steps, past 1.1 times the mean). It
+        changes a run's speed, never its results; a serial run ignores it. It may be changed
+        between runs."""
+        return self._load_balance
+
+    @load_balance.setter
+    def load_balance(self, value: LoadBalance) -> None:
+        if not isinstance(value, LoadBalance):
+            raise InputError(
+                f"load_balance must be a granulate.LoadBalance(every=..., threshold=...), "
+                f"got {value!r}"
+            )
+        self._load_balance = value
 
     @property
     def contact(self) -> Contact | None:

@@ -126,9 +126,12 @@ class Case:
 
     @property
     def fingerprint(self) -> str:
-        return hashlib.sha256(
-            json.dumps(self.spec.model_dump(mode="json"), sort_keys=True).encode()
-        ).hexdigest()
+        """The case's digest, in the set-up's fingerprint (checkpoints, --resume): of every
+        section but load_balance, which changes a distributed run's speed, never its results
+        (a run may resume with other settings, and checkpoints written before the section
+        existed keep their fingerprint)."""
+        spec = self.spec.model_dump(mode="json", exclude={"load_balance"})
+        return hashlib.sha256(json.dumps(spec, sort_keys=True).encode()).hexdigest()
 
     def build(
         self,
@@ -168,6 +171,7 @@ class Case:
             sim.add_wall(_wall(w, case), name=w.name)
         for load in spec.loading:
             _load(sim, load, case, named)
+        sim.load_balance = spec.load_balance.make()
         if spec.restart is not None:
             # On --resume too: the start checks judge the restart's positions, not the
             # reference ones (the checkpoint then replaces the whole state).

@@ -20,6 +20,7 @@ from granulate.case.shape_specs import ShapeRef, ShapeSpec
 from granulate.case.spec_types import Finite, NonNegative, Positive, Spec
 from granulate.contact import Contact
 from granulate.input_errors import NOT_BOOL
+from granulate.load_balance import LoadBalance
 from granulate.materials import Material
 from granulate.simulation import FIELDS
 
@@ -220,6 +221,22 @@ LoadSpec = Annotated[
 ]
 
 
+class LoadBalanceSpec(Spec):
+    """When the ranks of a distributed run compare their work and cut the grains anew
+    (granulate.LoadBalance); a serial run ignores it."""
+
+    every: Annotated[int, Field(ge=0), NOT_BOOL] = Field(
+        100, description="steps between comparisons of the ranks' work (0: only at the start)"
+    )
+    threshold: Annotated[float, Field(ge=1), NOT_BOOL] = Field(
+        1.1,
+        description="the most loaded rank's work over the mean that cuts anew [-] (.inf: never)",
+    )
+
+    def make(self) -> LoadBalance:
+        return LoadBalance(**self.model_dump())
+
+
 # ------------------------------------------------------------------- time, output, stop
 class TimeSpec(Spec):
     """Time stepping: dt (default: dt_safety x the stable estimate) and the run length."""
@@ -332,6 +349,7 @@ class CaseSpec(Spec):
     gravity: list[Finite] | None = Field(None, description="[m/s^2]")
     viscous_damping: NonNegative = Field(0.0, description="[1/s]")
     neighbor_skin: Positive | None = Field(None, description="[m]")
+    load_balance: LoadBalanceSpec = LoadBalanceSpec()
     time: TimeSpec
     output: OutputSpec | None = None
     checkpoint: CheckpointSpec | None = None

@@ -128,8 +128,9 @@ class DistributedRun:
     kept. Caps that hold every ghost node (coarse grains) are never picked anew.
 
     The start cuts the grains by their nodes; every migration cuts them by their work
-    (work_load.py), and at the start and every ``balance_every`` steps the ranks compare their
-    work and migrate when it has drifted past ``balance_threshold`` (_check_balance).
+    (work_load.py), and at the start and as the simulation's ``load_balance`` (granulate.
+    LoadBalance) says the ranks compare their work and migrate when it has drifted past its
+    threshold (_check_balance).
 
     Every rank calls the constructor and each method together.
     """
@@ -151,11 +152,6 @@ class DistributedRun:
     #: Caps picked anew fewer than this many steps after they were picked widen the default
     #: cap margin.
     short_cap_period = 50
-    #: Every this many steps (and at the start) the ranks compare their work (work_load.py);
-    #: when the most loaded one has over balance_threshold times the mean, and over that many
-    #: times what the last cut left it, they migrate, cut by the grains' work.
-    balance_every = 100
-    balance_threshold = 1.1
 
     def __init__(
         self,
@@ -791,7 +787,7 @@ class DistributedRun:
         farthest = self._check_step(int(core.step), failure)
         self._loaded_walls = None
         self._migration_due = self._migrates and self._travelled + farthest > 0.25 * self.margin
-        if int(core.step) % self.balance_every == 0:
+        if self._sim.load_balance.due(int(core.step)):
             self._check_balance()
         spans = np.diff(times)  # begin, caps' check, send, bonds, receive, finish
         self.seconds["steps"] += spans[0] + spans[3] - testing + spans[5]
@@ -851,14 +847,15 @@ class DistributedRun:
     def _check_balance(self) -> None:
         """Whether the ranks' work (work_load.py: each rank's own nodes, intact bond copies and
         contact list entries; one allgather) has drifted out of balance: the most loaded rank
-        over balance_threshold times the mean, and over balance_threshold times what the last
-        cut left it (so that grains too heavy to share out do not cut again and again). Then
-        the next step begins with a migration. Not without migrate, nor with one already due."""
+        over the simulation's load_balance.threshold times the mean, and over that times what
+        the last cut left it (so that grains too heavy to share out do not cut again and
+        again). Then the next step begins with a migration. Not without migrate, nor with one
+        already due."""
         if not self._migrates or self._migration_due:
             return
         start = time.perf_counter()
         self.work_imbalance = imbalance(np.array(self.comm.allgather(self.owned_work())))
-        limit = self.balance_threshold * max(1.0, self._left_imbalance)
+        limit = self._sim.load_balance.threshold * max(1.0, self._left_imbalance)
         self._rebalance_due = self.work_imbalance > limit
         self._migration_due = self._rebalance_due
         self.seconds["check"] += time.perf_counter() - start

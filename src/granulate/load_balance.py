@@ -1,0 +1,54 @@
+"""How a distributed run keeps its ranks' work even (granulate.parallel, docs/parallel.md).
+
+A rank's work is the sum over its grains' nodes of work_load.node_work (nodes, intact bond
+copies, contact list entries). The ranks compare it at the start, after a checkpoint is loaded
+and every ``every`` steps (one allgather of a number per rank); when the most loaded rank
+carries over ``threshold`` times the mean, and over ``threshold`` times what the last cut left
+it (a grain too heavy to share out would otherwise cut again at every check), the next step
+begins with a migration that cuts the grains anew by their work. LAMMPS users know this as
+``fix balance Nfreq thresh``. Whatever the cut, the run is the serial run, bit for bit: these
+settings change its speed, never its results. A serial run, and a body cut at node level
+(whose nodes never change hands), ignore them.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from granulate.errors import InputError
+from granulate.input_errors import checked_arguments
+
+
+@checked_arguments
+@dataclass(frozen=True)
+class LoadBalance:
+    """When the ranks of a distributed run compare their work and cut the grains anew.
+
+    Attributes:
+        every: steps between two comparisons (an integer >= 0; default 100); 0 compares only
+            at the start and after a checkpoint is loaded (the grains' migrations, which follow
+            their motion, still cut by work). Each comparison is one allgather.
+        threshold: the most loaded rank's work over the mean (a number >= 1; default 1.1)
+            above which the ranks cut anew; each such cut costs about what 20 steps do.
+            ``float("inf")`` (YAML ``.inf``) never cuts for the balance: the ranks keep the
+            cut by nodes of the start until the grains' motion makes them migrate.
+    """
+
+    every: int = 100
+    threshold: float = 1.1
+
+    def __post_init__(self) -> None:
+        if self.every < 0:
+            raise InputError(
+                f"LoadBalance: every must be a number of steps >= 0 (0: only at the start), "
+                f"got {self.every}"
+            )
+        if not self.threshold >= 1:  # nan too
+            raise InputError(
+                "LoadBalance: threshold must be a ratio >= 1 of the most loaded rank's work over "
+                f"the mean (1.1: cut anew past 10 % over; inf: never), got {self.threshold}"
+            )
+
+    def due(self, step: int) -> bool:
+        """Whether the ranks compare their work after `step`."""
+        return self.every > 0 and step % self.every == 0
