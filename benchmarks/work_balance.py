@@ -1,16 +1,20 @@
-"""Ranks balanced by their grains' work (granulate/parallel/work_load.py) against ranks balanced
-by nodes alone: the same run with the balance checks on and off, alternating.
+"""Ranks balanced by their grains' work (granulate/parallel/work_load.py), by that work scaled by
+measured time, and by nodes alone: the same run under each balance, in turn.
 
-    mpiexec -n K python benchmarks/work_balance.py [--case bonds|contact] [--steps S]
-                                                   [--rounds R]
+    mpiexec -n K python benchmarks/work_balance.py [--case bonds|contact|breaking] [--steps S]
+                                                   [--rounds R] [--compare off,work,time]
 
 Cases (granulate.bench_ranks' pile layout, 2D, at rest on a floor between two walls):
 - bonds: 200 grains at 16 nodes a radius; the left half's horizon is 4.5 mesh sizes, the
   right half's 3 (2.25 times fewer bonds a node);
 - contact: 400 grains at 5 nodes a radius; the left half touching on its lattice, the right
-  half's grains 1.5 times as far apart (no contact among them).
-Each round runs the case once with the balance off (gr.LoadBalance(threshold=inf): the ranks cut
-by nodes at the start and never again) and once on, the order alternating, one thread a rank.
+  half's grains 1.5 times as far apart (no contact among them);
+- breaking: 400 grains at 5 nodes a radius; the left half brittle and thrown at 8 m/s into
+  each other (they shatter), the right half at rest.
+Each round runs the case once under each balance of --compare (default off,work), in an order
+turning from round to round, one thread a rank: off, gr.LoadBalance(threshold=inf), the ranks
+cut by nodes at the start and never again; work, the default gr.LoadBalance(); time,
+gr.LoadBalance(weight="time").
 Rank 0 prints per run the wall seconds of the steps, each rank's step seconds (its own work,
 without the exchange and checks), each rank's work (DistributedRun.owned_work) at the end with its
 nodes, intact bond copies and contact list entries, and the steps the ranks rebalanced before
@@ -47,10 +51,33 @@ def contact_case() -> gr.Simulation:
     return _pile(400, lambda column: (bench_ranks.ROCK, 1.0 if column < 10 else 1.5), RADIUS / 5)
 
 
-def _pile(grains: int, half: Callable[[int], tuple[gr.Material, float]], h: float) -> gr.Simulation:
+def breaking_case() -> gr.Simulation:
+    """The pile of 400 grains at h = R/5, its left half brittle (fracture energy 0.5 J/m^2)
+    and each grain thrown at 8 m/s in a random direction into its neighbours, as bench_ranks'
+    shatter case: they crack and split from the first steps, at a cost their counts miss;
+    the right half at rest."""
+    brittle = bench_ranks.ROCK.model_copy(update={"fracture_energy": 0.5})
+    throws = np.random.default_rng(7).uniform(0.0, 2 * np.pi, 400)
+
+    def half(column: int) -> tuple[gr.Material, float]:
+        return (brittle, 1.0) if column < 10 else (bench_ranks.ROCK, 1.0)
+
+    def velocity(k: int, column: int) -> tuple[float, float]:
+        speed = 8.0 if column < 10 else 0.0
+        return speed * np.cos(throws[k]), speed * np.sin(throws[k])
+
+    return _pile(400, half, RADIUS / 5, velocity)
+
+
+def _pile(
+    grains: int,
+    half: Callable[[int], tuple[gr.Material, float]],
+    h: float,
+    velocity: Callable[[int, int], tuple[float, float]] = lambda k, column: (0.0, 0.0),
+) -> gr.Simulation:
     """Grains of radius 0.99 R in rows of 20 on a hexagonal lattice 2 R apart, on a floor,
     meshed at `h`; half(column) gives a column's material and how much farther apart its
-    grains are (the right half's, from x = 21 R on)."""
+    grains are (the right half's, from x = 21 R on), velocity(k, column) grain k's."""
     sim = gr.Simulation(2, gravity=(0, -9.81, 0))
     sim.contact = gr.Contact(restitution=0.5, friction=0.5)
     spacing = 2.0 * RADIUS
@@ -60,18 +87,27 @@ def _pile(grains: int, half: Callable[[int], tuple[gr.Material, float]], h: floa
         shift = 0.0 if column < 10 else 10.5 - 10 * spread  # the right half from x = 21 R on
         x = spacing * (shift + spread * (column + 0.5 * (row % 2)))
         y = spacing * np.sqrt(3) / 2 * row * spread
-        sim.add_body(gr.Disc((x, y), 0.99 * RADIUS), material, h)
+        disc = gr.Disc((x, y), 0.99 * RADIUS)
+        sim.add_body(disc, material, h, velocity=velocity(k, column))
     sim.add_wall(gr.Wall(gr.Plane((0, -0.99 * RADIUS, 0), (0, 1, 0))), name="floor")
     return sim
 
 
-CASES = {"bonds": bonds_case, "contact": contact_case}
+CASES = {"bonds": bonds_case, "contact": contact_case, "breaking": breaking_case}
 
 
-def one_run(case: str, steps: int, balance: bool, comm: MPI.Comm) -> dict | None:
-    """The case run `steps` steps after 20 untimed, with the balance checks on or off."""
+#: The balances compared: none (the cut by nodes of the start kept), by the counts, by time.
+BALANCES = {
+    "off": gr.LoadBalance(threshold=float("inf")),
+    "work": gr.LoadBalance(),
+    "time": gr.LoadBalance(weight="time"),
+}
+
+
+def one_run(case: str, steps: int, balance: str, comm: MPI.Comm) -> dict | None:
+    """The case run `steps` steps after 20 untimed, under BALANCES[balance]."""
     sim = CASES[case]()
-    sim.load_balance = gr.LoadBalance(threshold=1.1 if balance else float("inf"))
+    sim.load_balance = BALANCES[balance]
     with warnings.catch_warnings():
         warnings.filterwarnings("ignore", message="contact.*bodies pressed")
         run = DistributedRun(sim, comm)
@@ -100,18 +136,24 @@ def main() -> None:
     parser.add_argument("--case", choices=list(CASES), default="bonds")
     parser.add_argument("--steps", type=int, default=300)
     parser.add_argument("--rounds", type=int, default=2)
+    parser.add_argument(
+        "--compare", default="off,work", help="balances run in turn: off, work, time"
+    )
     arguments = parser.parse_args()
+    compared = arguments.compare.split(",")
+    if not set(compared) <= set(BALANCES):
+        parser.error(f"--compare takes {', '.join(BALANCES)}, got {arguments.compare}")
     comm = MPI.COMM_WORLD
     gr.set_num_threads(1, adaptive=False)
     for k in range(arguments.rounds):
-        for balance in (k % 2 == 0, k % 2 == 1):
+        for balance in compared[k % len(compared) :] + compared[: k % len(compared)]:
             result = one_run(arguments.case, arguments.steps, balance, comm)
             if result is None:
                 continue
             steps = ", ".join(f"{row[0]:.2f}" for row in result["rows"])
             work = ", ".join(f"{row[1]:,.0f} {row[2]}" for row in result["rows"])
             print(
-                f"round {k + 1} balance {'on ' if balance else 'off'}: {arguments.steps} steps in "
+                f"round {k + 1} balance {balance:4}: {arguments.steps} steps in "
                 f"{result['wall']:.2f} s; ranks' step seconds {steps}; work {work}; "
                 f"rebalanced before steps {result['rebalances']}",
                 flush=True,

@@ -164,7 +164,9 @@ def main() -> int:
     if sys.argv[1] == "balance":
         steps = int(sys.argv[2])
         balanced = compare(uneven_horizons, "uneven horizons", steps, comm)
-        return balanced | check_balance_settings(steps, comm)
+        serial = on_rank_0(comm, lambda: run_serially(uneven_horizons, steps))
+        settings = check_balance_settings(serial, steps, comm)
+        return balanced | settings | check_time_weights(serial, steps, comm)
     if sys.argv[1] == "drum":
         variant, steps = sys.argv[2], int(sys.argv[3])
         renew, widen = sys.argv[4:] == ["renew"], sys.argv[4:] == ["widen"]
@@ -257,12 +259,12 @@ def compare(
     return 0 if same_dt and not any(worst.values()) else 1
 
 
-def check_balance_settings(steps: int, comm: MPI.Comm) -> int:
+def check_balance_settings(serial: gr.Simulation | None, steps: int, comm: MPI.Comm) -> int:
     """The uneven horizons' run under two settings of sim.load_balance, each printed with
     the steps the ranks rebalanced before, the work over the mean at the start's check and at
     the last one, and the largest differences from the serial run: a check only at the start
-    (every=0) and no cut for the balance (threshold=inf). 0 when both are the serial run."""
-    serial = on_rank_0(comm, lambda: run_serially(uneven_horizons, steps))
+    (every=0) and no cut for the balance (threshold=inf). 0 when both are the serial run
+    (`serial`, on rank 0)."""
     failed = 0
     for balance in (gr.LoadBalance(every=0), gr.LoadBalance(threshold=float("inf"))):
         sim = uneven_horizons()
@@ -280,6 +282,54 @@ def check_balance_settings(steps: int, comm: MPI.Comm) -> int:
                 f"at the last check; largest difference in positions {worst}"
             )
     return int(comm.bcast(failed, root=0))
+
+
+class CostlyLeftGrains(DistributedRun):
+    """The uneven horizons' left half (its wide-horizon discs) costs 10 us a node more each
+    step than the counts say: each rank's step seconds (which LoadBalance(weight="time")
+    reads) are counted that much longer for the left discs it owns, as for a cost the counts
+    miss (contact costlier than its entries, breaking bonds). Their measured step loads, per
+    check, are in `loads` (rank 0)."""
+
+    extra = 1e-5  # [s] a node of a left disc, a step
+
+    def __init__(self, sim: gr.Simulation, comm: MPI.Comm) -> None:
+        self._left = {k for k in range(len(sim.bodies)) if k % 10 < 5}
+        self._node_counts = [body.node_count for body in sim.bodies]
+        self.loads: list[list[float]] = []
+        super().__init__(sim, comm)
+
+    def _step(self) -> None:
+        super()._step()
+        grains = self.partition.grains_of(self.comm.Get_rank())
+        left = sum(self._node_counts[g] for g in grains if g in self._left)
+        self.seconds["steps"] += self.extra * left
+
+
+def check_time_weights(serial: gr.Simulation | None, steps: int, comm: MPI.Comm) -> int:
+    """The uneven horizons under LoadBalance(weight="time") with their left discs costlier
+    than counted (CostlyLeftGrains): printed, the steps the ranks rebalanced before, the
+    most loaded rank's step seconds over the mean at the last check, each rank's own nodes at
+    the end and the largest difference from the serial run. 0 when it is the serial run
+    (`serial`, on rank 0)."""
+    sim = uneven_horizons()
+    sim.load_balance = gr.LoadBalance(weight="time")
+    distributed = CostlyLeftGrains(sim, comm)
+    imbalances = []
+    for _ in range(steps // 100):
+        distributed.run(100)
+        imbalances.append(round(distributed.work_imbalance, 3))
+    owned = comm.gather(len(distributed.owned_nodes), root=0)
+    positions = distributed.gather("positions")
+    if serial is None:
+        return int(comm.bcast(None, root=0))
+    worst = float(np.abs(positions - serial.positions).max())
+    print(
+        f"time weights, left discs costlier: rebalanced before steps "
+        f"{distributed.rebalance_steps}, step seconds over the mean at the checks {imbalances}, "
+        f"own nodes per rank {owned}; largest difference in positions {worst}"
+    )
+    return int(comm.bcast(worst != 0.0, root=0))
 
 
 def run_serially(make: Callable[[], gr.Simulation], steps: int) -> gr.Simulation:

@@ -36,6 +36,7 @@ ROCK = {"density": 2500, "youngs_modulus": 5e9, "poisson_ratio": 0.25, "fracture
         (lambda: gr.LoadBalance(every=2.5), "every must be an integer"),
         (lambda: gr.LoadBalance(threshold=0.9), "threshold must be a ratio >= 1"),
         (lambda: gr.LoadBalance(threshold=float("nan")), "threshold must be a ratio >= 1"),
+        (lambda: gr.LoadBalance(weight="timing"), "weight must be 'work' or 'time'"),
         (lambda: setattr(gr.Simulation(2), "load_balance", 100), "granulate.LoadBalance("),
     ],
 )

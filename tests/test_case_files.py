@@ -69,9 +69,9 @@ def test_a_case_sets_when_the_ranks_balance_their_work() -> None:
     is left out of the case's fingerprint, so a checkpoint resumes under other settings."""
     text = BASE.read_text()
     assert case_files.parse_case(text, BASE).build().load_balance == gr.LoadBalance()
-    given = text + "load_balance: {every: 0, threshold: .inf}\n"
+    given = text + "load_balance: {every: 0, threshold: .inf, weight: time}\n"
     built = case_files.parse_case(given, BASE).build()
-    assert built.load_balance == gr.LoadBalance(every=0, threshold=float("inf"))
+    assert built.load_balance == gr.LoadBalance(every=0, threshold=float("inf"), weight="time")
     # Its speed, not its results: the fingerprint a checkpoint is resumed by is the same.
     assert built.case_fingerprint == case_files.parse_case(text, BASE).fingerprint
 

@@ -100,8 +100,12 @@ def test_ranks_cut_by_their_work_keep_the_serial_run_bit_for_bit() -> None:
     (Model::cut_bond_blocks cut a particle by the model's bonds): forces 5.8e-11 apart after
     200 steps. The simulation's load_balance is followed: with every=0 the ranks compare
     their work only at the start (cut anew before step 0, the start's 1.14 the last measure);
-    with threshold=inf they compare it every 100 steps and never cut anew (1.14 at step 200);
-    both end as the serial run does."""
+    with threshold=inf they compare it every 100 steps and never cut anew (1.14 at step 200).
+    Under weight="time", with the left discs made to cost 10 us a node a step more than their
+    counts say (mpi_check.CostlyLeftGrains), the ranks' step seconds at step 100 are 1.60-1.61
+    times the mean (asserted above 1.3): they cut anew, giving the ranks of left discs fewer
+    nodes (1,456 each against 5,408), and at step 200 are 1.03-1.04 (asserted below 1.3; five
+    runs, three beside a busy process). Each run ends as the serial run does."""
     done = run_ranks(3, "balance", "200")
     assert done.returncode == 0, done.stdout + done.stderr
     assert "'positions': 0.0, 'velocities': 0.0, 'forces': 0.0, 'walls': 0.0}" in done.stdout
@@ -111,13 +115,21 @@ def test_ranks_cut_by_their_work_keep_the_serial_run_bit_for_bit() -> None:
     first = start.split()[0]
     unbalanced = f"work over the mean {first} at the start, {first} at the last check"
     assert (
-        f"LoadBalance(every=0, threshold=1.1): rebalanced before steps [0], {unbalanced}; "
-        "largest difference in positions 0.0"
+        f"LoadBalance(every=0, threshold=1.1, weight='work'): rebalanced before steps [0], "
+        f"{unbalanced}; largest difference in positions 0.0"
     ) in done.stdout, done.stdout
     assert (
-        f"LoadBalance(every=100, threshold=inf): rebalanced before steps [], {unbalanced}; "
-        "largest difference in positions 0.0"
+        f"LoadBalance(every=100, threshold=inf, weight='work'): rebalanced before steps [], "
+        f"{unbalanced}; largest difference in positions 0.0"
     ) in done.stdout, done.stdout
+    timed = done.stdout.split("time weights, left discs costlier: ")[1].splitlines()[0]
+    steps = timed.split("rebalanced before steps [")[1].split("]")[0]
+    assert steps == "0, 100", timed  # a cut due at step 200 would come after the run
+    checks = [float(x) for x in timed.split("at the checks [")[1].split("]")[0].split(", ")]
+    assert checks[0] > 1.3 and checks[1] < 1.3, timed
+    owned = [int(x) for x in timed.split("own nodes per rank [")[1].split("]")[0].split(", ")]
+    assert max(owned) > 2 * min(owned), timed
+    assert timed.endswith("largest difference in positions 0.0"), timed
 
 
 def test_the_default_margin_widens_when_grains_migrate_often() -> None:

@@ -9,6 +9,13 @@ begins with a migration that cuts the grains anew by their work. LAMMPS users kn
 ``fix balance Nfreq thresh``. Whatever the cut, the run is the serial run, bit for bit: these
 settings change its speed, never its results. A serial run, and a body cut at node level
 (whose nodes never change hands), ignore them.
+
+``weight="time"`` (LAMMPS' ``weight time``) scales each rank's modelled work by the seconds its
+steps took per unit of it since the last comparison (parallel/step_clock.py): the cut then
+follows costs the counts miss (contact costlier than its entries say, grains breaking), at
+the price of cuts that differ from run to run (the results do not). A grain carries its
+rank's factor to its next rank, so a rank slow for its own sake (a slower core) is not what
+it evens out: its grains are taken for costly ones wherever they go.
 """
 
 from __future__ import annotations
@@ -32,10 +39,15 @@ class LoadBalance:
             above which the ranks cut anew; each such cut costs about what 20 steps do.
             ``float("inf")`` (YAML ``.inf``) never cuts for the balance: the ranks keep the
             cut by nodes of the start until the grains' motion makes them migrate.
+        weight: ``"work"`` (default) weighs a grain by its counts (work_load.py), the same
+            every run; ``"time"`` by those counts times its rank's measured step seconds per
+            unit of them since the last comparison (before any step has been timed, by the
+            counts alone).
     """
 
     every: int = 100
     threshold: float = 1.1
+    weight: str = "work"
 
     def __post_init__(self) -> None:
         if self.every < 0:
@@ -48,6 +60,9 @@ class LoadBalance:
                 "LoadBalance: threshold must be a ratio >= 1 of the most loaded rank's work over "
                 f"the mean (1.1: cut anew past 10 % over; inf: never), got {self.threshold}"
             )
+
+        if self.weight not in ("work", "time"):
+            raise InputError(f"LoadBalance: weight must be 'work' or 'time', got {self.weight!r}")
 
     def due(self, step: int) -> bool:
         """Whether the ranks compare their work after `step`."""

@@ -233,6 +233,12 @@ class LoadBalanceSpec(Spec):
         description="the most loaded rank's work over the mean that cuts anew [-] (.inf: never)",
     )
 
+    weight: Literal["work", "time"] = Field(
+        "work",
+        description="'work': grains weighed by their counts; 'time': times their rank's "
+        "measured step seconds per unit of them",
+    )
+
     def make(self) -> LoadBalance:
         return LoadBalance(**self.model_dump())
 

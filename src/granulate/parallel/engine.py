@@ -60,6 +60,7 @@ from granulate.parallel.partition import (
 )
 from granulate.parallel.rank_threads import share_of_cores
 from granulate.parallel.run_measures import RankMeasures
+from granulate.parallel.step_clock import StepClock
 from granulate.parallel.step_parts import step_data, step_part
 from granulate.parallel.transplant import (
     GrainState,
@@ -253,6 +254,7 @@ class DistributedRun:
         #: Of the exchange's seconds, those spent waiting for the step's messages (Waitall,
         #: after the bond forces): what the overlap did not hide.
         self.waiting = 0.0
+        self._clock = StepClock()  # for LoadBalance(weight="time")
         self._check_balance()
 
     def _stable_time_step(
@@ -854,24 +856,37 @@ class DistributedRun:
         if not self._migrates or self._migration_due:
             return
         start = time.perf_counter()
-        self.work_imbalance = imbalance(np.array(self.comm.allgather(self.owned_work())))
+        work = self.owned_work()
+        loads = _weighed(self.comm.allgather((work, self._step_scale(work))))
+        self.work_imbalance = imbalance(np.array(loads))
         limit = self._sim.load_balance.threshold * max(1.0, self._left_imbalance)
         self._rebalance_due = self.work_imbalance > limit
         self._migration_due = self._rebalance_due
+        self._clock.restart(self.seconds["steps"], int(self.local.core.step), work)
         self.seconds["check"] += time.perf_counter() - start
 
     def owned_work(self) -> float:
         """This rank's work now: work_load.node_work summed over its own nodes."""
         return float(node_work(self.local.core, self._owned_nodes, self._sim.dimension).sum())
 
+    def _step_scale(self, work: float) -> float | None:
+        """Under LoadBalance(weight="time"), this rank's step seconds a step per unit of its
+        work `work` (StepClock; None before a step was timed); None under weight "work"."""
+        if self._sim.load_balance.weight != "time":
+            return None
+        return self._clock.scale(self.seconds["steps"], int(self.local.core.step), work)
+
     def _grain_work(self) -> NDArray[np.float64]:
-        """Every grain's work now (work_load.node_work summed over its nodes), on every rank:
-        each owner's grains (one allgather)."""
+        """Every grain's work now (work_load.node_work summed over its nodes; under
+        LoadBalance(weight="time") times its rank's step seconds per unit of work), on every
+        rank: each owner's grains (one allgather)."""
         work = node_work(self.local.core, self._owned_nodes, self._sim.dimension)
         sizes = [self._slices[g].stop - self._slices[g].start for g in self._owned]
         mine = np.add.reduceat(work, np.cumsum([0, *sizes[:-1]]))
+        parts = self.comm.allgather((self._owned, mine, self._step_scale(float(mine.sum()))))
+        weighed = _weighed([(theirs, scale) for _, theirs, scale in parts])
         weights = np.empty(len(self._slices))
-        for grains, theirs in self.comm.allgather((self._owned, mine)):
+        for (grains, _, _), theirs in zip(parts, weighed, strict=True):
             weights[grains] = theirs
         return weights
 
@@ -895,6 +910,7 @@ class DistributedRun:
         positions = self.local.core.positions
         layout = self._gathered_layout(self._owned, lambda g: positions[self.local_slice(g)])
         self._weights = self._grain_work()
+        self._clock.restart(self.seconds["steps"], int(self.local.core.step), self.owned_work())
         held = self._distribute(*layout)
         self._left_imbalance = imbalance(self.partition.loads(self._weights))
         if for_balance:
@@ -1343,6 +1359,16 @@ def _mask(size: int, indices: NDArray[np.int64]) -> NDArray[np.bool_]:
     mask = np.zeros(size, dtype=bool)
     mask[indices] = True
     return mask
+
+
+def _weighed(parts: list[tuple[Any, float | None]]) -> list[Any]:
+    """Each rank's work (a number, or its grains' array) times its step scale
+    (DistributedRun._step_scale) when every rank has one and it is positive, else as it is:
+    one rule for every rank, from the same allgathered parts."""
+    scales = [scale for _, scale in parts]
+    if any(scale is None or not scale > 0 for scale in scales):
+        return [work for work, _ in parts]
+    return [work * scale for work, scale in parts]
 
 
 def _sum_wall_terms(parts: list[tuple[NDArray[Any], ...]], walls: int) -> NDArray[np.float64]:
