@@ -2,8 +2,11 @@
 
 #include <cmath>
 #include <limits>
+#include <map>
+#include <mutex>
 #include <numbers>
 #include <sstream>
+#include <tuple>
 
 namespace granulate {
 namespace {
@@ -60,7 +63,10 @@ real influence_moment(InfluenceKind influence_kind, int power) {
   return sum / n;
 }
 
-FractureCoefficients fracture_coefficients(ForceModel model, InfluenceKind influence_kind, int dimension) {
+namespace {
+
+FractureCoefficients compute_fracture_coefficients(ForceModel model, InfluenceKind influence_kind,
+                                                   int dimension) {
   FractureCoefficients result;
   if (model == ForceModel::pmb) {
     // Pair energy w = c J s^2 r / 2 integrated over the bonds crossing a unit area:
@@ -101,6 +107,19 @@ FractureCoefficients fracture_coefficients(ForceModel model, InfluenceKind influ
   return result;
 }
 
+}  // namespace
+
+FractureCoefficients fracture_coefficients(ForceModel model, InfluenceKind influence_kind, int dimension) {
+  // They depend on these three alone, and LPS's double quadrature takes ~45 ms: each is computed
+  // once per process, not at every Model (a distributed run builds its parts anew at migrations).
+  static std::mutex mutex;
+  static std::map<std::tuple<ForceModel, InfluenceKind, int>, FractureCoefficients> known;
+  const std::lock_guard lock(mutex);
+  const auto [place, added] = known.try_emplace({model, influence_kind, dimension});
+  if (added) place->second = compute_fracture_coefficients(model, influence_kind, dimension);
+  return place->second;
+}
+
 namespace {
 
 /// The continuum PMB micromodulus c at horizon delta (Material::micromodulus).
@@ -134,8 +153,7 @@ real Material::critical_stretch_at(real delta) const {
   return energy_per_stretch2 > 0 ? std::sqrt(params.fracture_energy / energy_per_stretch2) : 0.0;
 }
 
-Material Material::make(const MaterialParams& params, int dimension, PlaneMode plane,
-                        const FractureCoefficients* known) {
+Material Material::make(const MaterialParams& params, int dimension, PlaneMode plane) {
   if (dimension != 2 && dimension != 3) {
     throw InputError("dimension must be 2 or 3, got " + std::to_string(dimension));
   }
@@ -176,7 +194,7 @@ Material Material::make(const MaterialParams& params, int dimension, PlaneMode p
   }
   if (params.model == ForceModel::pmb) m.micromodulus = pmb_micromodulus(m, params.horizon);
   if (params.fracture && !peridem) {
-    m.fracture = known ? *known : fracture_coefficients(params.model, params.influence, dimension);
+    m.fracture = fracture_coefficients(params.model, params.influence, dimension);
   }
   m.critical_stretch = m.critical_stretch_at(params.horizon);
   if (!(m.critical_stretch > 0)) {

@@ -50,15 +50,7 @@ void Model::set_whole_particle_bonds(std::size_t bonds) {
 
 index_t Model::add_material(const MaterialParams& params) {
   require_not_finalized("add a material");
-  const auto key = std::make_pair(params.model, params.influence);
-  auto known = fracture_coefficients_.find(key);
-  if (params.fracture && known == fracture_coefficients_.end()) {
-    known =
-        fracture_coefficients_.emplace(key, fracture_coefficients(params.model, params.influence, dimension_))
-            .first;
-  }
-  materials_.push_back(Material::make(params, dimension_, plane_,
-                                      known == fracture_coefficients_.end() ? nullptr : &known->second));
+  materials_.push_back(Material::make(params, dimension_, plane_));
   return static_cast<index_t>(materials_.size() - 1);
 }
 

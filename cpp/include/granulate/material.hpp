@@ -59,12 +59,11 @@ struct Material {
   real critical_stretch_at(real delta) const;
 
   /// Validates the parameters (throws InputError naming the bad one) and derives the constants.
-  /// `coefficients`: fracture_coefficients(params.model, params.influence, dimension) if already
-  /// known (they cost a quadrature of ~10^7 points), otherwise computed.
-  static Material make(const MaterialParams& params, int dimension, PlaneMode plane,
-                       const FractureCoefficients* coefficients = nullptr);
+  static Material make(const MaterialParams& params, int dimension, PlaneMode plane);
 };
 
+/// The fracture coefficients of a force model and influence function in `dimension`: a quadrature
+/// of ~10^7 points for LPS, made once per process for each of them (thread-safe) and kept.
 FractureCoefficients fracture_coefficients(ForceModel model, InfluenceKind influence, int dimension);
 
 /// Continuum moment int_0^1 J(xi) xi^p dxi of an influence function (midpoint quadrature).

@@ -3,7 +3,6 @@
 #pragma once
 
 #include <cstdint>
-#include <map>
 #include <optional>
 #include <span>
 #include <vector>
@@ -229,7 +228,6 @@ class Model {
   bool finalized_ = false;
   std::size_t whole_particle_bonds_ = default_whole_particle_bonds;
   std::vector<Material> materials_;
-  std::map<std::pair<ForceModel, InfluenceKind>, FractureCoefficients> fracture_coefficients_;
   std::vector<Shape> shapes_;
   std::vector<Particle> particles_;
   std::vector<real> reference_positions_;
