@@ -288,15 +288,13 @@ class CostlyLeftGrains(DistributedRun):
     """The uneven horizons' left half (its wide-horizon discs) costs 10 us a node more each
     step than the counts say: each rank's step seconds (which LoadBalance(weight="time")
     reads) are counted that much longer for the left discs it owns, as for a cost the counts
-    miss (contact costlier than its entries, breaking bonds). Their measured step loads, per
-    check, are in `loads` (rank 0)."""
+    miss (contact costlier than its entries, breaking bonds)."""
 
     extra = 1e-5  # [s] a node of a left disc, a step
 
     def __init__(self, sim: gr.Simulation, comm: MPI.Comm) -> None:
         self._left = {k for k in range(len(sim.bodies)) if k % 10 < 5}
         self._node_counts = [body.node_count for body in sim.bodies]
-        self.loads: list[list[float]] = []
         super().__init__(sim, comm)
 
     def _step(self) -> None:
@@ -309,7 +307,7 @@ class CostlyLeftGrains(DistributedRun):
 def check_time_weights(serial: gr.Simulation | None, steps: int, comm: MPI.Comm) -> int:
     """The uneven horizons under LoadBalance(weight="time") with their left discs costlier
     than counted (CostlyLeftGrains): printed, the steps the ranks rebalanced before, the
-    most loaded rank's step seconds over the mean at the last check, each rank's own nodes at
+    most loaded rank's step seconds over the mean at each check, each rank's own nodes at
     the end and the largest difference from the serial run. 0 when it is the serial run
     (`serial`, on rank 0)."""
     sim = uneven_horizons()

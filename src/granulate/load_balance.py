@@ -60,7 +60,6 @@ class LoadBalance:
                 "LoadBalance: threshold must be a ratio >= 1 of the most loaded rank's work over "
                 f"the mean (1.1: cut anew past 10 % over; inf: never), got {self.threshold}"
             )
-
         if self.weight not in ("work", "time"):
             raise InputError(f"LoadBalance: weight must be 'work' or 'time', got {self.weight!r}")
 
