@@ -232,7 +232,6 @@ class LoadBalanceSpec(Spec):
         1.1,
         description="the most loaded rank's work over the mean that cuts anew [-] (.inf: never)",
     )
-
     weight: Literal["work", "time"] = Field(
         "work",
         description="'work': grains weighed by their counts; 'time': times their rank's "
