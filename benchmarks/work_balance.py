@@ -4,7 +4,7 @@ measured time, and by nodes alone: the same run under each balance, in turn.
     mpiexec -n K python benchmarks/work_balance.py [--case bonds|contact|breaking] [--steps S]
                                                    [--rounds R] [--compare off,work,time]
 
-Cases (granulate.bench_ranks' pile layout, 2D, at rest on a floor between two walls):
+Cases (granulate.bench_ranks' pile layout, 2D, on a floor):
 - bonds: 200 grains at 16 nodes a radius; the left half's horizon is 4.5 mesh sizes, the
   right half's 3 (2.25 times fewer bonds a node);
 - contact: 400 grains at 5 nodes a radius; the left half touching on its lattice, the right
