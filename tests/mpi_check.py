@@ -163,8 +163,8 @@ def main() -> int:
         )
     if sys.argv[1] == "balance":
         steps = int(sys.argv[2])
-        balanced = compare(uneven_horizons, "uneven horizons", steps, comm)
         serial = on_rank_0(comm, lambda: run_serially(uneven_horizons, steps))
+        balanced = compare(uneven_horizons, "uneven horizons", steps, comm, serial=serial)
         settings = check_balance_settings(serial, steps, comm)
         return balanced | settings | check_time_weights(serial, steps, comm)
     if sys.argv[1] == "drum":
@@ -204,6 +204,10 @@ class NarrowMessages(DistributedRun):
     body_slots = 0
 
 
+#: compare's default: the serial reference is run there.
+RUN_HERE = object()
+
+
 def compare(
     make: Callable[[], gr.Simulation],
     name: str,
@@ -214,6 +218,8 @@ def compare(
     cap_margin: float | None = None,
     narrow: bool = False,
     widen: bool = False,
+    *,
+    serial: Any = RUN_HERE,
 ) -> int:
     """0 when `steps` steps of make() distributed over the ranks end with every node's
     position, velocity and force equal to the serial run's, at the same dt. `renew`: every
@@ -221,8 +227,10 @@ def compare(
     `margin`, `cap_margin`: the ghost and cap margins [m] (default DistributedRun's);
     `narrow`: a step's message carries one break and one body per grain at most (the others go
     in a second message, NarrowMessages); `widen`: the default margin widens after short
-    distributions, as in a run (else it stays, so that the grains migrate often)."""
-    serial = on_rank_0(comm, lambda: run_serially(make, steps))
+    distributions, as in a run (else it stays, so that the grains migrate often); `serial`:
+    the serial reference already run (rank 0's, None on the others), else run here."""
+    if serial is RUN_HERE:
+        serial = on_rank_0(comm, lambda: run_serially(make, steps))
     kind = NarrowMessages if renew or narrow else DistributedRun
     distributed = kind(make(), comm, margin=margin, cap_margin=cap_margin)
     distributed.always_renew = renew

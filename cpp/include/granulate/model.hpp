@@ -94,6 +94,7 @@ struct NodeBonds {
 /// A particle of more forward bonds than this is cut into ranges of BondSchedule blocks; one of
 /// up to this many is evaluated whole, in one block (Model::set_whole_particle_bonds).
 inline constexpr std::size_t default_whole_particle_bonds = 16384;
+
 /// The order of the force loops, which evaluate each bond once, at its lower-numbered end, and
 /// add the result to both ends. Nodes are cut into blocks of consecutive nodes (small particles
 /// whole); a block touches its nodes and their forward neighbours. Blocks that touch a common

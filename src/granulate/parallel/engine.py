@@ -876,19 +876,21 @@ class DistributedRun:
             return None
         return self._clock.scale(self.seconds["steps"], int(self.local.core.step), work)
 
-    def _grain_work(self) -> NDArray[np.float64]:
+    def _grain_work(self) -> tuple[NDArray[np.float64], float]:
         """Every grain's work now (work_load.node_work summed over its nodes; under
         LoadBalance(weight="time") times its rank's step seconds per unit of work), on every
-        rank: each owner's grains (one allgather)."""
+        rank: each owner's grains (one allgather); and this rank's own work by the counts
+        (owned_work)."""
         work = node_work(self.local.core, self._owned_nodes, self._sim.dimension)
         sizes = [self._slices[g].stop - self._slices[g].start for g in self._owned]
         mine = np.add.reduceat(work, np.cumsum([0, *sizes[:-1]]))
-        parts = self.comm.allgather((self._owned, mine, self._step_scale(float(mine.sum()))))
+        own = float(mine.sum())
+        parts = self.comm.allgather((self._owned, mine, self._step_scale(own)))
         weighed = _weighed([(theirs, scale) for _, theirs, scale in parts])
         weights = np.empty(len(self._slices))
         for (grains, _, _), theirs in zip(parts, weighed, strict=True):
             weights[grains] = theirs
-        return weights
+        return weights, own
 
     def migrate(self) -> None:
         """Cut the assembly anew where the grains are now (recursive coordinate bisection of
@@ -909,8 +911,8 @@ class DistributedRun:
         before, owners_before = self._held_by_rank(), self.partition.owner
         positions = self.local.core.positions
         layout = self._gathered_layout(self._owned, lambda g: positions[self.local_slice(g)])
-        self._weights = self._grain_work()
-        self._clock.restart(self.seconds["steps"], int(self.local.core.step), self.owned_work())
+        self._weights, own_work = self._grain_work()
+        self._clock.restart(self.seconds["steps"], int(self.local.core.step), own_work)
         held = self._distribute(*layout)
         self._left_imbalance = imbalance(self.partition.loads(self._weights))
         if for_balance:
