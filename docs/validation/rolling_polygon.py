@@ -35,8 +35,11 @@ SOFT = gr.Material(density=1200, bulk_modulus=2.16e7, shear_modulus=1.296e7, fra
 RADIUS, SPEED, GRAVITY = 1e-3, 0.1, 9.81
 
 
-def rolling_disc(nodes: int, restitution: float, stiffness_factor: float, law: str) -> np.ndarray:
-    """Rows of (time after launch [s], flying 0/1, centre height over rest [h], v / v0)."""
+def rolling_disc(
+    nodes: int, restitution: float, stiffness_factor: float, law: str, duration: float = 0.03
+) -> np.ndarray:
+    """Rows of (time after launch [s], flying 0/1, centre height over rest [h], v / v0), over
+    `duration` seconds from the launch."""
     h = RADIUS / nodes
     sim = gr.Simulation(2, gravity=(0, -GRAVITY))
     sim.contact = gr.Contact(
@@ -49,7 +52,7 @@ def rolling_disc(nodes: int, restitution: float, stiffness_factor: float, law: s
     sim.velocities[:, 0] += SPEED
     launch, before, then = sim.time, rigid_motion(sim, disc)[1][1], sim.time
     rows = []
-    while sim.time < launch + 0.03:
+    while sim.time < launch + duration:
         sim.run(10)
         centre, velocity, _ = rigid_motion(sim, disc)
         flying = abs(velocity[1] - before + GRAVITY * (sim.time - then)) < 1e-9
