@@ -58,10 +58,10 @@ def test_a_distributed_run_is_the_serial_run_bit_for_bit(
 @pytest.mark.parametrize(
     ("ranks", "variant", "renew"),
     [
-        (3, "lattice", False),
         (3, "surface", False),
         (3, "grid", True),
-        (3, "surface", True),
+        (2, "lattice", False),
+        (2, "surface", True),
         (2, "rolling", True),
     ],
 )
@@ -75,7 +75,9 @@ def test_grains_migrating_between_ranks_keep_the_serial_run_bit_for_bit(
     broke); with `renew` every rank does so at every migration, the others keep their part.
     Between migrations the ranks pick the ghost nodes they exchange anew (refresh_caps)
     within the steps that take a node past half the cap margin, which starts at half the mesh
-    size and widens as the caps last only a few dozen steps."""
+    size and widens as the caps last only a few dozen steps. Three ranks run the surface law
+    (the default) and the grid renewing; the node spheres' lattice and the surface law renewing
+    run on 2 ranks, which cost a third to a half of 3 on the CI's 2 cores."""
     done = run_ranks(ranks, "drum", variant, "3000", *(["renew"] if renew else []))
     assert done.returncode == 0, done.stdout + done.stderr
     assert "'positions': 0.0, 'velocities': 0.0, 'forces': 0.0, 'walls': 0.0}" in done.stdout
@@ -85,8 +87,9 @@ def test_grains_migrating_between_ranks_keep_the_serial_run_bit_for_bit(
     assert migrations >= 20
     assert int(done.stdout.split("caps picked anew ")[1].split(",")[0]) >= 5
     assert int(done.stdout.split("cap margin widened ")[1].split(" ")[0]) >= 2
-    assert handed > 0 or ranks == 2 or variant == "lattice"  # cut by work, it keeps its owners
-    assert renewals == ", ".join([str(migrations)] * ranks) if renew else renewals != "0, 0, 0"
+    assert handed > 0 or ranks == 2
+    every_migration, none = (", ".join([str(n)] * ranks) for n in (migrations, 0))
+    assert renewals == every_migration if renew else renewals != none
 
 
 def test_ranks_cut_by_their_work_keep_the_serial_run_bit_for_bit() -> None:
@@ -149,13 +152,13 @@ def test_ghosts_exchanged_as_caps_keep_the_serial_run_bit_for_bit() -> None:
     """Finely meshed brittle discs (R/h = 12) thrown at each other on 3 ranks, with a cap margin
     of 2e-5 m: each step sends about a sixth of the ghost nodes held (the caps: a third while
     they took every bonded neighbour), the others stay where they were; the ranks pick the caps
-    anew some 60 times, within the steps whose drift, or whose breaks, took a node or where the
-    lists see it past half the cap margin, and cut the grains anew a few times while the discs
-    shatter (10,542 bonds), the messages with room for one break and one body per grain
+    anew some 50 times, within the steps whose drift, or whose breaks, took a node or where the
+    lists see it past half the cap margin, and cut the grains anew once while the discs shatter
+    (8,424 bonds in 350 steps), the messages with room for one break and one body per grain
     (hundreds of second messages), and nodes join the caps within steps as the nodes of a cap
-    take new anchors when their bonds break (DistributedRun._joining). Every node ends as in
-    the serial run."""
-    done = run_ranks(3, "fine", "400", "4e-4", "2e-5")
+    take new anchors when their bonds break (DistributedRun._joining; 10 nodes). Every node
+    ends as in the serial run."""
+    done = run_ranks(3, "fine", "350", "4e-4", "2e-5")
     assert done.returncode == 0, done.stdout + done.stderr
     assert "'positions': 0.0, 'velocities': 0.0, 'forces': 0.0, 'walls': 0.0}" in done.stdout
     assert int(done.stdout.split("nodes joining caps ")[1].split(",")[0]) > 0

@@ -96,11 +96,12 @@ def test_a_case_on_k_ranks_writes_the_serial_runs_outputs(
 
 
 def test_a_serial_run_restarts_on_ranks(serial_run: Path, tmp_path: Path) -> None:
-    """Cut short serially at step 1,200 and resumed on 3 ranks: the folder ends as the
-    uninterrupted serial run's. (Ranks to fewer ranks: the frames in pieces' test.)"""
+    """Cut short serially at step 1,200 and resumed on 2 ranks: the folder ends as the
+    uninterrupted serial run's. (Ranks to fewer ranks: the frames in pieces' test; serially
+    to 3 ranks: the node-level cut's.)"""
     cut = granulate(tmp_path, "--out", "out", "--steps", "1200")
     assert cut.returncode == 0, cut.stderr
-    resumed = granulate(tmp_path, "--out", "out", "--resume", ranks=3)
+    resumed = granulate(tmp_path, "--out", "out", "--resume", ranks=2)
     assert resumed.returncode == 0, resumed.stderr
     assert "resuming from step 1200" in resumed.stdout
     assert_same_run(serial_run, tmp_path / "out")
@@ -199,12 +200,12 @@ def test_frames_in_pieces_join_to_the_serial_runs_frames(serial_run: Path, tmp_p
 
 def test_a_polydisperse_pile_runs_on_ranks_at_the_serial_time_step(tmp_path: Path) -> None:
     """The example pile (examples/cases/pile_2d.yaml: 30 discs and hexagons packed from size
-    distributions, each grain its own mesh size) on 3 ranks, 2,000 steps: each rank's
+    distributions, each grain its own mesh size) on 2 ranks, 2,000 steps: each rank's
     time-step probe builds its own grains and each material's coarsest, and finds the contact
     estimate against every grain as a partner (their summaries gathered), so the time step,
     and with it every frame and history column but the searches, is the serial run's."""
     case = Path(__file__).parents[1] / "examples" / "cases" / "pile_2d.yaml"
-    for ranks, name in ((1, "serial"), (3, "ranks")):
+    for ranks, name in ((1, "serial"), (2, "ranks")):
         done = granulate(tmp_path, "--out", name, "--steps", "2000", ranks=ranks, case=case)
         assert done.returncode == 0, done.stderr
     assert differing(tmp_path / "serial", tmp_path / "ranks") == []
@@ -217,7 +218,7 @@ def test_a_polydisperse_pile_runs_on_ranks_at_the_serial_time_step(tmp_path: Pat
 def test_a_peridem_deck_with_peridems_damping_runs_on_ranks(tmp_path: Path) -> None:
     """PeriDEM's small compression deck with its contact damping on (Damping_On: true) under
     --peridem-compat (PeriDEM's damping between particle centres, and from its wall particles'
-    nodes) on 3 ranks, 3,000 steps (the damping changes the run from step 2,000: 4 to 16 of
+    nodes) on 2 ranks, 3,000 steps (the damping changes the run from step 2,000: 4 to 16 of
     history.csv's columns differ from the undamped run's at each row from there): the serial
     run's frames and tables, and history.csv's every column but the searches, which a part of
     fewer nodes makes less often (162 serially against 147 on 2 ranks and 123 on 3 over the
@@ -228,7 +229,7 @@ def test_a_peridem_deck_with_peridems_damping_runs_on_ranks(tmp_path: Path) -> N
 
     deck = broken_deck(tmp_path, "compression_small_set", damped)
     assert deck.read_text().count("Damping_On: true") == 8
-    for ranks, name in ((1, "serial"), (3, "ranks")):
+    for ranks, name in ((1, "serial"), (2, "ranks")):
         arguments = ("--out", name, "--steps", "3000", "--peridem-compat")
         done = granulate(tmp_path, *arguments, ranks=ranks, case=deck)
         assert done.returncode == 0, done.stderr
