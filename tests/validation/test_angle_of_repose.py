@@ -38,13 +38,12 @@ def test_the_heap_of_a_collapsed_column_is_steeper_with_friction(full: bool) -> 
     degrees over mu = 0, mu = 0.5 at least 3 over mu = 0 and not below mu = 0.2 by more than a
     degree, and mu_r = 0.3 at least 5 over mu = 0.5 alone. One heap is a noisy measure: on the
     node spheres, changing the damping ratios by 1e-6 (a04e262) moved seed 1's angles from 5.2 /
-    7.4 / 10.6 / 18.5 to 4.8 / 7.6 / 10.0 / 18.9. The smoke test collapses an 8 mm x 24 mm
-    column (28 grains, packing 1) for 0.1 s with mu = 0 and 0.5 and asserts the second at least
-    2 degrees steeper: measured at af1eaf8 3.2 and 11.2 degrees (packing 2: 2.7 and 7.7; with
-    mu_r = 0.3 as well, 22.1 and 23.6). A single heap is noisy: on the node spheres, over
-    packings 1-6, the gaps were 6.1, 2.3, 1.6, 5.2, 8.0 and 3.3; under the surface law packing
-    1's gap is the larger of the two measured, and the smoke test checks the trend's sign with
-    a quarter of it as margin (two packings took 53 s)."""
+    7.4 / 10.6 / 18.5 to 4.8 / 7.6 / 10.0 / 18.9. The smoke test collapses a 6 mm x 18 mm
+    column (12 grains, packing 1) for 0.1 s with mu = 0 and 0.5 and asserts the second at least
+    2 degrees steeper: measured 2.0 and 6.6 degrees (packings 2 and 3: 2.3 and 9.6, 1.7 and
+    4.9), each heap at rest (kinetic energy 1e-4 of the bound) and each run 4 s alone. The 8 mm
+    x 24 mm column (28 grains) gave 3.2 and 11.2 at af1eaf8 in twice the time; on the node
+    spheres, over its packings 1-6, the gaps were 6.1, 2.3, 1.6, 5.2, 8.0 and 3.3."""
     if full:
         angles = [
             np.mean(
@@ -56,5 +55,5 @@ def test_the_heap_of_a_collapsed_column_is_steeper_with_friction(full: bool) -> 
         assert low > none + 1.5 and high > none + 3.0 and high > low - 1.0, angles
         assert rolling > high + 5.0, angles
     else:
-        frictionless, frictional = (settled_angle(mu, 8e-3, 0.1, seed=1) for mu in (0.0, 0.5))
+        frictionless, frictional = (settled_angle(mu, 6e-3, 0.1, seed=1) for mu in (0.0, 0.5))
         assert frictional > frictionless + 2.0, (frictionless, frictional)

@@ -220,7 +220,9 @@ def test_restitution_of_grains_of_different_sizes_meshed_alike(dimension: int, f
     3D: 0.594 / 0.898 / 1.000 at the default stiffness, lateral 0.01-0.03 %; the contact
     layer is just overrun at 0.9 and 1.0 (node pairs within 50-52 % of their contact radius,
     and the run warns). On the node spheres the 3D impact overran it further (e = 0.543 /
-    0.881 / 1.000) and needed stiffness_factor 10 (0.574 / 0.891 / 0.998)."""
+    0.881 / 1.000) and needed stiffness_factor 10 (0.574 / 0.891 / 0.998). The default suite
+    runs in 2D e = 0.6 at 0.05 m/s and e = 1.0 at 1 m/s, in 3D e = 0.6 at 1 m/s (measured
+    0.594; the elastic 3D impact, 1.000, took as long again and runs under --full)."""
     npr = 10 if dimension == 2 else 6
     if full:
         speeds = (0.01, 0.05, 1.0) if dimension == 2 else (0.05, 1.0)  # 3D 0.01 m/s: 150 s each
@@ -231,8 +233,8 @@ def test_restitution_of_grains_of_different_sizes_meshed_alike(dimension: int, f
         cases = [(*impact, e) for impact in impacts for e in (0.6, 0.9, 1.0)]
     elif dimension == 2:  # the slow impact damped, the fast one elastic
         cases = [(0.05, SOFT, 0.5e-3, 1.0, 0.6), (1.0, SOFT, 0.5e-3, 1.0, 1.0)]
-    else:
-        cases = [(1.0, SOFT, 0.5e-3, 1.0, 0.6), (1.0, SOFT, 0.5e-3, 1.0, 1.0)]
+    else:  # the elastic one, as in 2D, under --full
+        cases = [(1.0, SOFT, 0.5e-3, 1.0, 0.6)]
     for speed, material, radius, stiffness_factor, restitution in cases:
         e, _, sim, (a, b), _ = collide(
             dimension,
