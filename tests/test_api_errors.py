@@ -38,6 +38,11 @@ ROCK = {"density": 2500, "youngs_modulus": 5e9, "poisson_ratio": 0.25, "fracture
         (lambda: gr.LoadBalance(threshold=float("nan")), "threshold must be a ratio >= 1"),
         (lambda: gr.LoadBalance(weight="timing"), "weight must be 'work' or 'time'"),
         (lambda: setattr(gr.Simulation(2), "load_balance", 100), "granulate.LoadBalance("),
+        (lambda: gr.LoadBalance.from_text("evry=5"), "did you mean 'every'"),
+        (lambda: gr.LoadBalance.from_text("every=5,,"), "'' is not KEY=VALUE"),
+        (lambda: gr.LoadBalance.from_text("every"), "'every' is not KEY=VALUE"),
+        (lambda: gr.LoadBalance.from_text("every=ten"), "every must be an integer, got 'ten'"),
+        (lambda: gr.LoadBalance.from_text("threshold=high"), "threshold must be a number"),
     ],
 )
 def test_mistakes_in_api_calls_are_input_errors(call, message: str) -> None:
@@ -95,6 +100,16 @@ def test_reprs_say_what_objects_hold() -> None:
     grain = gr.Grain(gr.Disc((0, 0), 1e-3), material, 2e-4, gr.Uniform(0.5e-3, 1e-3))
     packing = gr.pack(gr.Rectangle((0, 0), (0.01, 0.01)), [grain], 10, seed=1)
     assert repr(packing).startswith("Packing(10 particles (10 x Disc); radius")
+
+
+def test_load_balance_reads_what_it_writes_as_text() -> None:
+    """The command line's form (granulate bench --ranks --load-balance): any of the
+    attributes, the others their defaults, inf for a threshold that never cuts."""
+    given = gr.LoadBalance.from_text(" every=50, threshold=inf ")
+    assert given == gr.LoadBalance(every=50, threshold=float("inf"))
+    assert given.as_text() == "every=50,threshold=inf,weight=work"
+    timed = gr.LoadBalance(every=0, threshold=1.05, weight="time")
+    assert gr.LoadBalance.from_text(timed.as_text()) == timed
 
 
 def test_a_settling_criterion_waits_for_its_start_time() -> None:

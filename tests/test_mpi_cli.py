@@ -20,6 +20,7 @@ import numpy as np
 import pytest
 
 from granulate.io.vtu import read_vtu_point_data
+from granulate.load_balance import LoadBalance
 from peridem_decks import broken_deck
 from run_folders import SEARCHES, differing, history, outputs
 from test_mpi import mpiexec
@@ -407,17 +408,37 @@ def test_bench_ranks_shatter_breaks_grains() -> None:
     assert sum(row["grains"] for row in result["rows"]) == 40
 
 
+def test_bench_ranks_follows_the_load_balance_it_is_given() -> None:
+    """`--load-balance every=5` on the quick drum: in the 20 timed steps (21-40) the ranks
+    compare their work at steps 25, 30, 35 and 40 (at the default every 100, never); the
+    result names the settings."""
+    for given, checks in (("every=5", 4), ("threshold=inf", 0)):
+        done = bench_ranks("--case", "drum", "--quick", "--json", "--load-balance", given)
+        assert done.returncode == 0, done.stderr
+        result = json.loads(done.stdout)
+        assert result["load_balance"] == LoadBalance.from_text(given).as_text()
+        assert result["balance_checks"] == checks and result["rebalance_steps"] == []
+
+
 def test_bench_ranks_refuses_what_it_cannot_run_once() -> None:
-    """A case it does not have, or --collect-every without --ranks: one message, exit 2 from
-    every rank."""
-    done = bench_ranks("--case", "lps3d_lattice")
-    assert done.returncode == 2
-    assert done.stderr.count("unknown distributed benchmark case 'lps3d_lattice'") == 1
-    done = subprocess.run(
-        [sys.executable, "-m", "granulate", "bench", "--collect-every", "5"],
-        capture_output=True,
-        text=True,
-        timeout=60,
-    )
-    assert done.returncode == 2
-    assert "go with --ranks" in done.stderr
+    """A case it does not have, a load balance it cannot read, or one for a body cut at node
+    level: one message, exit 2 from every rank. --collect-every or --load-balance without
+    --ranks: one message, exit 2."""
+    refusals = [
+        (("--case", "lps3d_lattice"), "unknown distributed benchmark case 'lps3d_lattice'"),
+        (("--quick", "--load-balance", "evry=5"), "did you mean 'every'"),
+        (("--case", "block", "--load-balance", "every=5"), "--load-balance does not apply"),
+    ]
+    for arguments, message in refusals:
+        done = bench_ranks(*arguments)
+        assert done.returncode == 2, done.stderr
+        assert done.stderr.count(message) == 1, done.stderr
+    for option in (("--collect-every", "5"), ("--load-balance", "every=5")):
+        done = subprocess.run(
+            [sys.executable, "-m", "granulate", "bench", *option],
+            capture_output=True,
+            text=True,
+            timeout=60,
+        )
+        assert done.returncode == 2
+        assert "go with --ranks" in done.stderr

@@ -1,6 +1,7 @@
 """The distributed benchmark: ``mpiexec -n K granulate bench --ranks [--case NAME] [--grains N]
-[--steps S] [--collect-every N] [--json]``, per rank its speed and the shares of its time spent
-communicating (granulate.parallel; benchmarks/distributed.py runs the same).
+[--steps S] [--collect-every N] [--load-balance KEY=VALUE,...] [--json]``, per rank its speed and
+the shares of its time spent communicating (granulate.parallel; benchmarks/distributed.py runs
+the same).
 
 Cases:
 
@@ -32,20 +33,20 @@ prints a table: per rank the grains and nodes it owns at the end, its work then 
 copies and contact list entries weighted: granulate/parallel/work_load.py), the ghost nodes it
 holds besides and those it received a step on average (the caps), the surface normals it
 received a step on average (of the caps' nodes within the normal reach), its owned node-steps
-per second,
-and the shares of its wall-clock time spent in the ghost exchange (and of that, waiting for
-the step's messages after the bond forces it evaluates while they travel: what the overlap
-did not hide), in the checks (a reduction
-after each step, and one within each step whose caps leave ghost nodes out), in picking the
-caps anew, in migrations and, with
-``--collect-every N``, in making an output step every N steps: of whole grains, the step made
-of the ranks' measures of their grains (DistributedRun.step_data, as a run with frames in pieces
-or no frames does at its output steps); of a body cut at node level, the whole state gathered
-into rank 0's simulation (NodeSplitRun.collect, as its outputs do); nothing is written, and
-no row is computed from it; then the migrations (and the steps the ranks rebalanced before)
-and grains handed over, the ghost and cap margins and how often the caps were picked anew.
-With ``--json``, one JSON object instead. On fewer cores than ranks (oversubscribed) the
-shares include waiting for the other ranks and are an upper bound.
+per second, and the shares of its wall-clock time spent in the ghost exchange (and of that,
+waiting for the step's messages after the bond forces it evaluates while they travel: what the
+overlap did not hide), in the checks (a reduction after each step, and one within each step
+whose caps leave ghost nodes out), in picking the caps anew, in migrations and, with
+``--collect-every N``, in making an output step every N steps: of whole grains, the step made of
+the ranks' measures of their grains (DistributedRun.step_data, as a run with frames in pieces or
+no frames does at its output steps); of a body cut at node level, the whole state gathered into
+rank 0's simulation (NodeSplitRun.collect, as its outputs do); nothing is written, and no row is
+computed from it; then the migrations (and the steps the ranks rebalanced before, under
+``--load-balance``'s settings, gr.LoadBalance.from_text, how many times the ranks compared their
+work and the most loaded rank's over the mean at the last comparison) and grains handed over,
+the ghost and cap margins and how often the caps were picked anew. With ``--json``, one JSON
+object instead. On fewer cores than ranks (oversubscribed) the shares include waiting for the
+other ranks and are an upper bound.
 """
 
 from __future__ import annotations
@@ -211,15 +212,26 @@ CASES: dict[str, tuple[Callable[[int], gr.Simulation], int, int]] = {
 
 
 def measure(
-    case: str, grains: int | None, steps: int, collect_every: int, comm: Any, quick: bool = False
+    case: str,
+    grains: int | None,
+    steps: int,
+    collect_every: int,
+    comm: Any,
+    quick: bool = False,
+    load_balance: gr.LoadBalance | None = None,
 ) -> dict[str, Any] | None:
     """Run `case` with `grains` grains (None: its default, or its quick size) for `steps` timed
     steps on the ranks of `comm`, gathering the whole state every `collect_every` steps (0:
-    never). On rank 0 the result (a dict, rows per rank); None on the others. Every rank calls
-    it."""
+    never), under `load_balance` (None: the simulation's default). On rank 0 the result (a
+    dict, rows per rank); None on the others. Every rank calls it."""
     from granulate.parallel import DistributedRun
 
     if case in SPLIT_CASES:
+        if load_balance is not None:
+            raise InputError(
+                f"bench --ranks: case {case!r} is one body cut at node level, whose nodes never "
+                "change hands; --load-balance does not apply"
+            )
         return measure_split(case, grains, steps, collect_every, comm, quick)
     if case not in CASES:
         names = ", ".join([*CASES, *SPLIT_CASES])
@@ -230,11 +242,15 @@ def measure(
         )
     make, default, small = CASES[case]
     grains = grains or (small if quick else default)
+    sim = make(grains)
+    if load_balance is not None:
+        sim.load_balance = load_balance
     with warnings.catch_warnings():
         warnings.filterwarnings("ignore", message="contact.*bodies pressed")  # placed pressed
-        run = DistributedRun(make(grains), comm)
+        run = DistributedRun(sim, comm)
         run.run(20)  # lists built, caches warm
     migrations, handed, rebalanced = run.migrations, run.handed_over, len(run.rebalance_steps)
+    checks = run.balance_checks
     refreshes, received, normals = run.cap_refreshes, run.nodes_received, run.normals_received
     broken = run.broken_bonds()
     wall = _timed(run, steps, collect_every, comm)
@@ -262,7 +278,10 @@ def measure(
         "threads": gr.get_num_threads(),
         "rows": rows,
         "migrations": run.migrations - migrations,
+        "load_balance": sim.load_balance.as_text(),
         "rebalance_steps": run.rebalance_steps[rebalanced:],
+        "balance_checks": run.balance_checks - checks,
+        "work_imbalance": run.work_imbalance,
         "handed_over": run.handed_over - handed,
         "margin": run.margin,
         "margin_widenings": run.margin_widenings,
@@ -354,7 +373,10 @@ def table(result: dict[str, Any]) -> str:
         )
     lines.append(
         f"{result['migrations']} migrations (for the balance before steps "
-        f"{result['rebalance_steps']}), {result['handed_over']} grains handed over in the "
+        f"{result['rebalance_steps']} under {result['load_balance']}: "
+        f"{result['balance_checks']} checks, the most loaded rank "
+        f"{result['work_imbalance']:.3f} times the mean at the last), "
+        f"{result['handed_over']} grains handed over in the "
         f"timed steps; ghost margin {1e3 * result['margin']:.3g} mm (widened "
         f"{result['margin_widenings']} times); cap margin {1e3 * result['cap_margin']:.3g} mm ("
         f"widened {result['cap_margin_widenings']} times), caps picked anew "
@@ -389,11 +411,12 @@ def main(
     collect_every: int,
     quick: bool,
     as_json: bool,
+    load_balance: gr.LoadBalance | None = None,
 ) -> int:
     """`granulate bench --ranks`: measure and print on rank 0 (`steps` None: 300, or 20 with
-    `quick`)."""
+    `quick`; `load_balance` None: the default)."""
     steps = steps if steps is not None else (20 if quick else 300)
-    result = measure(case or "pile3d", grains, steps, collect_every, comm, quick)
+    result = measure(case or "pile3d", grains, steps, collect_every, comm, quick, load_balance)
     if result is not None:
         print(json.dumps(result) if as_json else table(result), flush=True)
     return 0

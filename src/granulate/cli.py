@@ -10,6 +10,7 @@
     granulate schema [--json]                  the case-file reference (or its JSON Schema)
     granulate bench [--quick] [--case NAME ...] [--threads N] [--json] [--contended]
     mpirun -n K granulate bench --ranks [--case NAME] [--steps S] [--grains N] [--collect-every N]
+                                [--load-balance every=N,threshold=T,weight=work|time]
     granulate info                             version, build options, threads
 
 Exit codes: 0 success, 2 invalid input, 1 failed run, 130 interrupted. User errors print one
@@ -37,6 +38,7 @@ from granulate._version import __version__
 from granulate.errors import InputError, InstabilityError
 from granulate.io.files import existing_file
 from granulate.io.run_folder import check_writable
+from granulate.load_balance import LoadBalance
 from granulate.parallel.agreement import RankFailed
 from granulate.parallel.launch import launched_ranks, serial_only_message
 from granulate.progress import ProgressReporter, duration
@@ -333,6 +335,13 @@ def _parser() -> argparse.ArgumentParser:
         default=0,
         help="with --ranks: gather the whole state on rank 0 every N steps (0: never)",
     )
+    bench.add_argument(
+        "--load-balance",
+        metavar="KEY=VALUE,...",
+        help="with --ranks: when the ranks compare their work and cut anew, as gr.LoadBalance "
+        "takes it (default every=100,threshold=1.1,weight=work; weight=time follows the "
+        "measured step seconds)",
+    )
     plot = commands.add_parser("plot", help="PNG plots of a run's history.csv and fragment tables")
     plot.add_argument("directory", type=Path)
     render = commands.add_parser("render", help="PNG images of the particles coloured by damage")
@@ -371,8 +380,11 @@ def _dispatch(options: argparse.Namespace) -> int:
 
         if options.ranks:
             return _bench_ranks(options)
-        if options.steps is not None or options.grains is not None or options.collect_every:
-            raise InputError("bench: --steps, --grains and --collect-every go with --ranks")
+        ranks_only = (options.steps, options.grains, options.load_balance)
+        if any(option is not None for option in ranks_only) or options.collect_every:
+            raise InputError(
+                "bench: --steps, --grains, --collect-every and --load-balance go with --ranks"
+            )
         if options.contended:
             return benchmarks.contended(options.case, options.quick, options.json, options.out)
         return benchmarks.main(options.case, options.quick, None, options.json, options.out)
@@ -399,6 +411,7 @@ def _bench_ranks(options: argparse.Namespace) -> int:
     if options.threads is None:
         threads.set_num_threads(1, adaptive=False)
     case = cases[0] if cases else None
+    balance = options.load_balance
     return bench_ranks.main(
         comm,
         case,
@@ -407,6 +420,7 @@ def _bench_ranks(options: argparse.Namespace) -> int:
         options.collect_every,
         options.quick,
         options.json,
+        None if balance is None else LoadBalance.from_text(balance),
     )
 
 

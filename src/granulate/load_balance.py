@@ -63,6 +63,42 @@ class LoadBalance:
         if self.weight not in ("work", "time"):
             raise InputError(f"LoadBalance: weight must be 'work' or 'time', got {self.weight!r}")
 
+    @classmethod
+    def from_text(cls, text: str) -> LoadBalance:
+        """The settings a command line gives as comma-separated KEY=VALUE pairs of the
+        attributes, any of them (the others their defaults): ``every=50,threshold=1.05``,
+        ``weight=time``, ``threshold=inf``."""
+        values: dict[str, object] = {}
+        for item in text.split(","):
+            key, equals, value = (part.strip() for part in item.partition("="))
+            if not (key and equals and value):
+                raise InputError(
+                    f"LoadBalance {text!r}: {item.strip()!r} is not KEY=VALUE; write e.g. "
+                    "every=100,threshold=1.1,weight=time"
+                )
+            values[key] = _value(key, value)
+        return cls(**values)
+
+    def as_text(self) -> str:
+        """The settings as from_text reads them: ``every=100,threshold=1.1,weight=work``."""
+        return f"every={self.every},threshold={self.threshold!r},weight={self.weight}"
+
     def due(self, step: int) -> bool:
         """Whether the ranks compare their work after `step`."""
         return self.every > 0 and step % self.every == 0
+
+
+def _value(key: str, text: str) -> object:
+    """A LoadBalance attribute's value from its text: every an integer, threshold a number
+    (``inf`` included), anything else the text (LoadBalance names what it does not take)."""
+    kinds: dict[str, tuple[type, str]] = {
+        "every": (int, "an integer"),
+        "threshold": (float, "a number"),
+    }
+    if key not in kinds:
+        return text
+    kind, expected = kinds[key]
+    try:
+        return kind(text)
+    except ValueError:
+        raise InputError(f"LoadBalance: {key} must be {expected}, got {text!r}") from None

@@ -236,8 +236,10 @@ class DistributedRun:
         self.rebalance_steps: list[int] = []
         self._rebalance_due = False
         self._left_imbalance = 1.0  # what the last cut left, by the work it was cut by
-        #: The most loaded rank's work over the mean at the last check (_check_balance).
+        #: The most loaded rank's work over the mean at the last check (_check_balance), and
+        #: how many checks the ranks made.
         self.work_imbalance = 1.0
+        self.balance_checks = 0
         # The wall reactions a loaded checkpoint holds, until the next step evaluates them.
         self._loaded_walls: NDArray[np.float64] | None = None
         self._setup_digest: str | None = None  # of the set-up's fingerprint, made once
@@ -859,6 +861,7 @@ class DistributedRun:
         work = self.owned_work()
         loads = _weighed(self.comm.allgather((work, self._step_scale(work))))
         self.work_imbalance = imbalance(np.array(loads))
+        self.balance_checks += 1
         limit = self._sim.load_balance.threshold * max(1.0, self._left_imbalance)
         self._rebalance_due = self.work_imbalance > limit
         self._migration_due = self._rebalance_due
