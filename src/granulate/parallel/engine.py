@@ -86,7 +86,13 @@ _CAP_TAG = 19
 _BODY = 16  # numbers a body's motion takes in a message: its first node, then 15
 _JOINING = 7  # numbers a node joining a cap takes: its global number, x and v
 #: A step message's sections: breaks (node pairs), bodies, nodes joining the cap.
-_WIDTHS = np.array([2, _BODY, _JOINING])
+_SECTION_WIDTHS = (2, _BODY, _JOINING)
+_WIDTHS = np.array(_SECTION_WIDTHS)
+#: Most steps break no bond and add no node to a cap: these stand for the empty sections.
+_NO_PAIRS = np.zeros((0, 2), np.int64)
+_NO_JOINING = np.zeros((0, _JOINING))
+_NO_REST = np.zeros(0)
+_NO_NODES = np.zeros(0, np.int64)
 
 
 class _Exchange(NamedTuple):
@@ -401,6 +407,11 @@ class DistributedRun:
         rank = self.comm.Get_rank()
         owner = self.partition.owner
         self._node_map = node_map
+        self._firsts_kept: tuple[Any, NDArray[np.float64], NDArray[np.uint32]] = (
+            None,
+            np.zeros(0),
+            np.zeros(0, np.uint32),
+        )
         self._to_global = node_map.kept()  # subsets keep the serial order
         self._owned = self.partition.grains_of(rank)
         ghost_particles = np.flatnonzero(owner[self.held] != rank)  # the part's particle order
@@ -607,15 +618,15 @@ class DistributedRun:
         x, v = core.positions, core.velocities
         pairs = np.asarray([] if broken is None else broken, dtype=np.int64).reshape(-1, 2)
         bodies, rows = self._own_motions(broken is not None)
-        touched = np.unique(pairs)
+        touched = np.unique(pairs) if len(pairs) else pairs.ravel()
         faces = self._faces_out
         normals = core.surface_normals(faces) if broken is not None else np.zeros((len(faces), 3))
         requests = [self.comm.Irecv(box, source=q, tag=_TAG) for q, box in self._inbox.items()]
         overflow, joined = [], {}
         for q, nodes in self._send.items():
-            theirs = self._to_global[pairs[self._sent_to[q][pairs[:, 0]]]]
+            theirs = self._to_global[pairs[self._sent_to[q][pairs[:, 0]]]] if len(pairs) else pairs
             joined[q] = self._joining(q, touched)
-            joining = np.hstack([self._to_global[joined[q], None], x[joined[q]], v[joined[q]]])
+            joining = _joining_rows(self._to_global, joined[q], x, v)
             box = self._outbox[q]
             sections = [theirs, bodies[rows[q]], joining]
             fields = (x[nodes], v[nodes], normals[self._face_rows[q]])
@@ -650,7 +661,7 @@ class DistributedRun:
         given = np.concatenate([np.zeros((0, 3)), *(n for _, _, _, n in received.values())])
         self._grow_caps(exchange.joined, {q: joining for q, (_, _, joining, _) in received.items()})
         motions = np.concatenate([np.zeros((0, _BODY)), *(m for _, m, _, _ in received.values())])
-        first = self._node_map[motions[:, 0].astype(np.int64)].astype(np.uint32)
+        first = self._ghost_firsts(motions[:, 0])
         breaks = (b for b, _, _, _ in received.values())
         ghost_breaks = np.concatenate([np.zeros((0, 2), np.int64), *breaks])
         return (
@@ -668,6 +679,17 @@ class DistributedRun:
             return mine
         anchors = np.asarray(self.local.core.contact_anchors(mine.tolist()), dtype=np.int64)
         return anchors[~self._in_send[q][anchors]]
+
+    def _ghost_firsts(self, nodes: NDArray[np.float64]) -> NDArray[np.uint32]:
+        """The local numbers of the ghost fragments' first nodes (`nodes`, global, as a step's
+        messages carry them), as core.give_ghost_motions takes them. They change only when a
+        grain breaks or the grains are distributed anew, so the last answer is kept."""
+        kept_map, kept_nodes, kept_firsts = self._firsts_kept
+        if kept_map is self._node_map and np.array_equal(kept_nodes, nodes):
+            return kept_firsts
+        firsts = self._node_map[nodes.astype(np.int64)].astype(np.uint32)
+        self._firsts_kept = (self._node_map, nodes.copy(), firsts)
+        return firsts
 
     def _grow_caps(
         self, sent: dict[int, NDArray[np.int64]], received: dict[int, NDArray[np.int64]]
@@ -716,13 +738,14 @@ class DistributedRun:
             field[nodes] = motion[:, 3 * k : 3 * k + 3]
         normals = box[count : count + 3 * len(self._receive_faces[q])].reshape(-1, 3)
         count += normals.size
-        totals = box[count : count + len(_WIDTHS)].astype(np.int64)
-        kept = np.minimum(totals, self._rooms_in[q])
-        rest = np.empty(int(((totals - kept) * _WIDTHS).sum()))
+        totals = [int(total) for total in box[count : count + len(_WIDTHS)]]
+        kept = [min(total, room) for total, room in zip(totals, self._rooms_in[q], strict=True)]
+        missing = [total - k for total, k in zip(totals, kept, strict=True)]
+        rest = np.empty(_numbers(missing)) if any(missing) else _NO_REST
         if len(rest):
             self.comm.Recv(rest, source=q, tag=_REST_TAG)
-        breaks, bodies, joining = _sections(box[count + len(_WIDTHS) :], kept, rest, totals - kept)
-        joined = self._node_map[joining[:, 0].astype(np.int64)]
+        breaks, bodies, joining = _sections(box[count + len(_WIDTHS) :], kept, rest, missing)
+        joined = self._node_map[joining[:, 0].astype(np.int64)] if len(joining) else _NO_NODES
         for k, field in enumerate(fields):
             field[joined] = joining[:, 1 + 3 * k : 4 + 3 * k]
         return breaks.astype(np.int64), bodies, joined, normals
@@ -1309,6 +1332,19 @@ def _faces(model: Any, normal: NDArray[np.int64], cap: NDArray[np.int64]) -> NDA
     return np.asarray(model.bonded_beyond(normal.tolist(), cap.tolist()), dtype=np.int64)
 
 
+def _joining_rows(
+    to_global: NDArray[np.int64],
+    joined: NDArray[np.int64],
+    x: NDArray[np.float64],
+    v: NDArray[np.float64],
+) -> NDArray[np.float64]:
+    """A step message's rows for the nodes `joined` (local) joining a cap: global number, x
+    and v, (k, 7)."""
+    if len(joined) == 0:
+        return _NO_JOINING
+    return np.hstack([to_global[joined, None], x[joined], v[joined]])
+
+
 def _message(nodes: int, faces: int, rooms: NDArray[np.int64]) -> NDArray[np.float64]:
     """A buffer for the largest step message about `nodes` nodes and `faces` normals (_pack):
     their x and v, the normals, the sections' counts, and each section's `rooms` rows."""
@@ -1335,28 +1371,35 @@ def _pack(
     box[count : count + len(sections)] = [len(rows) for rows in sections]
     start, rest = count + len(sections), []
     for rows, room in zip(sections, rooms, strict=True):
+        if len(rows) == 0:  # most steps' breaks and joining nodes
+            continue
         kept = rows[:room].ravel()
         box[start : start + kept.size] = kept
         start += kept.size
-        rest.append(rows[room:].ravel().astype(float))
-    return start, np.concatenate(rest)
+        if len(rows) > room:
+            rest.append(rows[room:].ravel().astype(float))
+    return start, np.concatenate(rest) if rest else _NO_REST
 
 
 def _sections(
-    carried: NDArray[np.float64],
-    kept: NDArray[np.int64],
-    rest: NDArray[np.float64],
-    missing: NDArray[np.int64],
+    carried: NDArray[np.float64], kept: list[int], rest: NDArray[np.float64], missing: list[int]
 ) -> list[NDArray[np.float64]]:
     """The sections of a step's message as _pack wrote them: `kept` rows of each from the
     message (`carried`, after the counts), then `missing` rows of each from the second
     message (`rest`); each (rows, width)."""
     parts, here, there = [], 0, 0
-    for n, m, width in zip(kept, missing, _WIDTHS, strict=True):
-        rows = [carried[here : here + n * width], rest[there : there + m * width]]
-        parts.append(np.concatenate(rows).reshape(-1, width))
+    for n, m, width in zip(kept, missing, _SECTION_WIDTHS, strict=True):
+        rows = carried[here : here + n * width]
+        if m:
+            rows = np.concatenate([rows, rest[there : there + m * width]])
+        parts.append(rows.reshape(-1, width))
         here, there = here + n * width, there + m * width
     return parts
+
+
+def _numbers(rows: list[int]) -> int:
+    """The numbers that `rows` rows of each section of a step's message take."""
+    return sum(n * width for n, width in zip(rows, _SECTION_WIDTHS, strict=True))
 
 
 def _mask(size: int, indices: NDArray[np.int64]) -> NDArray[np.bool_]:
