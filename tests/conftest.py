@@ -32,17 +32,30 @@ def pytest_configure(config: pytest.Config) -> None:
     )
 
 
+#: The test modules that run MPI ranks (mpiexec): queued first.
+MPI_MODULES = ("test_mpi", "test_mpi_cli")
+
+
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
     """Without --full, the variants marked full_only are deselected (counted as such in
-    pytest's summary line). The validation tests, the longest, are queued first, so that the
-    workers end on short tests and finish together (the order of the rest is kept)."""
+    pytest's summary line). The MPI tests are queued first, then the validation tests, the
+    longest, so that the workers end on short tests and finish together (the order of the
+    rest is kept). With --dist load the first quarter of the queue is dealt to the workers in
+    turn, so both start on MPI tests: 2 or 3 ranks beside a serial test oversubscribe the 2
+    cores and slow it, and the suite took 4-5 % less so (two rounds alternating with the
+    validation tests first under worksteal: 305.8 and 325.6 s against 317.0 and 343.9 s)."""
     kept, dropped = [], []
     for item in items:
         full_only = item.get_closest_marker("full_only") is not None
         (dropped if full_only and not config.getoption("--full") else kept).append(item)
     if dropped:
         config.hook.pytest_deselected(items=dropped)
-    kept.sort(key=lambda item: item.get_closest_marker("validation") is None)
+    kept.sort(
+        key=lambda item: (
+            getattr(item.module, "__name__", "") not in MPI_MODULES,
+            item.get_closest_marker("validation") is None,
+        )
+    )
     items[:] = kept
 
 
