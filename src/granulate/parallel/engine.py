@@ -89,7 +89,6 @@ _JOINING = 7  # numbers a node joining a cap takes: its global number, x and v
 _SECTION_WIDTHS = (2, _BODY, _JOINING)
 _WIDTHS = np.array(_SECTION_WIDTHS)
 #: Most steps break no bond and add no node to a cap: these stand for the empty sections.
-_NO_PAIRS = np.zeros((0, 2), np.int64)
 _NO_JOINING = np.zeros((0, _JOINING))
 _NO_REST = np.zeros(0)
 _NO_NODES = np.zeros(0, np.int64)
