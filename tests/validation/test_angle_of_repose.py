@@ -41,9 +41,10 @@ def test_the_heap_of_a_collapsed_column_is_steeper_with_friction(full: bool) -> 
     7.4 / 10.6 / 18.5 to 4.8 / 7.6 / 10.0 / 18.9. The smoke test collapses a 6 mm x 18 mm
     column (12 grains, packing 1) for 0.1 s with mu = 0 and 0.5 and asserts the second at least
     2 degrees steeper: measured 2.0 and 6.6 degrees (packings 2 and 3: 2.3 and 9.6, 1.7 and
-    4.9), each heap at rest (kinetic energy 1e-4 of the bound) and each run 4 s alone. The 8 mm
-    x 24 mm column (28 grains) gave 3.2 and 11.2 at af1eaf8 in twice the time; on the node
-    spheres, over its packings 1-6, the gaps were 6.1, 2.3, 1.6, 5.2, 8.0 and 3.3."""
+    4.9), each heap at rest (kinetic energy 1e-4 of the weight times the width, a hundredth
+    of the bound) and each run 4 s alone. The 8 mm x 24 mm column (28 grains) gave 3.2 and
+    11.2 at af1eaf8 in twice the time; on the node spheres, over its packings 1-6, the gaps
+    were 6.1, 2.3, 1.6, 5.2, 8.0 and 3.3."""
     if full:
         angles = [
             np.mean(
