@@ -88,16 +88,19 @@ class LoadBalance:
         return self.every > 0 and step % self.every == 0
 
 
+#: The attributes whose text is a number: their type, and what the message calls it.
+_NUMBERS: dict[str, tuple[type, str]] = {
+    "every": (int, "an integer"),
+    "threshold": (float, "a number"),
+}
+
+
 def _value(key: str, text: str) -> object:
     """A LoadBalance attribute's value from its text: every an integer, threshold a number
     (``inf`` included), anything else the text (LoadBalance names what it does not take)."""
-    kinds: dict[str, tuple[type, str]] = {
-        "every": (int, "an integer"),
-        "threshold": (float, "a number"),
-    }
-    if key not in kinds:
+    if key not in _NUMBERS:
         return text
-    kind, expected = kinds[key]
+    kind, expected = _NUMBERS[key]
     try:
         return kind(text)
     except ValueError:

@@ -86,12 +86,10 @@ _CAP_TAG = 19
 _BODY = 16  # numbers a body's motion takes in a message: its first node, then 15
 _JOINING = 7  # numbers a node joining a cap takes: its global number, x and v
 #: A step message's sections: breaks (node pairs), bodies, nodes joining the cap.
-_SECTION_WIDTHS = (2, _BODY, _JOINING)
-_WIDTHS = np.array(_SECTION_WIDTHS)
+_WIDTHS = (2, _BODY, _JOINING)
 #: Most steps break no bond and add no node to a cap: these stand for the empty sections.
 _NO_JOINING = np.zeros((0, _JOINING))
 _NO_REST = np.zeros(0)
-_NO_NODES = np.zeros(0, np.int64)
 
 
 class _Exchange(NamedTuple):
@@ -406,11 +404,8 @@ class DistributedRun:
         rank = self.comm.Get_rank()
         owner = self.partition.owner
         self._node_map = node_map
-        self._firsts_kept: tuple[Any, NDArray[np.float64], NDArray[np.uint32]] = (
-            None,
-            np.zeros(0),
-            np.zeros(0, np.uint32),
-        )
+        # The ghost fragments' first nodes last looked up in node_map, global and local.
+        self._firsts_of, self._firsts = np.zeros(0), np.zeros(0, np.uint32)
         self._to_global = node_map.kept()  # subsets keep the serial order
         self._owned = self.partition.grains_of(rank)
         ghost_particles = np.flatnonzero(owner[self.held] != rank)  # the part's particle order
@@ -682,13 +677,12 @@ class DistributedRun:
     def _ghost_firsts(self, nodes: NDArray[np.float64]) -> NDArray[np.uint32]:
         """The local numbers of the ghost fragments' first nodes (`nodes`, global, as a step's
         messages carry them), as core.give_ghost_motions takes them. They change only when a
-        grain breaks or the grains are distributed anew, so the last answer is kept."""
-        kept_map, kept_nodes, kept_firsts = self._firsts_kept
-        if kept_map is self._node_map and np.array_equal(kept_nodes, nodes):
-            return kept_firsts
-        firsts = self._node_map[nodes.astype(np.int64)].astype(np.uint32)
-        self._firsts_kept = (self._node_map, nodes.copy(), firsts)
-        return firsts
+        grain breaks or the grains are distributed anew (_plan forgets it), so the last answer
+        is kept."""
+        if not np.array_equal(self._firsts_of, nodes):
+            self._firsts = self._node_map[nodes.astype(np.int64)].astype(np.uint32)
+            self._firsts_of = nodes.copy()
+        return self._firsts
 
     def _grow_caps(
         self, sent: dict[int, NDArray[np.int64]], received: dict[int, NDArray[np.int64]]
@@ -744,7 +738,7 @@ class DistributedRun:
         if len(rest):
             self.comm.Recv(rest, source=q, tag=_REST_TAG)
         breaks, bodies, joining = _sections(box[count + len(_WIDTHS) :], kept, rest, missing)
-        joined = self._node_map[joining[:, 0].astype(np.int64)] if len(joining) else _NO_NODES
+        joined = self._node_map[joining[:, 0].astype(np.int64)]
         for k, field in enumerate(fields):
             field[joined] = joining[:, 1 + 3 * k : 4 + 3 * k]
         return breaks.astype(np.int64), bodies, joined, normals
@@ -1347,7 +1341,7 @@ def _joining_rows(
 def _message(nodes: int, faces: int, rooms: NDArray[np.int64]) -> NDArray[np.float64]:
     """A buffer for the largest step message about `nodes` nodes and `faces` normals (_pack):
     their x and v, the normals, the sections' counts, and each section's `rooms` rows."""
-    return np.empty(6 * nodes + 3 * faces + len(_WIDTHS) + int((rooms * _WIDTHS).sum()))
+    return np.empty(6 * nodes + 3 * faces + len(_WIDTHS) + int(_numbers(rooms)))
 
 
 def _pack(
@@ -1387,7 +1381,7 @@ def _sections(
     message (`carried`, after the counts), then `missing` rows of each from the second
     message (`rest`); each (rows, width)."""
     parts, here, there = [], 0, 0
-    for n, m, width in zip(kept, missing, _SECTION_WIDTHS, strict=True):
+    for n, m, width in zip(kept, missing, _WIDTHS, strict=True):
         rows = carried[here : here + n * width]
         if m:
             rows = np.concatenate([rows, rest[there : there + m * width]])
@@ -1396,9 +1390,9 @@ def _sections(
     return parts
 
 
-def _numbers(rows: list[int]) -> int:
+def _numbers(rows: Sequence[int] | NDArray[np.int64]) -> int:
     """The numbers that `rows` rows of each section of a step's message take."""
-    return sum(n * width for n, width in zip(rows, _SECTION_WIDTHS, strict=True))
+    return sum(n * width for n, width in zip(rows, _WIDTHS, strict=True))
 
 
 def _mask(size: int, indices: NDArray[np.int64]) -> NDArray[np.bool_]:
