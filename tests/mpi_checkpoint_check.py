@@ -190,14 +190,14 @@ def check_failed_save(folder: Path, comm: MPI.Comm, failure: str) -> int:
 
 def check_command_line(folder: Path, comm: MPI.Comm, pieces: bool) -> int:
     """0 when `granulate run` of the drum case, its frames in pieces (`pieces`) or each in one
-    file, cut short at step 1,700 (its checkpoints in pieces, at 1,000 and at the end) and
-    resumed to step 3,000, never builds rank 0's whole simulation (the only one given the
+    file, cut short at step 850 (its checkpoints in pieces, at 500 and at the end) and
+    resumed to step 1,500, never builds rank 0's whole simulation (the only one given the
     communicator), and both commands succeed."""
     case = folder / "drum.yaml"
     if comm.Get_rank() == 0:
         text = (Path(__file__).parent / "cases" / "drum_mpi.yaml").read_text()
         if pieces:
-            text = text.replace("output: {every: 250}", "output: {every: 250, pieces: true}")
+            text = text.replace("output: {every: 125}", "output: {every: 125, pieces: true}")
         case.write_text(text)
     comm.Barrier()
     builds = []
@@ -213,7 +213,7 @@ def check_command_line(folder: Path, comm: MPI.Comm, pieces: bool) -> int:
     gr.Simulation._build = watched  # type: ignore[method-assign]
     out = ["--out", str(folder / "out"), "--quiet"]
     codes = [
-        cli.main(["run", str(case), *out, "--steps", "1700"]),
+        cli.main(["run", str(case), *out, "--steps", "850"]),
         cli.main(["run", str(case), *out, "--resume"]),
     ]
     gr.Simulation._build = build  # type: ignore[method-assign]
@@ -222,7 +222,7 @@ def check_command_line(folder: Path, comm: MPI.Comm, pieces: bool) -> int:
         return 0
     files = pieces_of(folder / "out" / "checkpoint.npz")
     print(f"exit codes {codes}; rank 0's whole builds {every_build[0]}; checkpoint {files}")
-    at_end = len(files) == comm.Get_size() and all(f.startswith("3000-") for f in files)
+    at_end = len(files) == comm.Get_size() and all(f.startswith("1500-") for f in files)
     return 0 if codes == [0, 0] and not every_build[0] and at_end else 1
 
 

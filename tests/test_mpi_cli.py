@@ -4,7 +4,7 @@ across restarts on another number of ranks; errors reported once, every rank end
 
 The case (tests/cases/drum_mpi.yaml) is the checkpoint tests' drum: four grains tumbling and
 breaking in a turning drum with a lifter, the surface law, friction, a moving wall; its grains
-migrate between the ranks many times in its 3,000 steps. Also: its frames in pieces, the
+migrate between the ranks many times in its 1,500 steps. Also: its frames in pieces, the
 example pile (grains of many sizes) and PeriDEM's compression deck under --peridem-compat."""
 
 from __future__ import annotations
@@ -59,8 +59,8 @@ def assert_same_history(
     its own part (whose nodes and cap nodes, fewer than the run's, call for a search less
     often): they lie between half the serial run's and `searches_within` (20 %) more, or within
     5 (None: not compared); the drum cut short and resumed on other numbers of ranks made 106
-    against 135 once the caps held only the anchors. `row_count` rows (13: steps 0, 250, ...,
-    3000)."""
+    against 135 once the caps held only the anchors (over 3,000 steps). `row_count` rows (13:
+    steps 0, 125, ..., 1500)."""
     rows, serial_rows = history(distributed), history(serial)
     assert len(rows) == len(serial_rows) == row_count
     for row, serial_row in zip(rows, serial_rows, strict=True):
@@ -90,21 +90,21 @@ def test_a_case_on_k_ranks_writes_the_serial_runs_outputs(
     grains pressed into each other, the deepest over every rank's part)."""
     done = granulate(tmp_path, "--out", "out", ranks=ranks)
     assert done.returncode == 0, done.stderr
-    assert done.stdout.count("finished at step 3000") == 1
+    assert done.stdout.count("finished at step 1500") == 1
     assert "bodies pressed" in done.stderr
     assert done.stderr == (serial_run.parent / "warnings.txt").read_text()
     assert_same_run(serial_run, tmp_path / "out")
 
 
 def test_a_serial_run_restarts_on_ranks(serial_run: Path, tmp_path: Path) -> None:
-    """Cut short serially at step 1,200 and resumed on 2 ranks: the folder ends as the
+    """Cut short serially at step 600 and resumed on 2 ranks: the folder ends as the
     uninterrupted serial run's. (Ranks to fewer ranks: the frames in pieces' test; serially
     to 3 ranks: the node-level cut's.)"""
-    cut = granulate(tmp_path, "--out", "out", "--steps", "1200")
+    cut = granulate(tmp_path, "--out", "out", "--steps", "600")
     assert cut.returncode == 0, cut.stderr
     resumed = granulate(tmp_path, "--out", "out", "--resume", ranks=2)
     assert resumed.returncode == 0, resumed.stderr
-    assert "resuming from step 1200" in resumed.stdout
+    assert "resuming from step 600" in resumed.stdout
     assert_same_run(serial_run, tmp_path / "out")
 
 
@@ -127,7 +127,7 @@ def test_a_time_step_above_the_stable_estimate_is_warned_of_once(tmp_path: Path)
     on."""
     case = tmp_path / "drum_dt.yaml"
     case.write_text(
-        CASE.read_text().replace("time: {steps: 3000}", "time: {steps: 20, dt: 1.2e-6}")
+        CASE.read_text().replace("time: {steps: 1500}", "time: {steps: 20, dt: 1.2e-6}")
     )
     done = granulate(tmp_path, "--out", "out", ranks=3, case=case)
     assert done.returncode == 0, done.stderr
@@ -141,7 +141,7 @@ def test_the_steps_contact_gave_way_are_the_serial_runs(tmp_path: Path) -> None:
     printed are those at the end of the chunk that saw it, which depends on timing."""
     case = tmp_path / "drum_fast.yaml"
     text = CASE.read_text().replace("velocity: [0.3, -4.0]}", "velocity: [300.0, -4.0]}")
-    case.write_text(text.replace("time: {steps: 3000}", "time: {steps: 300}"))
+    case.write_text(text.replace("time: {steps: 1500}", "time: {steps: 300}"))
     said = []
     for ranks, name in ((1, "serial"), (3, "ranks")):
         done = granulate(tmp_path, "--out", name, ranks=ranks, case=case)
@@ -153,32 +153,32 @@ def test_the_steps_contact_gave_way_are_the_serial_runs(tmp_path: Path) -> None:
 def test_a_case_restarting_from_a_frame_runs_on_ranks(serial_run: Path, tmp_path: Path) -> None:
     """`restart:` (positions and velocities of the serial run's frame at step 1,000, bonds
     intact) on 2 ranks writes what the same case writes serially, from step 1,000 on."""
-    frame = serial_run / "frames" / "frame_000004.vtu"
+    frame = serial_run / "frames" / "frame_000008.vtu"
     case = tmp_path / "drum_restart.yaml"
-    text = CASE.read_text().replace("time: {steps: 3000}", "time: {steps: 1500}")
+    text = CASE.read_text().replace("time: {steps: 1500}", "time: {steps: 1250}")
     case.write_text(text + f"restart: {{file: {frame}, step: 1000}}\n")
     for ranks, name in ((1, "serial"), (2, "ranks")):
         done = granulate(tmp_path, "--out", name, ranks=ranks, case=case)
         assert done.returncode == 0, done.stderr
-    assert [row["step"] for row in history(tmp_path / "serial")] == ["1000", "1250", "1500"]
+    assert [row["step"] for row in history(tmp_path / "serial")] == ["1000", "1125", "1250"]
     assert_same_run(tmp_path / "serial", tmp_path / "ranks", row_count=3)
 
 
 def test_frames_in_pieces_join_to_the_serial_runs_frames(serial_run: Path, tmp_path: Path) -> None:
-    """`output: {pieces: true}`, cut short on 3 ranks at step 1,700 and resumed on 2: each frame
-    a .pvtu over one piece per rank (3 up to step 1,500, then 2), each of the nodes that rank
+    """`output: {pieces: true}`, cut short on 3 ranks at step 850 and resumed on 2: each frame
+    a .pvtu over one piece per rank (3 up to step 750, then 2), each of the nodes that rank
     owns (every node in one piece, its number the serial run's), which joined
     (read_vtu_point_data, as Results reads them) are the uninterrupted serial run's one-file
     frames bit for bit; the other files and history.csv are the serial run's."""
     case = tmp_path / "drum_pieces.yaml"
     case.write_text(
-        CASE.read_text().replace("output: {every: 250}", "output: {every: 250, pieces: true}")
+        CASE.read_text().replace("output: {every: 125}", "output: {every: 125, pieces: true}")
     )
-    cut = granulate(tmp_path, "--out", "out", "--steps", "1700", ranks=3, case=case)
+    cut = granulate(tmp_path, "--out", "out", "--steps", "850", ranks=3, case=case)
     assert cut.returncode == 0, cut.stderr
     resumed = granulate(tmp_path, "--out", "out", "--resume", ranks=2, case=case)
     assert resumed.returncode == 0, resumed.stderr
-    assert "resuming from step 1700" in resumed.stdout
+    assert "resuming from step 850" in resumed.stdout
     frames = tmp_path / "out" / "frames"
     for k in range(13):
         expected = read_vtu_point_data(serial_run / "frames" / f"frame_{k:06d}.vtu")
@@ -256,16 +256,16 @@ def test_one_body_is_cut_at_node_level_and_writes_the_serial_runs_outputs(
     nodes dealt to the ranks (granulate.parallel.node_split; whole grains could not give two
     ranks one body each), it breaks in two as serially, and every frame (Fragment_ID
     included), table, checkpoint and history row is the serial run's. Cut short on 3 ranks at
-    step 1,300 and resumed on 2, and serially at step 700 and resumed on 3, so that 2 and 3
+    step 650 and resumed on 2, and serially at step 350 and resumed on 3, so that 2 and 3
     ranks each write part of both runs."""
     assert history(serial_plate)[-1]["fragments"] == "2"
-    for first, second, steps, name in ((3, 2, "1300", "a"), (1, 3, "700", "b")):
+    for first, second, steps, name in ((3, 2, "650", "a"), (1, 3, "350", "b")):
         cut = granulate(tmp_path, "--out", name, "--steps", steps, ranks=first, case=PLATE)
         assert cut.returncode == 0, cut.stderr
         resumed = granulate(tmp_path, "--out", name, "--resume", ranks=second, case=PLATE)
         assert resumed.returncode == 0, resumed.stderr
         assert f"resuming from step {steps}" in resumed.stdout
-        assert resumed.stdout.count("finished at step 2000") == 1
+        assert resumed.stdout.count("finished at step 1000") == 1
         assert_same_run(serial_plate, tmp_path / name, row_count=11)
 
 
@@ -277,7 +277,7 @@ def test_a_body_cut_at_node_level_writes_frames_in_pieces(
     joined are the serial run's frames bit for bit."""
     case = tmp_path / "plate_pieces.yaml"
     case.write_text(
-        PLATE.read_text().replace("output: {every: 200,", "output: {every: 200, pieces: true,")
+        PLATE.read_text().replace("output: {every: 100,", "output: {every: 100, pieces: true,")
     )
     done = granulate(tmp_path, "--out", "out", ranks=3, case=case)
     assert done.returncode == 0, done.stderr
