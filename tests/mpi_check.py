@@ -1,11 +1,11 @@
 """Run under `mpiexec -n K python tests/mpi_check.py DIMENSION STEPS` (tests/test_mpi.py does):
-the locality test's assembly (tests/test_locality.py: grains pressed into each other and thrown
+the locality test's assembly (tests/assemblies.py: grains pressed into each other and thrown
 at each other, friction, damping, the surface law), here also under gravity on a floor, run
 serially on every rank and distributed over the K ranks (granulate.parallel.DistributedRun).
 Rank 0 compares the two bit for bit and prints one line; the exit status is non-zero on any
 difference.
 
-`... drum VARIANT STEPS [renew]` runs the checkpoint tests' tumbling drum (tests/test_checkpoint.py:
+`... drum VARIANT STEPS [renew]` runs the checkpoint tests' tumbling drum (tests/assemblies.py:
 four grains tumbling and breaking in a rotating drum with a lifter; VARIANT lattice, grid,
 surface or rolling) the same way: the grains move far, so the ranks migrate them many times,
 handing grains over with their bonds, collisions and friction springs (with `renew`, every
@@ -62,12 +62,11 @@ from mpi4py import MPI
 
 sys.path.insert(0, str(Path(__file__).parent))
 import granulate as gr
+from assemblies import RADIUS, assembly, layout, rock, tumbling_drum
 from granulate import checkpoints, core_model, resources
 from granulate.parallel import DistributedRun
 from rank_zero import on_rank_0, wait_asleep
 from run_folders import SEARCHES, differing, history
-from test_checkpoint import tumbling_drum
-from test_locality import RADIUS, assembly, layout, rock
 
 
 def set_up(dimension: int) -> gr.Simulation:
@@ -140,7 +139,7 @@ DRUMS: dict[str, dict[str, Any]] = {
 
 
 def drum(variant: str, folder: Path) -> gr.Simulation:
-    """The tumbling drum of tests/test_checkpoint.py (its outputs planned in `folder`, not
+    """The tumbling drum of tests/assemblies.py (its outputs planned in `folder`, not
     written: the runs here call the core)."""
     return tumbling_drum(folder, **DRUMS[variant])
 

@@ -1,6 +1,6 @@
 """Run under `mpiexec -n K python tests/mpi_checkpoint_check.py CASE` (tests/test_mpi.py does):
 a distributed run's checkpoint in pieces (granulate/parallel/checkpoint_pieces.py) on the
-checkpoint tests' tumbling drum (tests/test_checkpoint.py). Rank 0 prints one line; the exit
+checkpoint tests' tumbling drum (tests/assemblies.py). Rank 0 prints one line; the exit
 status is non-zero when the check fails.
 
 `pieces`: a checkpoint of 600 steps written on K - 1 ranks is a header and one piece per rank;
@@ -39,11 +39,11 @@ from mpi4py import MPI
 
 sys.path.insert(0, str(Path(__file__).parent))
 import granulate as gr
+from assemblies import tumbling_drum
 from granulate import checkpoints, cli
 from granulate.io import checkpoint as checkpoint_file
 from granulate.parallel import DistributedRun, checkpoint_pieces
 from rank_zero import wait_asleep
-from test_checkpoint import tumbling_drum
 
 
 def pieces_of(path: Path) -> list[str]:

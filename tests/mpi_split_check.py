@@ -4,7 +4,7 @@ velocity, force and dilatation, the bonds broken, and each rank's halo.
 
     mpiexec -n K python tests/mpi_split_check.py SHAPE MODEL STEPS
 
-SHAPE and MODEL as tests/test_node_split.py's `pulled` takes them (plate, strip or block; lps
+SHAPE and MODEL as tests/assemblies.py's `pulled` takes them (plate, strip or block; lps
 or pmb)."""
 
 from __future__ import annotations
@@ -14,9 +14,9 @@ import sys
 import numpy as np
 from mpi4py import MPI
 
+from assemblies import pulled
 from granulate.parallel.node_split import NodeSplitRun
 from rank_zero import wait_asleep
-from test_node_split import pulled
 
 FIELDS = ("positions", "velocities", "forces", "dilatation")
 

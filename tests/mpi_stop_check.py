@@ -2,8 +2,8 @@
 does): the stop criteria's measures of a distributed run (parallel/run_measures.py) against
 the serial run's, bit for bit, and runs that stop on them at the serial run's step.
 
-ENGINE `grains` is the tumbling drum with a grid-meshed brittle grain (tests/test_checkpoint.py,
-whole grains per rank); `split` the notched plate pulled apart (tests/test_node_split.py, its
+ENGINE `grains` is the tumbling drum with a grid-meshed brittle grain (tests/assemblies.py,
+whole grains per rank); `split` the notched plate pulled apart (tests/assemblies.py, its
 one body cut at node level). Rank 0 prints one line per part and the exit status is non-zero
 on any difference:
 - measures: every 100 steps, the ranks' kinetic energy, farthest node, broken bonds, particles
@@ -42,6 +42,7 @@ from mpi4py import MPI
 
 sys.path.insert(0, str(Path(__file__).parent))
 import granulate as gr
+from assemblies import pulled, tumbling_drum
 from granulate import core_model
 from granulate.parallel import DistributedRun
 from granulate.parallel.node_split import NodeSplitRun
@@ -49,8 +50,6 @@ from granulate.writers import registry
 from granulate.writers.step_data import StepData
 from rank_zero import on_rank_0, wait_asleep
 from run_folders import SEARCHES, history, outputs
-from test_checkpoint import tumbling_drum
-from test_node_split import pulled
 
 CHECK_EVERY = 100
 MEASURES = (

@@ -15,53 +15,7 @@ import numpy as np
 import pytest
 
 import granulate as gr
-
-
-def tumbling_drum(
-    out: Path,
-    *,
-    resume: bool = False,
-    grid: bool = False,
-    law: str = "granulate",
-    rolling: float = 0.0,
-    comm: object | None = None,
-    fracture: bool = True,
-    outputs: bool = True,
-) -> gr.Simulation:
-    """Grains breaking in a rotating drum: contact, friction, damping, walls and fracture.
-    ``grid``: the fourth grain is a brittle grid-meshed square instead of a lattice triangle:
-    its surface nodes have their contact spheres centred inside them (surface anchors), and
-    they lose them as its bonds break (it is damaged all through by step 2,000). ``law``: the
-    contact's pair_law ("surface": probes of the grains' smooth surfaces, with their groups
-    and the nodes opened by cracks joining the lists). ``rolling``: mu_r, the rolling
-    resistance (its springs carried through the checkpoint). ``comm``: run it on MPI ranks
-    (tests/mpi_check.py). ``fracture``: False makes the grains unbreakable. ``outputs``: False
-    plans no outputs or checkpoints."""
-    rock = gr.Material(
-        density=2000, youngs_modulus=1e8, poisson_ratio=0.25, fracture_energy=0.5, fracture=fracture
-    )
-    sim = gr.Simulation(2, gravity=(0, -9.81), comm=comm)
-    sim.contact = gr.Contact(restitution=0.5, friction=0.4, pair_law=law, rolling_friction=rolling)
-    for k, (x, y) in enumerate([(-3e-3, -2e-3), (0, -4e-3), (3e-3, -2e-3), (0, 0)]):
-        velocity = (0.2 * k - 0.3, -4.0)
-        if k == 3 and grid:
-            square = gr.Rectangle((-1e-3, -1e-3), (1e-3, 1e-3))
-            brittle = rock.model_copy(update={"fracture_energy": 0.07})
-            sim.add_body(square, brittle, 0.3e-3, velocity=velocity, discretization="grid")
-            continue
-        shape = (
-            gr.Disc((x, y), 1.2e-3)
-            if k < 3
-            else gr.Polygon(((-1e-3, -1e-3), (1.2e-3, -1e-3), (0, 1.3e-3)))
-        )
-        sim.add_body(shape, rock, 0.3e-3, velocity=velocity)
-    lifter = gr.PolygonObstacle(((-1e-3, -7.5e-3), (1e-3, -7.5e-3), (0, -5.5e-3)))
-    drum = gr.Wall((gr.CircleContainer((0, 0), 7e-3), lifter), motion=gr.Rotation.steady(30.0))
-    sim.add_wall(drum, name="drum")
-    if outputs:
-        sim.output(out, every=250, overwrite=not resume, resume=resume)
-        sim.checkpoint_every(1000)
-    return sim
+from assemblies import tumbling_drum
 
 
 def output_files(directory: Path) -> list[str]:

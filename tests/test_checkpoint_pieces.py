@@ -12,12 +12,12 @@ import numpy as np
 import pytest
 
 import granulate as gr
+from assemblies import tumbling_drum
 from granulate import checkpoints, fingerprints
 from granulate.io import checkpoint as checkpoint_file
 from granulate.io.run_folder import CHECKPOINT_PIECES
 from granulate.parallel import checkpoint_pieces
 from granulate.parallel.transplant import GrainState, grain_states
-from test_checkpoint import tumbling_drum
 
 
 @pytest.fixture(scope="module")

@@ -18,63 +18,8 @@ import numpy as np
 import pytest
 
 import granulate as gr
+from assemblies import RADIUS, assembly, layout, pulled, tumbling_drum
 from granulate import core_model
-from test_checkpoint import tumbling_drum
-from test_node_split import pulled
-
-RADIUS = 1e-3
-
-
-def rock(horizon: float, fracture_energy: float = 50) -> gr.Material:
-    """The grains' material (a soft rock), with this horizon [m] and fracture energy [J/m^2]."""
-    return gr.Material(
-        density=1200,
-        bulk_modulus=2.16e7,
-        shear_modulus=1.296e7,
-        fracture_energy=fracture_energy,
-        horizon=horizon,
-    )
-
-
-ROCK = rock(0.6e-3)
-
-
-def layout(dimension: int) -> tuple[np.ndarray, np.ndarray]:
-    """Centres on a hexagonal (2D) or cubic (3D) lattice 1.9 mm apart, radii 0.98-1 mm (so the
-    grains are pressed up to 0.1 mm into each other), and a velocity of up to 0.5 m/s each."""
-    rng = np.random.default_rng(7)
-    spacing = 1.9 * RADIUS
-    if dimension == 2:
-        rows, columns = np.meshgrid(np.arange(9), np.arange(10), indexing="ij")
-        x = spacing * (columns + 0.5 * (rows % 2))
-        y = spacing * np.sqrt(3) / 2 * rows
-        centres = np.column_stack([x.ravel(), y.ravel()])
-    else:
-        grid = np.meshgrid(*(np.arange(5),) * 3, indexing="ij")
-        centres = spacing * np.column_stack([g.ravel() for g in grid]).astype(float)
-    radii = RADIUS * rng.uniform(0.98, 1.0, len(centres))
-    velocities = rng.uniform(-0.5, 0.5, (len(centres), dimension))
-    return centres, np.column_stack([radii[:, None], velocities])
-
-
-def assembly(dimension: int, keep: np.ndarray, dt: float | None = None) -> gr.Simulation:
-    """The grains `keep` (in their order) with friction and damping; hexagons among the discs."""
-    centres, rows = layout(dimension)
-    sim = gr.Simulation(dimension)
-    sim.contact = gr.Contact(restitution=0.6, friction=0.5)
-    h = RADIUS / 5 if dimension == 2 else RADIUS / 3
-    for k in keep:
-        radius, velocity = rows[k, 0], rows[k, 1:]
-        if dimension == 3:
-            shape = gr.Sphere(tuple(centres[k]), radius)
-        elif k % 3 == 0:
-            shape = gr.RegularPolygon(tuple(centres[k]), radius, 6, angle=0.3 * k)
-        else:
-            shape = gr.Disc(tuple(centres[k]), radius)
-        sim.add_body(shape, ROCK, h, velocity=velocity)
-    if dt is not None:
-        sim.dt = dt  # the stable estimate is the whole assembly's: a distributed run reduces it
-    return sim
 
 
 @pytest.mark.filterwarnings("ignore:contact.*bodies pressed")  # placed pressed, on purpose

@@ -20,57 +20,8 @@ import numpy as np
 import pytest
 
 import granulate as gr
+from assemblies import GLASS, pulled
 from granulate import core_model
-
-RATE = 60.0  # the strain rate [1/s]
-GLASS = dict(density=2500, youngs_modulus=70e9, poisson_ratio=0.22, fracture_energy=8.0)
-
-
-def pulled(shape: str, model: str, comm: object | None = None) -> gr.Simulation:
-    """A notched plate or strip (2D, plane stress) or block (3D) of glass stretched along its
-    length at the strain rate RATE: each node starts at v = RATE (x - c) along it (c its
-    centre) and its ends keep their speed (0.6 m/s for the plate), so it deforms throughout and
-    cracks from the notch within a few hundred steps. The strip stands upright, 10 nodes wide
-    across the lattice's numbering, so that its nodes gather (each evaluates all its bonds;
-    Model.particle_gathers); the plate's and the block's evaluate each bond once. ``comm``: run
-    it on MPI ranks (tests/mpi_stop_check.py)."""
-    poisson = {"pmb": 1 / 3, "lps": 0.22}[model]  # PMB's own in plane stress
-    glass = gr.Material(**{**GLASS, "poisson_ratio": poisson}, model=model)
-    axis = 1 if shape == "strip" else 0
-    if shape == "plate":
-        sim = gr.Simulation(dimension=2, plane="stress", comm=comm)
-        notch = gr.Rectangle((9.5e-3, 6e-3), (10.5e-3, 1))
-        sim.add_body(
-            gr.Difference(gr.Rectangle((0, 0), (0.02, 0.01)), notch), glass, mesh_size=0.4e-3
-        )
-        ends = gr.Rectangle((-1, -1), (1e-3, 1)), gr.Rectangle((19e-3, -1), (1, 1))
-    elif shape == "strip":
-        sim = gr.Simulation(dimension=2, plane="stress", comm=comm)
-        notch = gr.Rectangle((2.4e-3, 9.5e-3), (1, 10.5e-3))
-        sim.add_body(
-            gr.Difference(gr.Rectangle((0, 0), (4e-3, 0.02)), notch), glass, mesh_size=0.4e-3
-        )
-        ends = gr.Rectangle((-1, -1), (1, 1e-3)), gr.Rectangle((-1, 19e-3), (1, 1))
-    else:
-        sim = gr.Simulation(dimension=3, comm=comm)
-        notch = gr.Box((4.7e-3, 3e-3, -1), (5.3e-3, 1, 1))
-        sim.add_body(
-            gr.Difference(gr.Box((0, 0, 0), (0.01, 5e-3, 3e-3)), notch), glass, mesh_size=0.5e-3
-        )
-        ends = gr.Box((-1, -1, -1), (0.6e-3, 1, 1)), gr.Box((9.4e-3, -1, -1), (1, 1, 1))
-    sim.contact = None
-    start = np.asarray(sim.reference_positions)
-    x = start[:, axis]
-    centre = 0.5 * (x.min() + x.max())
-    velocities = np.zeros_like(start)
-    velocities[:, axis] = RATE * (x - centre)
-    sim.start_from(start, velocities)
-    for end in ends:
-        nodes = sim.select(end)
-        velocity = np.zeros(sim.dimension)
-        velocity[axis] = RATE * (x[nodes].mean() - centre)
-        sim.prescribe_velocity(nodes, tuple(velocity))
-    return sim
 
 
 def parts_of(sim: gr.Simulation, parts: int, dealt: str) -> np.ndarray:

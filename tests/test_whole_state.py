@@ -11,9 +11,9 @@ import numpy as np
 import pytest
 
 import granulate as gr
+from assemblies import tumbling_drum
 from granulate.analysis import GivenMeasures
 from granulate.parallel.whole_state import require_room
-from test_checkpoint import tumbling_drum
 
 
 @pytest.mark.parametrize("options", [{}, {"grid": True, "law": "surface"}])
