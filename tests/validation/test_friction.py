@@ -277,12 +277,13 @@ def test_a_stack_of_discs_stands_where_rigid_statics_lets_it() -> None:
     push (0.5 - 0.866 mu) / (1.732 + mu) of the top disc's weight W against mu 1.5 W: they
     stand if 1.5 mu^2 + 3.464 mu >= 0.5, mu >= 0.136, whatever mu_r. Measured (height of the
     top disc over R; standing is 1 + sqrt(3) = 2.73 less the overlaps): mu = 0.5 stands, 2.685
-    at 0.04 s, settling to 2.641 at 0.10 s and 2.642 at 0.12 s; mu = 0.2 collapses, 0.999 at
-    0.115 s; mu = 0.2 with mu_r = 0.5 stands, 2.707 from 0.03 s to 0.06 s; mu = 0.1 with mu_r
-    = 0.5 slides apart, 1.000 at 0.065 s. On the node spheres of pair_law "granulate" the
-    discs' node rows interlock: mu = 0.2 stands (2.592 at 0.15 s), and so did mu = 0.1 with
-    mu_r = 0.5 (2.605 at 0.12 s), which rigid statics forbids."""
+    at 0.04 s, settling to 2.641 at 0.10 s and 2.642 at 0.12 s; mu = 0.2 collapses (2.186 at
+    0.06 s, 1.070 at 0.08 s, 1.000 from 0.09 s on); mu = 0.2 with mu_r = 0.5 stands, 2.707
+    from 0.03 s to 0.06 s; mu = 0.1 with mu_r = 0.5 slides apart, 1.000 at 0.065 s. On the
+    node spheres of pair_law "granulate" the discs' node rows interlock: mu = 0.2 stands
+    (2.592 at 0.15 s), and so did mu = 0.1 with mu_r = 0.5 (2.605 at 0.12 s), which rigid
+    statics forbids."""
     assert stack_height(0.5, until=0.04) > 2.6
-    assert stack_height(0.2, until=0.13) < 1.1
+    assert stack_height(0.2, until=0.1) < 1.1
     assert stack_height(0.2, rolling_friction=0.5, until=0.04) > 2.6
     assert stack_height(0.1, rolling_friction=0.5, until=0.07) < 1.1
