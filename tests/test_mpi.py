@@ -203,10 +203,11 @@ def test_peridem_damping_on_ranks_keeps_the_serial_run_bit_for_bit() -> None:
 
 def test_grains_migrating_in_3d_under_the_surface_law_keep_the_serial_run_bit_for_bit() -> None:
     """The 3D locality assembly (spheres pressed and thrown, the surface law by default) with a
-    ghost margin of 2e-5 m: a migration every few steps, every part built anew each time."""
-    done = run_ranks(3, "3", "60", "2e-5", "compare")
+    ghost margin of 2e-5 m: a migration every few steps (6 in 40 steps, handing 62 grains
+    over; 10 in 60), every part built anew each time."""
+    done = run_ranks(3, "3", "40", "2e-5", "compare")
     assert done.returncode == 0, done.stdout + done.stderr
-    assert int(done.stdout.split("migrations ")[1].split(",")[0]) >= 5
+    assert int(done.stdout.split("migrations ")[1].split(",")[0]) >= 4
     assert "'positions': 0.0, 'velocities': 0.0, 'forces': 0.0, 'walls': 0.0}" in done.stdout
 
 
