@@ -258,10 +258,6 @@ class PvdSeries:
 def read_pvd(path: str | os.PathLike[str]) -> list[tuple[float, Path]]:
     """The (time, frame path) entries of a .pvd collection, paths resolved against its folder.
     Raises InputError when it is missing or not a collection."""
-    from xml.etree import ElementTree
-
-    from granulate.errors import InputError
-
     target = Path(path)
     try:
         root = ElementTree.parse(target).getroot()

@@ -734,8 +734,9 @@ class DistributedRun:
         totals = [int(total) for total in box[count : count + len(_WIDTHS)]]
         kept = [min(total, room) for total, room in zip(totals, self._rooms_in[q], strict=True)]
         missing = [total - k for total, k in zip(totals, kept, strict=True)]
-        rest = np.empty(_numbers(missing)) if any(missing) else _NO_REST
-        if len(rest):
+        rest = _NO_REST
+        if any(missing):
+            rest = np.empty(_numbers(missing))
             self.comm.Recv(rest, source=q, tag=_REST_TAG)
         breaks, bodies, joining = _sections(box[count + len(_WIDTHS) :], kept, rest, missing)
         joined = self._node_map[joining[:, 0].astype(np.int64)]
@@ -1341,7 +1342,7 @@ def _joining_rows(
 def _message(nodes: int, faces: int, rooms: NDArray[np.int64]) -> NDArray[np.float64]:
     """A buffer for the largest step message about `nodes` nodes and `faces` normals (_pack):
     their x and v, the normals, the sections' counts, and each section's `rooms` rows."""
-    return np.empty(6 * nodes + 3 * faces + len(_WIDTHS) + int(_numbers(rooms)))
+    return np.empty(6 * nodes + 3 * faces + len(_WIDTHS) + _numbers(rooms))
 
 
 def _pack(
@@ -1392,7 +1393,7 @@ def _sections(
 
 def _numbers(rows: Sequence[int] | NDArray[np.int64]) -> int:
     """The numbers that `rows` rows of each section of a step's message take."""
-    return sum(n * width for n, width in zip(rows, _WIDTHS, strict=True))
+    return int(sum(n * width for n, width in zip(rows, _WIDTHS, strict=True)))
 
 
 def _mask(size: int, indices: NDArray[np.int64]) -> NDArray[np.bool_]:
