@@ -9,6 +9,7 @@
 #include "contact_vectors.hpp"
 #include "granulate/cell_grid.hpp"
 #include "granulate/contact/contact_model.hpp"
+#include "granulate/in_parallel.hpp"
 
 namespace granulate {
 using namespace contact_vectors;
@@ -28,18 +29,20 @@ real ContactModel::largest_displacement(const Model& model, const State& state) 
   const std::int64_t n = model.node_count();
   const std::uint8_t* const inert = inert_.empty() ? nullptr : inert_.data();  // listed nowhere
   real worst = 0;
-#pragma omp parallel for schedule(static) reduction(max : worst)
-  for (std::int64_t i = 0; i < n; ++i) {
-    const index_t node = static_cast<index_t>(i);
-    const real* y = &state.positions[3 * node];
-    const vec3 x = centres_.moved(node) ? centres_.at_list(model, state, node) : vec3{y[0], y[1], y[2]};
-    real d2 = 0;
-    for (int k = 0; k < 3; ++k) {
-      const real d = x[k] - positions_at_build_[3 * i + k];
-      d2 += d * d;
+  in_parallel([&] {
+#pragma omp for schedule(static) reduction(max : worst)
+    for (std::int64_t i = 0; i < n; ++i) {
+      const index_t node = static_cast<index_t>(i);
+      const real* y = &state.positions[3 * node];
+      const vec3 x = centres_.moved(node) ? centres_.at_list(model, state, node) : vec3{y[0], y[1], y[2]};
+      real d2 = 0;
+      for (int k = 0; k < 3; ++k) {
+        const real d = x[k] - positions_at_build_[3 * i + k];
+        d2 += d * d;
+      }
+      if (!inert || !inert[i]) worst = std::max(worst, d2);
     }
-    if (!inert || !inert[i]) worst = std::max(worst, d2);
-  }
+  });
   return std::sqrt(worst);
 }
 
@@ -332,13 +335,15 @@ void ContactModel::carry_over_springs(const KeptLists& kept, index_t n) {
       if (old < old_offsets[node + 1] && old_keys[old] == keys[e]) new_springs[e] = old_springs[old];
     }
   };
-#pragma omp parallel for schedule(static)
-  for (std::int64_t ii = 0; ii < static_cast<std::int64_t>(n); ++ii) {
-    const index_t i = static_cast<index_t>(ii);
-    walk(kept.pair_offsets, kept.pair_partner, kept.pair_spring, pair_offsets_, pair_partner_, pair_spring_,
-         i);
-    walk(kept.wall_offsets, kept.wall_entry, kept.wall_spring, wall_offsets_, wall_entry_, wall_spring_, i);
-  }
+  in_parallel([&] {
+#pragma omp for schedule(static)
+    for (std::int64_t ii = 0; ii < static_cast<std::int64_t>(n); ++ii) {
+      const index_t i = static_cast<index_t>(ii);
+      walk(kept.pair_offsets, kept.pair_partner, kept.pair_spring, pair_offsets_, pair_partner_, pair_spring_,
+           i);
+      walk(kept.wall_offsets, kept.wall_entry, kept.wall_spring, wall_offsets_, wall_entry_, wall_spring_, i);
+    }
+  });
   compact_springs();
 }
 
@@ -508,18 +513,20 @@ void ContactModel::find_slots(const Model& model) {
   const std::size_t particle_slots = slots_.size();
   particle_slot_count_ = particle_slots;
   pair_slot_.resize(pair_partner_.size());
-#pragma omp parallel for schedule(static)
-  for (std::int64_t ii = 0; ii < static_cast<std::int64_t>(n); ++ii) {
-    const index_t i = static_cast<index_t>(ii);
-    for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
-      const index_t p = node_body[i], q = node_body[pair_partner_[e]];
-      const index_t a = std::min(p, q);
-      const std::array<index_t, 2> key{a, std::max(p, q)};
-      pair_slot_[e] = static_cast<index_t>(
-          std::lower_bound(slots_.begin() + body_slots[a], slots_.begin() + body_slots[a + 1], key) -
-          slots_.begin());
+  in_parallel([&] {
+#pragma omp for schedule(static)
+    for (std::int64_t ii = 0; ii < static_cast<std::int64_t>(n); ++ii) {
+      const index_t i = static_cast<index_t>(ii);
+      for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
+        const index_t p = node_body[i], q = node_body[pair_partner_[e]];
+        const index_t a = std::min(p, q);
+        const std::array<index_t, 2> key{a, std::max(p, q)};
+        pair_slot_[e] = static_cast<index_t>(
+            std::lower_bound(slots_.begin() + body_slots[a], slots_.begin() + body_slots[a + 1], key) -
+            slots_.begin());
+      }
     }
-  }
+  });
   std::vector<std::array<index_t, 2>> wall_keys = held.walls;
   for (index_t i = 0; i < n; ++i) {
     for (index_t e = wall_offsets_[i]; e < wall_offsets_[i + 1]; ++e)
@@ -637,15 +644,17 @@ void ContactModel::find_groups(const Model& model) {
   fit(groups_);
   // Each entry (i, j) of a node i with a surface point: the group of j that probes i's body.
   entry_target_.assign(pair_partner_.size(), no_group);
-#pragma omp parallel for schedule(static)
-  for (std::int64_t ii = 0; ii < static_cast<std::int64_t>(n); ++ii) {
-    const index_t i = static_cast<index_t>(ii);
-    if (surface_slot_[i] == no_group) continue;
-    for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
-      const index_t j = pair_partner_[e];
-      if (node_body_[j] != node_body_[i]) entry_target_[e] = target_group(i, j);
+  in_parallel([&] {
+#pragma omp for schedule(static)
+    for (std::int64_t ii = 0; ii < static_cast<std::int64_t>(n); ++ii) {
+      const index_t i = static_cast<index_t>(ii);
+      if (surface_slot_[i] == no_group) continue;
+      for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
+        const index_t j = pair_partner_[e];
+        if (node_body_[j] != node_body_[i]) entry_target_[e] = target_group(i, j);
+      }
     }
-  }
+  });
   probes_.clear();
   group_probe_.assign(groups_.size(), no_probe);
 }

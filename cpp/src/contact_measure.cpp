@@ -10,6 +10,7 @@
 
 #include "contact_vectors.hpp"
 #include "granulate/contact/contact_model.hpp"
+#include "granulate/in_parallel.hpp"
 
 namespace granulate {
 using namespace contact_vectors;
@@ -305,29 +306,33 @@ contact::matrix3 body_moment(const Model& model, const State& state, const index
 void ContactModel::measure_body_rotations(const Model& model, const State& state) {
   // The rotation of each body find_rotated_bodies listed, this step.
   const std::int64_t count = static_cast<std::int64_t>(rotated_bodies_.size());
-#pragma omp parallel for schedule(dynamic, 16)
-  for (std::int64_t k = 0; k < count; ++k) {
-    const index_t b = rotated_bodies_[k];
-    const auto rotation =
-        contact::best_rotation(body_moment(model, state, body_nodes_.data() + body_node_offsets_[b],
-                                           body_node_offsets_[b + 1] - body_node_offsets_[b]),
-                               dimension_);
-    body_rotated_[k] = rotation ? 1 : 0;
-    if (rotation) body_rotation_[k] = *rotation;
-  }
+  in_parallel([&] {
+#pragma omp for schedule(dynamic, 16)
+    for (std::int64_t k = 0; k < count; ++k) {
+      const index_t b = rotated_bodies_[k];
+      const auto rotation =
+          contact::best_rotation(body_moment(model, state, body_nodes_.data() + body_node_offsets_[b],
+                                             body_node_offsets_[b + 1] - body_node_offsets_[b]),
+                                 dimension_);
+      body_rotated_[k] = rotation ? 1 : 0;
+      if (rotation) body_rotation_[k] = *rotation;
+    }
+  });
 }
 
 void ContactModel::measure_surface_points(const Model& model, const State& state) {
   // The surface points of the nodes with list entries, once per step, for every probe that
   // reaches them (surface_slot_ numbers them in node order).
   const std::int64_t count = static_cast<std::int64_t>(surface_nodes_.size());
-#pragma omp parallel for schedule(static)
-  for (std::int64_t k = 0; k < count; ++k) {
-    const index_t j = surface_nodes_[k];
-    const SurfaceCentres::Seen seen = centres_.seen(model, j);
-    surface_points_[k] = surface_point_now(seen, state, j, surface_sizes_[k]);
-    surface_stretches_[k] = static_cast<float>(SurfaceCentres::stretch(seen, surface_sizes_[k]));
-  }
+  in_parallel([&] {
+#pragma omp for schedule(static)
+    for (std::int64_t k = 0; k < count; ++k) {
+      const index_t j = surface_nodes_[k];
+      const SurfaceCentres::Seen seen = centres_.seen(model, j);
+      surface_points_[k] = surface_point_now(seen, state, j, surface_sizes_[k]);
+      surface_stretches_[k] = static_cast<float>(SurfaceCentres::stretch(seen, surface_sizes_[k]));
+    }
+  });
 }
 
 contact::SurfacePoint ContactModel::surface_point_now(const SurfaceCentres::Seen& seen, const State& state,
@@ -354,8 +359,7 @@ void ContactModel::measure_contacts(const Model& model, const State& state) {
   if (any_surface_ && opened_rest_.size() != static_cast<std::size_t>(n)) opened_rest_.assign(n, -1);
   std::vector<ProbeState> touching_probes;  // the surface probes that touch, from every thread
   std::vector<index_t> sphere_pair_nodes;   // the nodes touching in sphere pairs under the surface law
-#pragma omp parallel
-  {
+  in_parallel([&] {
     std::vector<WallContact> found;  // scratch of this thread
     ProbeScratch probe_scratch;
     std::vector<index_t> touching_nodes, sphere_pairs;
@@ -416,7 +420,7 @@ void ContactModel::measure_contacts(const Model& model, const State& state) {
                              probe_scratch.touching.end());
       statistics_.add_overlap(deepest, state.step);
     }
-  }
+  });
   std::sort(touching_nodes_.begin(), touching_nodes_.end());  // the same for any thread count
   if (any_surface_) keep_touching_probes(touching_probes);
   release_rested_pairs(model, state, sphere_pair_nodes);
@@ -705,20 +709,22 @@ void ContactModel::measure_bodies(const Model& model, const State& state) {
   // only the ghost's nodes within reach of its own, the rest left where they were.
   const std::int64_t count = static_cast<std::int64_t>(touching_bodies_.size());
   std::vector<std::uint8_t> measured(ghosts_.any() ? count : 0, 1);
-#pragma omp parallel for schedule(dynamic, 16)
-  for (std::int64_t k = 0; k < count; ++k) {
-    const index_t b = touching_bodies_[k];
-    const index_t* nodes = body_nodes_.data() + body_node_offsets_[b];
-    body_load_[k] = {0, 0, 0, 0, 0, 0};
-    const BodyMotion* given = ghosts_.ghost(body_particle_[b]) ? ghosts_.given(nodes[0]) : nullptr;
-    if (given) {
-      body_motion_[k] = *given;
-      measured[k] = 0;
-    } else {
-      body_motion_[k] =
-          measure_body(model, state, nodes, body_node_offsets_[b + 1] - body_node_offsets_[b], dimension_);
+  in_parallel([&] {
+#pragma omp for schedule(dynamic, 16)
+    for (std::int64_t k = 0; k < count; ++k) {
+      const index_t b = touching_bodies_[k];
+      const index_t* nodes = body_nodes_.data() + body_node_offsets_[b];
+      body_load_[k] = {0, 0, 0, 0, 0, 0};
+      const BodyMotion* given = ghosts_.ghost(body_particle_[b]) ? ghosts_.given(nodes[0]) : nullptr;
+      if (given) {
+        body_motion_[k] = *given;
+        measured[k] = 0;
+      } else {
+        body_motion_[k] =
+            measure_body(model, state, nodes, body_node_offsets_[b + 1] - body_node_offsets_[b], dimension_);
+      }
     }
-  }
+  });
   if (ghosts_.any()) check_ghost_motions(measured);
 }
 
@@ -748,11 +754,13 @@ void ContactModel::measure_surface_normals(const Model& model, const State& stat
   release_excess(touching_nodes_);
   release_excess(touching_normals_);
   const std::int64_t count = static_cast<std::int64_t>(touching_nodes_.size());
-#pragma omp parallel for schedule(static)
-  for (std::int64_t k = 0; k < count; ++k) {
-    const vec3* given = ghosts_.normal(touching_nodes_[k]);
-    touching_normals_[k] = given ? *given : surface_normal_at(model, state, touching_nodes_[k]);
-  }
+  in_parallel([&] {
+#pragma omp for schedule(static)
+    for (std::int64_t k = 0; k < count; ++k) {
+      const vec3* given = ghosts_.normal(touching_nodes_[k]);
+      touching_normals_[k] = given ? *given : surface_normal_at(model, state, touching_nodes_[k]);
+    }
+  });
 }
 
 void ContactModel::release_rested_pairs(const Model& model, const State& state,

@@ -6,18 +6,18 @@
 
 #include "contact_vectors.hpp"
 #include "granulate/contact/contact_model.hpp"
+#include "granulate/in_parallel.hpp"
 
 namespace granulate {
 using namespace contact_vectors;
 
 void ContactModel::probe_frictions(const Model& model, const State& state, real dt) {
   const std::int64_t count = static_cast<std::int64_t>(contact_nodes_.size());
-#pragma omp parallel
-  {
+  in_parallel([&] {
     std::vector<real> shares;  // scratch of this thread
 #pragma omp for schedule(static)
     for (std::int64_t k = 0; k < count; ++k) probe_friction(model, state, contact_nodes_[k], dt, shares);
-  }
+  });
 }
 
 void ContactModel::probe_friction(const Model& model, const State& state, index_t i, real dt,
@@ -125,22 +125,24 @@ void ContactModel::node_forces(const Model& model, State& state, real dt) {
   // thread count; surface_centres.hpp).
   const std::int64_t count = static_cast<std::int64_t>(contact_nodes_.size());
   if (centres_.any()) anchor_forces_.assign(contact_nodes_.size(), vec3{0, 0, 0});
-#pragma omp parallel for schedule(static)
-  for (std::int64_t k = 0; k < count; ++k) {
-    const index_t i = contact_nodes_[k];
-    const SurfaceAnchor* anchor = centres_.anchor(model, i);
-    const NodeContactForces forces = gather_node_forces(model, state, i, anchor != nullptr, dt);
-    vec total{0, 0, 0};
-    for (int c = 0; c < 3; ++c) total[c] = forces.at_centre[c] + forces.at_surface[c] + forces.at_node[c];
-    if (anchor != nullptr) {
-      anchor_forces_[k] = anchored_vector_force(model, state, i, forces);
-      real weights = 0;
-      for (std::size_t a = 0; a < anchor->nodes.size() && anchor->nodes[a] != SurfaceAnchor::no_anchor; ++a)
-        weights += anchor->weights[a];
-      for (int c = 0; c < 3; ++c) total[c] -= weights * anchor_forces_[k][c];
+  in_parallel([&] {
+#pragma omp for schedule(static)
+    for (std::int64_t k = 0; k < count; ++k) {
+      const index_t i = contact_nodes_[k];
+      const SurfaceAnchor* anchor = centres_.anchor(model, i);
+      const NodeContactForces forces = gather_node_forces(model, state, i, anchor != nullptr, dt);
+      vec total{0, 0, 0};
+      for (int c = 0; c < 3; ++c) total[c] = forces.at_centre[c] + forces.at_surface[c] + forces.at_node[c];
+      if (anchor != nullptr) {
+        anchor_forces_[k] = anchored_vector_force(model, state, i, forces);
+        real weights = 0;
+        for (std::size_t a = 0; a < anchor->nodes.size() && anchor->nodes[a] != SurfaceAnchor::no_anchor; ++a)
+          weights += anchor->weights[a];
+        for (int c = 0; c < 3; ++c) total[c] -= weights * anchor_forces_[k][c];
+      }
+      for (int c = 0; c < 3; ++c) state.forces[3 * i + c] += total[c] / model.volumes()[i];
     }
-    for (int c = 0; c < 3; ++c) state.forces[3 * i + c] += total[c] / model.volumes()[i];
-  }
+  });
   if (centres_.any()) spread_anchor_forces(model, state);
 }
 

@@ -7,6 +7,7 @@
 #include "contact_vectors.hpp"
 #include "granulate/cell_grid.hpp"
 #include "granulate/contact/contact_model.hpp"
+#include "granulate/in_parallel.hpp"
 
 namespace granulate {
 using namespace contact_vectors;
@@ -129,8 +130,7 @@ void ContactModel::search_node_pairs(const Model& model, const State& state,
   pair_offsets_.assign(n + 1, 0);
   // One search: each thread keeps its nodes' partners, then copies them into place.
   const std::int64_t searched_count = static_cast<std::int64_t>(searched.size());
-#pragma omp parallel
-  {
+  in_parallel([&] {
     std::vector<index_t> found_partners;
     std::vector<std::array<index_t, 2>> found_nodes;  // (node, first of its partners)
 #pragma omp for schedule(static)
@@ -153,7 +153,7 @@ void ContactModel::search_node_pairs(const Model& model, const State& state,
       std::copy_n(found_partners.begin() + first, pair_offsets_[i + 1] - pair_offsets_[i],
                   pair_partner_.begin() + pair_offsets_[i]);
     }
-  }
+  });
 }
 
 bool ContactModel::lists_pair(const Model& model, const State& state, index_t i, index_t j, real r2,
@@ -184,10 +184,12 @@ void ContactModel::search_node_walls(const Model& model, const State& state,
     }
   }
   const std::int64_t wall_node_count = static_cast<std::int64_t>(wall_nodes.size());
-#pragma omp parallel for schedule(static)
-  for (std::int64_t a = 0; a < wall_node_count; ++a) {
-    list_node_walls(model, state.time, wall_nodes[a], per_node[wall_nodes[a]]);
-  }
+  in_parallel([&] {
+#pragma omp for schedule(static)
+    for (std::int64_t a = 0; a < wall_node_count; ++a) {
+      list_node_walls(model, state.time, wall_nodes[a], per_node[wall_nodes[a]]);
+    }
+  });
   wall_offsets_.assign(n + 1, 0);
   for (index_t i = 0; i < n; ++i)
     wall_offsets_[i + 1] = wall_offsets_[i] + static_cast<index_t>(per_node[i].size());

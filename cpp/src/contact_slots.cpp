@@ -7,6 +7,7 @@
 
 #include "contact_vectors.hpp"
 #include "granulate/contact/contact_model.hpp"
+#include "granulate/in_parallel.hpp"
 
 namespace granulate {
 using namespace contact_vectors;
@@ -279,26 +280,28 @@ void ContactModel::body_loads(const Model& model, State& state) {
   const auto& x = state.positions;
   auto& f = state.forces;
   const std::int64_t count = static_cast<std::int64_t>(touching_bodies_.size());
-#pragma omp parallel for schedule(dynamic, 16)
-  for (std::int64_t touch = 0; touch < count; ++touch) {
-    const index_t b = touching_bodies_[touch];
-    std::array<real, 6> total = body_load_[touch];
-    for (index_t k = body_contact_offsets_[b]; k < body_contact_offsets_[b + 1]; ++k) {
-      const vec couple = contact_couple(model, state, contact_nodes_[k]);
-      for (int c = 0; c < 3; ++c) total[3 + c] += couple[c];
+  in_parallel([&] {
+#pragma omp for schedule(dynamic, 16)
+    for (std::int64_t touch = 0; touch < count; ++touch) {
+      const index_t b = touching_bodies_[touch];
+      std::array<real, 6> total = body_load_[touch];
+      for (index_t k = body_contact_offsets_[b]; k < body_contact_offsets_[b + 1]; ++k) {
+        const vec couple = contact_couple(model, state, contact_nodes_[k]);
+        for (int c = 0; c < 3; ++c) total[3 + c] += couple[c];
+      }
+      if (total == std::array<real, 6>{0, 0, 0, 0, 0, 0}) continue;
+      const BodyMotion& motion = body_motion_[touch];
+      const real mass = body_mass_[b];
+      const vec acceleration{total[0] / mass, total[1] / mass, total[2] / mass};
+      const vec turn = symmetric_times(motion.inverse_inertia, {total[3], total[4], total[5]});
+      for (index_t k = body_node_offsets_[b]; k < body_node_offsets_[b + 1]; ++k) {
+        const index_t i = body_nodes_[k];
+        const vec spin = cross(turn, {x[3 * i] - motion.centre[0], x[3 * i + 1] - motion.centre[1],
+                                      x[3 * i + 2] - motion.centre[2]});
+        for (int c = 0; c < 3; ++c) f[3 * i + c] += model.density(i) * (acceleration[c] + spin[c]);
+      }
     }
-    if (total == std::array<real, 6>{0, 0, 0, 0, 0, 0}) continue;
-    const BodyMotion& motion = body_motion_[touch];
-    const real mass = body_mass_[b];
-    const vec acceleration{total[0] / mass, total[1] / mass, total[2] / mass};
-    const vec turn = symmetric_times(motion.inverse_inertia, {total[3], total[4], total[5]});
-    for (index_t k = body_node_offsets_[b]; k < body_node_offsets_[b + 1]; ++k) {
-      const index_t i = body_nodes_[k];
-      const vec spin = cross(turn, {x[3 * i] - motion.centre[0], x[3 * i + 1] - motion.centre[1],
-                                    x[3 * i + 2] - motion.centre[2]});
-      for (int c = 0; c < 3; ++c) f[3 * i + c] += model.density(i) * (acceleration[c] + spin[c]);
-    }
-  }
+  });
 }
 
 }  // namespace granulate

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "granulate/cell_grid.hpp"
+#include "granulate/in_parallel.hpp"
 
 namespace granulate {
 namespace {
@@ -222,43 +223,48 @@ BondFamilies Model::build_family(index_t shape_index, real horizon, InfluenceKin
   const CellGrid grid = CellGrid::build(x, 0, nodes, horizon * (1.0 + 1e-6));
   family.offsets.assign(nodes + 1, 0);
   family.forward.assign(nodes, 0);
-#pragma omp parallel for schedule(static)
-  for (std::int64_t aa = 0; aa < static_cast<std::int64_t>(nodes); ++aa) {
-    const index_t a = static_cast<index_t>(aa);
-    index_t count = 0;
-    grid.for_each_within(x, a, horizon, dimension_, [&](index_t, real) { ++count; });
-    family.offsets[a + 1] = count;
-  }
+  in_parallel([&] {
+#pragma omp for schedule(static)
+    for (std::int64_t aa = 0; aa < static_cast<std::int64_t>(nodes); ++aa) {
+      const index_t a = static_cast<index_t>(aa);
+      index_t count = 0;
+      grid.for_each_within(x, a, horizon, dimension_, [&](index_t, real) { ++count; });
+      family.offsets[a + 1] = count;
+    }
+  });
   for (index_t a = 0; a < nodes; ++a) family.offsets[a + 1] += family.offsets[a];
   const std::size_t bonds = family.offsets[nodes];
   family.neighbors.resize(bonds);
   family.weights.resize(bonds);
   family.lengths.resize(bonds);
   std::vector<std::pair<index_t, index_t>> coincident;
-#pragma omp parallel for schedule(static)
-  for (std::int64_t aa = 0; aa < static_cast<std::int64_t>(nodes); ++aa) {
-    const index_t a = static_cast<index_t>(aa);
-    index_t* out = family.neighbors.data() + family.offsets[a];
-    index_t filled = 0;
-    grid.for_each_within(x, a, horizon, dimension_, [&](index_t j, real) { out[filled++] = j; });
-    std::sort(out, out + filled);
-    family.forward[a] =
-        static_cast<index_t>(std::upper_bound(out, out + filled, a) - family.neighbors.data());
-    for (index_t b = family.offsets[a]; b < family.offsets[a + 1]; ++b) {
-      const index_t j = family.neighbors[b];
-      const real r = std::sqrt((x[3 * j] - x[3 * a]) * (x[3 * j] - x[3 * a]) +
-                               (x[3 * j + 1] - x[3 * a + 1]) * (x[3 * j + 1] - x[3 * a + 1]) +
-                               (x[3 * j + 2] - x[3 * a + 2]) * (x[3 * j + 2] - x[3 * a + 2]));
-      if (r == 0) {
+  in_parallel([&] {
+#pragma omp for schedule(static)
+    for (std::int64_t aa = 0; aa < static_cast<std::int64_t>(nodes); ++aa) {
+      const index_t a = static_cast<index_t>(aa);
+      index_t* out = family.neighbors.data() + family.offsets[a];
+      index_t filled = 0;
+      grid.for_each_within(x, a, horizon, dimension_, [&](index_t j, real) { out[filled++] = j; });
+      std::sort(out, out + filled);
+      family.forward[a] =
+          static_cast<index_t>(std::upper_bound(out, out + filled, a) - family.neighbors.data());
+      for (index_t b = family.offsets[a]; b < family.offsets[a + 1]; ++b) {
+        const index_t j = family.neighbors[b];
+        const real r = std::sqrt((x[3 * j] - x[3 * a]) * (x[3 * j] - x[3 * a]) +
+                                 (x[3 * j + 1] - x[3 * a + 1]) * (x[3 * j + 1] - x[3 * a + 1]) +
+                                 (x[3 * j + 2] - x[3 * a + 2]) * (x[3 * j + 2] - x[3 * a + 2]));
+        if (r == 0) {
 #pragma omp critical(granulate_coincident)
-        coincident.emplace_back(a, j);
+          coincident.emplace_back(a, j);
+        }
+        // Partial volume: a neighbour cell cut by the horizon counts for its share inside.
+        const real partial = r > horizon - 0.5 * h ? std::min(1.0, (horizon + 0.5 * h - r) / h) : 1.0;
+        family.lengths[b] = r;
+        family.weights[b] =
+            static_cast<float>(influence(influence_kind, std::min(r / horizon, 1.0)) * partial);
       }
-      // Partial volume: a neighbour cell cut by the horizon counts for its share inside.
-      const real partial = r > horizon - 0.5 * h ? std::min(1.0, (horizon + 0.5 * h - r) / h) : 1.0;
-      family.lengths[b] = r;
-      family.weights[b] = static_cast<float>(influence(influence_kind, std::min(r / horizon, 1.0)) * partial);
     }
-  }
+  });
   if (!coincident.empty()) {
     std::sort(coincident.begin(), coincident.end());
     throw InputError("nodes " + std::to_string(coincident[0].first) + " and " +
@@ -301,33 +307,35 @@ void Model::build_bonds() {
   lps_coefficients_.assign(any_lps ? nodes : 0, {});
   pmb_stiffness_.assign(any_pmb ? nodes : 0, 0);
   std::vector<index_t> isolated;
-#pragma omp parallel for schedule(static)
-  for (std::int64_t ii = 0; ii < static_cast<std::int64_t>(nodes); ++ii) {
-    const index_t i = static_cast<index_t>(ii);
-    const Material& material = materials_[node_material_[i]];
-    const NodeBonds bonds = node_bonds(i);
-    real m = 0, first_moment = 0;
-    for (index_t b = 0; b < bonds.count; ++b) {
-      const real r = bonds.length(b), w = bonds.weight(b);
-      m += w * r * r;
-      first_moment += w * r;
-    }
-    if (bonds.count == 0) {
+  in_parallel([&] {
+#pragma omp for schedule(static)
+    for (std::int64_t ii = 0; ii < static_cast<std::int64_t>(nodes); ++ii) {
+      const index_t i = static_cast<index_t>(ii);
+      const Material& material = materials_[node_material_[i]];
+      const NodeBonds bonds = node_bonds(i);
+      real m = 0, first_moment = 0;
+      for (index_t b = 0; b < bonds.count; ++b) {
+        const real r = bonds.length(b), w = bonds.weight(b);
+        m += w * r * r;
+        first_moment += w * r;
+      }
+      if (bonds.count == 0) {
 #pragma omp critical(granulate_isolated)
-      isolated.push_back(i);
+        isolated.push_back(i);
+      }
+      if (material.params.model == ForceModel::pmb && first_moment > 0) {
+        pmb_stiffness_[i] = dimension_ * dimension_ * material.dilatation_modulus / first_moment;
+      }
+      if (material.params.model == ForceModel::lps && m > 0) {
+        const real d = lps_dimension();
+        const real a = material.deviatoric_factor;
+        const real G = material.params.shear_modulus;
+        lps_coefficients_[i].dilatation_scale = d / m;
+        lps_coefficients_[i].dilatation_coupling = (d * material.dilatation_modulus - a * G / d) / m;
+        lps_coefficients_[i].deviatoric_stiffness = a * G / m;
+      }
     }
-    if (material.params.model == ForceModel::pmb && first_moment > 0) {
-      pmb_stiffness_[i] = dimension_ * dimension_ * material.dilatation_modulus / first_moment;
-    }
-    if (material.params.model == ForceModel::lps && m > 0) {
-      const real d = lps_dimension();
-      const real a = material.deviatoric_factor;
-      const real G = material.params.shear_modulus;
-      lps_coefficients_[i].dilatation_scale = d / m;
-      lps_coefficients_[i].dilatation_coupling = (d * material.dilatation_modulus - a * G / d) / m;
-      lps_coefficients_[i].deviatoric_stiffness = a * G / m;
-    }
-  }
+  });
   if (!isolated.empty()) {
     std::sort(isolated.begin(), isolated.end());
     const index_t i = isolated[0];

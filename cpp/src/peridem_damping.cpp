@@ -7,6 +7,7 @@
 #include <string>
 
 #include "granulate/cell_grid.hpp"
+#include "granulate/in_parallel.hpp"
 
 namespace granulate::contact {
 
@@ -61,8 +62,7 @@ void PeridemDamping::add_forces(const Model& model, State& state) const {
   const CellGrid center_grid = CellGrid::build(x, centers_, reach);
   const CellGrid wall_grid = CellGrid::build(x, wall_nodes_, max_contact_radius_);
 
-#pragma omp parallel
-  {
+  in_parallel([&] {
     std::vector<index_t> near;      // particles whose centres are within reach (scratch)
     std::vector<index_t> touching;  // wall nodes within Rc of this particle (scratch)
 #pragma omp for schedule(dynamic, 4)
@@ -126,7 +126,7 @@ void PeridemDamping::add_forces(const Model& model, State& state) const {
         for (int d = 0; d < 3; ++d) f[3 * i + d] += force[d];
       }
     }
-  }
+  });
 }
 
 }  // namespace granulate::contact

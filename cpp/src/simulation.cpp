@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "bond_extension.hpp"
+#include "granulate/in_parallel.hpp"
 #include "granulate/peridynamics/critical_stretch.hpp"
 #include "granulate/peridynamics/lps.hpp"
 #include "granulate/peridynamics/pmb.hpp"
@@ -30,17 +31,19 @@ void kick_and_drift(const Model& m, State& state, real dt, const std::uint8_t* o
   auto& x = state.positions;
   auto& v = state.velocities;
   const auto& f = state.forces;
-#pragma omp parallel for schedule(static)
-  for (std::int64_t i = 0; i < n; ++i) {
-    if constexpr (SkipOthers) {
-      if (others[i]) continue;
+  in_parallel([&] {
+#pragma omp for schedule(static)
+    for (std::int64_t i = 0; i < n; ++i) {
+      if constexpr (SkipOthers) {
+        if (others[i]) continue;
+      }
+      const real density = m.density(static_cast<index_t>(i));
+      for (std::int64_t k = 3 * i; k < 3 * i + 3; ++k) {
+        v[k] += 0.5 * dt * f[k] / density;
+        x[k] += dt * v[k];
+      }
     }
-    const real density = m.density(static_cast<index_t>(i));
-    for (std::int64_t k = 3 * i; k < 3 * i + 3; ++k) {
-      v[k] += 0.5 * dt * f[k] / density;
-      x[k] += dt * v[k];
-    }
-  }
+  });
 }
 
 /// The second half kick of every node (with SkipOthers, but other processes' nodes), and the
@@ -53,20 +56,22 @@ std::int64_t second_half_kick(const Model& m, State& state, real dt, const std::
   auto& v = state.velocities;
   const auto& f = state.forces;
   std::int64_t first_unstable = n;
-#pragma omp parallel for schedule(static) reduction(min : first_unstable)
-  for (std::int64_t i = 0; i < n; ++i) {
-    if constexpr (SkipOthers) {
-      if (others[i]) continue;
+  in_parallel([&] {
+#pragma omp for schedule(static) reduction(min : first_unstable)
+    for (std::int64_t i = 0; i < n; ++i) {
+      if constexpr (SkipOthers) {
+        if (others[i]) continue;
+      }
+      real speed2 = 0;
+      const real density = m.density(static_cast<index_t>(i));
+      for (std::int64_t k = 3 * i; k < 3 * i + 3; ++k) {
+        v[k] += 0.5 * dt * f[k] / density;
+        speed2 += v[k] * v[k];
+      }
+      const real limit = particles[node_particle[i]].mesh_size / dt;
+      if (!(speed2 <= limit * limit)) first_unstable = std::min(first_unstable, i);
     }
-    real speed2 = 0;
-    const real density = m.density(static_cast<index_t>(i));
-    for (std::int64_t k = 3 * i; k < 3 * i + 3; ++k) {
-      v[k] += 0.5 * dt * f[k] / density;
-      speed2 += v[k] * v[k];
-    }
-    const real limit = particles[node_particle[i]].mesh_size / dt;
-    if (!(speed2 <= limit * limit)) first_unstable = std::min(first_unstable, i);
-  }
+  });
   return first_unstable;
 }
 
@@ -83,8 +88,7 @@ real farthest_travel(const Model& m, const State& state, const ContactModel& con
   };
   const real* x = state.positions.data();
   real farthest = 0;  // squared
-#pragma omp parallel
-  {
+  in_parallel([&] {
 #pragma omp for schedule(static) reduction(max : farthest)
     for (std::int64_t i = 0; i < n; ++i) {
       if (!others || !others[i]) farthest = std::max(farthest, squared(&x[3 * i], &origin[3 * i]));
@@ -94,7 +98,7 @@ real farthest_travel(const Model& m, const State& state, const ContactModel& con
       const auto seen = contact.list_position(m, state, watched[k]);
       farthest = std::max(farthest, squared(seen.data(), &list_origin[3 * k]));
     }
-  }
+  });
   return std::sqrt(farthest);
 }
 
@@ -460,31 +464,33 @@ void Simulation::check_stability() const {
 void Simulation::strain_energy_density(real* out) const {
   const Model& m = *model_;
   const real inverse_dimension = 1.0 / m.lps_dimension();
-#pragma omp parallel for schedule(static)
-  for (std::int64_t ii = 0; ii < static_cast<std::int64_t>(m.node_count()); ++ii) {
-    const index_t i = static_cast<index_t>(ii);
-    if (others_node(i)) {  // another process's: it measures them
-      out[i] = 0;
-      continue;
+  in_parallel([&] {
+#pragma omp for schedule(static)
+    for (std::int64_t ii = 0; ii < static_cast<std::int64_t>(m.node_count()); ++ii) {
+      const index_t i = static_cast<index_t>(ii);
+      if (others_node(i)) {  // another process's: it measures them
+        out[i] = 0;
+        continue;
+      }
+      const Material& material = m.materials()[m.node_material()[i]];
+      const bool is_lps = material.params.model == ForceModel::lps;
+      const real theta = state_.dilatation[i];
+      const NodeBonds bonds = m.node_bonds(i);
+      real sum = 0;
+      for (index_t b = 0; b < bonds.count; ++b) {
+        if (!state_.bonds.intact(i, b)) continue;
+        const index_t j = bonds.neighbor(b);
+        const real r = bonds.length(b);
+        const real e = bond_extension(i, j, r, state_.positions.data());
+        sum += is_lps
+                   ? lps::deviatoric_energy_term(bonds.weight(b), r, e, theta, inverse_dimension)
+                   : pmb::energy_term(m.pmb_stiffness()[i] + m.pmb_stiffness()[j], bonds.weight(b), e / r, r);
+      }
+      out[i] = is_lps ? 0.5 * material.dilatation_modulus * theta * theta +
+                            0.5 * m.lps_coefficients()[i].deviatoric_stiffness * sum
+                      : sum;
     }
-    const Material& material = m.materials()[m.node_material()[i]];
-    const bool is_lps = material.params.model == ForceModel::lps;
-    const real theta = state_.dilatation[i];
-    const NodeBonds bonds = m.node_bonds(i);
-    real sum = 0;
-    for (index_t b = 0; b < bonds.count; ++b) {
-      if (!state_.bonds.intact(i, b)) continue;
-      const index_t j = bonds.neighbor(b);
-      const real r = bonds.length(b);
-      const real e = bond_extension(i, j, r, state_.positions.data());
-      sum += is_lps
-                 ? lps::deviatoric_energy_term(bonds.weight(b), r, e, theta, inverse_dimension)
-                 : pmb::energy_term(m.pmb_stiffness()[i] + m.pmb_stiffness()[j], bonds.weight(b), e / r, r);
-    }
-    out[i] = is_lps ? 0.5 * material.dilatation_modulus * theta * theta +
-                          0.5 * m.lps_coefficients()[i].deviatoric_stiffness * sum
-                    : sum;
-  }
+  });
 }
 
 real Simulation::strain_energy() const {
@@ -498,27 +504,29 @@ real Simulation::strain_energy() const {
 
 void Simulation::damage(real* phi, real* z) const {
   const Model& m = *model_;
-#pragma omp parallel for schedule(static)
-  for (std::int64_t ii = 0; ii < static_cast<std::int64_t>(m.node_count()); ++ii) {
-    const index_t i = static_cast<index_t>(ii);
-    if (others_node(i)) {  // another process's: it measures them
-      if (phi) phi[i] = 0;
-      if (z) z[i] = 0;
-      continue;
+  in_parallel([&] {
+#pragma omp for schedule(static)
+    for (std::int64_t ii = 0; ii < static_cast<std::int64_t>(m.node_count()); ++ii) {
+      const index_t i = static_cast<index_t>(ii);
+      if (others_node(i)) {  // another process's: it measures them
+        if (phi) phi[i] = 0;
+        if (z) z[i] = 0;
+        continue;
+      }
+      const real s0 = m.particles()[m.node_particle()[i]].critical_stretch;
+      const NodeBonds bonds = m.node_bonds(i);
+      real all = 0, intact = 0, max_stretch = 0;
+      for (index_t b = 0; b < bonds.count; ++b) {
+        const real w = bonds.weight(b), r = bonds.length(b);
+        all += w;
+        if (state_.bonds.intact(i, b)) intact += w;
+        max_stretch = std::max(
+            max_stretch, std::abs(bond_extension(i, bonds.neighbor(b), r, state_.positions.data()) / r));
+      }
+      if (phi) phi[i] = all > 0 ? 1.0 - intact / all : 0.0;
+      if (z) z[i] = std::isfinite(s0) ? max_stretch / s0 : 0.0;
     }
-    const real s0 = m.particles()[m.node_particle()[i]].critical_stretch;
-    const NodeBonds bonds = m.node_bonds(i);
-    real all = 0, intact = 0, max_stretch = 0;
-    for (index_t b = 0; b < bonds.count; ++b) {
-      const real w = bonds.weight(b), r = bonds.length(b);
-      all += w;
-      if (state_.bonds.intact(i, b)) intact += w;
-      max_stretch = std::max(max_stretch,
-                             std::abs(bond_extension(i, bonds.neighbor(b), r, state_.positions.data()) / r));
-    }
-    if (phi) phi[i] = all > 0 ? 1.0 - intact / all : 0.0;
-    if (z) z[i] = std::isfinite(s0) ? max_stretch / s0 : 0.0;
-  }
+  });
 }
 
 void Simulation::break_bonds(const std::vector<std::array<index_t, 2>>& pairs) {

@@ -8,6 +8,7 @@
 #include <limits>
 
 #include "bond_extension.hpp"
+#include "granulate/in_parallel.hpp"
 #include "granulate/peridynamics/critical_stretch.hpp"
 #include "granulate/peridynamics/lps.hpp"
 #include "granulate/peridynamics/pmb.hpp"
@@ -52,7 +53,7 @@ void add_dilatation_terms(index_t i, const NodeBonds& bonds, std::uint8_t* bond_
 }
 
 /// Runs body(i) for every node, colour by colour, the blocks of a colour in parallel (inside an
-/// omp parallel region). Each bond is evaluated once, at its lower-numbered end, and its terms are
+/// in_parallel region). Each bond is evaluated once, at its lower-numbered end, and its terms are
 /// added to both ends; the colours keep concurrent blocks on disjoint nodes (see BondSchedule), so
 /// there are no atomics and the sums do not depend on the thread count. Nodes of a particle that
 /// gathers evaluate all their bonds and write only their own sums. Only the blocks at places
@@ -74,7 +75,7 @@ void for_each_node_in_colours(const BondSchedule& schedule, Body&& body, std::in
 }
 
 /// for_each_node_in_colours over the blocks at places [from, to) of `inner`'s blocks followed
-/// by `outer`'s (inside an omp parallel region).
+/// by `outer`'s (inside an in_parallel region).
 template <class Body>
 void for_each_node_in_schedules(const BondSchedule& inner, const BondSchedule& outer, Body&& body,
                                 std::int64_t from, std::int64_t to) {
@@ -182,8 +183,7 @@ void Simulation::add_bond_forces(real* forces, std::int64_t from, std::int64_t t
       add_pair_forces<false, true>(i, bonds, bits, arrays);
     }
   };
-#pragma omp parallel
-  for_each_node_in_schedules(inner_schedule(), outer_schedule_, evaluate, from, to);
+  in_parallel([&] { for_each_node_in_schedules(inner_schedule(), outer_schedule_, evaluate, from, to); });
 }
 
 std::vector<real> Simulation::bond_force_densities() const {
@@ -287,8 +287,7 @@ void Simulation::sum_dilatation_terms(std::int64_t to) {
                                         broken_here);
     }
   };
-#pragma omp parallel
-  {
+  in_parallel([&] {
     if (begins) {
 #pragma omp for schedule(static)
       for (std::int64_t i = 0; i < n; ++i) dilatation_sums[i] = 0;
@@ -300,7 +299,7 @@ void Simulation::sum_dilatation_terms(std::int64_t to) {
 #pragma omp critical(granulate_broken_bonds)
       breaks_.insert(breaks_.end(), broken_here.begin(), broken_here.end());
     }
-  }
+  });
 }
 
 void Simulation::start_node_forces(NodeGroup group) {
@@ -314,24 +313,26 @@ void Simulation::start_node_forces(NodeGroup group) {
   const std::int64_t n = m.node_count();
   const auto g = body_acceleration_;
   const std::uint8_t* const foreign = foreign_.empty() ? nullptr : foreign_.data();
-#pragma omp parallel for schedule(static)
-  for (std::int64_t ii = 0; ii < n; ++ii) {
-    const index_t i = static_cast<index_t>(ii);
-    if (foreign && foreign[i] == far_foreign) continue;  // nothing here reads it
-    const bool halo = foreign && foreign[i];
-    if ((group == NodeGroup::own && halo) || (group == NodeGroup::halo && !halo)) continue;
-    if (materials[node_material[i]].params.model == ForceModel::lps) {
-      theta[i] *= lps_coefficients[i].dilatation_scale;
-      pressure_[i] = lps_coefficients[i].dilatation_coupling * theta[i];
-    } else {
-      theta[i] = 0;
+  in_parallel([&] {
+#pragma omp for schedule(static)
+    for (std::int64_t ii = 0; ii < n; ++ii) {
+      const index_t i = static_cast<index_t>(ii);
+      if (foreign && foreign[i] == far_foreign) continue;  // nothing here reads it
+      const bool halo = foreign && foreign[i];
+      if ((group == NodeGroup::own && halo) || (group == NodeGroup::halo && !halo)) continue;
+      if (materials[node_material[i]].params.model == ForceModel::lps) {
+        theta[i] *= lps_coefficients[i].dilatation_scale;
+        pressure_[i] = lps_coefficients[i].dilatation_coupling * theta[i];
+      } else {
+        theta[i] = 0;
+      }
+      const real* vi = &state_.velocities[3 * i];
+      const real density = materials[node_material[i]].params.density;
+      f[3 * i] = density * (g[0] - viscous_damping_ * vi[0]);
+      f[3 * i + 1] = density * (g[1] - viscous_damping_ * vi[1]);
+      f[3 * i + 2] = density * (g[2] - viscous_damping_ * vi[2]);
     }
-    const real* vi = &state_.velocities[3 * i];
-    const real density = materials[node_material[i]].params.density;
-    f[3 * i] = density * (g[0] - viscous_damping_ * vi[0]);
-    f[3 * i + 1] = density * (g[1] - viscous_damping_ * vi[1]);
-    f[3 * i + 2] = density * (g[2] - viscous_damping_ * vi[2]);
-  }
+  });
 }
 
 void Simulation::add_contact_forces() {

@@ -6,6 +6,8 @@
 #include <utility>
 #include <vector>
 
+#include "granulate/in_parallel.hpp"
+
 namespace granulate {
 
 void SurfaceCentres::find(const Model& model, const State& state, std::vector<real> depth,
@@ -157,11 +159,13 @@ template <class T>
 void SurfaceCentres::fill_positions(const Model& model, const State& state, std::vector<T>& x) const {
   x.resize(state.positions.size());
   const std::int64_t n = model.node_count();
-#pragma omp parallel for schedule(static)
-  for (std::int64_t i = 0; i < n; ++i) {
-    const vec3 c = at_list(model, state, static_cast<index_t>(i));
-    for (int k = 0; k < 3; ++k) x[3 * i + k] = static_cast<T>(c[k]);
-  }
+  in_parallel([&] {
+#pragma omp for schedule(static)
+    for (std::int64_t i = 0; i < n; ++i) {
+      const vec3 c = at_list(model, state, static_cast<index_t>(i));
+      for (int k = 0; k < 3; ++k) x[3 * i + k] = static_cast<T>(c[k]);
+    }
+  });
 }
 
 template void SurfaceCentres::fill_positions(const Model&, const State&, std::vector<float>&) const;
