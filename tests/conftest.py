@@ -40,10 +40,12 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
     """Without --full, the variants marked full_only are deselected (counted as such in
     pytest's summary line). The MPI tests are queued first, then the validation tests, the
     longest, so that the workers end on short tests and finish together (the order of the
-    rest is kept). With --dist load the first quarter of the queue is dealt to the workers in
-    turn, so both start on MPI tests: 2 or 3 ranks beside a serial test oversubscribe the 2
-    cores and slow it, and the suite took 4-5 % less so (two rounds alternating with the
-    validation tests first under worksteal: 305.8 and 325.6 s against 317.0 and 343.9 s)."""
+    rest is kept). With --dist load, pytest-xdist (3.8) first sends each worker a chunk of
+    consecutive tests, a quarter of its share of the queue: the first worker's holds every MPI
+    test, the second's validation tests, so one MPI test runs at a time, beside a serial
+    test (2 or 3 ranks beside it oversubscribe the 2 cores). The suite took 4-5 % less so
+    (two rounds alternating with the validation tests first under worksteal: 305.8 and 325.6 s
+    against 317.0 and 343.9 s)."""
     kept, dropped = [], []
     for item in items:
         full_only = item.get_closest_marker("full_only") is not None
