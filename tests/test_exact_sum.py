@@ -32,6 +32,24 @@ def test_is_the_correctly_rounded_sum(seed: int) -> None:
 
 
 @pytest.mark.parametrize("seed", range(5))
+def test_several_sums_at_once_are_each_arrays_sum(seed: int) -> None:
+    """ExactSum.each (a history row's sums in one pass) gives each array's exact sum, as
+    ExactSum.of does: arrays of different lengths and binary orders, empty ones, one whose
+    terms cancel to zero; with a non-finite term in one array, that array's inf and the
+    others' sums."""
+    rng = np.random.default_rng(seed)
+    lengths, orders = 10 * rng.integers(1, 30, 6), rng.integers(-20, 20, 6)
+    arrays = [_wide(rng, int(n)) * 2.0 ** int(k) for n, k in zip(lengths, orders, strict=True)]
+    arrays += [np.zeros(0), np.array([1e-300, 1e300, -1e300, -1e-300])]
+    sums = ExactSum.each(arrays)
+    assert sums == [ExactSum.of(x) for x in arrays]
+    assert [s.value for s in sums] == [math.fsum(x) for x in arrays]
+    assert sums[-1] == ExactSum() and sum(s != ExactSum() for s in sums) >= 5
+    with_inf = ExactSum.each([arrays[0], np.array([1.0, np.inf])])
+    assert with_inf[0] == sums[0] and with_inf[1].value == math.inf
+
+
+@pytest.mark.parametrize("seed", range(5))
 def test_parts_in_any_order_give_the_same_bits(seed: int) -> None:
     rng = np.random.default_rng(seed)
     for x in (_wide(rng, 4_000), rng.random(4_000)):

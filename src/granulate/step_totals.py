@@ -46,12 +46,8 @@ class TrackedSums:
         """The sums over the nodes whose per-node arrays these are ((n,) and (n, 3))."""
         v = np.asarray(volumes, dtype=np.float64)
         f, x, origin = (np.asarray(a, dtype=np.float64) for a in (forces, positions, reference))
-        return cls(
-            ExactSum.of(mass),
-            tuple(ExactSum.of(v * f[:, k]) for k in range(3)),
-            tuple(ExactSum.of(x[:, k] - origin[:, k]) for k in range(3)),
-            len(v),
-        )
+        total, *sums = ExactSum.each([mass, *(v[:, None] * f).T, *(x - origin).T])
+        return cls(total, tuple(sums[:3]), tuple(sums[3:]), len(v))
 
     def __add__(self, other: TrackedSums) -> TrackedSums:
         return TrackedSums(
@@ -112,10 +108,15 @@ def node_totals(
     per-node arrays these are (no contact energy, which the force evaluation sums, and no
     tracked body's)."""
     v = np.asarray(volumes, dtype=np.float64)
+    kinetic, strain, potential, damaged, volume = ExactSum.each(
+        [
+            kinetic_energies(mass, velocities),
+            np.asarray(strain_density, dtype=np.float64) * v,
+            gravity_energies(mass, positions, gravity),
+            v * np.asarray(damage, dtype=np.float64),
+            v,
+        ]
+    )
     return StepTotals(
-        kinetic=ExactSum.of(kinetic_energies(mass, velocities)),
-        strain=ExactSum.of(np.asarray(strain_density, dtype=np.float64) * v),
-        gravity=ExactSum.of(gravity_energies(mass, positions, gravity)),
-        damaged_volume=ExactSum.of(v * np.asarray(damage, dtype=np.float64)),
-        volume=ExactSum.of(v),
+        kinetic=kinetic, strain=strain, gravity=potential, damaged_volume=damaged, volume=volume
     )
