@@ -1,9 +1,9 @@
 """Run under `mpiexec -n K python tests/mpi_check.py DIMENSION STEPS` (tests/test_mpi.py does):
 the locality test's assembly (tests/assemblies.py: grains pressed into each other and thrown
 at each other, friction, damping, the surface law), here also under gravity on a floor, run
-serially on every rank and distributed over the K ranks (granulate.parallel.DistributedRun).
-Rank 0 compares the two bit for bit and prints one line; the exit status is non-zero on any
-difference.
+serially on rank 0 (the others wait asleep: rank_zero.py) and distributed over the K ranks
+(granulate.parallel.DistributedRun). Rank 0 compares the two bit for bit and prints one line;
+the exit status is non-zero on any difference.
 
 `... drum VARIANT STEPS [renew]` runs the checkpoint tests' tumbling drum (tests/assemblies.py:
 four grains tumbling and breaking in a rotating drum with a lifter; VARIANT lattice, grid,

@@ -65,8 +65,7 @@ class ExactSum:
                 return cls(0, float(np.sum(x[~finite])))
         scaled = 0
         for start in range(0, len(x), _CHUNK):
-            chunk = x[start : start + _CHUNK]
-            scaled += _scaled_sums(chunk, np.zeros(len(chunk), np.int64), 1)[0]
+            scaled += _scaled_sums(x[start : start + _CHUNK], 0, 1)[0]
         return cls(scaled)
 
     def __add__(self, other: ExactSum) -> ExactSum:
@@ -83,9 +82,10 @@ class ExactSum:
             return math.inf if self.scaled > 0 else -math.inf
 
 
-def _scaled_sums(x: np.ndarray, rows: np.ndarray, count: int) -> list[int]:
+def _scaled_sums(x: np.ndarray, rows: np.ndarray | int, count: int) -> list[int]:
     """For each of `count` rows, the sum of the terms of x in it (`rows`: each term's row,
-    0 <= row < count) times 2^1127, exactly, for finite x of at most _CHUNK terms."""
+    0 <= row < count, or one row for all) times 2^1127, exactly, for finite x of at most
+    _CHUNK terms."""
     fraction, exponent = np.frexp(x)  # x = fraction 2^exponent, 1/2 <= |fraction| < 1
     mantissa = np.ldexp(fraction, 53).astype(np.int64)  # exact: |mantissa| < 2^53
     shift = exponent.astype(np.int64) - 53 + _SCALE  # x = mantissa 2^(shift - 1127), shift >= 1

@@ -296,4 +296,4 @@ def test_a_stack_of_discs_stands_where_rigid_statics_lets_it(
     interlock: mu = 0.2 stands (2.592 at 0.15 s), and so did mu = 0.1 with mu_r = 0.5 (2.605
     at 0.12 s), which rigid statics forbids."""
     height = stack_height(mu, rolling_friction=rolling_friction, until=until)
-    assert height > 2.6 if stands else height < 1.1, height
+    assert (height > 2.6) if stands else (height < 1.1), height
