@@ -54,6 +54,21 @@ def test_a_block_cut_in_half_is_two_fragments_of_half_the_mass(dimension: int) -
     assert len(sim.fragments()) == 2
 
 
+def test_damage_and_fragments_follow_the_bonds_back_to_a_checkpoint(tmp_path: Path) -> None:
+    """The fragment labels and damage, kept while no bond changes (core.bond_changes), are
+    made anew when bonds break by hand and when a checkpoint of the intact block is loaded."""
+    side = 2e-3
+    sim = gr.Simulation(2)
+    sim.add_body(block(2, side), rock(), 2.5e-4)
+    saved = sim.save_checkpoint(tmp_path / "intact.npz")
+    assert len(sim.fragment_table()["fragment"]) == 1 and sim.damage.max() == 0
+    sim.precrack((side, 0), (1, 0))
+    assert len(sim.fragment_table()["fragment"]) == 2 and sim.damage.max() > 0
+    sim.load_checkpoint(saved)
+    assert len(sim.fragment_table()["fragment"]) == 1 and sim.damage.max() == 0
+    assert not sim.damage.flags.writeable  # kept: a caller cannot change it
+
+
 @pytest.mark.parametrize("dimension", [2, 3])
 def test_an_intact_assembly_is_one_fragment_per_particle_with_no_breakage(dimension: int) -> None:
     sim = gr.Simulation(dimension)

@@ -517,9 +517,12 @@ void Simulation::damage(real* phi, real* z) const {
       const NodeBonds bonds = m.node_bonds(i);
       real all = 0, intact = 0, max_stretch = 0;
       for (index_t b = 0; b < bonds.count; ++b) {
-        const real w = bonds.weight(b), r = bonds.length(b);
+        const real w = bonds.weight(b);
         all += w;
         if (state_.bonds.intact(i, b)) intact += w;
+      }
+      for (index_t b = 0; z && b < bonds.count; ++b) {
+        const real r = bonds.length(b);
         max_stretch = std::max(
             max_stretch, std::abs(bond_extension(i, bonds.neighbor(b), r, state_.positions.data()) / r));
       }
@@ -542,6 +545,7 @@ void Simulation::break_bonds(const std::vector<std::array<index_t, 2>>& pairs) {
       BondStates::clear(state_.bonds.node(forward[0]), forward[1]);
       BondStates::clear(state_.bonds.node(backward[0]), backward[1]);
       broken_bond_copies_ += 2;
+      ++bond_changes_;
       const std::array<index_t, 2> pair{i, j};
       contact_.bonds_broke(*model_, state_, {&pair, 1});
     }
@@ -551,6 +555,7 @@ void Simulation::break_bonds(const std::vector<std::array<index_t, 2>>& pairs) {
 
 void Simulation::count_broken_bond_copies() {
   const Model& m = *model_;
+  ++bond_changes_;  // called where the bond states were set anew
   if (foreign_.empty()) {
     broken_bond_copies_ = state_.bonds.broken(m.bond_offsets(), 0, m.node_count());
     return;

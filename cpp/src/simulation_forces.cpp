@@ -209,6 +209,7 @@ void Simulation::finish_forces(std::span<const std::array<index_t, 2>> ghost_bre
   blocks_evaluated_ = pass_not_begun;
   const std::size_t own = breaks_.size();
   break_ghost_bonds(ghost_breaks);
+  if (!breaks_.empty()) ++bond_changes_;
   contact_.bonds_broke(*model_, state_, std::span(breaks_).subspan(own));
   broken_bond_copies_ +=
       2 * (foreign_.empty()

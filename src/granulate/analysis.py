@@ -60,6 +60,13 @@ def complete_particle_table(
     return table, stresses
 
 
+def read_only(array: NDArray) -> NDArray:
+    """A view of `array` that cannot be written (the core keeps writing the original)."""
+    view = array.view()
+    view.flags.writeable = False
+    return view
+
+
 def squared_distances(positions: ArrayLike) -> NDArray[np.float64]:
     """Per node |x_i|^2 [m^2], its distance from the origin squared."""
     return _squared_norms(np.asarray(positions, dtype=np.float64))
@@ -92,7 +99,11 @@ class Analysis:
     def __init__(self, core: _core.Simulation, model: _core.Model, particles: int) -> None:
         self._core, self._model = core, model
         self._dimension, self._particles = model.dimension, particles
-        self._labels: tuple[tuple[int, int], NDArray[np.uint32]] | None = None
+        #: Measures that read only the bond states, kept with core.bond_changes at the time:
+        #: fragment labels and damage phi (a history row every few steps needs them anew only
+        #: when a bond broke).
+        self._labels: tuple[int, NDArray[np.uint32]] | None = None
+        self._phi: tuple[int, NDArray[np.float64]] | None = None
         self._given: tuple[tuple[int, int], GivenMeasures] | None = None
 
     def _key(self) -> tuple[int, int]:
@@ -119,6 +130,17 @@ class Analysis:
         phi, z = self._core.damage()
         return np.asarray(phi), np.asarray(z)
 
+    def damage_phi(self) -> NDArray[np.float64]:
+        """Per node the damage phi alone (damage()[0]; core.damage_phi, which reads the bonds
+        only, so it is kept until a bond state changes). Read-only."""
+        given = self._given_now()
+        if given is not None:
+            return given.damage
+        changes = int(self._core.bond_changes)
+        if self._phi is None or self._phi[0] != changes:
+            self._phi = (changes, read_only(np.asarray(self._core.damage_phi())))
+        return self._phi[1]
+
     def kinetic_energy(self) -> float:
         """sum_i 1/2 m_i |v_i|^2 [J; J/m in 2D], correctly rounded (ExactSum): the same bits
         however the nodes are dealt to ranks."""
@@ -142,13 +164,14 @@ class Analysis:
         return ExactSum.of(self.strain_energy_densities() * volumes).value
 
     def fragment_labels(self) -> NDArray[np.uint32]:
-        """Each node's piece: its smallest node (computed once per step and bond count)."""
+        """Each node's piece: its smallest node (core.fragments, kept until a bond state
+        changes). Read-only."""
         given = self._given_now()
         if given is not None:
             return given.labels
-        key = self._key()
-        if self._labels is None or self._labels[0] != key:
-            self._labels = (key, self._core.fragments())
+        changes = int(self._core.bond_changes)
+        if self._labels is None or self._labels[0] != changes:
+            self._labels = (changes, read_only(np.asarray(self._core.fragments())))
         return self._labels[1]
 
     def forget_fragments(self) -> None:
@@ -211,7 +234,7 @@ class Analysis:
         phi per node (the core's, when None)."""
         core, count = self._core, self._particles
         owner, volumes, motion = self._motion()
-        phi = self.damage()[0] if damage is None else np.asarray(damage)
+        phi = self.damage_phi() if damage is None else np.asarray(damage)
         particle_volume = np.bincount(owner, volumes, count)
         mean_damage = np.bincount(owner, volumes * phi, count) / particle_volume
         table, stresses = complete_particle_table(

@@ -16,7 +16,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from granulate import _core, core_model, fragments, network, particle_table, threads
 from granulate._version import __version__
-from granulate.analysis import Analysis
+from granulate.analysis import Analysis, read_only
 from granulate.assembly import Assembly, Body
 from granulate.errors import InputError
 from granulate.evaluation import Evaluation
@@ -24,13 +24,6 @@ from granulate.interactions import Interactions
 from granulate.run_loop import RunRecord
 from granulate.shapes import Shape
 from granulate.writers.outputs import Outputs
-
-
-def read_only(array: NDArray) -> NDArray:
-    """A view of `array` that cannot be written (the core keeps writing the original)."""
-    view = array.view()
-    view.flags.writeable = False
-    return view
 
 
 class SimulationResults:
@@ -101,8 +94,9 @@ class SimulationResults:
 
     @property
     def damage(self) -> NDArray[np.float64]:
-        """(n,) damage phi = 1 - intact / initial influence-weighted volume of the bonds."""
-        return self.analysis.damage()[0]
+        """(n,) damage phi = 1 - intact / initial influence-weighted volume of the bonds,
+        read-only."""
+        return self.analysis.damage_phi()
 
     @property
     def damage_z(self) -> NDArray[np.float64]:

@@ -17,6 +17,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from granulate import _core, assembly
+from granulate.analysis import read_only
 from granulate.assembly import Assembly, Body
 from granulate.contact import Contact
 from granulate.errors import InputError
@@ -30,7 +31,6 @@ from granulate.materials import Material
 from granulate.packing import Grain, Packing, Placements
 from granulate.reference_shapes import ReferenceShape
 from granulate.shapes import Shape
-from granulate.simulation_results import read_only
 from granulate.walls import Surface, Wall
 from granulate.writers.outputs import Outputs
 from granulate.writers.vtu_frame import FIELDS

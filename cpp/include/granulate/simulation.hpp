@@ -111,9 +111,13 @@ class Simulation {
   /// on ghost particles (set_ghost_particles: their owners measure them).
   void strain_energy_density(real* out) const;
   /// phi_i = 1 - (intact weighted volume)/(initial weighted volume); z_i = max_j |s_ij| / s0;
-  /// 0 on ghost particles.
+  /// 0 on ghost particles. z may be null: phi alone reads only the bond states (no stretch).
   void damage(real* phi, real* z) const;
   std::uint64_t broken_bonds() const;  ///< broken bonds, each counted once
+  /// A count that changes whenever a bond state does (bonds broken in a step, also a ghost's,
+  /// or by hand; states restored or assigned): what reads only the bond states (phi, the
+  /// fragments) is the same while it is.
+  std::uint64_t bond_changes() const { return bond_changes_; }
   /// Replaces every bond copy's state (one byte each, in the model's bond order, as checkpoints
   /// hold them); false when the count does not match. Rank 0 of a distributed run takes the
   /// ranks' bonds this way (granulate.parallel.whole_state).
@@ -260,7 +264,8 @@ class Simulation {
   /// inner_schedule_ and outer_schedule_ from the model's schedule and foreign_.
   void cut_schedule();
   /// broken_bond_copies_ from the bond states: every broken copy, or with foreign nodes twice
-  /// the bonds broken whose lower-numbered end is own (each bond once over the processes).
+  /// the bonds broken whose lower-numbered end is own (each bond once over the processes); and
+  /// a change of bond_changes_.
   void count_broken_bond_copies();
   void check_stability() const;
   std::shared_ptr<Model> model_;
@@ -307,6 +312,7 @@ class Simulation {
   std::int64_t dilatation_blocks_ = pass_not_begun;  // pass 1's blocks done within the step
   std::int64_t blocks_evaluated_ = pass_not_begun;   // pass 2's blocks done within the step
   std::uint64_t broken_bond_copies_ = 0;             // both copies of a broken bond count
+  std::uint64_t bond_changes_ = 0;                   // see bond_changes()
   ContactModel contact_;
   contact::PeridemDamping peridem_damping_;
   bool forces_current_ = false;

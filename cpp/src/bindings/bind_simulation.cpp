@@ -399,6 +399,16 @@ void bind_results(nb::class_<Simulation>& cls) {
              self.damage(phi.data(), z.data());
              return nb::make_tuple(copy_out(phi), copy_out(z));
            })
+      .def(
+          "damage_phi",
+          [](const Simulation& self) {
+            std::vector<real> phi(self.model().node_count());
+            self.damage(phi.data(), nullptr);
+            return copy_out(phi);
+          },
+          "Per node the damage phi alone (damage()[0], from the bond states only).")
+      .def_prop_ro("bond_changes", &Simulation::bond_changes,
+                   "A count that changes whenever a bond state does (Simulation::bond_changes).")
       .def("fixity", [](const Simulation& self) { return copy_out(self.fixity()); })
       .def("fragments",
            [](const Simulation& self) {

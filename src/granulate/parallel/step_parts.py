@@ -64,7 +64,7 @@ def step_part(run: DistributedRun, tracked: tuple[int, ...]) -> StepPart:
     core, model = local.core, local.model
     volumes = np.asarray(model.volumes)[nodes]
     mass = np.asarray(model.node_density)[nodes] * volumes
-    phi = np.asarray(core.damage()[0])[nodes]
+    phi = np.asarray(core.damage_phi())[nodes]
     density = np.asarray(core.strain_energy_density())[nodes]
     x, v = core.positions[nodes], core.velocities[nodes]
     evaluation = OwnEvaluation.of(run)

@@ -27,8 +27,8 @@ if TYPE_CHECKING:
 class StepData:
     """The current step: its time, sums over the nodes (StepTotals), broken bonds, fragment
     table, the last force evaluation (contacts, contact counts, wall reactions), the particles
-    and the walls' displacements; and, when made of the whole state, the simulation and its
-    damage per node (for writers that read them)."""
+    and the walls' displacements; and, when made of the whole state, the simulation (for
+    writers that read it)."""
 
     step: int
     time: float  #: [s]
@@ -43,10 +43,9 @@ class StepData:
     wall_displacements: tuple[float, ...]  #: [m or rad], in the walls' order
     gravity: NDArray[np.float64]  #: (3,) [m/s^2]
     dimension: int
-    #: the whole simulation and its damage phi and PeriDEM's Z per node; None when made of the
-    #: ranks' measures (a frame in pieces, written by the ranks)
+    #: the whole simulation; None when made of the ranks' measures (a frame in pieces, written
+    #: by the ranks)
     simulation: Simulation | None = None
-    damage: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None
     #: when made of the ranks' measures for a frame of every node: the ranks' rows of it,
     #: joined in node order (Outputs.one_file_frame)
     frame_rows: NodeRows | None = None
@@ -63,7 +62,7 @@ class StepData:
     def of(cls, simulation: Simulation, tracked: tuple[Body, ...] = ()) -> StepData:
         """The step of `simulation`'s whole state, with the sums of the `tracked` bodies."""
         sim = simulation
-        phi, z = sim.analysis.damage()
+        phi = sim.analysis.damage_phi()
         evaluation = sim.evaluation()
         particles, stresses, volumes = sim.analysis.particles(evaluation.contacts, phi)
         core = sim.core
@@ -78,7 +77,6 @@ class StepData:
             (stresses, volumes),
             *set_up_fields(sim, core),
             sim,
-            (phi, z),
         )
 
 

@@ -198,20 +198,22 @@ class VtuFrame:
     needs_whole_state = False
 
     def write(self, data: StepData, outputs: Outputs) -> None:
-        sim, damage = data.simulation, data.damage
+        sim = data.simulation
         name = f"frame_{outputs.frames:06d}"
         frames = outputs.directory / "frames"
         if not outputs.pieces:  # a frame of every node: the ranks' rows, or the simulation's
             rows = data.frame_rows
             if rows is None:
-                assert sim is not None and damage is not None
-                rows = node_rows(sim, outputs.fields, damage=damage)
+                assert sim is not None
+                rows = node_rows(sim, outputs.fields, damage=sim.analysis.damage())
             write_vtu(frames / f"{name}.vtu", rows.positions, rows.values)
             outputs.pvd.add(data.time, Path("frames") / f"{name}.vtu")
             return
         if not outputs.piece_ranks:  # a serial run's one piece; else the ranks wrote theirs
-            assert sim is not None and damage is not None
-            write_piece(frames / name / "piece_0.vtu", sim, outputs.fields, damage=damage)
+            assert sim is not None
+            write_piece(
+                frames / name / "piece_0.vtu", sim, outputs.fields, damage=sim.analysis.damage()
+            )
         count = outputs.piece_ranks or 1
         pieces = [f"piece_{r}.vtu" for r in range(count)]
         _check_pieces(frames / name, pieces)
