@@ -62,13 +62,25 @@ def test_parts_in_any_order_give_the_same_bits(seed: int) -> None:
         assert sum(x[::-1].tolist()) != whole or sum(x.tolist()) != whole  # order matters
 
 
-def test_chunks_of_the_bincount_are_joined_exactly(monkeypatch: pytest.MonkeyPatch) -> None:
+def test_chunks_are_joined_exactly(monkeypatch: pytest.MonkeyPatch) -> None:
     import granulate.exact_sum as exact
 
     rng = np.random.default_rng(7)
     x = _wide(rng, 1_000)
     monkeypatch.setattr(exact, "_CHUNK", 7)
     assert ExactSum.of(x).value == math.fsum(x)
+    assert ExactSum.each([x, x[:3]]) == [ExactSum.of(x), ExactSum.of(x[:3])]
+
+
+def test_many_terms_of_one_exponent_with_the_widest_mantissas() -> None:
+    """A million terms in one exponent's bin, each with every mantissa bit set (2 - 2^-52 and
+    its negative, and the largest subnormal): the core's 64-bit half sums stay exact."""
+    widest, subnormal = np.nextafter(2.0, 0.0), np.nextafter(np.finfo(np.float64).tiny, 0.0)
+    for term in (widest, -widest, subnormal):
+        x = np.full(1_000_000, term)
+        assert ExactSum.of(x).scaled == 1_000_000 * ExactSum.of([term]).scaled
+        assert ExactSum.of(x).value == math.fsum(x)
+    assert ExactSum.of(np.r_[np.full(999_999, widest), -widest]).value == 999_998 * widest
 
 
 def test_extremes() -> None:

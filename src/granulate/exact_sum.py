@@ -8,11 +8,11 @@ ExactSum holds N; adding two is adding their Ns (a rank's partial sums travel as
 ``value`` rounds N 2^-1127 to the nearest float once (Python's int division rounds correctly, to
 even on a tie): the correctly rounded sum of every term, as math.fsum gives it.
 
-The terms are added in NumPy: the mantissas are split into two halves of 26 and 27 bits and each
-half summed per exponent by np.bincount, whose float64 sums of integers stay exact while they
-are below 2^53 (chunks of 2^25 terms); the few exponents present are then put together in Python
-ints. About 35 ns a term (math.fsum: 46 ns). A sum of few terms costs the dozen NumPy calls,
-about 60 us; ``ExactSum.each`` makes several sums (a history row's dozen) in one pass.
+The terms are binned by the core (granulate._core.exact_sum_bins, cpp/src/exact_sum.cpp): each
+mantissa is split into two halves of 26 and 27 bits and each half summed per array and exponent
+in 64-bit integers, exact for up to 2^35 terms (a chunk); the few exponents present are then put
+together in Python ints. About 2 ns a term (math.fsum: 46 ns), and one call for several sums
+(``ExactSum.each``: a history row's dozen).
 
 A non-finite term (inf, nan) makes the sum non-finite as float addition would: inf, -inf or nan,
 whatever the order.
@@ -27,9 +27,11 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
+from granulate import _core
+
 _SCALE = 1127  # every finite float is a whole multiple of 2^-_SCALE
-_LOW_BITS = 26
-_CHUNK = 2**25  # terms per bincount: 2^25 halves below 2^27 sum below 2^52
+_LOW_BITS = 26  # the core splits each mantissa into high 2^26 + low
+_CHUNK = 2**35  # terms per call: 2^35 halves below 2^27 in size sum below 2^62
 
 
 @dataclass(frozen=True)
@@ -43,29 +45,28 @@ class ExactSum:
     @classmethod
     def of(cls, terms: ArrayLike) -> ExactSum:
         """The exact sum of every element of `terms` (any shape, taken as float64)."""
-        return cls._of_flat(np.asarray(terms, dtype=np.float64).ravel())
+        return cls._of_flat(_flat(terms))
 
     @classmethod
     def each(cls, arrays: Sequence[ArrayLike]) -> list[ExactSum]:
-        """[ExactSum.of(a) for a in arrays], in one NumPy pass over all their terms (each
-        array's sum binned apart) while they are finite and at most a chunk."""
-        flat = [np.asarray(a, dtype=np.float64).ravel() for a in arrays]
-        x = np.concatenate([np.zeros(0), *flat])
-        if len(x) > _CHUNK or not np.isfinite(x).all():
+        """[ExactSum.of(a) for a in arrays], in one call of the core (each array's sum binned
+        apart) while they are finite and at most a chunk."""
+        flat = [_flat(a) for a in arrays]
+        bins = None if any(len(t) > _CHUNK for t in flat) else _core.exact_sum_bins(flat)
+        if bins is None:  # a term is not finite, or an array is too long for one call
             return [cls._of_flat(terms) for terms in flat]
-        rows = np.repeat(np.arange(len(flat)), [len(terms) for terms in flat])
-        return [cls(scaled) for scaled in _scaled_sums(x, rows, len(flat))]
+        return [cls(scaled) for scaled in _added(bins, len(flat))]
 
     @classmethod
     def _of_flat(cls, x: np.ndarray) -> ExactSum:
-        """ExactSum.of a flat float64 array."""
-        finite = np.isfinite(x)
-        if not finite.all():
-            with np.errstate(invalid="ignore"):  # inf - inf: nan, as float addition gives
-                return cls(0, float(np.sum(x[~finite])))
+        """ExactSum.of a flat contiguous float64 array."""
         scaled = 0
         for start in range(0, len(x), _CHUNK):
-            scaled += _scaled_sums(x[start : start + _CHUNK], 0, 1)[0]
+            bins = _core.exact_sum_bins([x[start : start + _CHUNK]])
+            if bins is None:  # a term is inf or nan: so is the sum, as float addition gives
+                with np.errstate(invalid="ignore"):  # inf - inf: nan
+                    return cls(0, float(np.sum(x[~np.isfinite(x)])))
+            scaled += _added(bins, 1)[0]
         return cls(scaled)
 
     def __add__(self, other: ExactSum) -> ExactSum:
@@ -82,22 +83,16 @@ class ExactSum:
             return math.inf if self.scaled > 0 else -math.inf
 
 
-def _scaled_sums(x: np.ndarray, rows: np.ndarray | int, count: int) -> list[int]:
-    """For each of `count` rows, the sum of the terms of x in it (`rows`: each term's row,
-    0 <= row < count, or one row for all) times 2^1127, exactly, for finite x of at most
-    _CHUNK terms."""
-    fraction, exponent = np.frexp(x)  # x = fraction 2^exponent, 1/2 <= |fraction| < 1
-    mantissa = np.ldexp(fraction, 53).astype(np.int64)  # exact: |mantissa| < 2^53
-    shift = exponent.astype(np.int64) - 53 + _SCALE  # x = mantissa 2^(shift - 1127), shift >= 1
-    high = mantissa >> _LOW_BITS  # floor: mantissa = high 2^26 + low, 0 <= low < 2^26
-    low = mantissa - (high << _LOW_BITS)
-    first = int(shift.min()) if len(x) else 0
-    bins = int(shift.max()) - first + 1 if len(x) else 1
-    key = rows * bins + (shift - first)  # the row's bin of each exponent present
-    highs = np.bincount(key, weights=high.astype(np.float64), minlength=count * bins)
-    lows = np.bincount(key, weights=low.astype(np.float64), minlength=count * bins)
+def _flat(terms: ArrayLike) -> np.ndarray:
+    """`terms` as a flat contiguous float64 array (a view when they are one already)."""
+    return np.ascontiguousarray(terms, dtype=np.float64).ravel()
+
+
+def _added(bins: tuple[np.ndarray, ...], count: int) -> list[int]:
+    """For each of `count` arrays the sum of its terms times 2^1127, exactly, from the core's
+    bins (exact_sum_bins: each bin's array, exponent S and sums of the mantissas' halves, a
+    term being (high 2^26 + low) 2^(S - 1127))."""
     scaled = [0] * count
-    for k in np.flatnonzero((highs != 0) | (lows != 0)):
-        row, s = divmod(int(k), bins)
-        scaled[row] += ((int(highs[k]) << _LOW_BITS) + int(lows[k])) << (first + s)
+    for array, exponent, high, low in zip(*(column.tolist() for column in bins), strict=True):
+        scaled[array] += ((high << _LOW_BITS) + low) << exponent
     return scaled

@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from granulate import _core
 from granulate.io.table import read_columns, write_columns
 
 #: Columns of a particle table, in the order written.
@@ -26,6 +27,8 @@ COLUMNS = (
     "gyration_radius", "damage", "coordination", "sxx", "syy", "szz", "sxy", "sxz", "syz",
 )  # fmt: skip
 _INTEGERS = ("particle", "coordination")
+#: The inertia tensor's places in _core.particle_sums' six components (xx, yy, zz, xy, xz, yz).
+_TENSOR = np.array([[0, 3, 4], [3, 1, 5], [4, 5, 2]])
 _STRESS = (("sxx", 0, 0), ("syy", 1, 1), ("szz", 2, 2), ("sxy", 0, 1), ("sxz", 0, 2), ("syz", 1, 2))
 
 Table = dict[str, NDArray]
@@ -36,25 +39,16 @@ def motion(
 ) -> Table:
     """Mass, centre x y z, velocity vx vy vz, angular velocity wx wy wz and gyration_radius of
     each of `count` particles from per-node `owner` (particle index), mass, positions (n, 3)
-    and velocities (n, 3)."""
-    p = np.asarray(owner, dtype=np.int64)
-    m = np.asarray(mass, dtype=np.float64)
-    x = np.asarray(positions, dtype=np.float64)
-    v = np.asarray(velocities, dtype=np.float64)
-    total = np.bincount(p, m, count)
-    centre = np.column_stack([np.bincount(p, m * x[:, k], count) for k in range(3)])
-    velocity = np.column_stack([np.bincount(p, m * v[:, k], count) for k in range(3)])
-    centre /= total[:, None]
-    velocity /= total[:, None]
-    arm, relative = x - centre[p], v - velocity[p]
-    moment = m[:, None] * np.cross(arm, relative)
-    momentum = np.column_stack([np.bincount(p, moment[:, k], count) for k in range(3)])
-    r2 = np.einsum("ij,ij->i", arm, arm)
-    inertia = np.empty((count, 3, 3))
-    for a in range(3):  # m (r^2 delta_ab - arm_a arm_b), summed node by node as np.add.at
-        for b in range(a, 3):
-            term = r2 - arm[:, a] * arm[:, a] if a == b else 0.0 - arm[:, a] * arm[:, b]
-            inertia[:, a, b] = inertia[:, b, a] = np.bincount(p, m * term, count)
+    and velocities (n, 3). The sums over the nodes are the core's (_core.particle_sums), the
+    3 x 3 solves NumPy's."""
+    total, centre, velocity, momentum, components, spread = _core.particle_sums(
+        np.ascontiguousarray(owner, dtype=np.uint32),
+        np.ascontiguousarray(mass, dtype=np.float64),
+        np.ascontiguousarray(positions, dtype=np.float64),
+        np.ascontiguousarray(velocities, dtype=np.float64),
+        count,
+    )
+    inertia = components[:, _TENSOR]  # (count, 3, 3)
     spin = np.zeros((count, 3))
     solvable = np.linalg.matrix_rank(inertia) == 3
     spin[solvable] = np.linalg.solve(inertia[solvable], momentum[solvable][:, :, None])[:, :, 0]
@@ -65,7 +59,7 @@ def motion(
         table[axis] = centre[:, k]
         table["v" + axis] = velocity[:, k]
         table["w" + axis] = spin[:, k]
-    table["gyration_radius"] = np.sqrt(np.bincount(p, m * r2, count) / total)
+    table["gyration_radius"] = np.sqrt(spread / total)
     return table
 
 

@@ -35,4 +35,5 @@ NB_MODULE(_core, m) {
   bind_contact(m);
   bind_walls(m);
   bind_simulation(m);
+  bind_measures(m);
 }
