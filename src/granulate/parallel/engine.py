@@ -34,7 +34,7 @@ from __future__ import annotations
 import os
 import time
 import warnings
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from pathlib import Path
 from types import SimpleNamespace
 from typing import TYPE_CHECKING, Any, NamedTuple
@@ -526,8 +526,14 @@ class DistributedRun:
 
     def local_slice(self, grain: int) -> slice:
         """The local nodes of a held grain."""
-        first = int(self._node_map[self._slices[grain].start])
-        return slice(first, first + self._slices[grain].stop - self._slices[grain].start)
+        (nodes,) = self.local_slices([grain])
+        return nodes
+
+    def local_slices(self, grains: Iterable[int]) -> list[slice]:
+        """The local nodes of each of these held grains (one node-map lookup for them all)."""
+        whole = [self._slices[int(g)] for g in grains]
+        firsts = self._node_map[np.array([s.start for s in whole], dtype=np.int64)].tolist()
+        return [slice(f, f + s.stop - s.start) for f, s in zip(firsts, whole, strict=True)]
 
     def _nodes_of(
         self, grains: NDArray[np.int64], node_map: NodeMap | None = None
@@ -555,7 +561,7 @@ class DistributedRun:
 
     def owned_slices(self) -> list[slice]:
         """The local node slice of each owned grain, in grain order."""
-        return [self.local_slice(g) for g in self._owned]
+        return self.local_slices(self._owned)
 
     def is_owned_node(self, local: NDArray[np.int64]) -> NDArray[np.bool_]:
         """Whether each of these local nodes belongs to an owned grain."""
@@ -1022,7 +1028,7 @@ class DistributedRun:
         core = self.local.core
         giving = np.unique(np.concatenate(wanted))
         saved = dict(core.checkpoint()) if renew or len(giving) else {}
-        owned = {int(g): self.local_slice(g) for g in giving}
+        owned = dict(zip(giving.tolist(), self.local_slices(giving), strict=True))
         states = grain_states(self.local, saved, self._to_global, owned) if owned else {}
         outgoing = [{int(g): states[int(g)] for g in grains} for grains in wanted]
         received: dict[int, GrainState] = {}
@@ -1053,7 +1059,7 @@ class DistributedRun:
         the grains it owns (fingerprints.grain_digest; one gather, once per run), rank 0 puts
         the digests together in grain order."""
         if self._setup_digest is None:
-            slices = [self.local_slice(g) for g in self._owned]
+            slices = self.owned_slices()
             mine = (self._owned, fingerprints.model_grain_digests(self.local.model, slices))
             parts = self.comm.gather(mine, root=0)
 
@@ -1079,7 +1085,7 @@ class DistributedRun:
             [deepest.deepest_overlap, deepest.half_overlap_step, deepest.full_overlap_step],
             dtype=float,
         )
-        owned = {int(g): self.local_slice(g) for g in self._owned}
+        owned = dict(zip(self._owned.tolist(), self.owned_slices(), strict=True))
         return moment_of(saved), grain_states(self.local, saved, self._to_global, owned)
 
     def save_checkpoint(self, path: str | os.PathLike[str], outputs: Outputs | None = None) -> Path:

@@ -64,7 +64,7 @@ def step_part(run: DistributedRun, tracked: tuple[int, ...]) -> StepPart:
     core, model = local.core, local.model
     volumes = np.asarray(model.volumes)[nodes]
     mass = np.asarray(model.node_density)[nodes] * volumes
-    phi = np.asarray(core.damage_phi())[nodes]
+    phi = local.analysis.damage_phi()[nodes]  # kept until a bond state changes
     density = np.asarray(core.strain_energy_density())[nodes]
     x, v = core.positions[nodes], core.velocities[nodes]
     evaluation = OwnEvaluation.of(run)
@@ -129,7 +129,7 @@ def _own_fragments(run: DistributedRun, grains: NDArray[np.int64]) -> fragments.
     whole run's order, so that node is the piece's smallest here too."""
     local, nodes = run.local, run.owned_nodes
     core, model = local.core, local.model
-    place = np.searchsorted(nodes, np.asarray(core.fragments())[nodes])  # among the own nodes
+    place = np.searchsorted(nodes, local.analysis.fragment_labels()[nodes])  # among own nodes
     volumes, density = (np.asarray(a)[nodes] for a in (model.volumes, model.node_density))
     x, v = core.positions[nodes], core.velocities[nodes]
     table = fragments.fragment_table(place, grains, x, v, volumes, density, local.dimension)
