@@ -112,6 +112,28 @@ def test_a_second_run_into_a_locked_folder_is_refused(tmp_path: Path) -> None:
     assert not lock.exists() and len(listed_frames(out)) == 3
 
 
+def test_a_serial_run_on_one_of_several_ranks_is_told_to_give_its_simulation_a_comm(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """`mpiexec -n 2 granulate run example.py` of a script whose Simulation has no comm ran the
+    whole script on each rank, and the second rank was refused the folder the first was writing
+    with no word of MPI. Started as rank 1 of 2 (the launcher's variables), the refusal says so
+    and what to do."""
+    out = tmp_path / "run"
+    sim = plate(out)
+    out.mkdir()
+    (out / ".granulate.lock").write_text(
+        json.dumps({"pid": os.getpid(), "host": socket.gethostname()})
+    )
+    monkeypatch.setenv("PMI_SIZE", "2")
+    monkeypatch.setenv("PMI_RANK", "1")
+    with pytest.raises(gr.InputError) as refused:
+        sim.run(20)
+    assert str(refused.value).startswith(f"another run is writing into {out}")
+    assert "rank 1 of 2 MPI ranks" in str(refused.value)
+    assert "gr.Simulation(..., comm=MPI.COMM_WORLD)" in str(refused.value)
+
+
 def test_frames_without_a_pvd_are_a_run_too(tmp_path: Path) -> None:
     out = tmp_path / "run"
     (out / "frames").mkdir(parents=True)

@@ -237,7 +237,8 @@ def run_in_folder(sim: Simulation, plan: RunPlan, parts: LoopParts) -> str | Non
     """The run, in its output folder when outputs are set: its space checked, its lock held
     while it writes, and run.json with its status at the end, whatever ends it."""
     out, record = parts.outputs, parts.record
-    parts.stepper.on_root(lambda: _start_writing(sim, plan, out))  # refused: every rank stops
+    serial = isinstance(parts.stepper, CoreStepper)
+    parts.stepper.on_root(lambda: _start_writing(sim, plan, out, serial))  # refused: all stop
     if out is None:
         return advance(sim, plan, parts)
     record.status = "running"
@@ -259,8 +260,9 @@ def run_in_folder(sim: Simulation, plan: RunPlan, parts: LoopParts) -> str | Non
         out.folder.stop_writing()
 
 
-def _start_writing(sim: Simulation, plan: RunPlan, out: Outputs | None) -> None:
-    """The output folder checked for space and locked, when outputs are set."""
+def _start_writing(sim: Simulation, plan: RunPlan, out: Outputs | None, serial: bool) -> None:
+    """The output folder checked for space and locked, when outputs are set; refused to a
+    `serial` run on one of several MPI ranks, with what to do (launch.serial_copies_hint)."""
     if out is None:
         return
     # The frames this run writes: one every `every` steps, the last step's when it falls
@@ -269,7 +271,14 @@ def _start_writing(sim: Simulation, plan: RunPlan, out: Outputs | None) -> None:
     steps = plan.steps
     frames = steps // out.every + (steps % out.every > 0) + (out.frames == 0)
     out.folder.require_space(frames, sim.node_count * (12 + 8 * 3 * len(out.fields)))
-    out.folder.start_writing()
+    try:
+        out.folder.start_writing()
+    except InputError as error:
+        if not serial:
+            raise
+        from granulate.parallel.launch import serial_copies_hint
+
+        raise InputError(f"{error}{serial_copies_hint()}") from None
 
 
 def _report(progress: Callable[[Progress], None] | None, report: Progress) -> None:

@@ -39,3 +39,17 @@ def serial_only_message(command: str, size: int) -> str:
         f"would write the same files at once. Start one process: granulate --threads N {command} "
         "..."
     )
+
+
+def serial_copies_hint(environ: Mapping[str, str] | None = None) -> str:
+    """What is added to a serial simulation's refused output folder when this process is one
+    of several MPI ranks (a script started with mpiexec whose gr.Simulation has no comm: every
+    rank runs it whole and writes the same folder); "" otherwise."""
+    size, rank = launched_ranks(environ)
+    if size == 1:
+        return ""
+    return (
+        f". This process is rank {rank} of {size} MPI ranks, each running its own serial "
+        "simulation: give gr.Simulation(..., comm=MPI.COMM_WORLD) to run one simulation over "
+        "the ranks (docs/parallel.md), or each rank its own output folder"
+    )
