@@ -107,7 +107,7 @@ class Analysis:
         self._given: tuple[tuple[int, int], GivenMeasures] | None = None
 
     def _key(self) -> tuple[int, int]:
-        """The step and the broken bonds: the state the kept labels and given measures are of."""
+        """The step and the broken bonds: the state the given measures are of."""
         return int(self._core.step), int(self._core.broken_bonds())
 
     def give(self, measures: GivenMeasures | None) -> None:
@@ -175,9 +175,9 @@ class Analysis:
         return self._labels[1]
 
     def forget_fragments(self) -> None:
-        """Drop the kept labels and given measures (the bonds were restored from a
+        """Drop the kept labels, damage and given measures (the bonds were restored from a
         checkpoint)."""
-        self._labels = None
+        self._labels = self._phi = None
         self._given = None
 
     def fragments(self, min_nodes: int) -> list[NDArray[np.uint32]]:
