@@ -36,43 +36,169 @@ void normalise(vec& v, const char* what) {
   for (real& c : v) c /= n;
 }
 
-/// Signed distance from p to a polygon's boundary (positive outside) and the outward normal
-/// of the closest point (2D, z ignored).
-WallContact polygon_distance(const std::vector<std::array<real, 2>>& v, const vec& p) {
-  real best = std::numeric_limits<real>::max();
-  vec best_normal{0, 0, 0};
+/// Whether edge a of the polygon crosses the ray from p towards +x (one end above p, one not).
+bool crosses_ray(const std::vector<std::array<real, 2>>& v, std::size_t a, const vec& p) {
+  const auto& p0 = v[a];
+  const auto& p1 = v[(a + 1) % v.size()];
+  return (p0[1] > p[1]) != (p1[1] > p[1]) &&
+         p[0] < p0[0] + (p[1] - p0[1]) * (p1[0] - p0[0]) / (p1[1] - p0[1]);
+}
+
+/// Whether p lies inside the polygon: the parity of the edges the ray from p towards +x
+/// crosses, of every edge.
+bool inside_polygon(const std::vector<std::array<real, 2>>& v, const vec& p) {
   bool inside = false;
-  const std::size_t n = v.size();
-  for (std::size_t a = 0; a < n; ++a) {
+  for (std::size_t a = 0; a < v.size(); ++a) inside ^= crosses_ray(v, a, p);
+  return inside;
+}
+
+/// The same parity of the edges of p's band only: an edge the ray crosses has an end above
+/// p's height and one not, so its band range holds p's band (and none does when p is outside
+/// the polygon's heights).
+bool inside_polygon(const WallSurface& s, const vec& p) {
+  const auto& g = s.edge_grid;
+  if (!(p[1] >= g.lowest && p[1] < g.highest)) return false;
+  bool inside = false;
+  const auto band = static_cast<std::size_t>(g.band_of(p[1]));
+  for (index_t k = g.band_start[band]; k < g.band_start[band + 1]; ++k)
+    inside ^= crosses_ray(s.vertices, g.band_edges[k], p);
+  return inside;
+}
+
+/// The nearest of a polygon's edges to p: its distance and the normal of its closest point
+/// towards p (on an edge's interior the edge's normal, at a vertex the direction to p). Edges
+/// are offered in increasing order; a tie keeps the first.
+struct NearestEdge {
+  const std::vector<std::array<real, 2>>& v;
+  const vec& p;
+  real best = std::numeric_limits<real>::max();
+  vec normal{0, 0, 0};
+
+  void offer(std::size_t a) {
     const auto& p0 = v[a];
-    const auto& p1 = v[(a + 1) % n];
-    if ((p0[1] > p[1]) != (p1[1] > p[1]) &&
-        p[0] < p0[0] + (p[1] - p0[1]) * (p1[0] - p0[0]) / (p1[1] - p0[1])) {
-      inside = !inside;
-    }
+    const auto& p1 = v[(a + 1) % v.size()];
     const real ex = p1[0] - p0[0], ey = p1[1] - p0[1];
     const real t = std::clamp(((p[0] - p0[0]) * ex + (p[1] - p0[1]) * ey) / (ex * ex + ey * ey), 0.0, 1.0);
     const real dx = p[0] - (p0[0] + t * ex), dy = p[1] - (p0[1] + t * ey);
     const real d = std::sqrt(dx * dx + dy * dy);
-    if (d < best) {
-      best = d;
-      // On an edge's interior the normal is the edge normal; at a vertex, the direction to p.
-      if (d > 0 && (t == 0.0 || t == 1.0)) {
-        best_normal = {dx / d, dy / d, 0};
-      } else {
-        const real len = std::sqrt(ex * ex + ey * ey);
-        best_normal = {ey / len, -ex / len, 0};  // right-hand normal; fixed below by the inside test
-        if (best_normal[0] * dx + best_normal[1] * dy < 0)
-          best_normal = {-best_normal[0], -best_normal[1], 0};
-      }
+    if (!(d < best)) return;
+    best = d;
+    if (d > 0 && (t == 0.0 || t == 1.0)) {
+      normal = {dx / d, dy / d, 0};
+    } else {
+      const real len = std::sqrt(ex * ex + ey * ey);
+      normal = {ey / len, -ex / len, 0};  // right-hand normal, turned towards p
+      if (normal[0] * dx + normal[1] * dy < 0) normal = {-normal[0], -normal[1], 0};
     }
   }
+};
+
+/// The signed distance (positive outside) and outward normal of p from the polygon's nearest
+/// edge; `inside`: p inside the polygon.
+WallContact signed_polygon_distance(const NearestEdge& nearest, bool inside) {
   WallContact c;
-  c.distance = inside ? -best : best;
-  // Normal pointing away from the polygon's interior.
-  c.normal = inside ? vec{-best_normal[0], -best_normal[1], 0} : best_normal;
-  if (best == 0) c.normal = {0, 0, 0};
+  c.distance = inside ? -nearest.best : nearest.best;
+  c.normal = inside ? vec{-nearest.normal[0], -nearest.normal[1], 0} : nearest.normal;
+  if (nearest.best == 0) c.normal = {0, 0, 0};
   return c;
+}
+
+void build_edge_grid(WallSurface& s) {
+  auto& g = s.edge_grid;
+  const auto& v = s.vertices;
+  const std::size_t n = v.size();
+  std::array<real, 2> lo{std::numeric_limits<real>::max(), std::numeric_limits<real>::max()};
+  std::array<real, 2> hi{std::numeric_limits<real>::lowest(), std::numeric_limits<real>::lowest()};
+  std::vector<real> lengths(n);
+  for (std::size_t a = 0; a < n; ++a) {
+    const auto& p0 = v[a];
+    const auto& p1 = v[(a + 1) % n];
+    for (int k = 0; k < 2; ++k) lo[k] = std::min(lo[k], p0[k]), hi[k] = std::max(hi[k], p0[k]);
+    lengths[a] = std::max(std::abs(p1[0] - p0[0]), std::abs(p1[1] - p0[1]));
+  }
+  // Cells about the median edge's size, at most 16 a vertex: short edges in a cell or a few,
+  // long ones in every cell along them.
+  std::nth_element(lengths.begin(), lengths.begin() + static_cast<std::ptrdiff_t>(n / 2), lengths.end());
+  real cell = std::max({lengths[n / 2], 1e-9 * std::max(hi[0] - lo[0], hi[1] - lo[1]), 1e-300});
+  for (;;) {
+    for (int k = 0; k < 2; ++k)
+      g.dims[k] = std::max<std::int64_t>(1, static_cast<std::int64_t>((hi[k] - lo[k]) / cell) + 1);
+    if (g.dims[0] * g.dims[1] <= 16 * static_cast<std::int64_t>(n) + 16) break;
+    cell *= 1.5;
+  }
+  g.origin = lo;
+  g.cell_size = cell;
+  std::vector<std::vector<index_t>> bins(static_cast<std::size_t>(g.dims[0] * g.dims[1]));
+  for (std::size_t a = 0; a < n; ++a) {
+    const auto& p0 = v[a];
+    const auto& p1 = v[(a + 1) % n];
+    std::array<std::int64_t, 2> first{}, last{};
+    for (int k = 0; k < 2; ++k) {
+      first[k] = g.cell_of(std::min(p0[k], p1[k]), k);
+      last[k] = g.cell_of(std::max(p0[k], p1[k]), k);
+    }
+    for (std::int64_t y = first[1]; y <= last[1]; ++y)
+      for (std::int64_t x = first[0]; x <= last[0]; ++x)
+        bins[y * g.dims[0] + x].push_back(static_cast<index_t>(a));
+  }
+  g.cell_start.assign(bins.size() + 1, 0);
+  g.cell_edges.clear();
+  for (std::size_t c = 0; c < bins.size(); ++c) {
+    g.cell_edges.insert(g.cell_edges.end(), bins[c].begin(), bins[c].end());
+    g.cell_start[c + 1] = static_cast<index_t>(g.cell_edges.size());
+  }
+  // Horizontal bands, one an edge up to 4,096, over the vertices' heights.
+  g.lowest = lo[1];
+  g.highest = hi[1];
+  g.bands = std::clamp<std::int64_t>(static_cast<std::int64_t>(n), 1, 4096);
+  g.band_height = hi[1] > lo[1] ? (hi[1] - lo[1]) / static_cast<real>(g.bands) : 1.0;
+  std::vector<std::vector<index_t>> band_bins(static_cast<std::size_t>(g.bands));
+  for (std::size_t a = 0; a < n; ++a) {
+    const real y0 = v[a][1], y1 = v[(a + 1) % n][1];
+    for (std::int64_t b = g.band_of(std::min(y0, y1)); b <= g.band_of(std::max(y0, y1)); ++b)
+      band_bins[static_cast<std::size_t>(b)].push_back(static_cast<index_t>(a));
+  }
+  g.band_start.assign(band_bins.size() + 1, 0);
+  g.band_edges.clear();
+  for (std::size_t b = 0; b < band_bins.size(); ++b) {
+    g.band_edges.insert(g.band_edges.end(), band_bins[b].begin(), band_bins[b].end());
+    g.band_start[b + 1] = static_cast<index_t>(g.band_edges.size());
+  }
+}
+
+/// The contact of p with a polygon surface within `reach` (Wall::contacts). The nearest edge is
+/// sought among the edges whose boxes share a cell with the box of p widened by the reach (and
+/// a margin for round-off): every edge within the reach is among them, offered in order, so a
+/// contact found there is the one all edges give. Only a point on the particles' far side with
+/// no edge that near (deep in an obstacle, or out of a container) asks every edge.
+bool polygon_contact(const WallSurface& s, const vec& p, real reach, WallContact& out) {
+  const auto& g = s.edge_grid;
+  const bool inside = inside_polygon(s, p);
+  const real widened = reach + 1e-9 * (reach + g.cell_size + std::abs(p[0]) + std::abs(p[1]));
+  thread_local std::vector<index_t> candidates;
+  candidates.clear();
+  for (std::int64_t y = g.cell_of(p[1] - widened, 1); y <= g.cell_of(p[1] + widened, 1); ++y) {
+    for (std::int64_t x = g.cell_of(p[0] - widened, 0); x <= g.cell_of(p[0] + widened, 0); ++x) {
+      const auto c = static_cast<std::size_t>(y * g.dims[0] + x);
+      candidates.insert(candidates.end(), g.cell_edges.begin() + g.cell_start[c],
+                        g.cell_edges.begin() + g.cell_start[c + 1]);
+    }
+  }
+  std::sort(candidates.begin(), candidates.end());
+  candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
+  NearestEdge near{s.vertices, p};
+  for (const index_t a : candidates) near.offer(a);
+  if (near.best <= reach) {
+    out = signed_polygon_distance(near, inside);
+  } else {
+    if (inside == s.inside) return false;  // on the particles' side, beyond the reach
+    out = polygon_distance(s, p);
+  }
+  if (s.inside) {
+    out.distance = -out.distance;
+    for (real& c : out.normal) c = -c;
+  }
+  return true;
 }
 
 void build_triangle_grid(WallSurface& s) {
@@ -186,6 +312,12 @@ bool triangle_mesh_contact(const WallSurface& s, const vec& p, real reach, WallC
 
 }  // namespace
 
+WallContact polygon_distance(const WallSurface& s, const std::array<real, 3>& p) {
+  NearestEdge every{s.vertices, p};
+  for (std::size_t a = 0; a < s.vertices.size(); ++a) every.offer(a);
+  return signed_polygon_distance(every, inside_polygon(s.vertices, p));
+}
+
 std::array<real, 3> closest_point_on_triangle(const std::array<real, 3>& p, const std::array<real, 3>& a,
                                               const std::array<real, 3>& b, const std::array<real, 3>& c) {
   const vec ab{b[0] - a[0], b[1] - a[1], b[2] - a[2]}, ac{c[0] - a[0], c[1] - a[1], c[2] - a[2]};
@@ -290,6 +422,7 @@ void Wall::validate(int dimension) {
         for (const auto& v : s.vertices) {
           extent = std::max(extent, std::hypot(v[0] - center[0], v[1] - center[1]));
         }
+        build_edge_grid(s);
         break;
     }
   }
@@ -423,12 +556,9 @@ void Wall::contacts(std::size_t surface, const std::array<real, 3>& p, real reac
       break;
     }
     case WallSurface::Kind::polygon: {
-      WallContact c = polygon_distance(s.vertices, p);
-      if (s.inside) {
-        c.distance = -c.distance;
-        for (real& v : c.normal) v = -v;
-      }
-      if (c.distance < reach && (c.normal[0] != 0 || c.normal[1] != 0)) out.push_back(c);
+      WallContact c;
+      if (polygon_contact(s, p, reach, c) && c.distance < reach && (c.normal[0] != 0 || c.normal[1] != 0))
+        out.push_back(c);
       break;
     }
   }

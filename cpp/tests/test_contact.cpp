@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <cmath>
 #include <memory>
+#include <numbers>
 #include <random>
 
 #include "check.hpp"
@@ -179,6 +180,68 @@ TEST_CASE("wall distance queries: plane, box, circle, polygon") {
   out.clear();
   wall.contacts(3, {2.5, 1.0, 0}, 0.5, 2, out);  // outside: negative distance (penetration)
   CHECK(out.size() == 1 && std::abs(out[0].distance + 0.5) < 1e-12);
+}
+
+namespace {
+
+/// A floor of saw teeth (120 teeth, 0.3 high at a pitch of 1, tips at y = 0, closed 0.6 below)
+/// or a star of 200 points: polygons of many short edges and a few long ones.
+std::vector<std::array<real, 2>> many_edged_polygon(bool teeth) {
+  std::vector<std::array<real, 2>> v;
+  if (teeth) {
+    for (int k = 0; k <= 240; ++k) v.push_back({0.5 * k, k % 2 == 0 ? 0.0 : -0.3});
+    v.push_back({120.0, -0.6});
+    v.push_back({0.0, -0.6});
+    return v;
+  }
+  for (int k = 0; k < 400; ++k) {
+    const real angle = 2 * std::numbers::pi * k / 400, radius = k % 2 == 0 ? 10.0 : 9.0;
+    v.push_back({3 + radius * std::cos(angle), -1 + radius * std::sin(angle)});
+  }
+  return v;
+}
+
+}  // namespace
+
+TEST_CASE("polygon walls: the edge grid's contacts are every edge's, bit for bit") {
+  // Random points near and far, inside and outside, obstacles and containers, small and large
+  // reaches: Wall::contacts (the grid's nearest edge) against polygon_distance (every edge),
+  // with the sign a container turns and the reach the caller keeps.
+  std::mt19937 rng(11);
+  int compared = 0, kept = 0;
+  for (const bool teeth : {true, false}) {
+    for (const bool inside : {false, true}) {
+      Wall wall;
+      wall.name = "w";
+      WallSurface polygon;
+      polygon.kind = WallSurface::Kind::polygon;
+      polygon.vertices = many_edged_polygon(teeth);
+      polygon.inside = inside;
+      wall.surfaces = {polygon};
+      wall.validate(2);
+      std::uniform_real_distribution<real> x(teeth ? -5 : -12, teeth ? 125 : 18),
+          y(teeth ? -3 : -16, teeth ? 2 : 14);
+      for (int k = 0; k < 20000; ++k) {
+        const std::array<real, 3> p{x(rng), y(rng), 0};
+        const real reach = std::array<real, 3>{0.05, 0.4, 3.0}[k % 3];
+        std::vector<WallContact> out;
+        wall.contacts(0, p, reach, 2, out);
+        WallContact every = polygon_distance(wall.surfaces[0], p);
+        if (inside) {
+          every.distance = -every.distance;
+          for (real& c : every.normal) c = -c;
+        }
+        const bool expected = every.distance < reach && (every.normal[0] != 0 || every.normal[1] != 0);
+        CHECK(out.size() == (expected ? 1u : 0u));
+        if (expected && out.size() == 1) {
+          CHECK(out[0].distance == every.distance && out[0].normal == every.normal);
+          ++kept;
+        }
+        ++compared;
+      }
+    }
+  }
+  CHECK(compared == 80000 && kept > 8000);
 }
 
 TEST_CASE("moving walls: reference frame and surface velocity") {

@@ -3,6 +3,7 @@
 // with the distance from the node to the surface.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <string>
 #include <vector>
@@ -44,6 +45,27 @@ struct WallSurface {
   std::vector<std::array<real, 3>> mesh_vertices;
   std::vector<std::array<index_t, 3>> mesh_triangles;
 
+  /// Uniform grid of polygon edge bounding boxes and horizontal bands of their heights (built
+  /// by Wall::validate): a point's nearest edge within a reach is sought among the edges of
+  /// the cells that reach covers, and whether it is inside among the edges of its band.
+  struct EdgeGrid {
+    std::array<real, 2> origin{0, 0};
+    real cell_size = 1;
+    std::array<std::int64_t, 2> dims{1, 1};
+    std::vector<index_t> cell_start, cell_edges;    ///< edge a joins vertices a and a + 1
+    real lowest = 0, highest = 0, band_height = 1;  ///< the vertices' heights, bands over them
+    std::int64_t bands = 1;
+    std::vector<index_t> band_start, band_edges;
+    /// The cell of coordinate x along axis k, clamped to the grid (0 for nan).
+    std::int64_t cell_of(real x, int k) const { return clamped((x - origin[k]) / cell_size, dims[k]); }
+    /// The band of height y, clamped to the bands (0 for nan).
+    std::int64_t band_of(real y) const { return clamped((y - lowest) / band_height, bands); }
+    static std::int64_t clamped(real place, std::int64_t count) {
+      if (!(place > 0)) return 0;
+      return static_cast<std::int64_t>(std::min(place, static_cast<real>(count - 1)));
+    }
+  } edge_grid;
+
   /// Uniform grid of triangle bounding boxes (built by Wall::validate) for closest-point queries.
   struct TriangleGrid {
     std::array<real, 3> origin{0, 0, 0};
@@ -63,6 +85,11 @@ struct WallContact {
   real distance = 0;
   std::array<real, 3> normal{0, 0, 0};
 };
+
+/// Signed distance from p to a polygon surface's boundary, positive outside the polygon, and the
+/// outward normal of its closest point (2D, z ignored), over every edge: what Wall::contacts
+/// gives of the edges its grid offers, before the sign of a container (inside == true).
+WallContact polygon_distance(const WallSurface& s, const std::array<real, 3>& p);
 
 struct Wall {
   enum class Motion : std::uint8_t { fixed, translation, rotation };
