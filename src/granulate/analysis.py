@@ -8,7 +8,7 @@ granulate.fragments, granulate.particle_table and granulate.network."""
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Literal
 
@@ -99,11 +99,9 @@ class Analysis:
     def __init__(self, core: _core.Simulation, model: _core.Model, particles: int) -> None:
         self._core, self._model = core, model
         self._dimension, self._particles = model.dimension, particles
-        #: Measures that read only the bond states, kept with core.bond_changes at the time:
-        #: fragment labels and damage phi (a history row every few steps needs them anew only
-        #: when a bond broke).
-        self._labels: tuple[int, NDArray[np.uint32]] | None = None
-        self._phi: tuple[int, NDArray[np.float64]] | None = None
+        #: Measures that read only the bond states, by name, kept with core.bond_changes at the
+        #: time (_of_bonds): a history row every few steps needs them anew only when a bond broke.
+        self._kept: dict[str, tuple[int, NDArray]] = {}
         self._given: tuple[tuple[int, int], GivenMeasures] | None = None
 
     def _key(self) -> tuple[int, int]:
@@ -134,12 +132,7 @@ class Analysis:
         """Per node the damage phi alone (damage()[0]; core.damage_phi, which reads the bonds
         only, so it is kept until a bond state changes). Read-only."""
         given = self._given_now()
-        if given is not None:
-            return given.damage
-        changes = int(self._core.bond_changes)
-        if self._phi is None or self._phi[0] != changes:
-            self._phi = (changes, read_only(np.asarray(self._core.damage_phi())))
-        return self._phi[1]
+        return self._of_bonds("phi", self._core.damage_phi) if given is None else given.damage
 
     def kinetic_energy(self) -> float:
         """sum_i 1/2 m_i |v_i|^2 [J; J/m in 2D], correctly rounded (ExactSum): the same bits
@@ -167,17 +160,21 @@ class Analysis:
         """Each node's piece: its smallest node (core.fragments, kept until a bond state
         changes). Read-only."""
         given = self._given_now()
-        if given is not None:
-            return given.labels
+        return self._of_bonds("labels", self._core.fragments) if given is None else given.labels
+
+    def _of_bonds(self, name: str, measure: Callable[[], ArrayLike]) -> NDArray:
+        """The measure `name` of the bond states (`measure` makes it), kept read-only until
+        core.bond_changes changes."""
         changes = int(self._core.bond_changes)
-        if self._labels is None or self._labels[0] != changes:
-            self._labels = (changes, read_only(np.asarray(self._core.fragments())))
-        return self._labels[1]
+        kept = self._kept.get(name)
+        if kept is None or kept[0] != changes:
+            kept = self._kept[name] = (changes, read_only(np.asarray(measure())))
+        return kept[1]
 
     def forget_fragments(self) -> None:
         """Drop the kept labels, damage and given measures (the bonds were restored from a
         checkpoint)."""
-        self._labels = self._phi = None
+        self._kept.clear()
         self._given = None
 
     def fragments(self, min_nodes: int) -> list[NDArray[np.uint32]]:
