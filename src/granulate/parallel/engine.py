@@ -174,6 +174,8 @@ class DistributedRun:
         self._sim = sim
         share_of_cores(comm)
         self._slices = [body.node_slice for body in sim.bodies]  # each grain's global nodes
+        self._firsts_global = np.array([s.start for s in self._slices], dtype=np.int64)
+        self._counts = np.array([s.stop - s.start for s in self._slices], dtype=np.int64)
         self._node_count = sim._assembly.node_count
         self._weights = np.array([body.node_count for body in sim.bodies], dtype=float)
         start = _start_positions(sim)
@@ -531,9 +533,10 @@ class DistributedRun:
 
     def local_slices(self, grains: Iterable[int]) -> list[slice]:
         """The local nodes of each of these held grains (one node-map lookup for them all)."""
-        whole = [self._slices[int(g)] for g in grains]
-        firsts = self._node_map[np.array([s.start for s in whole], dtype=np.int64)].tolist()
-        return [slice(f, f + s.stop - s.start) for f, s in zip(firsts, whole, strict=True)]
+        index = np.fromiter(grains, dtype=np.int64)
+        firsts = self._node_map[self._firsts_global[index]]
+        counts = self._counts[index].tolist()
+        return [slice(f, f + c) for f, c in zip(firsts.tolist(), counts, strict=True)]
 
     def _nodes_of(
         self, grains: NDArray[np.int64], node_map: NodeMap | None = None
@@ -1293,7 +1296,7 @@ class DistributedRun:
     def broken_bonds(self) -> int:
         """The broken bonds of every grain, each counted once, on every rank (one reduction)."""
         core = self.local.core
-        copies = sum(core.broken_bond_copies(s.start, s.stop) for s in self.owned_slices())
+        copies = sum(core.broken_bond_copies(s.start, s.stop) for s in _joined(self.owned_slices()))
         return int(self.comm.allreduce(copies)) // 2
 
     @property
@@ -1447,6 +1450,17 @@ def _coarsest_of_each_material(sim: Simulation) -> NDArray[np.int64]:
         if best is None or body.mesh_size > sim.bodies[best].mesh_size:
             coarsest[id(body.material)] = body.index
     return np.array(sorted(coarsest.values()), dtype=np.int64)
+
+
+def _joined(slices: list[slice]) -> list[slice]:
+    """`slices` (in increasing order) with each run of adjacent ones joined into one."""
+    joined: list[slice] = []
+    for piece in slices:
+        if joined and joined[-1].stop == piece.start:
+            joined[-1] = slice(joined[-1].start, piece.stop)
+        else:
+            joined.append(piece)
+    return joined
 
 
 def _check_grains_for_ranks(grains: int, ranks: int) -> None:
