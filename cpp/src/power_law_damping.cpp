@@ -1,6 +1,7 @@
 #include "granulate/contact/power_law_damping.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <map>
 #include <mutex>
@@ -80,34 +81,57 @@ real power_law_damping_ratio(real restitution, real exponent, real low, real hig
   return 0.5 * (low + high);
 }
 
+/// One restitution's entries: entry k is zeta at exponent 1 + 0.1 k; those below `made` are
+/// final.
+struct DampingTable::Entries {
+  explicit Entries(real zeta_at_one)
+      : linear_zeta(zeta_at_one), restitution(linear_restitution(zeta_at_one)) {}
+
+  /// Entry k, made first (with every one before it) when it is not yet.
+  real entry(int k) {
+    if (k < made.load(std::memory_order_acquire)) return zeta[k];
+    const std::lock_guard<std::mutex> lock(mutex);
+    for (int next = made.load(std::memory_order_relaxed); next <= k; ++next) {
+      zeta[next] = make(next);
+      made.store(next + 1, std::memory_order_release);
+    }
+    return zeta[k];
+  }
+
+  /// Entry k from the one before: the force that cannot pull takes more damping than the
+  /// linear formula's (from linear_zeta up), and zeta grows with p (bracketed from the
+  /// previous exponent's).
+  real make(int k) const {
+    if (linear_zeta == 0) return 0;
+    if (k == 0) return power_law_damping_ratio(restitution, 1.0, linear_zeta, 2 * linear_zeta + 1e-3);
+    const real previous = zeta[k - 1];
+    return power_law_damping_ratio(restitution, smallest_exponent + k * exponent_step, previous,
+                                   1.5 * previous + 1e-3);
+  }
+
+  const real linear_zeta, restitution;
+  std::array<real, size> zeta{};
+  std::atomic<int> made{0};
+  std::mutex mutex;
+};
+
 DampingTable::DampingTable(real linear_zeta) {
-  // Tables are shared between laws of the same restitution (one per process and zeta).
+  // One table per restitution in the process, shared by every law of it.
   static std::mutex mutex;
-  static std::map<real, std::array<real, size>> made;
+  static std::map<real, std::shared_ptr<Entries>> made;
   const std::lock_guard<std::mutex> lock(mutex);
-  const auto found = made.find(linear_zeta);
-  if (found != made.end()) {
-    zeta_ = found->second;
-    return;
-  }
-  const real restitution = linear_restitution(linear_zeta);
-  // The force that cannot pull takes more damping than the linear formula's (from linear_zeta up).
-  zeta_[0] =
-      linear_zeta == 0 ? 0 : power_law_damping_ratio(restitution, 1.0, linear_zeta, 2 * linear_zeta + 1e-3);
-  for (int k = 1; k < size; ++k) {  // zeta grows with p: bracketed from the previous exponent's
-    const real previous = zeta_[k - 1];
-    zeta_[k] = linear_zeta == 0 ? 0
-                                : power_law_damping_ratio(restitution, smallest_exponent + k * exponent_step,
-                                                          previous, 1.5 * previous + 1e-3);
-  }
-  made.emplace(linear_zeta, zeta_);
+  auto& entries = made[linear_zeta];
+  if (!entries) entries = std::make_shared<Entries>(linear_zeta);
+  entries_ = entries;
 }
 
 real DampingTable::at(real exponent) const {
+  if (!entries_) return 0;
   const real position = std::clamp((exponent - smallest_exponent) / exponent_step, 0.0, real(size - 1));
   const int k = std::min(static_cast<int>(position), size - 2);
   const real share = position - k;
-  return (1 - share) * zeta_[k] + share * zeta_[k + 1];
+  const real above = entries_->entry(k + 1);  // makes entry k too
+  return (1 - share) * entries_->entry(k) + share * above;
 }
 
 }  // namespace granulate::contact

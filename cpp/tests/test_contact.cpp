@@ -48,6 +48,31 @@ TEST_CASE("power-law collisions whose force never pulls: stiffer laws rebound mo
   CHECK(contact::power_law_damping_ratio(1.0, 2.0) == 0.0);
 }
 
+TEST_CASE("damping tables made as collisions need them hold the entries made all at once") {
+  // Each entry bracketed from the one before (power_law_damping.hpp), as the eager table made
+  // them; asked from four threads at once, from the largest exponent down, a restitution not
+  // asked before (0.37) gives those entries: at their exponents, and between them to round-off
+  // (an entry bracketed otherwise would differ by up to the search's 1e-6).
+  const real zeta = contact::damping_ratio_from_restitution(0.37);
+  std::array<real, contact::DampingTable::size> expected{};
+  const real restitution = std::exp(-std::numbers::pi * zeta / std::sqrt(1 - zeta * zeta));
+  expected[0] = contact::power_law_damping_ratio(restitution, 1.0, zeta, 2 * zeta + 1e-3);
+  for (int k = 1; k < contact::DampingTable::size; ++k)
+    expected[k] = contact::power_law_damping_ratio(restitution, 1.0 + 0.1 * k, expected[k - 1],
+                                                   1.5 * expected[k - 1] + 1e-3);
+  const contact::DampingTable table(zeta);
+  std::array<real, 81> asked{};
+#pragma omp parallel for num_threads(4)
+  for (int k = 80; k >= 0; --k) asked[k] = table.at(1.0 + 0.025 * k);
+  for (int k = 0; k < 81; ++k) {
+    const int below = std::min(k / 4, 19);
+    const real share = 0.25 * (k - 4 * below);
+    CHECK_CLOSE(asked[k], (1 - share) * expected[below] + share * expected[below + 1], 1e-13);
+  }
+  CHECK(table.at(1.0) == expected[0] && table.at(3.0) == expected[20]);
+  CHECK(contact::DampingTable().at(2.0) == 0.0);
+}
+
 TEST_CASE("the friction spring sticks below mu F_n, slides at it, turns with the normal, is odd") {
   const real normal[3] = {0, 1, 0}, slip[3] = {2.0, 0.5, 0}, dt = 1e-3;
   real shear[3] = {0, 0, 0}, force[3];

@@ -18,6 +18,7 @@
 #pragma once
 
 #include <array>
+#include <memory>
 
 #include "granulate/types.hpp"
 
@@ -32,6 +33,11 @@ real power_law_restitution(real zeta, real exponent);
 real power_law_damping_ratio(real restitution, real exponent, real low = 0, real high = 50);
 
 /// zeta at one restitution for exponents 1, 1.1, ..., 3, interpolated linearly between them.
+/// Each entry is a root search from the one before (power_law_damping_ratio), about a
+/// millisecond; the entries are made when a collision first reaches their exponent, so a run
+/// pays only for the exponents its contacts have (a 2D collision's p is about 1.5, a 3D one's
+/// 2). Tables are shared by the laws of one restitution in a process, and filled under a lock
+/// (at may be called from any thread): an entry's value does not depend on when it is made.
 class DampingTable {
  public:
   static constexpr int size = 21;
@@ -40,11 +46,12 @@ class DampingTable {
   DampingTable() = default;
   /// The table of the restitution whose linear damping ratio is `linear_zeta` (zeta at p = 1).
   explicit DampingTable(real linear_zeta);
-  /// zeta for exponent p, clamped to [1, 3].
+  /// zeta for exponent p, clamped to [1, 3] (0 for a table of no restitution).
   real at(real exponent) const;
 
  private:
-  std::array<real, size> zeta_{};
+  struct Entries;
+  std::shared_ptr<Entries> entries_;
 };
 
 }  // namespace granulate::contact
