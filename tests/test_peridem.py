@@ -238,8 +238,8 @@ def test_attrition_drum_turns_as_in_peridem(tmp_path: Path) -> None:
     leaves the drum: no grain node passes the drum's inner surface (radius 15 mm) by half a
     grain's mesh size (0.17 mm), where it would slip between the drum's nodes. PeriDEM's law
     runs the deck's 40,000 steps at its dt (2.6 times granulate's stable estimate). Under
-    granulate's surface law the deck blows up at step 10,013 at its dt and runs its 120,000
-    steps at a third of it (ARCHITECTURE.md, "Not robust past the surface points' reach")."""
+    granulate's surface law the deck blows up at step 2,272 at its dt and at step 38,540 of
+    120,000 at a third of it (ARCHITECTURE.md, "Not robust past the surface points' reach")."""
     out = run_deck("attrition_mix_particles_small_set", tmp_path / "out", 4000, "--peridem-compat")
     ref = reference("attrition_mix_particles_small_set")
     for k in range(5):
