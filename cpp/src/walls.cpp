@@ -36,6 +36,17 @@ void normalise(vec& v, const char* what) {
   for (real& c : v) c /= n;
 }
 
+/// `bins` as one list, `items`, and where each bin starts in it, `start` (one more than bins).
+void flatten(const std::vector<std::vector<index_t>>& bins, std::vector<index_t>& start,
+             std::vector<index_t>& items) {
+  start.assign(bins.size() + 1, 0);
+  items.clear();
+  for (std::size_t b = 0; b < bins.size(); ++b) {
+    items.insert(items.end(), bins[b].begin(), bins[b].end());
+    start[b + 1] = static_cast<index_t>(items.size());
+  }
+}
+
 /// Whether edge a of the polygon crosses the ray from p towards +x (one end above p, one not).
 bool crosses_ray(const std::vector<std::array<real, 2>>& v, std::size_t a, const vec& p) {
   const auto& p0 = v[a];
@@ -55,7 +66,7 @@ bool inside_polygon(const std::vector<std::array<real, 2>>& v, const vec& p) {
 /// The same parity of the edges of p's band only: an edge the ray crosses has an end above
 /// p's height and one not, so its band range holds p's band (and none does when p is outside
 /// the polygon's heights).
-bool inside_polygon(const WallSurface& s, const vec& p) {
+bool inside_polygon_by_band(const WallSurface& s, const vec& p) {
   const auto& g = s.edge_grid;
   if (!(p[1] >= g.lowest && p[1] < g.highest)) return false;
   bool inside = false;
@@ -141,12 +152,7 @@ void build_edge_grid(WallSurface& s) {
       for (std::int64_t x = first[0]; x <= last[0]; ++x)
         bins[y * g.dims[0] + x].push_back(static_cast<index_t>(a));
   }
-  g.cell_start.assign(bins.size() + 1, 0);
-  g.cell_edges.clear();
-  for (std::size_t c = 0; c < bins.size(); ++c) {
-    g.cell_edges.insert(g.cell_edges.end(), bins[c].begin(), bins[c].end());
-    g.cell_start[c + 1] = static_cast<index_t>(g.cell_edges.size());
-  }
+  flatten(bins, g.cell_start, g.cell_edges);
   // Horizontal bands, one an edge up to 4,096, over the vertices' heights.
   g.lowest = lo[1];
   g.highest = hi[1];
@@ -158,12 +164,7 @@ void build_edge_grid(WallSurface& s) {
     for (std::int64_t b = g.band_of(std::min(y0, y1)); b <= g.band_of(std::max(y0, y1)); ++b)
       band_bins[static_cast<std::size_t>(b)].push_back(static_cast<index_t>(a));
   }
-  g.band_start.assign(band_bins.size() + 1, 0);
-  g.band_edges.clear();
-  for (std::size_t b = 0; b < band_bins.size(); ++b) {
-    g.band_edges.insert(g.band_edges.end(), band_bins[b].begin(), band_bins[b].end());
-    g.band_start[b + 1] = static_cast<index_t>(g.band_edges.size());
-  }
+  flatten(band_bins, g.band_start, g.band_edges);
 }
 
 /// The contact of p with a polygon surface within `reach` (Wall::contacts). The nearest edge is
@@ -173,7 +174,7 @@ void build_edge_grid(WallSurface& s) {
 /// no edge that near (deep in an obstacle, or out of a container) asks every edge.
 bool polygon_contact(const WallSurface& s, const vec& p, real reach, WallContact& out) {
   const auto& g = s.edge_grid;
-  const bool inside = inside_polygon(s, p);
+  const bool inside = inside_polygon_by_band(s, p);
   const real widened = reach + 1e-9 * (reach + g.cell_size + std::abs(p[0]) + std::abs(p[1]));
   thread_local std::vector<index_t> candidates;
   candidates.clear();
@@ -249,12 +250,7 @@ void build_triangle_grid(WallSurface& s) {
       for (std::int64_t y = a[1]; y <= b[1]; ++y)
         for (std::int64_t x = a[0]; x <= b[0]; ++x) bins[(z * g.dims[1] + y) * g.dims[0] + x].push_back(t);
   }
-  g.cell_start.assign(cells + 1, 0);
-  g.cell_triangles.clear();
-  for (std::size_t c = 0; c < cells; ++c) {
-    g.cell_triangles.insert(g.cell_triangles.end(), bins[c].begin(), bins[c].end());
-    g.cell_start[c + 1] = static_cast<index_t>(g.cell_triangles.size());
-  }
+  flatten(bins, g.cell_start, g.cell_triangles);
 }
 
 /// Closest triangle to p within reach: signed distance (positive on the particles' side) and

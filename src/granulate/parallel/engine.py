@@ -1296,7 +1296,7 @@ class DistributedRun:
     def broken_bonds(self) -> int:
         """The broken bonds of every grain, each counted once, on every rank (one reduction)."""
         core = self.local.core
-        copies = sum(core.broken_bond_copies(s.start, s.stop) for s in _joined(self.owned_slices()))
+        copies = sum(core.broken_bond_copies(s.start, s.stop) for s in self.owned_slices())
         return int(self.comm.allreduce(copies)) // 2
 
     @property
@@ -1450,17 +1450,6 @@ def _coarsest_of_each_material(sim: Simulation) -> NDArray[np.int64]:
         if best is None or body.mesh_size > sim.bodies[best].mesh_size:
             coarsest[id(body.material)] = body.index
     return np.array(sorted(coarsest.values()), dtype=np.int64)
-
-
-def _joined(slices: list[slice]) -> list[slice]:
-    """`slices` (in increasing order) with each run of adjacent ones joined into one."""
-    joined: list[slice] = []
-    for piece in slices:
-        if joined and joined[-1].stop == piece.start:
-            joined[-1] = slice(joined[-1].start, piece.stop)
-        else:
-            joined.append(piece)
-    return joined
 
 
 def _check_grains_for_ranks(grains: int, ranks: int) -> None:

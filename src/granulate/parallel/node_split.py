@@ -277,7 +277,7 @@ class NodeSplitRun:
             mine = None if whole is None else [whole[nodes] for nodes in self.nodes_of]
             labels = self.large.scatter(mine, root=0)
         local = [f for f in fields if f != "Fragment_ID"]
-        values = point_fields(self.local, tuple(local), self.local.core.damage())
+        values = point_fields(self.local, tuple(local))
         rows = {name: field[self.own] for name, field in values.items()}
         if labels is not None:
             rows["Fragment_ID"] = labels

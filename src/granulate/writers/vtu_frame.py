@@ -9,6 +9,7 @@ the whole run's particles and fragments, so the pieces joined are the one-file f
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -109,16 +110,15 @@ def require_room_for_frames(nodes: int, fields: tuple[str, ...]) -> None:
 
 
 def point_fields(
-    sim: Simulation,
-    fields: tuple[str, ...],
-    damage: tuple[NDArray[np.float64], NDArray[np.float64]],
-    numbering: Numbering | None = None,
+    sim: Simulation, fields: tuple[str, ...], numbering: Numbering | None = None
 ) -> dict[str, NDArray[np.generic]]:
-    """The point fields `fields` of every node of `sim` (FIELD_TYPES); `damage`: phi and
-    PeriDEM's Z per node (core.damage()); `numbering`: how the whole run numbers the nodes and
-    particles of `sim` when it is a part (Particle_ID and Fragment_ID are the whole run's)."""
+    """The point fields `fields` of every node of `sim` (FIELD_TYPES), each made only when
+    asked (the damage phi and PeriDEM's Z once, for both: Analysis.damage); `numbering`: how
+    the whole run numbers the nodes and particles of `sim` when it is a part (Particle_ID and
+    Fragment_ID are the whole run's)."""
     core, model = sim.core, sim.model
     volumes = model.volumes
+    damage = functools.cache(sim.analysis.damage)
 
     def particles() -> NDArray[np.generic]:
         owner = np.asarray(model.node_particle)
@@ -133,8 +133,8 @@ def point_fields(
         "Velocity": lambda: core.velocities,
         "Force_Density": lambda: core.forces,
         "Force": lambda: core.forces * volumes[:, None],
-        "Damage": lambda: damage[0],
-        "Damage_Z": lambda: damage[1],
+        "Damage": lambda: damage()[0],
+        "Damage_Z": lambda: damage()[1],
         "Dilatation": lambda: core.dilatation,
         "Particle_ID": particles,
         "Fragment_ID": fragments,
@@ -149,12 +149,10 @@ def node_rows(
     fields: tuple[str, ...],
     nodes: NDArray[np.int64] | None = None,
     numbering: Numbering | None = None,
-    damage: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None,
 ) -> NodeRows:
     """The rows of the nodes `nodes` of `sim` (all when None): their `fields` and their
-    numbers in the whole run (`numbering`, for a part of a distributed run); `damage` as
-    point_fields takes it (core.damage() when not given)."""
-    values = point_fields(sim, fields, damage or sim.core.damage(), numbering)
+    numbers in the whole run (`numbering`, for a part of a distributed run)."""
+    values = point_fields(sim, fields, numbering)
     if nodes is None and numbering is None:  # every node, as they are
         return NodeRows(np.arange(sim.node_count), np.asarray(sim.core.positions), values)
     chosen = np.arange(sim.node_count) if nodes is None else nodes
@@ -169,10 +167,9 @@ def write_piece(
     fields: tuple[str, ...],
     nodes: NDArray[np.int64] | None = None,
     numbering: Numbering | None = None,
-    damage: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None,
 ) -> None:
     """One piece of a frame: node_rows(...) of those arguments, with the nodes' numbers."""
-    rows = node_rows(sim, fields, nodes, numbering, damage)
+    rows = node_rows(sim, fields, nodes, numbering)
     write_piece_rows(path, rows.positions, rows.values, rows.numbers)
 
 
@@ -205,15 +202,13 @@ class VtuFrame:
             rows = data.frame_rows
             if rows is None:
                 assert sim is not None
-                rows = node_rows(sim, outputs.fields, damage=sim.analysis.damage())
+                rows = node_rows(sim, outputs.fields)
             write_vtu(frames / f"{name}.vtu", rows.positions, rows.values)
             outputs.pvd.add(data.time, Path("frames") / f"{name}.vtu")
             return
         if not outputs.piece_ranks:  # a serial run's one piece; else the ranks wrote theirs
             assert sim is not None
-            write_piece(
-                frames / name / "piece_0.vtu", sim, outputs.fields, damage=sim.analysis.damage()
-            )
+            write_piece(frames / name / "piece_0.vtu", sim, outputs.fields)
         count = outputs.piece_ranks or 1
         pieces = [f"piece_{r}.vtu" for r in range(count)]
         _check_pieces(frames / name, pieces)
