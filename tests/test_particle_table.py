@@ -1,5 +1,5 @@
-"""The particle table's motion columns (granulate.particle_table.motion, the core's
-particle_sums): a rigid body's centre, velocity and angular velocity come back as they were
+"""The particle table's motion columns (granulate.particle_table.motion, summed run by run:
+run_sums.py): a rigid body's centre, velocity and angular velocity come back as they were
 given, and its radius of gyration as its shape has it."""
 
 from __future__ import annotations
@@ -29,7 +29,9 @@ def test_a_rigid_body_in_3d_gives_back_its_motion() -> None:
     points = lattice + np.array([0.2, -0.1, 3.0])
     velocity, spin = np.array([0.3, -1.2, 0.5]), np.array([40.0, -15.0, 25.0])
     mass, v = _rigid_motion(points, velocity, spin)
-    table = particle_table.motion(np.zeros(len(points), np.uint32), mass, points, v, 1)
+    table = particle_table.motion(
+        np.zeros(len(points)), np.arange(len(points)), mass, mass, points, v, 1
+    )
     centre = (mass[:, None] * points).sum(axis=0) / mass.sum()
     np.testing.assert_allclose([table[a][0] for a in "xyz"], centre, rtol=1e-12)
     np.testing.assert_allclose([table["v" + a][0] for a in "xyz"], velocity, rtol=1e-12)
@@ -49,7 +51,7 @@ def test_bodies_in_a_plane_turn_about_z_and_a_ring_has_its_radius_of_gyration() 
     owner = np.array([0] * 64 + [1], np.uint32)
     order = np.argsort(np.r_[np.arange(64) * 2, 7], kind="stable")  # the lone node among them
     table = particle_table.motion(
-        owner[order], np.full(65, 1e-6)[order], points[order], velocities[order], 2
+        owner[order], np.arange(65), *[np.full(65, 1e-6)] * 2, points[order], velocities[order], 2
     )
     assert table["wz"][0] == pytest.approx(-30.0, rel=1e-12)
     assert table["wx"][0] == table["wy"][0] == 0.0
@@ -60,5 +62,11 @@ def test_bodies_in_a_plane_turn_about_z_and_a_ring_has_its_radius_of_gyration() 
 def test_a_node_of_a_particle_past_the_count_is_refused() -> None:
     with pytest.raises(InputError, match="past count"):
         particle_table.motion(
-            np.array([0, 2], np.uint32), np.ones(2), np.zeros((2, 3)), np.zeros((2, 3)), 2
+            np.array([0, 2]),
+            np.arange(2),
+            np.ones(2),
+            np.ones(2),
+            np.zeros((2, 3)),
+            np.zeros((2, 3)),
+            2,
         )

@@ -194,6 +194,7 @@ class Analysis:
         core, model = self._core, self._model
         return fragments.fragment_table(
             self.fragment_labels(),
+            np.arange(model.node_count),
             model.node_particle,
             core.positions,
             core.velocities,
@@ -232,8 +233,8 @@ class Analysis:
         core, count = self._core, self._particles
         owner, volumes, motion = self._motion()
         phi = self.damage_phi() if damage is None else np.asarray(damage)
-        particle_volume = np.bincount(owner, volumes, count)
-        mean_damage = np.bincount(owner, volumes * phi, count) / particle_volume
+        nodes = np.arange(len(owner))
+        particle_volume, mean_damage = particle_table.volumes(owner, nodes, volumes, phi, count)
         table, stresses = complete_particle_table(
             motion, particle_volume, mean_damage, contacts, float(core.time), self._dimension
         )
@@ -248,9 +249,8 @@ class Analysis:
         if given is not None:
             return owner, volumes, dict(given.motion)  # the callers add columns
         mass = np.asarray(model.node_density) * volumes
-        motion = particle_table.motion(
-            owner, mass, core.positions, core.velocities, self._particles
-        )
+        nodes, x, v = np.arange(len(owner)), core.positions, core.velocities
+        motion = particle_table.motion(owner, nodes, mass, volumes, x, v, self._particles)
         return owner, volumes, motion
 
     def particle_stresses(
@@ -263,8 +263,11 @@ class Analysis:
         centres = np.column_stack([table[axis] for axis in "xyz"])
         if method == "contacts":
             network_table = self.contact_table() if contacts is None else contacts
+            nodes = np.arange(len(owner))
+            phi = self.damage_phi()
+            particle_volume = particle_table.volumes(owner, nodes, volumes, phi, count)[0]
             return network.love_weber_stresses(
-                network_table, centres, np.bincount(owner, volumes, count), self._dimension
+                network_table, centres, particle_volume, self._dimension
             )
         if method == "bonds":
             bonds = np.asarray(core.bond_force_densities()).reshape(-1, 3)

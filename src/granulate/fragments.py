@@ -36,6 +36,7 @@ from numpy.typing import ArrayLike, NDArray
 from granulate import reductions
 from granulate.errors import InputError
 from granulate.io.table import read_columns, write_columns
+from granulate.run_sums import Runs
 
 #: Columns of a fragment table, in the order they are written.
 COLUMNS = (
@@ -57,6 +58,7 @@ def equivalent_diameter(measure: ArrayLike, dimension: int) -> NDArray[np.float6
 
 def fragment_table(
     labels: ArrayLike,
+    nodes: ArrayLike,
     particles: ArrayLike,
     positions: ArrayLike,
     velocities: ArrayLike,
@@ -67,26 +69,48 @@ def fragment_table(
     """One row per piece, in the order of its id (its smallest node): the parent particle,
     node count, debris flag (1 node), mass [kg; kg/m in 2D], volume [m^3; m^2 in 2D], centre
     of mass [m], its velocity [m/s] and the equivalent diameter [m]. `labels` gives each
-    node's piece, `particles` its particle; the other arrays are per node."""
-    ids, piece = np.unique(np.asarray(labels), return_inverse=True)
-    count = len(ids)
+    node's piece, `nodes` its index (increasing), `particles` its particle; the other arrays
+    are per node. The sums run run by run (run_sums.py): fragment_runs and table_of_runs make
+    the table of several processes' nodes."""
+    ids, first = np.unique(np.asarray(labels, dtype=np.int64), return_index=True)
+    runs = fragment_runs(labels, nodes, positions, velocities, volumes, densities)
+    return table_of_runs(runs, ids, np.asarray(particles, dtype=np.int64)[first], dimension)
+
+
+def fragment_runs(
+    labels: ArrayLike,
+    nodes: ArrayLike,
+    positions: ArrayLike,
+    velocities: ArrayLike,
+    volumes: ArrayLike,
+    densities: ArrayLike,
+) -> Runs:
+    """The runs of the pieces' sums (Runs.first_sums: m, V, m x, m v)."""
     volume = np.asarray(volumes, dtype=np.float64)
     mass = np.asarray(densities, dtype=np.float64) * volume
-    piece_mass = np.bincount(piece, mass, count)
-    nodes = np.bincount(piece, minlength=count)
+    return Runs.first_sums(labels, nodes, mass, volume, positions, velocities)
+
+
+def table_of_runs(
+    runs: Runs, ids: NDArray[np.int64], particles: NDArray[np.int64], dimension: int
+) -> Table:
+    """The fragment table (fragment_table) of the pieces `ids` (sorted), whose parents are
+    `particles`, from the runs of their nodes in node order."""
+    places = np.searchsorted(ids, runs.group)
+    sums, nodes = runs.totals(len(ids), places), runs.nodes(len(ids), places)
+    piece_mass = sums[:, 0]
     table: Table = {
         "fragment": ids.astype(np.int64),
-        "particle": np.asarray(particles, dtype=np.int64)[ids],
+        "particle": particles.astype(np.int64),
         "nodes": nodes,
         "debris": (nodes == 1).astype(np.int64),
         "mass": piece_mass,
-        "volume": np.bincount(piece, volume, count),
+        "volume": sums[:, 1],
     }
-    for name, array in (("x", positions), ("vx", velocities)):
-        values = np.asarray(array, dtype=np.float64)
-        for k, axis in enumerate("xyz"):
-            column = name.replace("x", axis)
-            table[column] = np.bincount(piece, mass * values[:, k], count) / piece_mass
+    for k, axis in enumerate("xyz"):
+        table[axis] = sums[:, 2 + k] / piece_mass
+    for k, axis in enumerate("xyz"):
+        table["v" + axis] = sums[:, 5 + k] / piece_mass
     table["diameter"] = equivalent_diameter(table["volume"], dimension)
     return table
 

@@ -18,8 +18,8 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from granulate import _core
 from granulate.io.table import read_columns, write_columns
+from granulate.run_sums import Runs
 
 #: Columns of a particle table, in the order written.
 COLUMNS = (
@@ -27,7 +27,7 @@ COLUMNS = (
     "gyration_radius", "damage", "coordination", "sxx", "syy", "szz", "sxy", "sxz", "syz",
 )  # fmt: skip
 _INTEGERS = ("particle", "coordination")
-#: The inertia tensor's places in _core.particle_sums' six components (xx, yy, zz, xy, xz, yz).
+#: The inertia tensor's places in the six moment sums' components (xx, yy, zz, xy, xz, yz).
 _TENSOR = np.array([[0, 3, 4], [3, 1, 5], [4, 5, 2]])
 _STRESS = (("sxx", 0, 0), ("syy", 1, 1), ("szz", 2, 2), ("sxy", 0, 1), ("sxz", 0, 2), ("syz", 1, 2))
 
@@ -35,20 +35,64 @@ Table = dict[str, NDArray]
 
 
 def motion(
-    owner: ArrayLike, mass: ArrayLike, positions: ArrayLike, velocities: ArrayLike, count: int
+    owner: ArrayLike,
+    nodes: ArrayLike,
+    mass: ArrayLike,
+    volumes: ArrayLike,
+    positions: ArrayLike,
+    velocities: ArrayLike,
+    count: int,
 ) -> Table:
     """Mass, centre x y z, velocity vx vy vz, angular velocity wx wy wz and gyration_radius of
-    each of `count` particles from per-node `owner` (particle index), mass, positions (n, 3)
-    and velocities (n, 3). The sums over the nodes are the core's (_core.particle_sums), the
-    3 x 3 solves NumPy's."""
-    total, centre, velocity, momentum, components, spread = _core.particle_sums(
-        np.ascontiguousarray(owner, dtype=np.uint32),
-        np.ascontiguousarray(mass, dtype=np.float64),
-        np.ascontiguousarray(positions, dtype=np.float64),
-        np.ascontiguousarray(velocities, dtype=np.float64),
-        count,
-    )
-    inertia = components[:, _TENSOR]  # (count, 3, 3)
+    each of `count` particles from per-node `owner` (particle index), node index (increasing),
+    mass, volume, positions (n, 3) and velocities (n, 3): the sums over the nodes run by run
+    (run_sums.py), so that processes holding whole blocks of a particle each make their share
+    (Runs.first_sums, then with the centres Runs.moments); the 3 x 3 solves are NumPy's."""
+    first = Runs.first_sums(owner, nodes, mass, volumes, positions, velocities).totals(count)
+    centre, velocity = centres(first)
+    moments = Runs.moments(owner, nodes, mass, positions, velocities, centre, velocity)
+    return table_of(first, moments.totals(count))
+
+
+def volumes(
+    owner: ArrayLike,
+    nodes: ArrayLike,
+    node_volumes: ArrayLike,
+    damage: ArrayLike,
+    count: int,
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Per particle its volume sum V_i [m^3; m^2 in 2D] and volume-weighted damage
+    sum V_i phi_i / sum V_i (`damage`: phi per node), run by run."""
+    return volumes_of(volume_runs(owner, nodes, node_volumes, damage).totals(count))
+
+
+def volume_runs(
+    owner: ArrayLike, nodes: ArrayLike, node_volumes: ArrayLike, damage: ArrayLike
+) -> Runs:
+    """The runs of the volume sums, 2 a run: V, V phi."""
+    volume = np.asarray(node_volumes, dtype=np.float64)
+    weighted = volume * np.asarray(damage, dtype=np.float64)
+    return Runs.of(owner, nodes, np.column_stack([volume, weighted]))
+
+
+def volumes_of(sums: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Volumes and mean damage from the volume sums (count, 2)."""
+    return sums[:, 0], sums[:, 1] / sums[:, 0]
+
+
+def centres(first: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Per particle its centre of mass c = sum m x / M and velocity V = sum m v / M, from its
+    first sums (count, 8: Runs.first_sums')."""
+    return first[:, 2:5] / first[:, :1], first[:, 5:8] / first[:, :1]
+
+
+def table_of(first: NDArray[np.float64], moments: NDArray[np.float64]) -> Table:
+    """The motion columns of particles from their first sums (count, 8: Runs.first_sums') and
+    moment sums (count, 10: Runs.moments')."""
+    count = len(first)
+    total = first[:, 0]
+    centre, velocity = centres(first)
+    momentum, inertia = moments[:, :3], moments[:, 3:9][:, _TENSOR]  # (count, 3, 3)
     spin = np.zeros((count, 3))
     solvable = np.linalg.matrix_rank(inertia) == 3
     spin[solvable] = np.linalg.solve(inertia[solvable], momentum[solvable][:, :, None])[:, :, 0]
@@ -59,7 +103,7 @@ def motion(
         table[axis] = centre[:, k]
         table["v" + axis] = velocity[:, k]
         table["w" + axis] = spin[:, k]
-    table["gyration_radius"] = np.sqrt(spread / total)
+    table["gyration_radius"] = np.sqrt(moments[:, 9] / total)
     return table
 
 

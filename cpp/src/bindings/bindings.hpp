@@ -57,7 +57,7 @@ void bind_model(nb::module_& m);       // Model: particles, shapes, bonds
 void bind_contact(nb::module_& m);     // contact laws, damping ratios, statistics
 void bind_walls(nb::module_& m);       // wall surfaces and walls
 void bind_simulation(nb::module_& m);  // Simulation: loading, contact set-up, state, results
-void bind_measures(nb::module_& m);    // exact sums' bins and particle sums of NumPy arrays
+void bind_measures(nb::module_& m);    // exact sums' bins and run sums of NumPy arrays
 
 /// Everything a run needs to continue bit for bit, as a dict of arrays (copies) and numbers.
 nb::dict checkpoint_dict(const Simulation& self);

@@ -7,9 +7,10 @@ Each rank sends rank 0 (StepPart):
   it owns), exact, so that rank 0's totals are the serial run's correctly rounded sums;
 - the fragment table of its grains' pieces (fragments.fragment_table over its nodes, labelled by
   their smallest node in the whole run): a piece lies in one grain, and its sums run over its
-  nodes in node order wherever they are made, so each row is the serial row to the bit;
+  nodes run by run (run_sums.py) wherever they are made, so each row is the serial row to the
+  bit;
 - per grain its motion (particle_table.motion), volume and volume-weighted damage, summed over
-  its nodes in node order as the serial Analysis sums them;
+  its nodes run by run (run_sums.py) as the serial Analysis sums them;
 - what the last force evaluation left of its grains (whole_state.OwnEvaluation, as for the
   whole state).
 Rank 0 puts the fragment rows in the serial order (by id), the grains' rows in grain order, the
@@ -71,14 +72,15 @@ def step_part(run: DistributedRun, tracked: tuple[int, ...]) -> StepPart:
     totals = node_totals(mass, volumes, v, x, local.gravity, density, phi)
     sums = tuple(_tracked_sums(run, grain) for grain in tracked)
     grain, count = own_grain_places(run), len(run.owned)
-    grain_volumes = np.bincount(grain, volumes, count)
+    numbers = run.global_nodes(nodes)
+    grain_volumes, damage = particle_table.volumes(grain, numbers, volumes, phi, count)
     return StepPart(
         replace(totals, contact=evaluation.contact_energy, tracked=sums),
         _own_fragments(run, run.owned[grain]),
         run.owned,
-        particle_table.motion(grain, mass, x, v, count),
+        particle_table.motion(grain, numbers, mass, volumes, x, v, count),
         grain_volumes,
-        np.bincount(grain, volumes * phi, count) / grain_volumes,
+        damage,
         evaluation,
     )
 
@@ -129,12 +131,13 @@ def _own_fragments(run: DistributedRun, grains: NDArray[np.int64]) -> fragments.
     whole run's order, so that node is the piece's smallest here too."""
     local, nodes = run.local, run.owned_nodes
     core, model = local.core, local.model
-    place = np.searchsorted(nodes, local.analysis.fragment_labels()[nodes])  # among own nodes
+    labels = run.global_nodes(local.analysis.fragment_labels()[nodes])
     volumes, density = (np.asarray(a)[nodes] for a in (model.volumes, model.node_density))
     x, v = core.positions[nodes], core.velocities[nodes]
-    table = fragments.fragment_table(place, grains, x, v, volumes, density, local.dimension)
-    table["fragment"] = run.global_nodes(nodes[table["fragment"]]).astype(np.int64)
-    return table
+    numbers = run.global_nodes(nodes)
+    return fragments.fragment_table(
+        labels, numbers, grains, x, v, volumes, density, local.dimension
+    )
 
 
 def _tracked_sums(run: DistributedRun, grain: int) -> TrackedSums:

@@ -144,15 +144,17 @@ def _owned_measures(run: DistributedRun) -> GivenMeasures:
     """The measures of the rank's own grains (analysis.GivenMeasures): per own node, in grain
     order, its damage, Z, fragment label (a global node) and strain energy density, and per
     own grain its motion. Each node's and each grain's are the whole core's, bit for bit: a
-    node's reads only its own bonds, and a grain's sums run over its nodes in the serial order
-    (np.bincount adds in the order given), whatever else the part holds."""
+    node's reads only its own bonds, and a grain's sums run over its nodes run by run in the serial
+    order (run_sums.py), whatever else the part holds."""
     local, nodes = run.local, run.owned_nodes
     core, model = local.core, local.model
     phi, z = (np.asarray(a)[nodes] for a in core.damage())
     labels = run.global_nodes(np.asarray(core.fragments())[nodes]).astype(np.uint32)
-    mass = (np.asarray(model.node_density) * np.asarray(model.volumes))[nodes]
+    volumes = np.asarray(model.volumes)[nodes]
+    mass = np.asarray(model.node_density)[nodes] * volumes
     x, v = core.positions[nodes], core.velocities[nodes]
-    motion = particle_table.motion(own_grain_places(run), mass, x, v, len(run.owned))
+    numbers, grains = run.global_nodes(nodes), len(run.owned)
+    motion = particle_table.motion(own_grain_places(run), numbers, mass, volumes, x, v, grains)
     density = np.asarray(core.strain_energy_density())[nodes]
     return GivenMeasures(phi, z, labels, density, motion)
 
