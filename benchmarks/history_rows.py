@@ -1,14 +1,16 @@
 """What a history row costs a distributed run: (a) made of what the ranks measure of their own
-grains (DistributedRun.step_data: parallel/step_parts.py, no node array on rank 0), and (b) the
-whole state gathered into rank 0's simulation (DistributedRun.collect, with the ranks' measures
-of their grains) and the row computed from it, as every output step did before session 50 (and
-still does for a frame of every node), each followed by the row's sections (energies,
-breakage, granular measures), at one fixed state.
+grains (DistributedRun.step_data: parallel/step_parts.py, no node array on rank 0), or of their
+own nodes for a body cut at node level (NodeSplitRun.step_data), and (b) the whole state
+gathered into rank 0's simulation (collect) and the row computed from it, as every output step
+did before session 50 for grains and before session 59 for a body cut at node level, each
+followed by the row's sections (energies, breakage, granular measures), at one fixed state.
 
     mpiexec -n 2 python benchmarks/history_rows.py CASE [--peridem-compat] [--steps 10]
         [--repeats 40]
 
-CASE is a case file or a PeriDEM deck (the paper's n500_circ_hex deck, say). The run takes
+CASE is a case file or a PeriDEM deck (the paper's n500_circ_hex deck, say), run with whole
+grains per rank, or `block`, `granulate bench --ranks`' notched LPS block of 53,400 nodes, cut
+at node level. The run takes
 `--steps` steps, then makes the row both ways, alternating, `--repeats` times, the ranks
 starting each together (a barrier); rank 0 prints the medians in ms, its resident memory
 (VmRSS, MB) before the first gathering and after, and whether both rows are equal. One thread
@@ -26,8 +28,9 @@ import numpy as np
 from mpi4py import MPI
 from process_memory import resident_mb
 
+from granulate.bench_ranks import SPLIT_CASES
 from granulate.case import load_case
-from granulate.parallel import DistributedRun
+from granulate.parallel import DistributedRun, NodeSplitRun
 from granulate.writers import history_sections
 from granulate.writers.step_data import StepData
 
@@ -40,14 +43,18 @@ SECTIONS = (
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("case", type=Path)
+    parser.add_argument("case", help="a case file, a PeriDEM deck or " + ", ".join(SPLIT_CASES))
     parser.add_argument("--peridem-compat", action="store_true")
     parser.add_argument("--steps", type=int, default=10)
     parser.add_argument("--repeats", type=int, default=40)
     args = parser.parse_args()
     comm = MPI.COMM_WORLD
-    sim = load_case(args.case, peridem_compat=args.peridem_compat).build(outputs=False)
-    run = DistributedRun(sim, comm)
+    if args.case in SPLIT_CASES:
+        sim = SPLIT_CASES[args.case](False)
+        run: DistributedRun | NodeSplitRun = NodeSplitRun(sim, comm)
+    else:
+        sim = load_case(Path(args.case), peridem_compat=args.peridem_compat).build(outputs=False)
+        run = DistributedRun(sim, comm)
     run.run(args.steps)
     outputs = SimpleNamespace(tracked=())
     measured, gathered = [], []

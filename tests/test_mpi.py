@@ -373,13 +373,16 @@ def test_a_body_split_at_node_level_is_the_serial_run_bit_for_bit(
 ) -> None:
     """A notched body cut across the ranks (granulate.parallel.node_split), stretched until it
     cracks: every node's position, velocity, force and dilatation after `steps` steps, and the
-    bonds broken, as serially."""
+    bonds broken, as serially; the fragment labels the ranks find together, and the output
+    step made of their measures (totals, fragment and particle tables), bit for bit."""
     done = run_ranks(ranks, shape, model, str(steps), script=SPLIT_CHECK)
     assert done.returncode == 0, done.stdout + done.stderr
     zero = "{'positions': 0.0, 'velocities': 0.0, 'forces': 0.0, 'dilatation': 0.0}"
     assert f"ranks {ranks}, {shape} {model}, {steps} steps: {zero}" in done.stdout
     broken = done.stdout.split("bonds broken ")[1].split()
     assert int(broken[0]) == int(broken[2]) > 100
+    assert "fragment labels as serially: True" in done.stdout
+    assert "step data as serially: True" in done.stdout
 
 
 STOP_CHECK = Path(__file__).with_name("mpi_stop_check.py")

@@ -22,6 +22,8 @@ import pytest
 import granulate as gr
 from assemblies import GLASS, pulled
 from granulate import core_model
+from granulate.parallel.node_split import _dealt_in_blocks
+from granulate.run_sums import BLOCK
 
 
 def parts_of(sim: gr.Simulation, parts: int, dealt: str) -> np.ndarray:
@@ -136,3 +138,16 @@ def test_foreign_nodes_must_be_this_process_particles() -> None:
     sim = pulled("plate", "lps")
     with pytest.raises(gr.InputError, match="foreign node 99999999 is not a node"):
         sim.core.set_foreign_nodes([99999999])
+
+
+def test_nodes_are_dealt_in_whole_blocks_of_the_run_sums() -> None:
+    """NodeSplitRun deals the notched block's nodes to 3 ranks in whole blocks of 64 (so each
+    rank makes the serial run's runs of the tables' sums, run_sums.py), each rank's weight
+    within 10 % of a third."""
+    sim = pulled("block", "lps")
+    weights = np.diff(np.asarray(sim.model.bond_offsets)) + 1.0
+    owner = _dealt_in_blocks(sim.reference_positions, weights, 3)
+    blocks = np.arange(sim.node_count) // BLOCK
+    assert all(len(np.unique(owner[blocks == b])) == 1 for b in np.unique(blocks))
+    shares = np.bincount(owner, weights, 3) / weights.sum()
+    np.testing.assert_allclose(shares, 1 / 3, rtol=0.1)

@@ -494,6 +494,43 @@ index_t Model::fragments_in(const BondStates& intact, index_t first, index_t cou
   return fragments;
 }
 
+void Model::fragments_among(const BondStates& intact, const std::vector<index_t>& nodes, index_t* labels,
+                            std::vector<std::array<index_t, 2>>& leaving) const {
+  constexpr index_t outside = std::numeric_limits<index_t>::max();
+  std::vector<index_t> place(node_count(), outside);
+  for (std::size_t k = 0; k < nodes.size(); ++k) {
+    if (nodes[k] >= node_count() || (k > 0 && nodes[k] <= nodes[k - 1]))
+      throw InputError("fragments_among: the nodes must increase and be the model's");
+    place[nodes[k]] = static_cast<index_t>(k);
+  }
+  // Union-find over places; a set's root is its smallest place, so its smallest node.
+  std::vector<index_t> parent(nodes.size());
+  for (std::size_t k = 0; k < nodes.size(); ++k) parent[k] = static_cast<index_t>(k);
+  auto root = [&](index_t k) {
+    while (parent[k] != k) {
+      parent[k] = parent[parent[k]];
+      k = parent[k];
+    }
+    return k;
+  };
+  leaving.clear();
+  for (std::size_t k = 0; k < nodes.size(); ++k) {
+    const NodeBonds bonds = node_bonds(nodes[k]);
+    for (index_t b = 0; b < bonds.count; ++b) {
+      if (!intact.intact(nodes[k], b)) continue;
+      const index_t j = bonds.neighbor(b);
+      if (place[j] == outside) {
+        leaving.push_back({nodes[k], j});
+        continue;
+      }
+      const index_t a = root(static_cast<index_t>(k)), c = root(place[j]);
+      if (a < c) parent[c] = a;
+      if (c < a) parent[a] = c;
+    }
+  }
+  for (std::size_t k = 0; k < nodes.size(); ++k) labels[k] = nodes[root(static_cast<index_t>(k))];
+}
+
 real Model::stable_time_step() const {
   real dt = std::numeric_limits<real>::infinity();
   for (index_t i = 0; i < node_count(); ++i) {

@@ -378,6 +378,35 @@ TEST_CASE("fragments are the connected components of intact bonds") {
   CHECK(labels[12 * 12 - 1] == 6);
 }
 
+TEST_CASE("fragments among some nodes are theirs, with the intact bonds that leave them") {
+  auto model = lattice_block(2, 12, ForceModel::lps, InfluenceKind::linear, true);
+  Simulation sim(model);
+  const auto& X = model->reference_positions();
+  for (index_t i = 0; i < model->node_count(); ++i) {  // cut across x = 6h, as above
+    const NodeBonds b = model->node_bonds(i);
+    for (index_t k = 0; k < b.count; ++k) {
+      if ((X[3 * i] < 6e-3) != (X[3 * b.neighbor(k)] < 6e-3)) BondStates::clear(sim.state().bonds.node(i), k);
+    }
+  }
+  std::vector<index_t> among;  // the lower half, y < 6h: both sides of the cut
+  for (index_t i = 0; i < model->node_count(); ++i)
+    if (X[3 * i + 1] < 6e-3) among.push_back(i);
+  std::vector<index_t> labels(among.size());
+  std::vector<std::array<index_t, 2>> leaving;
+  sim.fragments_among(among, labels.data(), leaving);
+  std::size_t expected = 0;
+  for (std::size_t k = 0; k < among.size(); ++k) {
+    CHECK(labels[k] == (X[3 * among[k]] < 6e-3 ? 0u : 6u));
+    const NodeBonds b = model->node_bonds(among[k]);
+    for (index_t q = 0; q < b.count; ++q)
+      if (sim.state().bonds.intact(among[k], q) && X[3 * b.neighbor(q) + 1] >= 6e-3) ++expected;
+  }
+  CHECK(leaving.size() == expected);
+  CHECK(expected > 0);
+  for (const auto& [i, j] : leaving) CHECK(X[3 * i + 1] < 6e-3 && X[3 * j + 1] >= 6e-3);
+  CHECK_THROWS(sim.fragments_among({5, 3}, labels.data(), leaving), InputError);
+}
+
 TEST_CASE("bad particles are refused with InputError") {
   auto model = std::make_shared<Model>(2, PlaneMode::strain);
   MaterialParams p;

@@ -208,6 +208,12 @@ class Model {
   /// The same over the `count` nodes from `first`, whole particles (bonds never leave a
   /// particle): labels[k] for node first + k.
   index_t fragments_in(const BondStates& intact, index_t first, index_t count, index_t* labels) const;
+  /// The fragments of the graph of intact bonds among `nodes` (increasing): labels[k], the
+  /// smallest of them connected to nodes[k] within them, and, into `leaving`, each intact bond
+  /// (nodes[k], j) to a node j not among them, in node and bond order. The pieces of a body
+  /// cut across processes: joined through the leaving bonds, they are the whole fragments.
+  void fragments_among(const BondStates& intact, const std::vector<index_t>& nodes, index_t* labels,
+                       std::vector<std::array<index_t, 2>>& leaving) const;
   /// Node i's bond to node j (its index among i's bonds), or nothing when they are not bonded
   /// (out of range, of different particles, or beyond the horizon).
   std::optional<index_t> bond_between(index_t i, index_t j) const;

@@ -133,6 +133,11 @@ class Simulation {
   /// Fragments: connected components of the graph of intact bonds. Writes each node's label
   /// (the smallest node index of its fragment) and returns the number of fragments.
   index_t fragments(index_t* labels) const;
+  /// Model::fragments_among of these nodes in the current bond states.
+  void fragments_among(const std::vector<index_t>& nodes, index_t* labels,
+                       std::vector<std::array<index_t, 2>>& leaving) const {
+    model_->fragments_among(state_.bonds, nodes, labels, leaving);
+  }
   /// Bit k set: component k of the node is prescribed.
   std::vector<std::uint8_t> fixity() const;
   const PhaseTimes& phase_times() const { return phase_times_; }

@@ -416,6 +416,22 @@ void bind_results(nb::class_<Simulation>& cls) {
              self.fragments(labels.data());
              return copy_out(labels);
            })
+      .def(
+          "fragments_among",
+          [](const Simulation& self, Indices nodes) {
+            const std::vector<index_t> among = to_vector(nodes);
+            std::vector<index_t> labels(among.size());
+            std::vector<std::array<index_t, 2>> leaving;
+            self.fragments_among(among, labels.data(), leaving);
+            std::vector<index_t> flat;
+            flat.reserve(2 * leaving.size());
+            for (const auto& [i, j] : leaving) flat.insert(flat.end(), {i, j});
+            return nb::make_tuple(copy_out(labels), rows_out(std::move(flat), 2));
+          },
+          "nodes"_a,
+          "The fragments among these nodes (increasing): each one's label, the smallest of them "
+          "it is connected to through intact bonds among them, and the intact bonds (node, "
+          "partner) leaving them (Model::fragments_among).")
       .def_prop_ro("phase_times", &Simulation::phase_times)
       .def("memory_bytes", &Simulation::memory_bytes);
 }

@@ -3,30 +3,34 @@ one body's fracture on many processes, bit for bit the serial run. Simulation(co
 model in which nothing touches (no contact law, wall or PeriDEM damping:
 Interactions.contact_free) this way, `mpiexec granulate run case.yaml` included.
 
-The nodes are dealt by recursive coordinate bisection (partition.bisect over the nodes, each
-weighted by its bonds plus one), so a body larger than a subdomain is cut wherever the cuts
-fall and its bonds cross ranks. Each rank evaluates its own nodes (core.set_foreign_nodes) and
-receives, of the others, its halo: the nodes bonded to its own, one horizon deep. A step
-exchanges twice with each neighbouring rank: the halo's positions after the drift (core.move),
-then, for LPS, the halo's dilatation sums after the bonds' stretch and breaking
-(core.begin_step), before the forces (core.finish_step). The core evaluates of a halo node only
-its bonds to own nodes, so every own node sums the serial run's terms in the serial order and a
-bond across a cut breaks alike on both sides (tests/test_node_split.py in one process,
-tests/test_mpi.py on 2 and 3 ranks). The halo is fixed by the bonds, so no node ever needs to
-change hands.
+The nodes are dealt by recursive coordinate bisection (partition.bisect over blocks of 64
+consecutive nodes, each weighted by its nodes' bonds plus one), so a body larger than a
+subdomain is cut wherever the cuts fall and its bonds cross ranks. Each rank evaluates its own
+nodes (core.set_foreign_nodes) and receives, of the others, its halo: the nodes bonded to its
+own, one horizon deep. A step exchanges twice with each neighbouring rank: the halo's positions
+after the drift (core.move), then, for LPS, the halo's dilatation sums after the bonds' stretch
+and breaking (core.begin_step), before the forces (core.finish_step). The core evaluates of a
+halo node only its bonds to own nodes, so every own node sums the serial run's terms in the
+serial order and a bond across a cut breaks alike on both sides (tests/test_node_split.py in
+one process, tests/test_mpi.py on 2 and 3 ranks). The halo is fixed by the bonds, so no node
+ever needs to change hands.
 
-Every rank holds the whole model, as a distributed run's ranks do (engine.py). For outputs,
-stop criteria and checkpoints rank 0's simulation takes every node's state from its owner
-(collect); the measures (damage, fragments, energies) it then makes of the whole state itself.
-Contact is not split: a body's rigid motion and fragments, which contact reads, would be sums
-across ranks.
+Every rank holds the whole model, as a distributed run's ranks do (engine.py). An output step
+is made of what each rank measures of its own nodes (step_data): exact totals, fragment labels
+found by the ranks together (fragment_labels), and the fragment and particle tables' sums run
+by run (run_sums.py: the nodes are dealt in whole blocks of 64, so each rank's runs are the
+serial run's). For writers that read the simulation, checkpoints and the end of a run, rank 0's
+simulation takes every node's state from its owner (collect). Contact is not split: a body's
+rigid motion, which contact reads each step, is a sum in node order across ranks.
 """
 
 from __future__ import annotations
 
+import functools
+import operator
 import os
 import time
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from pathlib import Path
 from types import SimpleNamespace
 from typing import TYPE_CHECKING, Any
@@ -34,7 +38,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
-from granulate import checkpoints, fingerprints
+from granulate import checkpoints, fingerprints, fragments, particle_table
+from granulate.analysis import complete_particle_table
 from granulate.errors import InputError
 from granulate.evaluation import Evaluation
 from granulate.parallel.agreement import attempt, on_root, stop_if_any_failed, together
@@ -43,7 +48,10 @@ from granulate.parallel.overlap import while_travelling
 from granulate.parallel.partition import bisect
 from granulate.parallel.rank_threads import share_of_cores
 from granulate.parallel.run_measures import RankMeasures
-from granulate.writers.vtu_frame import FIELD_TYPES, point_fields, write_piece_rows
+from granulate.run_sums import BLOCK, Runs
+from granulate.step_totals import StepTotals, TrackedSums, node_totals
+from granulate.writers.step_data import StepData, set_up_fields
+from granulate.writers.vtu_frame import FIELD_TYPES, NodeRows, point_fields, write_piece_rows
 
 if TYPE_CHECKING:
     from granulate.simulation import Simulation
@@ -71,9 +79,11 @@ class NodeSplitRun:
         self.large = large_message_comm(comm)  # for messages of states (large_messages.py)
         share_of_cores(comm)
         ranks, nodes = comm.Get_size(), sim.node_count
-        if ranks > nodes:
+        blocks = -(-nodes // BLOCK)
+        if ranks > blocks:
             raise InputError(
-                f"{ranks} ranks for {nodes} nodes: run on at most as many ranks as nodes"
+                f"{ranks} ranks for {nodes} nodes: a body is cut in blocks of {BLOCK} nodes, "
+                f"so run it on at most {blocks} rank(s)"
             )
         every = np.arange(len(sim.bodies))
         self.local: Simulation = together(comm, lambda: _built(sim._subdomain(every)[0]))
@@ -82,7 +92,7 @@ class NodeSplitRun:
         self.stable_dt = float(core.stable_time_step)
         self._offsets = np.asarray(model.bond_offsets, dtype=np.int64)
         points = np.asarray(model.reference_positions)[:, : sim.dimension]
-        self.owner = bisect(points, np.diff(self._offsets) + 1.0, ranks).owner
+        self.owner = _dealt_in_blocks(points, np.diff(self._offsets) + 1.0, ranks)
         rank = comm.Get_rank()
         self.nodes_of = [np.flatnonzero(self.owner == q) for q in range(ranks)]
         self.own = self.nodes_of[rank]
@@ -103,6 +113,7 @@ class NodeSplitRun:
         self.seconds = dict.fromkeys(("steps", "exchange", "collect"), 0.0)
         self.waiting = 0.0  # of the exchange's seconds, those waiting for the halo (Waitall)
         self._setup_digest: str | None = None  # of the set-up's fingerprint, made once
+        self._labels: tuple[int, NDArray[np.int64]] | None = None  # (step, fragment_labels())
 
     @property
     def dt(self) -> float:
@@ -231,6 +242,147 @@ class NodeSplitRun:
             Evaluation.of_core(core, sim.analysis.contact_table()), list_rebuilds=searches
         )
 
+    def fragment_labels(self) -> NDArray[np.int64]:
+        """Every rank: its own nodes' fragment labels, each the smallest node of its piece in
+        the whole body (the serial run's core.fragments): the pieces among its own nodes
+        (core.fragments_among), joined through the intact bonds leaving them to the pieces
+        their partners' owners found (one exchange with each neighbouring rank, one
+        allgather of the pairs of pieces so joined). Kept for the step."""
+        step = int(self.local.core.step)
+        if self._labels is not None and self._labels[0] == step:
+            return self._labels[1]
+        labels, leaving = self.local.core.fragments_among(self.own.astype(np.uint32))
+        labels = np.asarray(labels, dtype=np.int64)
+        field = np.zeros(len(self.owner))  # node indices as floats: exact below 2^53
+        field[self.own] = labels
+        self._exchange(field, lambda share: None, None)
+        leaving = np.asarray(leaving, dtype=np.int64)
+        mine = labels[np.searchsorted(self.own, leaving[:, 0])]
+        pairs = np.unique(np.column_stack([mine, field[leaving[:, 1]].astype(np.int64)]), axis=0)
+        joined = _joined_pieces(self.comm.allgather(pairs))
+        if joined:
+            pieces, place = np.unique(labels, return_inverse=True)
+            labels = np.array([joined.get(int(p), int(p)) for p in pieces], np.int64)[place]
+        self._labels = (step, labels)
+        return labels
+
+    def step_data(
+        self, tracked: tuple[int, ...], frame: tuple[str, ...] | None = None
+    ) -> StepData | None:
+        """Every rank: the current output step made of what each rank measures of its own
+        nodes, with no whole state on rank 0 (as DistributedRun.step_data makes it of whole
+        grains), with the sums of the `tracked` bodies and, for a frame of every node with the
+        fields `frame`, each rank's rows of its own nodes joined in node order
+        (StepData.frame_rows); on rank 0 (None on the others). The
+        sums over the nodes are exact (step_totals.py); the fragment and particle tables'
+        run by run (run_sums.py) of the nodes dealt in whole blocks, joined in node order
+        on rank 0, which sends back the particles' centres for their second sums: every
+        column is the serial run's."""
+        start = time.perf_counter()
+        labels, broken = self.fragment_labels(), self.broken_bonds()
+        searches = self.comm.reduce(
+            int(self.local.core.contact_statistics.rebuilds), op=self.mpi.MAX, root=0
+        )
+        part = together(self.comm, lambda: self._part(tracked, labels), "measuring its nodes")
+        parts = self.large.gather(part, root=0)
+        count = len(self._sim.bodies)
+        first = on_root(self.comm, lambda: Runs.joined([p.first for p in parts]).totals(count))
+        centre, velocity = self.comm.bcast(
+            None if first is None else particle_table.centres(first), root=0
+        )
+        mine = together(self.comm, lambda: self._moments(centre, velocity), "measuring its nodes")
+        moments = self.large.gather(mine, root=0)
+        rows = None if frame is None else self.large.gather(self._own_rows(frame), root=0)
+        step = (int(self.local.core.step), float(self.local.core.time), broken, searches)
+        data = on_root(self.comm, lambda: self._step_data(parts, first, moments, step, rows))
+        self.seconds["collect"] += time.perf_counter() - start
+        return data
+
+    def _part(self, tracked: tuple[int, ...], labels: NDArray[np.int64]) -> _NodesPart:
+        """This rank's _NodesPart of an output step, its fragment `labels` given."""
+        local, own = self.local, self.own
+        core, model = local.core, local.model
+        volumes = np.asarray(model.volumes)[own]
+        density = np.asarray(model.node_density)[own]
+        mass = density * volumes
+        phi = local.analysis.damage_phi()[own]
+        energy = np.asarray(core.strain_energy_density())[own]
+        x, v = core.positions[own], core.velocities[own]
+        particle = np.asarray(model.node_particle)[own]
+        totals = node_totals(mass, volumes, v, x, local.gravity, energy, phi)
+        sums = tuple(self._tracked_sums(body, mass, volumes) for body in tracked)
+        return _NodesPart(
+            replace(totals, tracked=sums),
+            fragments.fragment_runs(labels, own, x, v, volumes, density),
+            np.unique(labels),
+            Runs.first_sums(particle, own, mass, volumes, x, v),
+            particle_table.volume_runs(particle, own, volumes, phi),
+        )
+
+    def _tracked_sums(
+        self, body: int, mass: NDArray[np.float64], volumes: NDArray[np.float64]
+    ) -> TrackedSums:
+        """The sums of the tracked body's own nodes (`mass` and `volumes`: the own nodes')."""
+        span = self._sim.bodies[body].node_slice
+        mine = slice(*np.searchsorted(self.own, [span.start, span.stop]))
+        nodes, model, core = self.own[mine], self.local.model, self.local.core
+        return TrackedSums.of(
+            mass[mine],
+            volumes[mine],
+            core.forces[nodes],
+            core.positions[nodes],
+            np.asarray(model.reference_positions)[nodes],
+        )
+
+    def _moments(self, centre: NDArray[np.float64], velocity: NDArray[np.float64]) -> Runs:
+        """The runs of this rank's particle sums about the particles' `centre` and `velocity`."""
+        own, model, core = self.own, self.local.model, self.local.core
+        mass = (np.asarray(model.node_density) * np.asarray(model.volumes))[own]
+        particle = np.asarray(model.node_particle)[own]
+        x, v = core.positions[own], core.velocities[own]
+        return Runs.moments(particle, own, mass, x, v, centre, velocity)
+
+    def _step_data(
+        self,
+        parts: list[_NodesPart],
+        first: NDArray[np.float64],
+        moments: list[Runs],
+        step: tuple[int, float, int, int],
+        rows: list[NodeRows] | None,
+    ) -> StepData:
+        """Rank 0: the output step of every rank's part, the particles' first sums and the
+        runs of their moments, and the ranks' rows of a frame of every node (`rows`, when one
+        is due); `step`: the step, time [s], bonds broken and list searches."""
+        sim, core = self._sim, self.local.core
+        number, time_now, broken, searches = step
+        totals = functools.reduce(operator.add, (part.totals for part in parts))
+        ids = np.unique(np.concatenate([part.ids for part in parts]))
+        particle_of = np.asarray(self.local.model.node_particle)[ids]
+        pieces = Runs.joined([part.pieces for part in parts])
+        table = fragments.table_of_runs(pieces, ids, particle_of, sim.dimension)
+        count = len(sim.bodies)
+        motion = particle_table.table_of(first, Runs.joined(moments).totals(count))
+        volumes, damage = particle_table.volumes_of(
+            Runs.joined([part.volumes for part in parts]).totals(count)
+        )
+        contacts = self.local.analysis.contact_table()  # none: nothing touches
+        evaluation = replace(Evaluation.of_core(core, contacts), list_rebuilds=searches)
+        particles, stresses = complete_particle_table(
+            motion, volumes, damage, evaluation.contacts, time_now, sim.dimension
+        )
+        return StepData(
+            number,
+            time_now,
+            totals,
+            broken,
+            table,
+            evaluation,
+            particles,
+            (stresses, volumes),
+            *set_up_fields(sim, core),
+            frame_rows=None if rows is None else NodeRows.joined(rows, len(self.owner)),
+        )
+
     def fingerprint(self) -> str:
         """The set-up's fingerprint (Simulation.fingerprint), on every rank from the whole
         model it holds (no message)."""
@@ -265,25 +417,73 @@ class NodeSplitRun:
         start = time.perf_counter()
         state = self.large.bcast(on_root(self.comm, read), root=0)
         together(self.comm, lambda: self.local.core.restore(state), "restoring the checkpoint")
+        self._labels = None
         self.seconds["collect"] += time.perf_counter() - start
 
     def write_piece(self, folder: Path, fields: tuple[str, ...]) -> None:
         """This rank's piece of a frame in pieces (writers/vtu_frame.py): its own nodes now,
-        with `fields`, as folder/piece_<rank>.vtu. The fragment labels come from rank 0, which
-        holds every bond (collect): a rank's own bonds do not tell which piece a node is in."""
-        labels = None
-        if "Fragment_ID" in fields:
-            whole = on_root(self.comm, lambda: self._sim.analysis.fragment_labels())
-            mine = None if whole is None else [whole[nodes] for nodes in self.nodes_of]
-            labels = self.large.scatter(mine, root=0)
-        local = [f for f in fields if f != "Fragment_ID"]
-        values = point_fields(self.local, tuple(local))
+        with `fields`, as folder/piece_<rank>.vtu."""
+        rows = self._own_rows(fields)
+        path = Path(folder) / f"piece_{self.comm.Get_rank()}.vtu"
+        write_piece_rows(path, rows.positions, rows.values, rows.numbers)
+
+    def _own_rows(self, fields: tuple[str, ...]) -> NodeRows:
+        """Every rank: the rows of its own nodes in a frame with `fields`, the fragment labels
+        the ranks' together (fragment_labels)."""
+        labels = self.fragment_labels() if "Fragment_ID" in fields else None
+        local = tuple(f for f in fields if f != "Fragment_ID")
+        values = together(self.comm, lambda: point_fields(self.local, local), "measuring its nodes")
         rows = {name: field[self.own] for name, field in values.items()}
         if labels is not None:
             rows["Fragment_ID"] = labels
-        path = Path(folder) / f"piece_{self.comm.Get_rank()}.vtu"
         ordered = {f: rows[f].astype(FIELD_TYPES[f][0]) for f in fields}
-        write_piece_rows(path, self.local.core.positions[self.own], ordered, self.own)
+        return NodeRows(self.own, self.local.core.positions[self.own], ordered)
+
+
+@dataclass(frozen=True)
+class _NodesPart:
+    """What one rank sends rank 0 for an output step (NodeSplitRun.step_data): the sums over its
+    own nodes, the runs of its pieces' sums and the pieces (their labels, sorted), and the runs
+    of the particles' first sums and volumes."""
+
+    totals: StepTotals
+    pieces: Runs
+    ids: NDArray[np.int64]
+    first: Runs
+    volumes: Runs
+
+
+def _dealt_in_blocks(
+    points: NDArray[np.float64], weights: NDArray[np.float64], ranks: int
+) -> NDArray[np.int64]:
+    """Each node's rank: the blocks of run_sums.BLOCK consecutive nodes dealt whole by recursive
+    coordinate bisection of their centres, each weighing its nodes' `weights`, so that every
+    rank makes the runs of its nodes' sums as the serial run does (run_sums.py)."""
+    block = np.arange(len(points)) // BLOCK
+    count = int(block[-1]) + 1
+    sizes = np.bincount(block, minlength=count)
+    centres = np.column_stack(
+        [np.bincount(block, points[:, k], count) for k in range(points.shape[1])]
+    )
+    dealt = bisect(centres / sizes[:, None], np.bincount(block, weights, count), ranks)
+    return dealt.owner[block]
+
+
+def _joined_pieces(pairs: list[NDArray[np.int64]]) -> dict[int, int]:
+    """Per piece in `pairs` (rows of two pieces joined by an intact bond, every rank's), the
+    smallest piece it is joined to through them."""
+    parent: dict[int, int] = {}
+
+    def root(piece: int) -> int:
+        while parent.setdefault(piece, piece) != piece:
+            parent[piece] = parent[parent[piece]]
+            piece = parent[piece]
+        return piece
+
+    for a, b in np.concatenate(pairs).tolist():
+        first, second = root(a), root(b)
+        parent[max(first, second)] = min(first, second)
+    return {piece: root(piece) for piece in list(parent)}
 
 
 def _built(part: Simulation) -> Simulation:

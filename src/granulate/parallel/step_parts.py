@@ -19,10 +19,9 @@ contacts in the serial slot order, and completes the particle table from them
 
 A frame of every node (output without pieces) is made of the ranks' rows of their own nodes,
 joined on rank 0 (DistributedRun.step_data). A writer that may read the simulation
-(writers/base.py), the end of a run (unless run(gather=False)) and a body cut at node level
-(NodeSplitRun, whose pieces span ranks) still take the whole state on rank 0
-(DistributedRun.collect).
-"""
+(writers/base.py) and the end of a run (unless run(gather=False)) still take the whole state
+on rank 0 (DistributedRun.collect). A body cut at node level makes its output steps of its
+ranks' nodes (NodeSplitRun.step_data)."""
 
 from __future__ import annotations
 

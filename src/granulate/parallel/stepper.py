@@ -1,9 +1,9 @@
 """Simulation.run's loop on the ranks of a distributed run (granulate.run_loop.Stepper): every
 rank takes the steps of the chunks rank 0 decides; rank 0 writes the outputs of the step its
-ranks measured of their grains (step_parts.py; a frame of every node from their rows), or of
-the whole state its simulation takes (DistributedRun.collect) for writers that may read the
-simulation or bodies cut at node level; the stop criteria read the ranks' measures put together
-(run_measures.py); rank 0's decisions and errors reach every rank."""
+ranks measured of their grains (step_parts.py) or of their nodes (NodeSplitRun.step_data; a
+frame of every node from their rows), or of the whole state its simulation takes (collect)
+for writers that may read the simulation; the stop criteria read the ranks' measures put
+together (run_measures.py); rank 0's decisions and errors reach every rank."""
 
 from __future__ import annotations
 
@@ -65,7 +65,7 @@ class DistributedStepper:
     def step_data(
         self, sim: Simulation, tracked: tuple[int, ...], whole: bool, frame: tuple[str, ...] | None
     ) -> StepData | None:
-        if whole or not isinstance(self.run, DistributedRun):  # a node split's pieces span ranks
+        if whole:
             self.run.collect(measures=True)
             return None
         return self.run.step_data(tracked, frame)
