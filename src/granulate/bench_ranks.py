@@ -37,10 +37,9 @@ per second, and the shares of its wall-clock time spent in the ghost exchange (a
 waiting for the step's messages after the bond forces it evaluates while they travel: what the
 overlap did not hide), in the checks (a reduction after each step, and one within each step
 whose caps leave ghost nodes out), in picking the caps anew, in migrations and, with
-``--collect-every N``, in making an output step every N steps: of whole grains, the step made of
-the ranks' measures of their grains (DistributedRun.step_data, as a run with frames in pieces or
-no frames does at its output steps); of a body cut at node level, the whole state gathered into
-rank 0's simulation (NodeSplitRun.collect, as its outputs do); nothing is written, and no row is
+``--collect-every N``, in making an output step every N steps: the step made of the ranks'
+measures of their grains or nodes (DistributedRun.step_data, NodeSplitRun.step_data, as a run
+with frames in pieces or no frames does at its output steps); nothing is written, and no row is
 computed from it; then the migrations (and the steps the ranks rebalanced before, under
 ``--load-balance``'s settings, gr.LoadBalance.from_text, how many times the ranks compared their
 work and the most loaded rank's over the mean at the last comparison) and grains handed over,
@@ -333,12 +332,13 @@ def _timed(run: Any, steps: int, collect_every: int, comm: Any) -> float:
     """The wall-clock seconds of `steps` steps of `run` (a DistributedRun or NodeSplitRun),
     making an output step every `collect_every` (0: never; module docstring); its `seconds`
     and `waiting` count these steps alone."""
-    from granulate.parallel import DistributedRun
-
     every = collect_every or steps
-    output = (lambda: run.step_data(())) if isinstance(run, DistributedRun) else run.collect
+
+    def output() -> None:
+        run.step_data(())
+
     if collect_every:
-        output()  # once untimed (NodeSplitRun: rank 0 builds its whole simulation)
+        output()  # once untimed
     run.seconds = dict.fromkeys(run.seconds, 0.0)
     run.waiting = 0.0
     comm.Barrier()  # every rank's clock starts together
