@@ -175,14 +175,15 @@ def pile3d(grains: int, comm: Any = None, placed: bool = False) -> gr.Simulation
     return sim
 
 
-def block(quick: bool = False) -> gr.Simulation:
+def block(quick: bool = False, comm: Any = None) -> gr.Simulation:
     """A notched glass block, 30 x 15 x 15 mm at h = 0.5 mm (7 x 3.5 x 3.5 mm with `quick`),
     each node starting at v_x = 60/s (x - c) (c its centre), its ends held at that speed: it
-    deforms throughout and cracks from the notch within a hundred steps. No contact."""
+    deforms throughout and cracks from the notch within a hundred steps. No contact. `comm`:
+    run it on those MPI ranks (Simulation's comm)."""
     glass = gr.Material(density=2500, youngs_modulus=70e9, poisson_ratio=0.22, fracture_energy=8.0)
     length = 7e-3 if quick else 0.03
     width = length / 2
-    sim = gr.Simulation(dimension=3)
+    sim = gr.Simulation(dimension=3, comm=comm)
     notch = gr.Box((length / 2 - 0.3e-3, 2 / 3 * width, -1), (length / 2 + 0.3e-3, 1, 1))
     sim.add_body(gr.Difference(gr.Box((0, 0, 0), (length, width, width)), notch), glass, 0.5e-3)
     sim.contact = None

@@ -130,9 +130,15 @@ def save(
     `fingerprint`: sim's, when already known."""
     core = sim.core
     header = header_of(core.step, core.time, fingerprint or sim.fingerprint(), outputs)
+    return save_state(path, core.checkpoint(), header)
+
+
+def save_state(path: str | Path, state: dict[str, Any], header: dict[str, Any]) -> Path:
+    """Write a core's `state` (core.checkpoint) with `header` (header_of) to `path` atomically,
+    then remove the pieces of a distributed run's checkpoint there before (pieces_folder)."""
     target = Path(path)
     target.parent.mkdir(parents=True, exist_ok=True)
-    checkpoint_file.save(target, core.checkpoint(), header)
+    checkpoint_file.save(target, state, header)
     shutil.rmtree(pieces_folder(target), ignore_errors=True)
     return target
 

@@ -411,21 +411,19 @@ class Simulation(SimulationSetup, SimulationResults):
     def _require_room_on_root(self, plan: RunPlan) -> None:
         """Every rank, before a distributed run's first step: InputError when rank 0 will take
         the whole state in this run (at its end unless plan.gather is False, for outputs or
-        stop criteria that read the whole simulation, or for every output of bodies cut at
-        node level) and the whole model would not fit in its memory (whole_state.require_room);
+        stop criteria that read the whole simulation) and the whole model would not fit in
+        its memory (whole_state.require_room);
         or when it will join frames of every node from the ranks' rows and those would not
         (vtu_frame.require_room_for_frames): refused now, not hours in. Each checked once."""
-        from granulate.parallel import NodeSplitRun
         from granulate.parallel.agreement import on_root
         from granulate.parallel.whole_state import require_room
         from granulate.writers.vtu_frame import require_room_for_frames
 
-        run = self._distributed_run()
+        self._distributed_run()  # made by every rank together, before any check
         out = self._output  # rank 0's
         gathers, frames = self._comm.bcast(
             (
                 plan.gather
-                or isinstance(run, NodeSplitRun)
                 or any(criterion.needs_whole_state for criterion in plan.stop)
                 or (out is not None and out.may_need_whole_state()),
                 out is not None and not out.pieces,

@@ -19,8 +19,9 @@ Every rank holds the whole model, as a distributed run's ranks do (engine.py). A
 is made of what each rank measures of its own nodes (step_data): exact totals, fragment labels
 found by the ranks together (fragment_labels), and the fragment and particle tables' sums run
 by run (run_sums.py: the nodes are dealt in whole blocks of 64, so each rank's runs are the
-serial run's). For writers that read the simulation, checkpoints and the end of a run, rank 0's
-simulation takes every node's state from its owner (collect). Contact is not split: a body's
+serial run's). For writers that read the simulation and the end of a run, rank 0's simulation
+takes every node's state from its owner (collect); a checkpoint, in the serial format, rank 0
+writes from its own core's state with the other ranks' nodes put in. Contact is not split: a body's
 rigid motion, which contact reads each step, is a sum in node order across ranks.
 """
 
@@ -215,9 +216,7 @@ class NodeSplitRun:
         the same message, else rank 0's error and RankFailed."""
         start = time.perf_counter()
         core = self.local.core
-        intact = np.asarray(core.bond_intact)[_copies_of(self._offsets, self.own)]
-        mine = (*(np.asarray(getattr(core, f))[self.own] for f in _NODE_FIELDS), intact)
-        parts = self.large.gather(mine, root=0)
+        parts = self.large.gather(self._own_state(), root=0)
         searches = self.comm.reduce(int(core.contact_statistics.rebuilds), op=self.mpi.MAX, root=0)
         moment = (float(core.time), int(core.step))
         on_root(self.comm, lambda: self._install(parts, moment, int(searches)))
@@ -392,31 +391,65 @@ class NodeSplitRun:
 
     def save_checkpoint(self, path: str | os.PathLike[str], outputs: Outputs | None = None) -> Path:
         """The serial run's checkpoint (granulate.checkpoints, with `outputs`' bookkeeping),
-        written by rank 0 from the whole state (collect); it restarts on any number of ranks,
-        or serially, bit for bit. Rank 0 raises a failure to write, the others RankFailed. The
+        written by rank 0 from its own core's state with every other rank's nodes put in:
+        rank 0 builds no whole simulation for it. It restarts on any number of ranks, or
+        serially, bit for bit. Rank 0 raises a failure to write, the others RankFailed. The
         path written, on every rank."""
-        self.collect(measures=False)
+        start = time.perf_counter()
+        parts = self.large.gather(self._own_state(), root=0)
 
         def write() -> Path:
-            self._sim.analysis.forget_fragments()
-            return checkpoints.save(self._sim, path, outputs, self.fingerprint())
+            state = self._whole_checkpoint(parts)
+            moment = (int(state["step"]), float(state["time"]))
+            header = checkpoints.header_of(*moment, self.fingerprint(), outputs)
+            return checkpoints.save_state(path, state, header)
 
-        return Path(self.comm.bcast(on_root(self.comm, write), root=0))
+        written = Path(self.comm.bcast(on_root(self.comm, write), root=0))
+        self.seconds["collect"] += time.perf_counter() - start
+        return written
+
+    def _own_state(self) -> tuple[NDArray[Any], ...]:
+        """This rank's own nodes' fields (_NODE_FIELDS) and bond states (their bond copies)."""
+        core = self.local.core
+        intact = np.asarray(core.bond_intact)[_copies_of(self._offsets, self.own)]
+        return (*(np.asarray(getattr(core, f))[self.own] for f in _NODE_FIELDS), intact)
+
+    def _whole_checkpoint(self, parts: list[tuple[NDArray[Any], ...]]) -> dict[str, Any]:
+        """Rank 0: its core's checkpoint (core.checkpoint) with every node's fields and bond
+        states from its owner (`parts`, every rank's _own_state in rank order)."""
+        state = dict(self.local.core.checkpoint())
+        nodes = len(self.owner)
+        fields = {f: np.array(state[f], dtype=np.float64).reshape(nodes, -1) for f in _NODE_FIELDS}
+        bonds = np.array(state["bond_intact"], dtype=np.uint8)
+        for own, part in zip(self.nodes_of, parts, strict=True):
+            for name, values in zip(_NODE_FIELDS, part[:-1], strict=True):
+                fields[name][own] = np.asarray(values).reshape(len(own), -1)
+            bonds[_copies_of(self._offsets, own)] = part[-1]
+        for name, values in fields.items():
+            state[name] = values.reshape(np.shape(state[name]))
+        state["bond_intact"] = bonds
+        return state
 
     def load_checkpoint(self, path: str | os.PathLike[str], outputs: Outputs | None = None) -> None:
         """Continue from a checkpoint of this set-up written by a run on any number of ranks,
-        or serially (else InputError on every rank): rank 0 reads it into its simulation (with
-        `outputs`' bookkeeping) and every rank restores the whole state from it."""
+        or serially (else InputError on every rank): rank 0 reads it into its own core (with
+        `outputs`' bookkeeping; no whole simulation is built for it) and the other ranks
+        restore the whole state from it."""
 
         def read() -> dict[str, Any]:
-            self._sim._ranks_ahead = False  # it reads the whole state itself
-            checkpoints.load(self._sim, path, outputs, self.fingerprint())
-            self._sim._gathered = None  # the evaluation gathered before is not the checkpoint's
-            return dict(self._sim.core.checkpoint())
+            checkpoints.load(self.local, path, outputs, self.fingerprint())
+            return dict(self.local.core.checkpoint())
 
         start = time.perf_counter()
         state = self.large.bcast(on_root(self.comm, read), root=0)
-        together(self.comm, lambda: self.local.core.restore(state), "restoring the checkpoint")
+
+        def restore() -> None:
+            if self.comm.Get_rank() != 0:  # rank 0's core holds it already
+                self.local.core.restore(state)
+
+        together(self.comm, restore, "restoring the checkpoint")
+        self._sim._ranks_ahead = True  # rank 0's simulation does not hold the checkpoint's state
+        self._sim._gathered = None
         self._labels = None
         self.seconds["collect"] += time.perf_counter() - start
 
