@@ -70,8 +70,8 @@ def fragment_table(
     node count, debris flag (1 node), mass [kg; kg/m in 2D], volume [m^3; m^2 in 2D], centre
     of mass [m], its velocity [m/s] and the equivalent diameter [m]. `labels` gives each
     node's piece, `nodes` its index (increasing), `particles` its particle; the other arrays
-    are per node. The sums run run by run (run_sums.py): fragment_runs and table_of_runs make
-    the table of several processes' nodes."""
+    are per node. The sums are made run by run (run_sums.py): fragment_runs and table_of_runs
+    make the table of several processes' nodes."""
     ids, first = np.unique(np.asarray(labels, dtype=np.int64), return_index=True)
     runs = fragment_runs(labels, nodes, positions, velocities, volumes, densities)
     return table_of_runs(runs, ids, np.asarray(particles, dtype=np.int64)[first], dimension)

@@ -22,8 +22,6 @@ from granulate.errors import InputError
 
 #: The node indices of a block: no run crosses a multiple of it (the core's kRunBlock).
 BLOCK = 64
-#: The columns of Runs.first_sums.
-FIRST_COLUMNS = ("m", "V", "mx", "my", "mz", "mvx", "mvy", "mvz")
 
 
 @dataclass(frozen=True)
@@ -58,7 +56,7 @@ class Runs:
         positions: ArrayLike,
         velocities: ArrayLike,
     ) -> Runs:
-        """The runs of the first sums, FIRST_COLUMNS a run: m, V, m x (3), m v (3), from each
+        """The runs of the first sums, 8 a run: m, V, m x (3), m v (3), from each
         node's mass [kg], volume, position [m] and velocity [m/s] (_core.first_runs)."""
         return cls(
             *_core.first_runs(

@@ -254,7 +254,9 @@ class NodeSplitRun:
         labels = np.asarray(labels, dtype=np.int64)
         field = np.zeros(len(self.owner))  # node indices as floats: exact below 2^53
         field[self.own] = labels
+        exchanged, waited = self.seconds["exchange"], self.waiting
         self._exchange(field, lambda share: None, None)
+        self.seconds["exchange"], self.waiting = exchanged, waited  # an output's, not a step's
         leaving = np.asarray(leaving, dtype=np.int64)
         mine = labels[np.searchsorted(self.own, leaving[:, 0])]
         pairs = np.unique(np.column_stack([mine, field[leaving[:, 1]].astype(np.int64)]), axis=0)
@@ -272,11 +274,11 @@ class NodeSplitRun:
         nodes, with no whole state on rank 0 (as DistributedRun.step_data makes it of whole
         grains), with the sums of the `tracked` bodies and, for a frame of every node with the
         fields `frame`, each rank's rows of its own nodes joined in node order
-        (StepData.frame_rows); on rank 0 (None on the others). The
-        sums over the nodes are exact (step_totals.py); the fragment and particle tables'
-        run by run (run_sums.py) of the nodes dealt in whole blocks, joined in node order
-        on rank 0, which sends back the particles' centres for their second sums: every
-        column is the serial run's."""
+        (StepData.frame_rows); on rank 0 (None on the others). The sums over the nodes are
+        exact (step_totals.py); the fragment and particle tables' are made run by run
+        (run_sums.py) of the nodes dealt in whole blocks and joined in node order on rank 0,
+        which sends back the particles' centres for their second sums: every column is the
+        serial run's."""
         start = time.perf_counter()
         labels, broken = self.fragment_labels(), self.broken_bonds()
         searches = self.comm.reduce(
@@ -462,7 +464,7 @@ class NodeSplitRun:
 
     def _own_rows(self, fields: tuple[str, ...]) -> NodeRows:
         """Every rank: the rows of its own nodes in a frame with `fields`, the fragment labels
-        the ranks' together (fragment_labels)."""
+        found by the ranks together (fragment_labels)."""
         labels = self.fragment_labels() if "Fragment_ID" in fields else None
         local = tuple(f for f in fields if f != "Fragment_ID")
         values = together(self.comm, lambda: point_fields(self.local, local), "measuring its nodes")
