@@ -62,6 +62,8 @@ def main() -> None:
     before = resident_mb()
     for _ in range(args.repeats):
         comm.Barrier()
+        if isinstance(run, NodeSplitRun):
+            run._labels = None  # found anew, as at each output step of a run whose bonds break
         start = time.perf_counter()
         data = run.step_data(())
         if data is not None:

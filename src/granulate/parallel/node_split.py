@@ -259,11 +259,11 @@ class NodeSplitRun:
         self.seconds["exchange"], self.waiting = exchanged, waited  # an output's, not a step's
         leaving = np.asarray(leaving, dtype=np.int64)
         mine = labels[np.searchsorted(self.own, leaving[:, 0])]
-        pairs = np.unique(np.column_stack([mine, field[leaving[:, 1]].astype(np.int64)]), axis=0)
-        joined = _joined_pieces(self.comm.allgather(pairs))
+        nodes = len(self.owner)  # a pair of pieces (a, b) as the key a n + b
+        keys = np.unique(mine * nodes + field[leaving[:, 1]].astype(np.int64))
+        joined = _joined_pieces(self.comm.allgather(np.column_stack(np.divmod(keys, nodes))))
         if joined:
-            pieces, place = np.unique(labels, return_inverse=True)
-            labels = np.array([joined.get(int(p), int(p)) for p in pieces], np.int64)[place]
+            labels = _relabelled(labels, joined)
         self._labels = (step, labels)
         return labels
 
@@ -519,6 +519,16 @@ def _joined_pieces(pairs: list[NDArray[np.int64]]) -> dict[int, int]:
         first, second = root(a), root(b)
         parent[max(first, second)] = min(first, second)
     return {piece: root(piece) for piece in list(parent)}
+
+
+def _relabelled(labels: NDArray[np.int64], joined: dict[int, int]) -> NDArray[np.int64]:
+    """`labels` with each piece that `joined` names replaced by the piece it joins."""
+    pieces = np.fromiter(joined.keys(), np.int64, len(joined))
+    roots = np.fromiter(joined.values(), np.int64, len(joined))
+    order = np.argsort(pieces)
+    pieces, roots = pieces[order], roots[order]
+    place = np.minimum(np.searchsorted(pieces, labels), len(pieces) - 1)
+    return np.where(pieces[place] == labels, roots[place], labels)
 
 
 def _built(part: Simulation) -> Simulation:
