@@ -40,7 +40,6 @@ import numpy as np
 from numpy.typing import NDArray
 
 from granulate import checkpoints, fingerprints, fragments, particle_table
-from granulate.analysis import complete_particle_table
 from granulate.errors import InputError
 from granulate.evaluation import Evaluation
 from granulate.parallel.agreement import attempt, on_root, stop_if_any_failed, together
@@ -51,7 +50,7 @@ from granulate.parallel.rank_threads import share_of_cores
 from granulate.parallel.run_measures import RankMeasures
 from granulate.run_sums import BLOCK, Runs
 from granulate.step_totals import StepTotals, TrackedSums, node_totals
-from granulate.writers.step_data import StepData, set_up_fields
+from granulate.writers.step_data import StepData
 from granulate.writers.vtu_frame import FIELD_TYPES, NodeRows, point_fields, write_piece_rows
 
 if TYPE_CHECKING:
@@ -294,8 +293,8 @@ class NodeSplitRun:
         mine = together(self.comm, lambda: self._moments(centre, velocity), "measuring its nodes")
         moments = self.large.gather(mine, root=0)
         rows = None if frame is None else self.large.gather(self._own_rows(frame), root=0)
-        step = (int(self.local.core.step), float(self.local.core.time), broken, searches)
-        data = on_root(self.comm, lambda: self._step_data(parts, first, moments, step, rows))
+        counts = (broken, searches)
+        data = on_root(self.comm, lambda: self._step_data(parts, first, moments, counts, rows))
         self.seconds["collect"] += time.perf_counter() - start
         return data
 
@@ -348,14 +347,14 @@ class NodeSplitRun:
         parts: list[_NodesPart],
         first: NDArray[np.float64],
         moments: list[Runs],
-        step: tuple[int, float, int, int],
+        counts: tuple[int, int],
         rows: list[NodeRows] | None,
     ) -> StepData:
         """Rank 0: the output step of every rank's part, the particles' first sums and the
         runs of their moments, and the ranks' rows of a frame of every node (`rows`, when one
-        is due); `step`: the step, time [s], bonds broken and list searches."""
+        is due); `counts`: the bonds broken and the list searches."""
         sim, core = self._sim, self.local.core
-        number, time_now, broken, searches = step
+        broken, searches = counts
         totals = functools.reduce(operator.add, (part.totals for part in parts))
         ids = np.unique(np.concatenate([part.ids for part in parts]))
         particle_of = np.asarray(self.local.model.node_particle)[ids]
@@ -368,21 +367,9 @@ class NodeSplitRun:
         )
         contacts = self.local.analysis.contact_table()  # none: nothing touches
         evaluation = replace(Evaluation.of_core(core, contacts), list_rebuilds=searches)
-        particles, stresses = complete_particle_table(
-            motion, volumes, damage, evaluation.contacts, time_now, sim.dimension
-        )
-        return StepData(
-            number,
-            time_now,
-            totals,
-            broken,
-            table,
-            evaluation,
-            particles,
-            (stresses, volumes),
-            *set_up_fields(sim, core),
-            frame_rows=None if rows is None else NodeRows.joined(rows, len(self.owner)),
-        )
+        frame = None if rows is None else NodeRows.joined(rows, len(self.owner))
+        sums = (totals, broken, table, evaluation)
+        return StepData.of_measures(sim, core, sums, (motion, volumes, damage), frame)
 
     def fingerprint(self) -> str:
         """The set-up's fingerprint (Simulation.fingerprint), on every rank from the whole

@@ -34,10 +34,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from granulate import fragments, particle_table
-from granulate.analysis import complete_particle_table
 from granulate.parallel.whole_state import OwnEvaluation, merged_evaluation, own_grain_places
 from granulate.step_totals import StepTotals, TrackedSums, node_totals
-from granulate.writers.step_data import StepData, set_up_fields
+from granulate.writers.step_data import StepData
 
 if TYPE_CHECKING:
     from granulate.parallel.engine import DistributedRun
@@ -106,22 +105,8 @@ def step_data(
         volumes[part.grains] = part.volumes
         damage[part.grains] = part.damage
     evaluation = merged_evaluation([part.evaluation for part in parts], wall_reactions)
-    time = float(core.time)
-    particles, stresses = complete_particle_table(
-        motion, volumes, damage, evaluation.contacts, time, sim.dimension
-    )
-    return StepData(
-        int(core.step),
-        time,
-        totals,
-        broken,
-        table,
-        evaluation,
-        particles,
-        (stresses, volumes),
-        *set_up_fields(sim, core),
-        frame_rows=frame_rows,
-    )
+    sums = (totals, broken, table, evaluation)
+    return StepData.of_measures(sim, core, sums, (motion, volumes, damage), frame_rows)
 
 
 def _own_fragments(run: DistributedRun, grains: NDArray[np.int64]) -> fragments.Table:

@@ -12,6 +12,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from granulate import fragments, network, particle_table
+from granulate.analysis import complete_particle_table
 from granulate.evaluation import Evaluation
 from granulate.exact_sum import ExactSum
 from granulate.step_totals import StepTotals, TrackedSums, node_totals
@@ -77,6 +78,38 @@ class StepData:
             (stresses, volumes),
             *set_up_fields(sim, core),
             sim,
+        )
+
+    @classmethod
+    def of_measures(
+        cls,
+        sim: Simulation,
+        core: Any,
+        sums: tuple[StepTotals, int, fragments.Table, Evaluation],
+        particles: tuple[particle_table.Table, NDArray[np.float64], NDArray[np.float64]],
+        frame_rows: NodeRows | None = None,
+    ) -> StepData:
+        """The step of `sim`'s set-up at `core`'s step and time (a rank's part: its walls) made
+        of measures its ranks put together: `sums`, the totals, bonds broken, fragment table
+        and evaluation; `particles`, the particles' motion columns, volumes and volume-weighted
+        damage, which complete_particle_table completes; the rows of a frame of every node."""
+        totals, broken, table, evaluation = sums
+        motion, volumes, damage = particles
+        time = float(core.time)
+        rows, stresses = complete_particle_table(
+            motion, volumes, damage, evaluation.contacts, time, sim.dimension
+        )
+        return cls(
+            int(core.step),
+            time,
+            totals,
+            broken,
+            table,
+            evaluation,
+            rows,
+            (stresses, volumes),
+            *set_up_fields(sim, core),
+            frame_rows=frame_rows,
         )
 
 
