@@ -141,13 +141,21 @@ def test_foreign_nodes_must_be_this_process_particles() -> None:
 
 
 def test_nodes_are_dealt_in_whole_blocks_of_the_run_sums() -> None:
-    """NodeSplitRun deals the notched block's nodes to 3 ranks in whole blocks of 64 (so each
-    rank makes the serial run's runs of the tables' sums, run_sums.py), each rank's weight
-    within 10 % of a third."""
-    sim = pulled("block", "lps")
+    """NodeSplitRun deals the nodes of a block and a bar beside it (the bar's first nodes share
+    a block with the block's last) to 3 ranks in whole blocks of 64, cut where a particle
+    ends (so each rank makes the serial run's runs of the tables' sums, run_sums.py), no rank
+    holding nodes of both bodies from one block, each rank's weight within 10 % of a third."""
+    sim = gr.Simulation(dimension=3)
+    for box in (gr.Box((0, 0, 0), (0.01, 5e-3, 3e-3)), gr.Box((0.012, 0, 0), (0.02, 2e-3, 2e-3))):
+        sim.add_body(box, gr.Material(**GLASS), mesh_size=0.5e-3)
     weights = np.diff(np.asarray(sim.model.bond_offsets)) + 1.0
-    owner = _dealt_in_blocks(sim.reference_positions, weights, 3)
+    particles = np.asarray(sim.model.node_particle, dtype=np.int64)
+    owner = _dealt_in_blocks(sim.reference_positions, particles, weights, 3)
     blocks = np.arange(sim.node_count) // BLOCK
-    assert all(len(np.unique(owner[blocks == b])) == 1 for b in np.unique(blocks))
+    shared = blocks[sim.bodies[1].first_node]
+    assert particles[blocks == shared].min() == 0 and particles[blocks == shared].max() == 1
+    for b in np.unique(blocks):
+        for q in np.unique(particles[blocks == b]):
+            assert len(np.unique(owner[(blocks == b) & (particles == q)])) == 1
     shares = np.bincount(owner, weights, 3) / weights.sum()
     np.testing.assert_allclose(shares, 1 / 3, rtol=0.1)

@@ -4,22 +4,22 @@ model in which nothing touches (no contact law, wall or PeriDEM damping:
 Interactions.contact_free) this way, `mpiexec granulate run case.yaml` included.
 
 The nodes are dealt by recursive coordinate bisection (partition.bisect over blocks of 64
-consecutive nodes, each weighted by its nodes' bonds plus one), so a body larger than a
-subdomain is cut wherever the cuts fall and its bonds cross ranks. Each rank evaluates its own
-nodes (core.set_foreign_nodes) and receives, of the others, its halo: the nodes bonded to its
-own, one horizon deep. A step exchanges twice with each neighbouring rank: the halo's positions
-after the drift (core.move), then, for LPS, the halo's dilatation sums after the bonds' stretch
-and breaking (core.begin_step), before the forces (core.finish_step). The core evaluates of a
-halo node only its bonds to own nodes, so every own node sums the serial run's terms in the
-serial order and a bond across a cut breaks alike on both sides (tests/test_node_split.py in
-one process, tests/test_mpi.py on 2 and 3 ranks). The halo is fixed by the bonds, so no node
-ever needs to change hands.
+consecutive nodes cut where a particle ends, each weighted by its nodes' bonds plus one), so a
+body larger than a subdomain is cut wherever the cuts fall and its bonds cross ranks. Each rank
+evaluates its own nodes (core.set_foreign_nodes) and receives, of the others, its halo: the
+nodes bonded to its own, one horizon deep. A step exchanges twice with each neighbouring rank:
+the halo's positions after the drift (core.move), then, for LPS, the halo's dilatation sums
+after the bonds' stretch and breaking (core.begin_step), before the forces (core.finish_step).
+The core evaluates of a halo node only its bonds to own nodes, so every own node sums the
+serial run's terms in the serial order and a bond across a cut breaks alike on both sides
+(tests/test_node_split.py in one process, tests/test_mpi.py on 2 and 3 ranks). The halo is
+fixed by the bonds, so no node ever needs to change hands.
 
 Every rank holds the whole model, as a distributed run's ranks do (engine.py). An output step
 is made of what each rank measures of its own nodes (step_data): exact totals, fragment labels
 found by the ranks together (fragment_labels), and the fragment and particle tables' sums run
-by run (run_sums.py: the nodes are dealt in whole blocks of 64, so each rank's runs are the
-serial run's). For writers that read the simulation and the end of a run, rank 0's simulation
+by run (run_sums.py: the nodes are dealt in whole blocks, so each rank's runs are the serial
+run's). For writers that read the simulation and the end of a run, rank 0's simulation
 takes every node's state from its owner (collect); a checkpoint, in the serial format, rank 0
 writes from its own core's state with the other ranks' nodes put in. Contact is not split: a body's
 rigid motion, which contact reads each step, is a sum in node order across ranks.
@@ -92,7 +92,8 @@ class NodeSplitRun:
         self.stable_dt = float(core.stable_time_step)
         self._offsets = np.asarray(model.bond_offsets, dtype=np.int64)
         points = np.asarray(model.reference_positions)[:, : sim.dimension]
-        self.owner = _dealt_in_blocks(points, np.diff(self._offsets) + 1.0, ranks)
+        particles = np.asarray(model.node_particle, dtype=np.int64)
+        self.owner = _dealt_in_blocks(points, particles, np.diff(self._offsets) + 1.0, ranks)
         rank = comm.Get_rank()
         self.nodes_of = [np.flatnonzero(self.owner == q) for q in range(ranks)]
         self.own = self.nodes_of[rank]
@@ -476,19 +477,25 @@ class _NodesPart:
 
 
 def _dealt_in_blocks(
-    points: NDArray[np.float64], weights: NDArray[np.float64], ranks: int
+    points: NDArray[np.float64],
+    particles: NDArray[np.int64],
+    weights: NDArray[np.float64],
+    ranks: int,
 ) -> NDArray[np.int64]:
-    """Each node's rank: the blocks of run_sums.BLOCK consecutive nodes dealt whole by recursive
-    coordinate bisection of their centres, each weighing its nodes' `weights`, so that every
-    rank makes the runs of its nodes' sums as the serial run does (run_sums.py)."""
+    """Each node's rank: the blocks of run_sums.BLOCK consecutive nodes, each cut where a
+    particle ends, dealt whole by recursive coordinate bisection of their centres, each
+    weighing its nodes' `weights`, so that every rank makes the runs of its nodes' sums as the
+    serial run does (run_sums.py: no run crosses a block or a particle's end)."""
     block = np.arange(len(points)) // BLOCK
-    count = int(block[-1]) + 1
-    sizes = np.bincount(block, minlength=count)
+    starts = (block[1:] != block[:-1]) | (particles[1:] != particles[:-1])
+    unit = np.concatenate([[0], np.cumsum(starts)])
+    count = int(unit[-1]) + 1
+    sizes = np.bincount(unit, minlength=count)
     centres = np.column_stack(
-        [np.bincount(block, points[:, k], count) for k in range(points.shape[1])]
+        [np.bincount(unit, points[:, k], count) for k in range(points.shape[1])]
     )
-    dealt = bisect(centres / sizes[:, None], np.bincount(block, weights, count), ranks)
-    return dealt.owner[block]
+    dealt = bisect(centres / sizes[:, None], np.bincount(unit, weights, count), ranks)
+    return dealt.owner[unit]
 
 
 def _joined_pieces(pairs: list[NDArray[np.int64]]) -> dict[int, int]:
