@@ -13,8 +13,11 @@ grains per rank, or `block`, `granulate bench --ranks`' notched LPS block of 53,
 at node level. The run takes
 `--steps` steps, then makes the row both ways, alternating, `--repeats` times, the ranks
 starting each together (a barrier); rank 0 prints the medians in ms, its resident memory
-(VmRSS, MB) before the first gathering and after, and whether both rows are equal. One thread
-per rank unless OMP_NUM_THREADS says otherwise.
+(VmRSS, MB) before the first gathering and after, and whether both rows are equal. The ranks
+keep their damage and fragment labels from the first row (as a run does until a bond breaks;
+a split body's labels are found at every output step) unless `--fresh` (as after bonds broke
+between rows); the gathered path makes them anew each time. One thread per rank unless
+OMP_NUM_THREADS says otherwise.
 """
 
 from __future__ import annotations
@@ -47,6 +50,12 @@ def main() -> None:
     parser.add_argument("--peridem-compat", action="store_true")
     parser.add_argument("--steps", type=int, default=10)
     parser.add_argument("--repeats", type=int, default=40)
+    parser.add_argument(
+        "--fresh",
+        action="store_true",
+        help="make the ranks' damage and fragment labels anew for each row (as after bonds "
+        "broke), not kept from the first",
+    )
     args = parser.parse_args()
     comm = MPI.COMM_WORLD
     if args.case in SPLIT_CASES:
@@ -62,8 +71,10 @@ def main() -> None:
     before = resident_mb()
     for _ in range(args.repeats):
         comm.Barrier()
+        if args.fresh:
+            run.local.analysis.forget_fragments()
         if isinstance(run, NodeSplitRun):
-            run._labels = None  # found anew, as at each output step of a run whose bonds break
+            run._labels = None  # a run finds them anew at each output step
         start = time.perf_counter()
         data = run.step_data(())
         if data is not None:
