@@ -1,5 +1,5 @@
 // Sums over groups of nodes (particles, fragments) that give the same bits however the nodes
-// are dealt to processes (granulate/block_sums.py): each group's nodes are summed run by run,
+// are dealt to processes (granulate/run_sums.py): each group's nodes are summed run by run,
 // a run being consecutive nodes of the group within one block of kRunBlock node indices, and a
 // group's runs are then added in node order. A process holding whole blocks makes the runs of
 // its nodes exactly as one holding every node does.
@@ -31,7 +31,7 @@ RunSums run_sums(std::span<const std::int64_t> groups, std::span<const std::int6
 
 /// The runs of the first sums of groups of nodes, 8 numbers a run: m, V, m x (3), m v (3),
 /// from each node's mass m, volume V, position x and velocity v (3 numbers a node), every
-/// product rounded before it is added (the file is built without contraction into fused
+/// product rounded before it is added (run_sums.cpp is built without contraction into fused
 /// multiply-adds), as NumPy would round it. Runs as run_sums makes them.
 RunSums first_runs(std::span<const std::int64_t> groups, std::span<const std::int64_t> nodes,
                    std::span<const real> mass, std::span<const real> volumes, std::span<const real> positions,
