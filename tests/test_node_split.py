@@ -159,3 +159,20 @@ def test_nodes_are_dealt_in_whole_blocks_of_the_run_sums() -> None:
             assert len(np.unique(owner[(blocks == b) & (particles == q)])) == 1
     shares = np.bincount(owner, weights, 3) / weights.sum()
     np.testing.assert_allclose(shares, 1 / 3, rtol=0.1)
+
+
+def test_a_run_on_ranks_tells_how_it_deals_its_work() -> None:
+    """Simulation.distribution (granulate run prints it): None serially; on ranks "nodes" when
+    nothing touches (the bodies cut at node level), "grains" with contact."""
+    from mpi4py import MPI
+
+    def plate(comm: object | None, contact: bool) -> gr.Simulation:
+        sim = gr.Simulation(dimension=2, plane="stress", comm=comm)
+        sim.add_body(gr.Rectangle((0, 0), (0.01, 0.01)), gr.Material(**GLASS), mesh_size=1e-3)
+        if not contact:
+            sim.contact = None
+        return sim
+
+    assert plate(None, contact=False).distribution is None
+    assert plate(MPI.COMM_SELF, contact=False).distribution == "nodes"
+    assert plate(MPI.COMM_SELF, contact=True).distribution == "grains"

@@ -196,7 +196,10 @@ def _run_case(
     stop = case.stop_criteria()
     check_every = case.spec.stop.check_every if case.spec.stop is not None else 100
     if not quiet and speaks:
-        ranks = "" if comm is None else f" on {comm.Get_size()} MPI ranks"
+        dealt = {"grains": "whole grains per rank", "nodes": "the bodies cut at node level"}
+        ranks = (
+            "" if comm is None else f" on {comm.Get_size()} MPI ranks, {dealt[sim.distribution]}"
+        )
         print(
             f"{sim.node_count} nodes, {sim.bond_count} bonds, dt {sim.dt:.4g} s, {steps} steps"
             f"{ranks}; output in {directory}"

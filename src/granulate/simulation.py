@@ -306,6 +306,15 @@ class Simulation(SimulationSetup, SimulationResults):
             self._core.time_step = self._dt
 
     @property
+    def distribution(self) -> str | None:
+        """How a distributed run (``comm``) deals its work to the ranks: "grains" (whole grains
+        per rank, granulate.parallel.DistributedRun) or "nodes" (nothing touches, so the bodies
+        are cut at node level, NodeSplitRun); None for a serial run."""
+        if self._comm is None:
+            return None
+        return "nodes" if self._interactions.contact_free() else "grains"
+
+    @property
     def stable_dt(self) -> float:
         """Stable time-step estimate [s] (Silling & Askari's bound, see Model::stable_time_step)."""
         return self._build().stable_time_step
@@ -395,7 +404,7 @@ class Simulation(SimulationSetup, SimulationResults):
         if self._distributed is None:
             from granulate.parallel import DistributedRun
 
-            if self._interactions.contact_free():  # nothing touches: the nodes are dealt
+            if self.distribution == "nodes":  # nothing touches: the nodes are dealt
                 from granulate.parallel.node_split import NodeSplitRun
 
                 run: DistributedRun | NodeSplitRun = NodeSplitRun(self, self._comm)
