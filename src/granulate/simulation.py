@@ -201,7 +201,8 @@ class Simulation(SimulationSetup, SimulationResults):
             raise InputError(
                 f"rank 0's simulation does not hold the run's state at step {self.step}: it "
                 "takes the ranks' state at the end of run() and at outputs that read it, not "
-                "after run(..., gather=False) or a checkpoint loaded in pieces; run with "
+                "after run(..., gather=False) or a checkpoint loaded on ranks (in pieces, or "
+                "of bodies cut at node level); run with "
                 "gather=True, read sim.measures() on every rank, or read the run's outputs"
             )
         if self._core is not None:
