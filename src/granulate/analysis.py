@@ -19,6 +19,7 @@ from granulate import _core, fragments, network, particle_table
 from granulate.assembly import Body
 from granulate.errors import InputError
 from granulate.exact_sum import ExactSum
+from granulate.run_sums import Runs
 
 
 def kinetic_energies(mass: ArrayLike, velocities: ArrayLike) -> NDArray[np.float64]:
@@ -263,9 +264,7 @@ class Analysis:
         centres = np.column_stack([table[axis] for axis in "xyz"])
         if method == "contacts":
             network_table = self.contact_table() if contacts is None else contacts
-            nodes = np.arange(len(owner))
-            phi = self.damage_phi()
-            particle_volume = particle_table.volumes(owner, nodes, volumes, phi, count)[0]
+            particle_volume = Runs.of(owner, np.arange(len(owner)), volumes).totals(count)[:, 0]
             return network.love_weber_stresses(
                 network_table, centres, particle_volume, self._dimension
             )

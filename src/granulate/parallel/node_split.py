@@ -97,6 +97,11 @@ class NodeSplitRun:
         rank = comm.Get_rank()
         self.nodes_of = [np.flatnonzero(self.owner == q) for q in range(ranks)]
         self.own = self.nodes_of[rank]
+        #: The own nodes' volumes, densities, masses and particles (set-up data, for outputs).
+        self._own_volumes = np.asarray(model.volumes)[self.own]
+        self._own_density = np.asarray(model.node_density)[self.own]
+        self._own_mass = self._own_density * self._own_volumes
+        self._own_particles = np.asarray(model.node_particle)[self.own]
         core.set_foreign_nodes(np.flatnonzero(self.owner != rank).tolist())
         self._receive, self._send = _halos(model, self.owner, self.own, rank)
         # The halo's messages in and out, for positions (3 numbers a node) and dilatation sums
@@ -140,26 +145,32 @@ class NodeSplitRun:
         the rest of the step; and the reduction that agrees on failures. Every rank goes
         through every exchange whatever failed."""
         core = self.local.core
-        start, exchanged = time.perf_counter(), self.seconds["exchange"]
+        start = time.perf_counter()
         failure = attempt(core.move)
-        failure = self._exchange(core.positions, core.evaluate_dilatation, failure)
+        failure, communicated, waited = self._exchange(
+            core.positions, core.evaluate_dilatation, failure
+        )
         failure = attempt(core.begin_step, failure)
         if self._lps:
-            failure = self._exchange(core.dilatation, core.evaluate_bonds, failure)
+            failure, more, waits = self._exchange(core.dilatation, core.evaluate_bonds, failure)
+            communicated, waited = communicated + more, waited + waits
         failure = attempt(lambda: core.finish_step(_NO_BREAKS), failure)
         reducing = time.perf_counter()
         stop_if_any_failed(self.comm, failure, f"taking step {int(core.step) + 1}")
         end = time.perf_counter()
-        self.seconds["exchange"] += end - reducing
-        self.seconds["steps"] += end - start - (self.seconds["exchange"] - exchanged)
+        communicated += end - reducing
+        self.seconds["exchange"] += communicated
+        self.seconds["steps"] += end - start - communicated
+        self.waiting += waited
 
     def _exchange(
         self, field: NDArray[np.float64], inner: Any, failure: Exception | None
-    ) -> Exception | None:
+    ) -> tuple[Exception | None, float, float]:
         """The halo's rows of `field` (positions, n x 3, or dilatation sums, n) from their
         owners, one message each way per neighbouring rank, while `inner` (core.
         evaluate_dilatation or evaluate_bonds: the inner blocks, which read nothing of them)
-        runs (overlap.while_travelling). The step's failure so far, or `inner`'s."""
+        runs (overlap.while_travelling). The step's failure so far, or `inner`'s; the seconds
+        spent communicating (`inner`'s not counted) and, of them, waiting for the halo [s]."""
         start = time.perf_counter()
         width = 1 if field.ndim == 1 else field.shape[1]
         inbox = self._inboxes[width]
@@ -172,11 +183,10 @@ class NodeSplitRun:
         failure, testing = while_travelling(self.mpi, requests, inner, failure)
         waiting = time.perf_counter()
         self.mpi.Request.Waitall(requests)
-        self.waiting += time.perf_counter() - waiting
+        waited = time.perf_counter() - waiting
         for q, halo in self._receive.items():
             field[halo] = inbox[q][:, 0] if field.ndim == 1 else inbox[q]
-        self.seconds["exchange"] += posted - start + testing + time.perf_counter() - waiting
-        return failure
+        return failure, posted - start + testing + time.perf_counter() - waiting, waited
 
     def gather(self, field: str, root: int = 0) -> NDArray[np.float64] | None:
         """core.<field> (positions, velocities, forces or dilatation) of every node on `root`,
@@ -254,9 +264,7 @@ class NodeSplitRun:
         labels = np.asarray(labels, dtype=np.int64)
         field = np.zeros(len(self.owner))  # node indices as floats: exact below 2^53
         field[self.own] = labels
-        exchanged, waited = self.seconds["exchange"], self.waiting
-        self._exchange(field, lambda share: None, None)
-        self.seconds["exchange"], self.waiting = exchanged, waited  # an output's, not a step's
+        self._exchange(field, lambda share: None, None)  # its seconds are an output's, not a step's
         leaving = np.asarray(leaving, dtype=np.int64)
         mine = labels[np.searchsorted(self.own, leaving[:, 0])]
         nodes = len(self.owner)  # a pair of pieces (a, b) as the key a n + b
@@ -301,17 +309,14 @@ class NodeSplitRun:
 
     def _part(self, tracked: tuple[int, ...], labels: NDArray[np.int64]) -> _NodesPart:
         """This rank's _NodesPart of an output step, its fragment `labels` given."""
-        local, own = self.local, self.own
-        core, model = local.core, local.model
-        volumes = np.asarray(model.volumes)[own]
-        density = np.asarray(model.node_density)[own]
-        mass = density * volumes
+        local, own, core = self.local, self.own, self.local.core
+        volumes, density, mass = self._own_volumes, self._own_density, self._own_mass
+        particle = self._own_particles
         phi = local.analysis.damage_phi()[own]
         energy = np.asarray(core.strain_energy_density())[own]
         x, v = core.positions[own], core.velocities[own]
-        particle = np.asarray(model.node_particle)[own]
         totals = node_totals(mass, volumes, v, x, local.gravity, energy, phi)
-        sums = tuple(self._tracked_sums(body, mass, volumes) for body in tracked)
+        sums = tuple(self._tracked_sums(body) for body in tracked)
         return _NodesPart(
             replace(totals, tracked=sums),
             fragments.fragment_runs(labels, own, x, v, volumes, density),
@@ -320,16 +325,14 @@ class NodeSplitRun:
             particle_table.volume_runs(particle, own, volumes, phi),
         )
 
-    def _tracked_sums(
-        self, body: int, mass: NDArray[np.float64], volumes: NDArray[np.float64]
-    ) -> TrackedSums:
-        """The sums of the tracked body's own nodes (`mass` and `volumes`: the own nodes')."""
+    def _tracked_sums(self, body: int) -> TrackedSums:
+        """The sums of the tracked body's own nodes."""
         span = self._sim.bodies[body].node_slice
         mine = slice(*np.searchsorted(self.own, [span.start, span.stop]))
         nodes, model, core = self.own[mine], self.local.model, self.local.core
         return TrackedSums.of(
-            mass[mine],
-            volumes[mine],
+            self._own_mass[mine],
+            self._own_volumes[mine],
             core.forces[nodes],
             core.positions[nodes],
             np.asarray(model.reference_positions)[nodes],
@@ -337,11 +340,9 @@ class NodeSplitRun:
 
     def _moments(self, centre: NDArray[np.float64], velocity: NDArray[np.float64]) -> Runs:
         """The runs of this rank's particle sums about the particles' `centre` and `velocity`."""
-        own, model, core = self.own, self.local.model, self.local.core
-        mass = (np.asarray(model.node_density) * np.asarray(model.volumes))[own]
-        particle = np.asarray(model.node_particle)[own]
+        own, core = self.own, self.local.core
         x, v = core.positions[own], core.velocities[own]
-        return Runs.moments(particle, own, mass, x, v, centre, velocity)
+        return Runs.moments(self._own_particles, own, self._own_mass, x, v, centre, velocity)
 
     def _step_data(
         self,

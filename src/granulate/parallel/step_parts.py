@@ -58,23 +58,31 @@ class StepPart:
 
 
 def step_part(run: DistributedRun, tracked: tuple[int, ...]) -> StepPart:
-    """This rank's StepPart, with the sums of the `tracked` grains it owns (others' empty)."""
+    """This rank's StepPart, with the sums of the `tracked` grains it owns (others' empty). Its
+    fragment rows label each piece by its smallest node in the whole run's numbering: the part
+    numbers a grain's nodes in the whole run's order, so that node is the piece's smallest here
+    too."""
     local, nodes = run.local, run.owned_nodes
     core, model = local.core, local.model
     volumes = np.asarray(model.volumes)[nodes]
-    mass = np.asarray(model.node_density)[nodes] * volumes
+    density = np.asarray(model.node_density)[nodes]
+    mass = density * volumes
     phi = local.analysis.damage_phi()[nodes]  # kept until a bond state changes
-    density = np.asarray(core.strain_energy_density())[nodes]
+    energy = np.asarray(core.strain_energy_density())[nodes]
     x, v = core.positions[nodes], core.velocities[nodes]
     evaluation = OwnEvaluation.of(run)
-    totals = node_totals(mass, volumes, v, x, local.gravity, density, phi)
+    totals = node_totals(mass, volumes, v, x, local.gravity, energy, phi)
     sums = tuple(_tracked_sums(run, grain) for grain in tracked)
     grain, count = own_grain_places(run), len(run.owned)
     numbers = run.global_nodes(nodes)
+    labels = run.global_nodes(local.analysis.fragment_labels()[nodes])
+    pieces = fragments.fragment_table(
+        labels, numbers, run.owned[grain], x, v, volumes, density, local.dimension
+    )
     grain_volumes, damage = particle_table.volumes(grain, numbers, volumes, phi, count)
     return StepPart(
         replace(totals, contact=evaluation.contact_energy, tracked=sums),
-        _own_fragments(run, run.owned[grain]),
+        pieces,
         run.owned,
         particle_table.motion(grain, numbers, mass, volumes, x, v, count),
         grain_volumes,
@@ -107,21 +115,6 @@ def step_data(
     evaluation = merged_evaluation([part.evaluation for part in parts], wall_reactions)
     sums = (totals, broken, table, evaluation)
     return StepData.of_measures(sim, core, sums, (motion, volumes, damage), frame_rows)
-
-
-def _own_fragments(run: DistributedRun, grains: NDArray[np.int64]) -> fragments.Table:
-    """The fragment rows of the rank's own nodes (whose grains these are), each piece labelled
-    by its smallest node in the whole run's numbering. The part numbers a grain's nodes in the
-    whole run's order, so that node is the piece's smallest here too."""
-    local, nodes = run.local, run.owned_nodes
-    core, model = local.core, local.model
-    labels = run.global_nodes(local.analysis.fragment_labels()[nodes])
-    volumes, density = (np.asarray(a)[nodes] for a in (model.volumes, model.node_density))
-    x, v = core.positions[nodes], core.velocities[nodes]
-    numbers = run.global_nodes(nodes)
-    return fragments.fragment_table(
-        labels, numbers, grains, x, v, volumes, density, local.dimension
-    )
 
 
 def _tracked_sums(run: DistributedRun, grain: int) -> TrackedSums:
