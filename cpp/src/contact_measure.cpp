@@ -9,6 +9,7 @@
 #include <string>
 
 #include "contact_vectors.hpp"
+#include "granulate/contact/body_sums.hpp"
 #include "granulate/contact/contact_model.hpp"
 #include "granulate/in_parallel.hpp"
 
@@ -35,6 +36,8 @@ std::array<real, 6> inverse_inertia(const std::array<real, 6>& m, int dimension)
 
 BodyMotion measure_body(const Model& model, const State& state, const index_t* nodes, index_t count,
                         int dimension) {
+  if (measured_order_free(model, nodes, count))
+    return measure_order_free(model, state, nodes, count, dimension);
   const auto& x = state.positions;
   const auto& v = state.velocities;
   const vec origin{x[3 * nodes[0]], x[3 * nodes[0] + 1], x[3 * nodes[0] + 2]};
@@ -60,6 +63,11 @@ BodyMotion measure_body(const Model& model, const State& state, const index_t* n
     second[4] += m * r[0] * r[2];
     second[5] += m * r[1] * r[2];
   }
+  return motion_about(origin, mass, first, momentum, spin, second, dimension);
+}
+
+BodyMotion motion_about(const vec3& origin, real mass, const vec3& first, const vec3& momentum,
+                        const vec3& spin, const std::array<real, 6>& second, int dimension) {
   BodyMotion motion;
   const vec d{first[0] / mass, first[1] / mass, first[2] / mass};  // centre - origin
   for (int k = 0; k < 3; ++k) {
@@ -278,6 +286,7 @@ namespace {
 /// first node in both frames, so far from the origin nothing cancels:
 /// sum m (y - y_0)(X - X_0)^T - M d D^T, d = c - y_0, D = C - X_0.
 contact::matrix3 body_moment(const Model& model, const State& state, const index_t* nodes, index_t count) {
+  if (measured_order_free(model, nodes, count)) return moment_order_free(model, state, nodes, count);
   const real* y = state.positions.data();
   const real* X = model.reference_positions().data();
   const index_t first = nodes[0];
@@ -657,21 +666,45 @@ real ContactModel::surface_share(const ProbeState& probe, index_t j) const {
 }
 
 void ContactModel::sum_slot_stiffness() {
-  // K per pair of bodies, summed in entry order: each node pair of the sphere law is listed
-  // twice; a surface probe's entries share its stiffness.
+  // K per pair of bodies, summed in entry order (a splittable particle's slots in block sums):
+  // each node pair of the sphere law is listed twice; a surface probe's entries share its
+  // stiffness.
   std::fill(slot_stiffness_.begin(), slot_stiffness_.end(), 0.0);
+  slot_stiffness_sums_.start(slots_.size());
   std::uint64_t touching = 0, wall_touching = 0;
-  for (std::size_t e = 0; e < pair_stiffness_.size(); ++e) {
+  auto add = [&](std::size_t slot, index_t i, real k) {
+    if (k == 0) return;  // most entries: apart (and +0.0 changes no sum)
+    if (slot_splittable(slot)) {
+      slot_stiffness_sums_.add(slot, i, {k});
+    } else {
+      slot_stiffness_[slot] += k;
+    }
+  };
+  // Entry by entry; node by node when some slots take block sums, which need the nodes.
+  const index_t n = static_cast<index_t>(pair_offsets_.size()) - 1;
+  auto pair_entry = [&](index_t i, std::size_t e) {
     const bool probe = probe_entry(e);
-    slot_stiffness_[pair_slot_[e]] += (probe ? 1.0 : 0.5) * pair_stiffness_[e];
+    add(pair_slot_[e], i, (probe ? 1.0 : 0.5) * pair_stiffness_[e]);
     touching += pair_stiffness_[e] > 0 && !probe ? 1 : 0;
+  };
+  auto wall_entry = [&](index_t i, std::size_t e) {
+    add(wall_slot_[e], i, wall_entry_stiffness_[e]);
+    wall_touching += wall_entry_stiffness_[e] > 0 ? 1 : 0;
+  };
+  if (any_body_splittable_) {
+    for (index_t i = 0; i < n; ++i)
+      for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) pair_entry(i, e);
+    for (index_t i = 0; i < n; ++i)
+      for (index_t e = wall_offsets_[i]; e < wall_offsets_[i + 1]; ++e) wall_entry(i, e);
+  } else {
+    for (std::size_t e = 0; e < pair_stiffness_.size(); ++e) pair_entry(0, e);
+    for (std::size_t e = 0; e < wall_entry_stiffness_.size(); ++e) wall_entry(0, e);
   }
   touching /= 2;
   touching += probes_.size();
-  for (std::size_t e = 0; e < wall_entry_stiffness_.size(); ++e) {
-    slot_stiffness_[wall_slot_[e]] += wall_entry_stiffness_[e];
-    wall_touching += wall_entry_stiffness_[e] > 0 ? 1 : 0;
-  }
+  slot_stiffness_sums_.finish_sweep();
+  for (const std::size_t slot : slot_stiffness_sums_.items())
+    slot_stiffness_[slot] = slot_stiffness_sums_.rounded(slot)[0];
   statistics_.node_contacts = touching;
   statistics_.wall_contacts = wall_touching;
   assign_springs();
@@ -685,8 +718,10 @@ void ContactModel::sum_slot_stiffness() {
     touching_bodies_.push_back(body);
   };
   index_t in_contact = 0;
+  touch_splittable_.clear();
   for (std::size_t slot = 0; slot < slots_.size(); ++slot) {
     slot_touch_[slot] = slot_stiffness_[slot] > 0 ? in_contact++ : not_touching;
+    if (slot_stiffness_[slot] > 0) touch_splittable_.push_back(slot_splittable(slot) ? 1 : 0);
     if (slot_stiffness_[slot] == 0 && !(collisions_.approach(slot) > 0)) continue;
     touch(slots_[slot][0]);
     if (slot < particle_slot_count_) touch(slots_[slot][1]);
@@ -786,7 +821,9 @@ void ContactModel::release_rested_pairs(const Model& model, const State& state,
 
 void ContactModel::sum_slot_springs(const Model& model, const State& state) {
   // Spring force, spring-weighted normal (from the first body to the second, or from the wall to
-  // the particle) and spring-weighted contact point per slot, summed in node order.
+  // the particle) and spring-weighted contact point per slot, summed in node order (a
+  // splittable particle's slots in block sums).
+  slot_spring_sums_.start(slot_force_.size(), [&](std::size_t touch) { return touch_splittable_[touch]; });
   for (const index_t i : contact_nodes_) {
     for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
       const index_t j = pair_partner_[e];
@@ -794,21 +831,16 @@ void ContactModel::sum_slot_springs(const Model& model, const State& state) {
       if (pair_stiffness_[e] == 0 || probe_entry(e) || node_body_[i] == node_body_[j] ||
           node_body_[i] != slots_[slot][0])
         continue;
-      const index_t touch = slot_touch_[slot];
       const PairGeometry g = pair_geometry(model, state, i, e);
       const real spring = contact::normal_force(entry_stiffness(model, i, e), g.overlap);
       const vec surface = slot_law(slot).node_pair ? g.normal : pair_surface_normal(i, j, g.normal);
-      slot_force_[touch] += spring;
-      for (int k = 0; k < 3; ++k) {
-        slot_normal_[touch][k] += spring * g.normal[k];
-        slot_point_[touch][k] += spring * (g.centre_i[k] + g.lever_i * g.normal[k]);
-        slot_surface_normal_[touch][k] += spring * surface[k];
-      }
+      const vec point{g.centre_i[0] + g.lever_i * g.normal[0], g.centre_i[1] + g.lever_i * g.normal[1],
+                      g.centre_i[2] + g.lever_i * g.normal[2]};
+      add_slot_spring(slot_touch_[slot], i, spring, g.normal, point, surface);
     }
     for (index_t e = wall_offsets_[i]; e < wall_offsets_[i + 1]; ++e) {
       const std::size_t slot = wall_slot_[e];
       if (wall_entry_stiffness_[e] == 0) continue;
-      const index_t touch = slot_touch_[slot];
       const WallPoints& points = wall_points_[e];
       const WallSpheres spheres = wall_spheres(model, state, i, e);
       for (std::size_t k = 0; k < points.count; ++k) {
@@ -817,14 +849,31 @@ void ContactModel::sum_slot_springs(const Model& model, const State& state) {
         const real spring =
             contact::normal_force(points.weights[k] * wall_spring_stiffness(model, i, e), overlap);
         const real lever = spheres.radius[sphere] - 0.5 * overlap;
-        slot_force_[touch] += spring;
-        for (int c = 0; c < 3; ++c) {
-          slot_normal_[touch][c] += spring * points.points[k].normal[c];
-          slot_surface_normal_[touch][c] += spring * points.points[k].normal[c];
-          slot_point_[touch][c] += spring * (spheres.centre[sphere][c] - lever * points.points[k].normal[c]);
-        }
+        const vec& normal = points.points[k].normal;
+        const vec point{spheres.centre[sphere][0] - lever * normal[0],
+                        spheres.centre[sphere][1] - lever * normal[1],
+                        spheres.centre[sphere][2] - lever * normal[2]};
+        add_slot_spring(slot_touch_[slot], i, spring, normal, point, normal);
       }
     }
+  }
+  slot_spring_sums_.finish_sweep();  // the probes' sweep next
+}
+
+void ContactModel::add_slot_spring(index_t touch, index_t i, real spring, const vec3& normal,
+                                   const vec3& point, const vec3& surface) {
+  if (slot_spring_sums_.summed(touch)) {
+    slot_spring_sums_.add(touch, i,
+                          {spring, spring * normal[0], spring * normal[1], spring * normal[2],
+                           spring * point[0], spring * point[1], spring * point[2], spring * surface[0],
+                           spring * surface[1], spring * surface[2]});
+    return;
+  }
+  slot_force_[touch] += spring;
+  for (int k = 0; k < 3; ++k) {
+    slot_normal_[touch][k] += spring * normal[k];
+    slot_point_[touch][k] += spring * point[k];
+    slot_surface_normal_[touch][k] += spring * surface[k];
   }
 }
 
@@ -833,17 +882,21 @@ void ContactModel::sum_probe_springs() {
   // (from the slot's first body to its second), at the probe point.
   for (const ProbeState& probe : probes_) {
     const ProbeGroup& group = groups_[probe.group];
-    const index_t touch = slot_touch_[group.slot];
     const real size = std::sqrt(dot(probe.gradient, probe.gradient));
-    const real force = probe.push * size;
     // G points out of the target body; the slot's normal from its first body to its second.
     const real sign = group.body == slots_[group.slot][0] ? 1.0 : -1.0;
-    slot_force_[touch] += force;
+    const vec along{sign * probe.gradient[0] / size, sign * probe.gradient[1] / size,
+                    sign * probe.gradient[2] / size};
+    add_slot_spring(slot_touch_[group.slot], group.probe, probe.push * size, along, probe.point, along);
+  }
+  slot_spring_sums_.finish_sweep();
+  for (const std::size_t touch : slot_spring_sums_.items()) {
+    const auto sums = slot_spring_sums_.rounded(touch);
+    slot_force_[touch] = sums[0];
     for (int k = 0; k < 3; ++k) {
-      const real along = sign * probe.gradient[k] / size;
-      slot_normal_[touch][k] += force * along;
-      slot_surface_normal_[touch][k] += force * along;
-      slot_point_[touch][k] += force * probe.point[k];
+      slot_normal_[touch][k] = sums[1 + k];
+      slot_point_[touch][k] = sums[4 + k];
+      slot_surface_normal_[touch][k] = sums[7 + k];
     }
   }
 }

@@ -230,6 +230,15 @@ void ContactModel::probe_couples(const State& state) {
   // (at their mean y = foot): the probe's body takes (p - y_i) x F_t, the target's
   // (y - p) x F_t, so both act at p and their moments cancel.
   const real* x = state.positions.data();
+  body_couple_sums_.start(touching_bodies_.size(),
+                          [&](std::size_t touch) { return body_splittable_[touching_bodies_[touch]]; });
+  auto add = [&](index_t touch, index_t i, const vec& couple) {
+    if (body_couple_sums_.summed(touch)) {
+      body_couple_sums_.add(touch, i, couple);
+    } else {
+      for (int c = 0; c < 3; ++c) body_load_[touch][3 + c] += couple[c];
+    }
+  };
   for (const ProbeState& probe : probes_) {
     if (probe.friction == vec3{0, 0, 0}) continue;
     const ProbeGroup& group = groups_[probe.group];
@@ -240,12 +249,10 @@ void ContactModel::probe_couples(const State& state) {
     const vec target = cross(
         {probe.foot[0] - probe.point[0], probe.foot[1] - probe.point[1], probe.foot[2] - probe.point[2]},
         probe.friction);
-    const index_t probe_touch = body_touch_[node_body_[i]], target_touch = body_touch_[group.body];
-    for (int c = 0; c < 3; ++c) {
-      body_load_[probe_touch][3 + c] += own[c];
-      body_load_[target_touch][3 + c] += target[c];
-    }
+    add(body_touch_[node_body_[i]], i, own);
+    add(body_touch_[group.body], i, target);
   }
+  body_couple_sums_.finish_sweep();  // body_loads' sweep next
 }
 
 vec3 ContactModel::pair_force(const Model& model, const State& state, index_t i, index_t e, real dt) {

@@ -285,9 +285,19 @@ void ContactModel::body_loads(const Model& model, State& state) {
     for (std::int64_t touch = 0; touch < count; ++touch) {
       const index_t b = touching_bodies_[touch];
       std::array<real, 6> total = body_load_[touch];
+      const bool summed = body_couple_sums_.summed(touch);
       for (index_t k = body_contact_offsets_[b]; k < body_contact_offsets_[b + 1]; ++k) {
         const vec couple = contact_couple(model, state, contact_nodes_[k]);
-        for (int c = 0; c < 3; ++c) total[3 + c] += couple[c];
+        if (summed) {
+          body_couple_sums_.add(touch, contact_nodes_[k], couple);
+        } else {
+          for (int c = 0; c < 3; ++c) total[3 + c] += couple[c];
+        }
+      }
+      if (summed) {  // the slots' loads, then the couples' block sums
+        body_couple_sums_.finish_sweep(touch);
+        const auto couples = body_couple_sums_.rounded(touch);
+        for (int c = 0; c < 3; ++c) total[3 + c] += couples[c];
       }
       if (total == std::array<real, 6>{0, 0, 0, 0, 0, 0}) continue;
       const BodyMotion& motion = body_motion_[touch];

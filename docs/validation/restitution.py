@@ -28,10 +28,13 @@ RADIUS = 1e-3
 NODES_ACROSS_RADIUS = {2: 10, 3: 6}
 
 
-def rebound(dimension: int, restitution: float, speed: float) -> float:
+def rebound(
+    dimension: int, restitution: float, speed: float, nodes_across_radius: float | None = None
+) -> float:
     """Measured e of one normal impact on a plane: rebound speed of the centre of mass over the
-    impact speed, 50 steps after the last node left the plane."""
-    h = RADIUS / NODES_ACROSS_RADIUS[dimension]
+    impact speed, 50 steps after the last node left the plane. The grain has R/h =
+    `nodes_across_radius` (default NODES_ACROSS_RADIUS)."""
+    h = RADIUS / (nodes_across_radius or NODES_ACROSS_RADIUS[dimension])
     sim = gr.Simulation(dimension)
     sim.contact = gr.Contact(restitution=restitution)
     centre = (0.0, RADIUS + 0.6 * h, 0.0)[:dimension]

@@ -27,9 +27,16 @@ inline constexpr int body_motion_size = 15;
 
 /// Rigid-body motion of the body made of `count` nodes (in node order) at the state's positions
 /// and velocities: one pass, moments about its first node, so far from the origin nothing
-/// cancels. Centre c, velocity V = sum m v / M, inertia I = sum m (|r|^2 1 - r r^T) and angular
-/// momentum L = sum m r x (v - V) about c, omega = I^-1 L (m = rho V of each node).
+/// cancels; a body of a large particle order-free (body_sums.hpp). Centre c, velocity
+/// V = sum m v / M, inertia I = sum m (|r|^2 1 - r r^T) and angular momentum
+/// L = sum m r x (v - V) about c, omega = I^-1 L (m = rho V of each node).
 BodyMotion measure_body(const Model& model, const State& state, const index_t* nodes, index_t count,
                         int dimension);
+
+/// The motion from a body's sums about an origin o (r = y - o): mass M, first moment sum m r,
+/// momentum sum m v, moment of momentum sum r x m v and second moments sum m r r^T (xx, yy,
+/// zz, xy, xz, yz).
+BodyMotion motion_about(const vec3& origin, real mass, const vec3& first, const vec3& momentum,
+                        const vec3& spin, const std::array<real, 6>& second, int dimension);
 
 }  // namespace granulate

@@ -9,6 +9,7 @@
 #include <span>
 #include <vector>
 
+#include "granulate/contact/block_sums.hpp"
 #include "granulate/contact/body_motion.hpp"
 #include "granulate/contact/body_rotation.hpp"
 #include "granulate/contact/collisions.hpp"
@@ -566,6 +567,9 @@ class ContactModel {
   void check_ghost_motions(const std::vector<std::uint8_t>& measured) const;
   void sum_slot_springs(const Model& model, const State& state);
   void sum_probe_springs();
+  /// Adds node i's spring (force, normal, contact point, surface normal) to a slot in contact.
+  void add_slot_spring(index_t touch, index_t i, real spring, const vec3& normal, const vec3& point,
+                       const vec3& surface);
   void slot_dashpots(const State& state, real dt);
   void slot_rolling_resistance(const State& state, real dt);
   /// Whether a slot's bodies resist rolling this step: a law with mu_r > 0, two bodies (or a
@@ -719,9 +723,11 @@ class ContactModel {
   std::vector<Wall> walls_;
   std::vector<contact::Law> wall_laws_;  // wall x material
   std::vector<std::uint8_t> wall_law_set_;
-  real skin_ = -1;                  // < 0: 0.5 x the largest contact radius
-  std::vector<index_t> node_body_;  // body of each node
-  std::vector<real> body_mass_;
+  real skin_ = -1;                             // < 0: 0.5 x the largest contact radius
+  std::vector<index_t> node_body_;             // body of each node
+  std::vector<real> body_mass_;                // a splittable particle's bodies' order-free (body_sums.hpp)
+  std::vector<std::uint8_t> body_splittable_;  // per body: of a splittable particle
+  bool any_body_splittable_ = false;
   std::vector<std::uint8_t> node_kinematic_;  // empty: none
   std::vector<std::uint8_t> body_kinematic_;  // every node of the body kinematic
   std::vector<index_t> body_material_;
@@ -792,6 +798,19 @@ class ContactModel {
   GhostBodies ghosts_;                          // ghost particles and their bodies' motions
   std::vector<std::array<real, 6>> body_load_;  // per touching body: force, torque about the centre
   std::vector<index_t> slot_touch_;             // per slot: its index among the slots in contact
+  // The order-free sums (block_sums.hpp) of the slots of a splittable particle's bodies: per slot
+  // its stiffness; per slot in contact its spring force, normal, contact point and surface
+  // normal sums (as slot_force_ ... below); per touching body of a splittable particle, the
+  // couples its contact nodes and the probes put on it.
+  BlockSums<1> slot_stiffness_sums_;
+  BlockSums<10> slot_spring_sums_;
+  BlockSums<3> body_couple_sums_;
+  std::vector<std::uint8_t> touch_splittable_;  // per slot in contact: slot_splittable
+  /// Whether a slot's sums are block sums: one of its bodies is a splittable particle's.
+  bool slot_splittable(std::size_t slot) const {
+    return body_splittable_[slots_[slot][0]] ||
+           (slot < particle_slot_count_ && body_splittable_[slots_[slot][1]]);
+  }
   std::vector<real> slot_force_;                // per slot in contact: spring force, and the
   std::vector<vec3> slot_normal_, slot_point_;  // spring-weighted normal and contact point sums
   std::vector<vec3> slot_surface_normal_;       // spring-weighted sum of the surfaces' normals
