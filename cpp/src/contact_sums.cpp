@@ -54,6 +54,10 @@ void ContactModel::sum_slot_stiffness() {
   statistics_.node_contacts = touching;
   statistics_.wall_contacts = wall_touching;
   assign_springs();
+  find_touching();
+}
+
+void ContactModel::find_touching() {
   // The touching bodies (in a collision, or in a gap of one) and the slots in contact, numbered
   // in slot order.
   for (const index_t b : touching_bodies_) body_touch_[b] = not_touching;

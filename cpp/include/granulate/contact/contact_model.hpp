@@ -561,6 +561,8 @@ class ContactModel {
   // The passes of add_forces, in order (see there).
   void measure_contacts(const Model& model, const State& state);
   void sum_slot_stiffness();
+  /// The touching bodies and the slots in contact this step (after sum_slot_stiffness).
+  void find_touching();
   void measure_bodies(const Model& model, const State& state);
   /// std::runtime_error if a ghost body whose motion was not given touches one of this
   /// process's bodies (`measured`: per touching body, 1 where its motion was measured here).
