@@ -293,11 +293,9 @@ void ContactModel::label_bodies(const Model& model, const State& state, std::uin
   std::vector<index_t> fill(body_node_offsets_.begin(), body_node_offsets_.end() - 1);
   for (index_t i = 0; i < n; ++i) body_nodes_[fill[node_body_[i]]++] = i;
   body_splittable_.assign(count, 0);
-  any_body_splittable_ = false;
   for (index_t b = 0; b < count; ++b) {
     if (!splittable(model, body_particle_[b])) continue;
     body_splittable_[b] = 1;
-    any_body_splittable_ = true;
     const index_t* nodes = body_nodes_.data() + body_node_offsets_[b];
     body_mass_[b] = order_free_mass(model, nodes, body_node_offsets_[b + 1] - body_node_offsets_[b]);
   }

@@ -18,33 +18,26 @@ void ContactModel::sum_slot_stiffness() {
   std::fill(slot_stiffness_.begin(), slot_stiffness_.end(), 0.0);
   slot_stiffness_sums_.start(slots_.size());
   std::uint64_t touching = 0, wall_touching = 0;
-  auto add = [&](std::size_t slot, index_t i, real k) {
+  // Entry by entry; a block sum needs the entry's node: its list's, found by bisection (the
+  // few entries in contact only).
+  auto add = [&](std::size_t slot, std::size_t e, const std::vector<index_t>& offsets, real k) {
     if (k == 0) return;  // most entries: apart (and +0.0 changes no sum)
-    if (slot_splittable(slot)) {
-      slot_stiffness_sums_.add(slot, i, {k});
-    } else {
+    if (!slot_splittable(slot)) {
       slot_stiffness_[slot] += k;
+      return;
     }
+    const auto node =
+        std::upper_bound(offsets.begin(), offsets.end(), static_cast<index_t>(e)) - offsets.begin() - 1;
+    slot_stiffness_sums_.add(slot, static_cast<index_t>(node), {k});
   };
-  // Entry by entry; node by node when some slots take block sums, which need the nodes.
-  const index_t n = static_cast<index_t>(pair_offsets_.size()) - 1;
-  auto pair_entry = [&](index_t i, std::size_t e) {
+  for (std::size_t e = 0; e < pair_stiffness_.size(); ++e) {
     const bool probe = probe_entry(e);
-    add(pair_slot_[e], i, (probe ? 1.0 : 0.5) * pair_stiffness_[e]);
+    add(pair_slot_[e], e, pair_offsets_, (probe ? 1.0 : 0.5) * pair_stiffness_[e]);
     touching += pair_stiffness_[e] > 0 && !probe ? 1 : 0;
-  };
-  auto wall_entry = [&](index_t i, std::size_t e) {
-    add(wall_slot_[e], i, wall_entry_stiffness_[e]);
+  }
+  for (std::size_t e = 0; e < wall_entry_stiffness_.size(); ++e) {
+    add(wall_slot_[e], e, wall_offsets_, wall_entry_stiffness_[e]);
     wall_touching += wall_entry_stiffness_[e] > 0 ? 1 : 0;
-  };
-  if (any_body_splittable_) {
-    for (index_t i = 0; i < n; ++i)
-      for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) pair_entry(i, e);
-    for (index_t i = 0; i < n; ++i)
-      for (index_t e = wall_offsets_[i]; e < wall_offsets_[i + 1]; ++e) wall_entry(i, e);
-  } else {
-    for (std::size_t e = 0; e < pair_stiffness_.size(); ++e) pair_entry(0, e);
-    for (std::size_t e = 0; e < wall_entry_stiffness_.size(); ++e) wall_entry(0, e);
   }
   touching /= 2;
   touching += probes_.size();

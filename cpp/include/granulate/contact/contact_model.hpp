@@ -729,9 +729,8 @@ class ContactModel {
   std::vector<index_t> node_body_;             // body of each node
   std::vector<real> body_mass_;                // a splittable particle's bodies' order-free (body_sums.hpp)
   std::vector<std::uint8_t> body_splittable_;  // per body: of a splittable particle
-  bool any_body_splittable_ = false;
-  std::vector<std::uint8_t> node_kinematic_;  // empty: none
-  std::vector<std::uint8_t> body_kinematic_;  // every node of the body kinematic
+  std::vector<std::uint8_t> node_kinematic_;   // empty: none
+  std::vector<std::uint8_t> body_kinematic_;   // every node of the body kinematic
   std::vector<index_t> body_material_;
   std::vector<index_t> body_particle_;
   std::vector<index_t> body_node_offsets_, body_nodes_;  // CSR: nodes of each body
