@@ -142,10 +142,10 @@ def test_ranks_cut_by_their_work_keep_the_serial_run_bit_for_bit() -> None:
 
 def test_a_splittable_grain_breaking_among_others_keeps_the_serial_run_bit_for_bit() -> None:
     """A disc of 4,301 nodes (a splittable particle: its bodies' rigid motion and the sums of
-    the slots it takes part in are block sums added exactly) struck by three small discs and
-    breaking (11,149 bonds in 450 steps, 39 pieces), whole grains on 2 ranks: the rank holding
-    it as a ghost sums the slots with it over the nodes of its caps, its owner sends its
-    fragments' motions. Every node ends as in the serial run."""
+    the slots it takes part in are block sums added exactly) struck by three coarser discs
+    (R/h = 8) and breaking (11,149 bonds in 450 steps, 39 pieces), whole grains on 2 ranks:
+    the rank holding it as a ghost sums the slots with it over the nodes of its caps, its
+    owner sends its fragments' motions. Every node ends as in the serial run."""
     done = run_ranks(2, "splittable", "450")
     assert done.returncode == 0, done.stdout + done.stderr
     assert "'positions': 0.0, 'velocities': 0.0, 'forces': 0.0, 'walls': 0.0}" in done.stdout
