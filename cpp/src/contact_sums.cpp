@@ -61,10 +61,8 @@ void ContactModel::find_touching() {
     touching_bodies_.push_back(body);
   };
   index_t in_contact = 0;
-  touch_splittable_.clear();
   for (std::size_t slot = 0; slot < slots_.size(); ++slot) {
     slot_touch_[slot] = slot_stiffness_[slot] > 0 ? in_contact++ : not_touching;
-    if (slot_stiffness_[slot] > 0) touch_splittable_.push_back(slot_splittable(slot) ? 1 : 0);
     if (slot_stiffness_[slot] == 0 && !(collisions_.approach(slot) > 0)) continue;
     touch(slots_[slot][0]);
     if (slot < particle_slot_count_) touch(slots_[slot][1]);
@@ -86,7 +84,7 @@ void ContactModel::sum_slot_springs(const Model& model, const State& state) {
   // Spring force, spring-weighted normal (from the first body to the second, or from the wall to
   // the particle) and spring-weighted contact point per slot, summed in node order (a
   // splittable particle's slots in block sums).
-  slot_spring_sums_.start(slot_force_.size(), [&](std::size_t touch) { return touch_splittable_[touch]; });
+  slot_spring_sums_.start(slot_force_.size());
   for (const index_t i : contact_nodes_) {
     for (index_t e = pair_offsets_[i]; e < pair_offsets_[i + 1]; ++e) {
       const index_t j = pair_partner_[e];
@@ -99,7 +97,7 @@ void ContactModel::sum_slot_springs(const Model& model, const State& state) {
       const vec surface = slot_law(slot).node_pair ? g.normal : pair_surface_normal(i, j, g.normal);
       const vec point{g.centre_i[0] + g.lever_i * g.normal[0], g.centre_i[1] + g.lever_i * g.normal[1],
                       g.centre_i[2] + g.lever_i * g.normal[2]};
-      add_slot_spring(slot_touch_[slot], i, spring, g.normal, point, surface);
+      add_slot_spring(slot, i, spring, g.normal, point, surface);
     }
     for (index_t e = wall_offsets_[i]; e < wall_offsets_[i + 1]; ++e) {
       const std::size_t slot = wall_slot_[e];
@@ -116,16 +114,17 @@ void ContactModel::sum_slot_springs(const Model& model, const State& state) {
         const vec point{spheres.centre[sphere][0] - lever * normal[0],
                         spheres.centre[sphere][1] - lever * normal[1],
                         spheres.centre[sphere][2] - lever * normal[2]};
-        add_slot_spring(slot_touch_[slot], i, spring, normal, point, normal);
+        add_slot_spring(slot, i, spring, normal, point, normal);
       }
     }
   }
   slot_spring_sums_.finish_sweep();  // the probes' sweep next
 }
 
-void ContactModel::add_slot_spring(index_t touch, index_t i, real spring, const vec3& normal,
+void ContactModel::add_slot_spring(std::size_t slot, index_t i, real spring, const vec3& normal,
                                    const vec3& point, const vec3& surface) {
-  if (slot_spring_sums_.summed(touch)) {
+  const index_t touch = slot_touch_[slot];
+  if (slot_splittable(slot)) {
     slot_spring_sums_.add(touch, i,
                           {spring, spring * normal[0], spring * normal[1], spring * normal[2],
                            spring * point[0], spring * point[1], spring * point[2], spring * surface[0],
@@ -150,7 +149,7 @@ void ContactModel::sum_probe_springs() {
     const real sign = group.body == slots_[group.slot][0] ? 1.0 : -1.0;
     const vec along{sign * probe.gradient[0] / size, sign * probe.gradient[1] / size,
                     sign * probe.gradient[2] / size};
-    add_slot_spring(slot_touch_[group.slot], group.probe, probe.push * size, along, probe.point, along);
+    add_slot_spring(group.slot, group.probe, probe.push * size, along, probe.point, along);
   }
   slot_spring_sums_.finish_sweep();
   for (const std::size_t touch : slot_spring_sums_.items()) {

@@ -569,8 +569,9 @@ class ContactModel {
   void check_ghost_motions(const std::vector<std::uint8_t>& measured) const;
   void sum_slot_springs(const Model& model, const State& state);
   void sum_probe_springs();
-  /// Adds node i's spring (force, normal, contact point, surface normal) to a slot in contact.
-  void add_slot_spring(index_t touch, index_t i, real spring, const vec3& normal, const vec3& point,
+  /// Adds node i's spring (force, normal, contact point, surface normal) to a slot in contact
+  /// (the sums of its index among them).
+  void add_slot_spring(std::size_t slot, index_t i, real spring, const vec3& normal, const vec3& point,
                        const vec3& surface);
   void slot_dashpots(const State& state, real dt);
   void slot_rolling_resistance(const State& state, real dt);
@@ -806,7 +807,6 @@ class ContactModel {
   BlockSums<1> slot_stiffness_sums_;
   BlockSums<10> slot_spring_sums_;
   BlockSums<3> body_couple_sums_;
-  std::vector<std::uint8_t> touch_splittable_;  // per slot in contact: slot_splittable
   /// Whether a slot's sums are block sums: one of its bodies is a splittable particle's.
   bool slot_splittable(std::size_t slot) const {
     return body_splittable_[slots_[slot][0]] ||
